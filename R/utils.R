@@ -1,0 +1,108 @@
+# Argument checks shared by the exported functions. Each returns the clean
+# value (or stops with a message that names the argument) so that C++ never
+# sees unchecked input.
+
+# A short description of what `x` is, for error messages.
+describe_type <- function(x) {
+  if (is.null(x)) return("NULL")
+  if (is.factor(x)) return("a factor")
+  if (is.data.frame(x)) return("a data frame")
+  if (is.matrix(x)) return(paste("a", typeof(x), "matrix"))
+  if (is.list(x)) return("a list")
+  switch(typeof(x),
+    logical = "a logical vector",
+    character = "a character vector",
+    complex = "a complex vector",
+    integer = "an integer vector",
+    double = "a double vector",
+    paste("an object of type", typeof(x))
+  )
+}
+
+format_value <- function(x) {
+  if (is.null(x)) return("NULL")
+  if (length(x) != 1L) return(paste0("of length ", length(x)))
+  if (is.character(x)) return(encodeString(x, quote = '"'))
+  format(x)
+}
+
+abort <- function(...) stop(paste0(...), call. = FALSE)
+
+# `values`: a numeric vector (or ts, or a one-column matrix/data frame) of
+# finite numbers with at least `min_n` samples; returned as a plain double.
+check_values <- function(values, min_n = 2L, arg = "values") {
+  if (is.data.frame(values) || is.matrix(values)) {
+    if (NCOL(values) != 1L) {
+      abort("`", arg, "` must be a single series; got ", describe_type(values),
+            " with ", NCOL(values), " columns. Pass one column at a time, ",
+            "or use allan() for several channels.")
+    }
+    values <- if (is.data.frame(values)) values[[1L]] else values[, 1L]
+  }
+  if (is.null(values) || is.factor(values) || is.list(values) ||
+      !(is.double(values) || is.integer(values))) {
+    abort("`", arg, "` must be a numeric vector, not ", describe_type(values), ".")
+  }
+  n <- length(values)
+  if (n < min_n) {
+    abort("`", arg, "` must have at least ", min_n, " samples, not ", n, ".")
+  }
+  bad <- which(!is.finite(values))
+  if (length(bad)) {
+    first <- bad[1L]
+    abort("`", arg, "` must contain only finite numbers; found ",
+          format(values[first]), " at position ", first,
+          if (length(bad) > 1L) paste0(" (and ", length(bad) - 1L, " more)"),
+          ".")
+  }
+  as.double(values)
+}
+
+# `freq`: a single positive finite number (sampling frequency in Hz).
+check_freq <- function(freq, arg = "freq") {
+  if (is.null(freq) || !(is.double(freq) || is.integer(freq)) ||
+      is.factor(freq) || length(freq) != 1L || is.na(freq) ||
+      !is.finite(freq) || freq <= 0) {
+    abort("`", arg, "` must be a single positive number (the sampling ",
+          "frequency in Hz), not ", describe_freq(freq), ".")
+  }
+  as.double(freq)
+}
+
+describe_freq <- function(freq) {
+  if (is.null(freq) || is.factor(freq) || !is.atomic(freq) ||
+      !(is.numeric(freq))) {
+    return(describe_type(freq))
+  }
+  format_value(freq)
+}
+
+# Stop with a clear message when a required argument is missing.
+check_present <- function(missing, arg, what) {
+  if (missing) abort("`", arg, "` is missing; give ", what, ".")
+  invisible(TRUE)
+}
+
+# A single number in [lo, hi] (or (lo, hi) when open).
+check_number <- function(x, arg, lo = -Inf, hi = Inf, open = FALSE,
+                         integer = FALSE) {
+  ok <- (is.double(x) || is.integer(x)) && length(x) == 1L && !is.na(x) &&
+    is.finite(x)
+  if (ok) ok <- if (open) x > lo && x < hi else x >= lo && x <= hi
+  if (ok && integer) ok <- x == round(x)
+  if (!ok) {
+    range <- if (open) sprintf("in (%s, %s)", lo, hi) else
+      sprintf("in [%s, %s]", lo, hi)
+    abort("`", arg, "` must be a single ", if (integer) "whole " else "",
+          "number ", range, ", not ",
+          if (is.numeric(x) && !is.factor(x)) format_value(x) else describe_type(x), ".")
+  }
+  if (integer) as.integer(x) else as.double(x)
+}
+
+# Threads the C++ kernels may use: option `allanvar.threads` (default 2).
+allanvar_threads <- function() {
+  n <- getOption("allanvar.threads", 2L)
+  if (!is.numeric(n) || length(n) != 1L || is.na(n) || n < 1) n <- 1L
+  as.integer(min(n, 64L))
+}
