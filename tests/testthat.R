@@ -1,0 +1,4 @@
+library(testthat)
+library(allanvar)
+
+test_check("allanvar")

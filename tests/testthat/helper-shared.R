@@ -1,0 +1,20 @@
+# The measured recordings live in ../shared/data beside the repository; they
+# are never shipped. Tests that need them skip when they are absent.
+shared_data_dir <- function() {
+  env <- Sys.getenv("ALLANVAR_SHARED_DATA")
+  if (nzchar(env) && dir.exists(env)) return(normalizePath(env))
+  dir <- normalizePath(getwd(), mustWork = FALSE)
+  repeat {
+    candidate <- file.path(dir, "shared", "data")
+    if (file.exists(file.path(candidate, "gyroz.rds"))) return(candidate)
+    parent <- dirname(dir)
+    if (identical(parent, dir)) return(NULL)
+    dir <- parent
+  }
+}
+
+skip_if_no_shared <- function() {
+  if (is.null(shared_data_dir())) skip("../shared/data is not available")
+}
+
+shared_file <- function(name) file.path(shared_data_dir(), name)

@@ -1,0 +1,18 @@
+# Runs tests/testthat against the installed package and ends with the plain
+# closing line "N passed, N failed, N skipped"; exits 1 on any failure.
+suppressPackageStartupMessages({
+  library(testthat)
+  library(allanvar)
+})
+options(allanvar.threads = 2L)
+results <- testthat::test_dir(
+  "tests/testthat", package = "allanvar", load_package = "installed",
+  reporter = testthat::ProgressReporter$new(show_praise = FALSE),
+  stop_on_failure = FALSE
+)
+df <- as.data.frame(results)
+failed <- sum(df$failed) + sum(df$error)
+skipped <- sum(df$skipped)
+passed <- sum(df$nb) - sum(df$failed) - sum(df$skipped)
+cat(sprintf("%d passed, %d failed, %d skipped\n", passed, failed, skipped))
+quit(status = if (failed > 0) 1L else 0L, save = "no")
