@@ -118,6 +118,13 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   sub <- allan_subset(m)
   res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub], allan_type_code(type),
                         rate, octave, allanvar_threads())
+  if (any(res$bad > 0)) {
+    col <- which(res$bad > 0)[1L]
+    row <- res$bad[col]
+    abort("`x` must contain only finite numbers; found ",
+          format(ch$values[[(col - 1) * N + row]]), " at position ", row,
+          if (ch$nc > 1L) paste0(" of column ", col), ".")
+  }
   norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
                  2 * m^2)
   scale <- if (rate) 1 else freq^2
@@ -185,15 +192,9 @@ allan_channels <- function(x, min_n) {
     abort("`x` must have at least ", min_n, " samples per channel, not ", N, ".")
   }
   if (!is.double(x)) storage.mode(x) <- "double"
-  v <- x  # passed to C++ as is: attributes (ts, dim) cost no copy
-  bad <- allan_first_nonfinite_cpp(v)
-  if (bad > 0) {
-    col <- (bad - 1) %/% N + 1
-    row <- (bad - 1) %% N + 1
-    abort("`x` must contain only finite numbers; found ", format(v[[bad]]),
-          " at position ", row, if (nc > 1L) paste0(" of column ", col), ".")
-  }
-  list(values = v, N = N, nc = nc, names = nm)
+  # passed to C++ as is (attributes such as ts or dim cost no copy); the
+  # kernel checks finiteness in the pass it makes anyway
+  list(values = x, N = N, nc = nc, names = nm)
 }
 
 #' @export
