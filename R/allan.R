@@ -114,7 +114,8 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
           "\" with ", N, " samples (largest cluster size: ", maxm, ").")
   }
   nterms <- allan_nterms(type, m, L)
-  octave <- type == "standard" && rate && all(m == 2^round(log2(m)))
+  octave <- type == "standard" && rate && length(m) <= 64L &&
+    all(m == 2^round(log2(m)))
   sub <- allan_subset(m)
   res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub], allan_type_code(type),
                         rate, octave, allanvar_threads())
@@ -133,14 +134,15 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     av <- res$sums[, j] / (norm * nterms) * scale
     e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
     ci <- allan_ci(av, e$edf, conf)
-    d <- data.frame(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
-                    adev = sqrt(av), lower = ci$lower, upper = ci$upper,
-                    edf = e$edf, alpha = e$alpha)
-    if (ch$nc > 1L) d$channel <- ch$names[j]
-    out[[j]] <- d
+    d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
+              adev = sqrt(av), lower = ci$lower, upper = ci$upper,
+              edf = e$edf, alpha = e$alpha)
+    if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
+    out[[j]] <- structure(d, class = "data.frame",
+                          row.names = .set_row_names(length(m)))
   }
   out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)
-  rownames(out) <- NULL
+  if (ch$nc > 1L) rownames(out) <- NULL
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf)
 }
