@@ -56,6 +56,25 @@
 #'   \eqn{\alpha \in \{0, -1, -2\}}, the larger of it and NIST SP 1065's
 #'   \eqn{b (L-1)/m - c} approximation.
 #'
+#' @section Methods:
+#' `print()` shows a header line and the table (`digits`, default 4);
+#' `summary()` gives, per channel, the tau range and the minimum ADEV with
+#' its interval; `plot(x, col = NULL, main = NULL, xlab, ylab, legend = TRUE,
+#' ...)` draws ADEV against tau on log-log axes with the confidence bars, one
+#' colour per channel and a legend when there are several;
+#' `as.data.frame()` drops the class and attributes.
+#'
+#' @section Cost:
+#' The phase is accumulated once per channel as a pair of double arrays
+#' (hi on a fixed grid, lo the remainder), \eqn{16 N} bytes, besides at most
+#' one copy of the input (integer or data-frame input is converted). The
+#' standard type at octave cluster sizes needs no prefix arrays at all: it
+#' builds the cluster sums pairwise in one pass over the data. Stride-1
+#' types cost \eqn{O(N)} per tau (so `taus = "all"` is \eqn{O(N^2)} for
+#' them), stride-\eqn{m} types \eqn{O(N/m)}. Channels are shared between
+#' `getOption("allanvar.threads", 2)` threads; a single channel splits its
+#' work between them.
+#'
 #' @param x Numeric vector, `ts`, matrix or data frame of samples; one curve
 #'   per column. Rate samples (angular rate, acceleration, fractional
 #'   frequency) with `input = "rate"`; angle, velocity or clock phase with
@@ -259,7 +278,10 @@ plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
   d <- as.data.frame(x)
   if (is.null(d$channel)) d$channel <- "x"
   chans <- unique(d$channel)
-  if (is.null(col)) col <- grDevices::hcl.colors(max(2, length(chans)), "Dark 3")
+  if (is.null(col)) {
+    col <- c("black", "#D55E00", "#0072B2", "#009E73", "#CC79A7", "#E69F00",
+             "#56B4E9", "#999999")
+  }
   col <- rep_len(col, length(chans))
   type <- attr(x, "type")
   if (is.null(ylab)) {

@@ -221,11 +221,12 @@ inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
   return tail;
 }
 
-// Runs f(i) for i in [0, n): in parallel from the main thread, serially (no
-// R API at all) inside a worker.
+// Runs f(i) for i in [0, n): from the main thread through parallel_for
+// (which polls for interrupts between items), serially and without any R
+// API inside a worker.
 template <class F>
 void run_items(R_xlen_t n, int threads, bool main, F f) {
-  if (main && threads > 1) {
+  if (main) {
     allanvar::parallel_for(n, threads, [&](R_xlen_t i, int) { f(i); });
   } else {
     for (R_xlen_t i = 0; i < n; ++i) f(i);
