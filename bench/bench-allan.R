@@ -15,13 +15,19 @@ status <- system2(file.path(R.home("bin"), "R"),
 if (status != 0) stop("R CMD INSTALL failed")
 library(allanvar, lib.loc = lib)
 
-# Median elapsed seconds over `reps` runs (after one warm-up run).
-timed <- function(expr, reps = 5, warmup = TRUE) {
+# Median elapsed seconds over `reps` runs (after one warm-up run); bench::mark
+# when available (sub-millisecond resolution), else system.time().
+timed <- function(expr, reps = 5) {
   f <- substitute(expr)
   e <- parent.frame()
-  if (warmup) eval(f, e)
-  t <- vapply(seq_len(reps), function(i) system.time(eval(f, e))[["elapsed"]], 0)
-  stats::median(t)
+  eval(f, e)
+  if (requireNamespace("bench", quietly = TRUE)) {
+    b <- bench::mark(eval(f, e), iterations = reps, check = FALSE,
+                     memory = FALSE, filter_gc = FALSE)
+    return(as.numeric(b$median))
+  }
+  stats::median(vapply(seq_len(reps),
+                       function(i) system.time(eval(f, e))[["elapsed"]], 0))
 }
 
 rows <- list()
@@ -45,6 +51,9 @@ add("sum(x)", 1e6, sum6, sum6, reps = 51)
 add("allan standard, octave", 1e7, timed(allan(x7, 1, type = "standard")), sum7, "<= 3")
 add("allan overlapping, octave", 1e7, timed(allan(x7, 1)), sum7, "<= 10")
 add("allan overlapping, octave (first call)", 1e7, first, sum7, reps = 1)
+options(allanvar.threads = 1)
+add("allan overlapping, octave, 1 thread", 1e7, timed(allan(x7, 1)), sum7)
+options(allanvar.threads = 2)
 add("allan standard, all m", 1e6, timed(allan(x6, 1, type = "standard", taus = "all"), 3),
     sum6, "<= 100", reps = 3)
 add("allan modified, octave", 1e6, timed(allan(x6, 1, type = "modified"), 3), sum6, reps = 3)
