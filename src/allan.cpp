@@ -528,7 +528,7 @@ void detrend(std::vector<double>& v, int deg) {
     const double mid = 0.5 * (static_cast<double>(n) - 1);
     for (size_t i = 0; i < n; ++i) {
       const double t = (static_cast<double>(i) - mid) / (mid + 1);
-      b[i] = std::pow(t, p);
+      b[i] = p == 0 ? 1.0 : p == 1 ? t : t * t;
     }
     for (auto& q : basis) {
       double dot = 0;
