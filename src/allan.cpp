@@ -42,6 +42,18 @@ struct Acc {
   double value() const { return s + c; }
 };
 
+// Runs f(i) for i in [0, n): from the main thread through parallel_for
+// (which polls for interrupts between items), serially and without any R
+// API inside a worker.
+template <class F>
+void run_items(R_xlen_t n, int threads, bool main, F f) {
+  if (main) {
+    allanvar::parallel_for(n, threads, [&](R_xlen_t i, int) { f(i); });
+  } else {
+    for (R_xlen_t i = 0; i < n; ++i) f(i);
+  }
+}
+
 // A large double buffer, uninitialised. On Linux it is 2 MiB aligned and
 // marked for transparent huge pages: a fresh 100 MB prefix array otherwise
 // costs tens of thousands of page faults, more than the sums themselves.
@@ -96,7 +108,7 @@ inline double grid_step(double bound) {
 // points), levels = 2 the prefix sums of X (n + 2 points). `bound` bounds
 // |v - c|.
 void build_prefix(const double* v, R_xlen_t n, double c, double bound,
-                  int levels, Split& out) {
+                  int levels, Split& out, int threads, bool main) {
   const R_xlen_t len = n + levels;
   out.hi.resize(len);
   out.lo.resize(len);
@@ -108,31 +120,54 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   if (levels == 2) b *= static_cast<double>(n + 1);
   const double q = grid_step(b);
   const double C = 1.5 * q * 4503599627370496.0;  // 1.5 q 2^52: ulp(C) = q
+  if (levels == 1) {
+    // X_{i+1} = X_i + (v_i - c). With two threads the second one first runs
+    // the same additions over the first part without storing them, so the
+    // result is bit-identical to the serial loop.
+    auto run = [&](R_xlen_t i0, R_xlen_t i1, double& s1, double& e1, bool store) {
+      for (R_xlen_t i = i0; i < i1; ++i) {
+        double r, re, t, te;
+        two_sum(v[i], -c, r, re);
+        two_sum(s1, r, t, te);
+        s1 = t;
+        e1 += te + re;
+        if (store) {
+          const double h = (s1 + C) - C;
+          hi[i + 1] = h;
+          lo[i + 1] = (s1 - h) + e1;
+        }
+      }
+    };
+    const R_xlen_t cut = (threads > 1 && n >= 65536)
+                             ? static_cast<R_xlen_t>(0.58 * static_cast<double>(n))
+                             : n;
+    run_items(cut < n ? 2 : 1, threads, main, [&](R_xlen_t p) {
+      double s1 = 0, e1 = 0;
+      if (p == 0) {
+        run(0, cut, s1, e1, true);
+      } else {
+        run(0, cut, s1, e1, false);
+        run(cut, n, s1, e1, true);
+      }
+    });
+    return;
+  }
+  // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c)
   double s1 = 0, e1 = 0, s2 = 0, e2 = 0;
   for (R_xlen_t i = 0; i < n; ++i) {
     double r, re, t, te;
     two_sum(v[i], -c, r, re);
-    if (levels == 1) {
-      two_sum(s1, r, t, te);
-      s1 = t;
-      e1 += te + re;
-      const double h = (s1 + C) - C;
-      hi[i + 1] = h;
-      lo[i + 1] = (s1 - h) + e1;
-    } else {
-      // P_{i+1} = P_i + X_i, then X_{i+1} = X_i + r_i.
-      two_sum(s2, s1, t, te);
-      s2 = t;
-      e2 += te + e1;
-      const double h = (s2 + C) - C;
-      hi[i + 1] = h;
-      lo[i + 1] = (s2 - h) + e2;
-      two_sum(s1, r, t, te);
-      s1 = t;
-      e1 += te + re;
-    }
+    two_sum(s2, s1, t, te);
+    s2 = t;
+    e2 += te + e1;
+    const double h = (s2 + C) - C;
+    hi[i + 1] = h;
+    lo[i + 1] = (s2 - h) + e2;
+    two_sum(s1, r, t, te);
+    s1 = t;
+    e1 += te + re;
   }
-  if (levels == 2) {
+  {
     double t, te;
     two_sum(s2, s1, t, te);
     s2 = t;
@@ -219,18 +254,6 @@ inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
     tail += d * d;
   }
   return tail;
-}
-
-// Runs f(i) for i in [0, n): from the main thread through parallel_for
-// (which polls for interrupts between items), serially and without any R
-// API inside a worker.
-template <class F>
-void run_items(R_xlen_t n, int threads, bool main, F f) {
-  if (main) {
-    allanvar::parallel_for(n, threads, [&](R_xlen_t i, int) { f(i); });
-  } else {
-    for (R_xlen_t i = 0; i < n; ++i) f(i);
-  }
 }
 
 const R_xlen_t kBlock = 8192;  // terms per cache block (measured best of 512..8192)
@@ -646,7 +669,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   if (level == 0) {
     build_split(v, N, c, bound, X);
   } else {
-    build_prefix(v, N, c, bound, level, X);
+    build_prefix(v, N, c, bound, level, X, threads, main);
   }
   double* o = out.sums.data();
   switch (type) {
