@@ -94,10 +94,10 @@
 #'   0.683 is one sigma.
 #' @return A data frame of class `c("allan", "data.frame")` with columns
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
-#'   `lower` and `upper` (confidence limits of `adev`), `edf`, `alpha` (the
-#'   noise exponent used for the EDF) and, when `x` has several columns,
-#'   `channel` (rows stacked channel by channel). Attributes: `freq`, `type`,
-#'   `input`, `N` (samples per channel), `conf`.
+#'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
+#'   has several columns, `channel` (the column name; rows stacked channel by
+#'   channel), and last `alpha` (the integer noise exponent behind the EDF).
+#'   Attributes: `freq`, `type`, `input`, `N` (samples per channel), `conf`.
 #' @seealso [avar()], [avarn()] and [avari()] for the results of
 #'   'allanvar' 1.1.
 #' @export
@@ -155,8 +155,9 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     ci <- allan_ci(av, e$edf, conf)
     d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
               adev = sqrt(av), lower = ci$lower, upper = ci$upper,
-              edf = e$edf, alpha = e$alpha)
+              edf = e$edf)
     if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
+    d$alpha <- e$alpha
     out[[j]] <- structure(d, class = "data.frame",
                           row.names = .set_row_names(length(m)))
   }

@@ -183,6 +183,8 @@ test_that("several channels: one curve per column, in parallel, same numbers", {
   m <- cbind(gx = rnorm(3000), gy = cumsum(rnorm(3000)), gz = rnorm(3000, 5))
   for (type in c("overlapping", "standard", "total")) {
     a <- allan(m, 100, type = type)
+    expect_named(a, c("tau", "m", "n", "avar", "adev", "lower", "upper", "edf",
+                      "channel", "alpha"))
     expect_equal(unique(a$channel), colnames(m))
     for (j in colnames(m)) {
       s <- allan(m[, j], 100, type = type)
