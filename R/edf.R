@@ -93,15 +93,18 @@ allan_edf_direct <- function(type, m, n, L, alpha) {
 # interpolation error is below 1e-6 relative.
 allan_ci <- function(avar, edf, conf) {
   p <- (1 - conf) / 2
-  fac <- function(e) cbind(log(e / stats::qchisq(1 - p, e)),
-                           log(e / stats::qchisq(p, e)))
-  if (length(edf) <= 2000L) {
-    f <- fac(edf)
+  r <- range(edf)
+  if (length(edf) <= 2000L || r[2] <= r[1] * (1 + 1e-12)) {
+    lo <- edf / stats::qchisq(1 - p, edf)
+    hi <- edf / stats::qchisq(p, edf)
   } else {
     g <- exp(seq(log(min(edf)), log(max(edf)), length.out = 2000L))
-    fg <- fac(g)
-    f <- cbind(stats::splinefun(log(g), fg[, 1], method = "fmm")(log(edf)),
-               stats::splinefun(log(g), fg[, 2], method = "fmm")(log(edf)))
+    lg <- log(g)
+    le <- log(edf)
+    lo <- exp(stats::splinefun(lg, log(g / stats::qchisq(1 - p, g)),
+                               method = "fmm")(le))
+    hi <- exp(stats::splinefun(lg, log(g / stats::qchisq(p, g)),
+                               method = "fmm")(le))
   }
-  list(lower = sqrt(avar * exp(f[, 1])), upper = sqrt(avar * exp(f[, 2])))
+  list(lower = sqrt(avar * lo), upper = sqrt(avar * hi))
 }
