@@ -9,17 +9,15 @@ Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values,
   const double tau = 1.0 / freq;
   const int p = allanvar::octave_count(N);
   Rcpp::NumericVector time(p + 1), av(p + 1), error(p + 1);
-  std::vector<double> means(N);
-  const double* x = values.begin();
+  std::vector<R_xlen_t> sizes(p + 1);
+  for (int i = 0; i <= p; ++i) sizes[i] = static_cast<R_xlen_t>(1) << i;
+  std::vector<double> sums(N);
+  allanvar::cluster_avars(values.begin(), N, sizes.data(), p + 1, av.begin(),
+                          sums.data(), [] { Rcpp::checkUserInterrupt(); });
   for (int i = 0; i <= p; ++i) {
     const double c = std::ldexp(1.0, i);
-    const R_xlen_t ci = static_cast<R_xlen_t>(c);
-    const R_xlen_t M = N / ci;
-    allanvar::cluster_means(x, ci, M, means.data());
-    av[i] = allanvar::cluster_mean_avar(means.data(), M);
     time[i] = c * tau;
     error[i] = allanvar::cluster_error(N, c);
-    Rcpp::checkUserInterrupt();
   }
   return Rcpp::DataFrame::create(Rcpp::Named("time") = time,
                                  Rcpp::Named("av") = av,
