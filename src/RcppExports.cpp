@@ -12,13 +12,14 @@ Rcpp::Rostream<false>& Rcpp::Rcerr = Rcpp::Rcpp_cerr_get();
 #endif
 
 // avar_octave_exact
-Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values, double freq);
-RcppExport SEXP _allanvar_avar_octave_exact(SEXP valuesSEXP, SEXP freqSEXP) {
+Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values, double freq, int threads);
+RcppExport SEXP _allanvar_avar_octave_exact(SEXP valuesSEXP, SEXP freqSEXP, SEXP threadsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type values(valuesSEXP);
     Rcpp::traits::input_parameter< double >::type freq(freqSEXP);
-    rcpp_result_gen = Rcpp::wrap(avar_octave_exact(values, freq));
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(avar_octave_exact(values, freq, threads));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -57,7 +58,7 @@ END_RCPP
 }
 
 static const R_CallMethodDef CallEntries[] = {
-    {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 2},
+    {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 3},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
