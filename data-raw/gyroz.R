@@ -7,10 +7,11 @@ stopifnot(inherits(gyroz, "ts"), length(gyroz) == 10000L,
           abs(frequency(gyroz) - 97.65625) < 1e-9)
 save(gyroz, file = file.path("data", "gyroz.rda"), compress = "xz")
 
-# The 65,536-sample series: stored once, in inst/extdata, and exposed both as
-# data(gyroz_long) and, for code written for allanvar 1.1, as
-# data(gyroz_complete), which (like the original) defines an object `gyroz`.
+# The 65,536-sample series, stored once: data(gyroz_long) gives it under its
+# own name and, for code written for allanvar 1.1, data(gyroz_complete)
+# (data/gyroz_complete.R) defines an object `gyroz` holding it, as the
+# original's gyroz_complete.rda did.
 gyroz_long <- readRDS(file.path(shared, "gyroz_long.rds"))
-stopifnot(length(gyroz_long) == 65536L, abs(frequency(gyroz_long) - 97.65625) < 1e-9)
-saveRDS(gyroz_long, file.path("inst", "extdata", "gyroz_long.rds"),
-        compress = "xz")
+stopifnot(length(gyroz_long) == 65536L,
+          abs(frequency(gyroz_long) - 97.65625) < 1e-9)
+save(gyroz_long, file = file.path("data", "gyroz_long.rda"), compress = "xz")
