@@ -29,8 +29,15 @@
 #' standardized residuals
 #' \deqn{z_j = \frac{\ln\widehat{AV}_j - \ln AV_j - [\psi(\nu_j/2) -
 #'   \ln(\nu_j/2)]}{\sqrt{\psi'(\nu_j/2)}}.}
-#' The correlation between the estimates at different \eqn{\tau} is not
-#' modelled (octave-spaced points are the least correlated choice).
+#' By default the estimates at different \eqn{\tau} are taken as
+#' independent (octave-spaced points are the least correlated choice); with
+#' `correlation = TRUE` the objective is the generalised
+#' \eqn{r^\top\Sigma^{-1}r} with \eqn{\Sigma = D_s R D_s},
+#' \eqn{D_s = \mathrm{diag}(\sqrt{\psi'(\nu_j/2)})} and \eqn{R} the exact
+#' correlation of the AV estimates for white rate noise (Isserlis' theorem,
+#' computed in C++ for the estimator type). It is exact for white noise and
+#' an approximation otherwise; the correlation of the log estimates is taken
+#' as that of the estimates.
 #' For fixed nonlinear parameters the squared amplitudes \eqn{c_k = a_k^2}
 #' are found by Gauss-Newton steps, each a non-negative least-squares
 #' problem (C++); the nonlinear parameters are profiled on a log grid
@@ -78,6 +85,9 @@
 #'   the chi-square log bias \eqn{\psi(\nu/2) - \ln(\nu/2)} is removed
 #'   from \eqn{\ln\widehat{AV}}; set `FALSE` to fit a noise-free
 #'   theoretical curve.
+#' @param correlation If `TRUE`, account for the correlation between the
+#'   estimates at different tau (white-noise correlation; needs `n` and
+#'   `freq`). `chi2` is then \eqn{r^\top\Sigma^{-1}r} per degree of freedom.
 #' @param ... Unused.
 #' @return An object of class `"avfit"`: a list with `coefficients` (named:
 #'   `Q`, `N`, `B`, `K`, `R`, `gm1.sigma`, `gm1.tc`, `sinusoid1.amp`,
@@ -105,15 +115,20 @@
 #'            type = "non-overlapping"))
 avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
                   type = "overlapping", channel = NULL, start = NULL,
-                  fixed = NULL, tau_range = NULL, bias_correct = TRUE, ...) {
+                  fixed = NULL, tau_range = NULL, bias_correct = TRUE,
+                  correlation = FALSE, ...) {
   cl <- match.call()
   if (!isTRUE(bias_correct) && !isFALSE(bias_correct)) {
     abort("`bias_correct` must be TRUE or FALSE.")
+  }
+  if (!isTRUE(correlation) && !isFALSE(correlation)) {
+    abort("`correlation` must be TRUE or FALSE.")
   }
   check_present(missing(av), "av", "an Allan variance curve")
   terms <- check_terms(terms)
   if (inherits(av, "avfit")) {
     if (missing(bias_correct)) bias_correct <- isTRUE(av$bias_correct)
+    if (missing(correlation)) correlation <- isTRUE(av$correlation)
     # previous nonlinear estimates start the refit
     old <- av$coefficients[av$layout$role == "nonlinear"]
     old <- old[names(old) %in% coef_layout(terms)$name]
@@ -143,6 +158,19 @@ avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
           " free parameters of terms ", paste(terms, collapse = ", "), ".")
   }
   tau0 <- if (is.null(d$freq)) NULL else 1 / d$freq
+  corr <- NULL
+  if (correlation) {
+    if (is.null(d$freq) || is.null(d$n)) {
+      abort("`correlation = TRUE` needs `n` and `freq` (the cluster sizes ",
+            "and the record length).")
+    }
+    corr <- if (inherits(av, "avfit") && !is.null(av$corr) &&
+                is.null(tau_range) && nrow(av$corr) == nrow(d$data)) {
+      av$corr
+    } else {
+      white_corr(d$data$m, d$n, d$type)
+    }
+  }
   fit <- NULL
   passes <- if (d$edf_source == "input") 1L else 2L
   for (pass in seq_len(passes)) {
@@ -156,7 +184,7 @@ avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
       }
     }
     fit <- fit_core(d$data, tau0, lay, start, if (is.null(fit)) NULL else fit,
-                    bias_correct)
+                    bias_correct, corr)
   }
   finish_fit(fit, d, input, terms, cl)
 }
@@ -374,9 +402,37 @@ nl_range <- function(kind, tau, freq) {
   c(min(0.2 / max(tau), hi / 10), hi)
 }
 
+# Correlation matrix of the AV estimates at cluster sizes m for white rate
+# noise (exact Gaussian moments, C++).
+white_corr <- function(m, n, type) {
+  C <- avar_white_cov(as.double(round(m)), as.double(n),
+                      type == "overlapping", allanvar_threads())
+  d <- sqrt(diag(C))
+  R <- C / outer(d, d)
+  R[!is.finite(R)] <- 0
+  diag(R) <- 1
+  R
+}
+
+# Whitening matrix W with ||W r||^2 = r' Sigma^-1 r, Sigma = diag(s) R diag(s).
+whitening <- function(s, corr) {
+  if (is.null(corr)) return(diag(1 / s, length(s)))
+  Sig <- corr * outer(s, s)
+  U <- tryCatch(chol(Sig), error = function(e) NULL)
+  # nearly coincident taus can make Sigma numerically singular: add a ridge
+  ridge <- 1e-10
+  while (is.null(U) && ridge < 1e-2) {
+    U <- tryCatch(chol(Sig + diag(ridge * s^2, length(s))),
+                  error = function(e) NULL)
+    ridge <- ridge * 100
+  }
+  if (is.null(U)) return(diag(1 / s, length(s)))
+  t(backsolve(U, diag(length(s))))
+}
+
 # Solve for the amplitudes at given nonlinear values; returns list with c
 # (named by free amp label), objective.
-solve_amps <- function(data, tau0, lay, nlv, y, s, cstart = NULL) {
+solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL) {
   lay2 <- lay
   lay2$value[lay2$role == "nonlinear" & !lay2$fixed] <- nlv
   Bm <- term_basis_matrix(data$tau, tau0, lay2)
@@ -388,22 +444,24 @@ solve_amps <- function(data, tau0, lay, nlv, y, s, cstart = NULL) {
   if (is.null(cstart)) cstart <- numeric(length(freeamp))
   if (length(freeamp) == 0L) {
     av <- off
-    obj <- if (all(av > 0)) sum(((y - log(av)) / s)^2) else Inf
+    obj <- if (all(av > 0)) sum((W %*% (y - log(av)))^2) else Inf
     return(list(c = numeric(0), objective = obj, layout = lay2))
   }
-  r <- avfit_log_nnls(Bf, off, y, s, cstart, 100L, 1e-12)
+  r <- avfit_log_nnls(Bf, off, y, W, cstart, 100L, 1e-12)
   cc <- stats::setNames(r$c, freeamp)
   list(c = cc, objective = r$objective, layout = lay2)
 }
 
-fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE) {
+fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
+                     corr = NULL) {
   y <- log(data$avar) - if (bias_correct) log_bias(data$edf) else 0
   s <- log_sd(data$edf)
+  W <- whitening(s, corr)
   freq <- if (is.null(tau0)) NULL else 1 / tau0
   nlrows <- which(lay$role == "nonlinear" & !lay$fixed)
   nlv <- numeric(length(nlrows))
   names(nlv) <- lay$name[nlrows]
-  obj <- function(lognl) solve_amps(data, tau0, lay, exp(lognl), y, s)$objective
+  obj <- function(lognl) solve_amps(data, tau0, lay, exp(lognl), y, W)$objective
   if (length(nlrows)) {
     ranges <- lapply(nlrows, function(i) nl_range(lay$kind[i], data$tau, freq))
     # initial values: start, previous fit, or grid centre
@@ -442,12 +500,12 @@ fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE) {
     }
     nlv[] <- exp(lognl)
   }
-  sol <- solve_amps(data, tau0, lay, nlv, y, s)
+  sol <- solve_amps(data, tau0, lay, nlv, y, W)
   lay2 <- sol$layout
   amprows <- which(lay2$role == "amp" & !lay2$fixed)
   lay2$value[amprows] <- sqrt(pmax(sol$c[lay2$label[amprows]], 0))
-  list(layout = lay2, objective = sol$objective, y = y, s = s, data = data,
-       tau0 = tau0, bias_correct = bias_correct)
+  list(layout = lay2, objective = sol$objective, y = y, s = s, W = W,
+       corr = corr, data = data, tau0 = tau0, bias_correct = bias_correct)
 }
 
 # Jacobian of ln AV with respect to the free parameters (amplitudes, or c for
@@ -502,14 +560,15 @@ finish_fit <- function(fit, d, input, terms, cl) {
   comp <- model_components(data$tau, tau0, lay)
   fitted <- rowSums(comp)
   z <- (fit$y - log(fitted)) / fit$s
+  objective <- sum((fit$W %*% (fit$y - log(fitted)))^2)
   nfree <- sum(!lay$fixed)
   dfres <- nrow(data) - nfree
-  chi2 <- if (dfres > 0) sum(z^2) / dfres else NA_real_
+  chi2 <- if (dfres > 0) objective / dfres else NA_real_
   rms <- 100 * sqrt(mean((sqrt(fitted / data$avar) - 1)^2))
   coef <- stats::setNames(lay$value, lay$name)
   # covariance
   jj <- jacobian_lnav(fit)
-  Js <- jj$J / fit$s
+  Js <- -fit$W %*% jj$J
   V <- pinv(crossprod(Js)) * max(1, if (is.na(chi2)) 1 else chi2)
   vc <- matrix(0, nrow(lay), nrow(lay), dimnames = list(lay$name, lay$name))
   se <- stats::setNames(numeric(nrow(lay)), lay$name)
@@ -536,10 +595,12 @@ finish_fit <- function(fit, d, input, terms, cl) {
   input$data$edf <- if (d$edf_source == "input") input$data$edf else NA_real_
   structure(list(
     coefficients = coef, se = se, vcov = vc, chi2 = chi2, rms = rms,
-    objective = sum(z^2), df.residual = dfres, nobs = nrow(data),
+    objective = objective, logdet = -2 * sum(log(diag(fit$W))),
+    df.residual = dfres, nobs = nrow(data),
     npar = nfree, terms = terms, layout = lay, data = data,
     components = comp, freq = d$freq, n = d$n, type = d$type,
-    edf_source = d$edf_source, bias_correct = fit$bias_correct, steps = steps,
+    edf_source = d$edf_source, bias_correct = fit$bias_correct,
+    correlation = !is.null(fit$corr), corr = fit$corr, steps = steps,
     input = input, call = cl),
     class = "avfit")
 }
@@ -557,7 +618,8 @@ finish_fit <- function(fit, d, input, terms, cl) {
 #' `confint()` gives Wald intervals: for amplitudes on the linear scale,
 #' truncated at 0; for `tc` and `f0` on the log scale.
 #' `logLik()` is the Gaussian log-likelihood of \eqn{\ln\widehat{AV}_j}
-#' (bias-corrected) with variances \eqn{\psi'(\nu_j/2)}; its `df` is the
+#' (bias-corrected) with variances \eqn{\psi'(\nu_j/2)} (and the
+#' white-noise correlation when the fit used `correlation = TRUE`); its `df` is the
 #' number of free parameters and `nobs` the number of points, so AIC() and
 #' BIC() work.
 #'
@@ -664,7 +726,9 @@ predict.avfit <- function(object, newdata = NULL, type = c("avar", "adev"),
 logLik.avfit <- function(object, ...) {
   d <- object$data
   s <- log_sd(d$edf)
-  ll <- sum(stats::dnorm(d$z * s, sd = s, log = TRUE))
+  # -1/2 [J ln(2 pi) + ln det Sigma + r' Sigma^-1 r], Sigma = diag(s) R diag(s)
+  ldet <- if (!is.null(object$logdet)) object$logdet else 2 * sum(log(s))
+  ll <- -0.5 * (length(s) * log(2 * pi) + ldet + object$objective)
   structure(ll, df = object$npar, nobs = object$nobs, class = "logLik")
 }
 
@@ -753,7 +817,8 @@ plot.avfit <- function(x, terms = TRUE, residuals = TRUE, ...) {
   comp <- predict(x, tt, by_term = TRUE)
   tot <- rowSums(comp)
   yl <- range(c(lo, hi, sqrt(tot)), finite = TRUE)
-  yl[1] <- max(yl[1], yl[2] * 1e-6)
+  # room below the data for the terms' curves (down to half their peak)
+  yl[1] <- max(min(yl[1], 0.5 * apply(sqrt(comp), 2, max)), yl[2] * 1e-4)
   graphics::plot(d$tau, sqrt(d$avar), log = "xy", ylim = yl, pch = 19,
                  cex = 0.7, xlab = if (residuals) "" else "tau [s]",
                  ylab = "Allan deviation", xaxt = if (residuals) "n" else "s",

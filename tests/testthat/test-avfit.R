@@ -200,3 +200,76 @@ test_that("bad input errors name the argument", {
   expect_error(avfit(tab, "N", n = n, freq = f, tau_range = 1), "`tau_range`")
   expect_error(avfit(tab[1:2, ], c("N", "B", "K"), n = n, freq = f), "free parameters")
 })
+
+test_that("white-noise covariance kernel: exact values, strided sums, Monte Carlo", {
+  nn <- 4096
+  m <- c(1, 2, 4, 16, 64, 256, 1000)
+  C <- avar_white_cov(m, nn, FALSE, 2L)
+  M <- floor(nn / m) - 1
+  expect_equal(2 / m^2 / diag(C), 2 * M^2 / (3 * M - 1))
+  Co <- avar_white_cov(m, nn, TRUE, 2L)
+  expect_equal(2 / m^2 / diag(Co), edf_simple_oavar(m, nn + 1, 0), tolerance = 0.02)
+  # brute-force R sum for a long pair (the C++ sum is strided there)
+  brute <- function(mi, mj, n) {
+    w <- function(t, mm) ifelse(t >= 0 & t < mm, -1 / mm,
+                                ifelse(t >= mm & t < 2 * mm, 1 / mm, 0))
+    Mi <- n - 2 * mi + 1; Mj <- n - 2 * mj + 1
+    t <- 0:(2 * mi - 1)
+    tot <- 0
+    for (h in (-2 * mj + 1):(2 * mi - 1)) {
+      cnt <- min(Mi, Mj - h) - max(0, -h)
+      if (cnt > 0) tot <- tot + cnt * sum(w(t, mi) * w(t - h, mj))^2
+    }
+    tot / (2 * Mi * Mj)
+  }
+  expect_equal(avar_white_cov(c(1500, 1100), 12000, TRUE, 1L)[1, 2],
+               brute(1500, 1100, 12000), tolerance = 2e-3)
+  expect_equal(avar_white_cov(c(3, 5), 500, TRUE, 1L)[1, 2], brute(3, 5, 500),
+               tolerance = 1e-12)
+  # correlation between neighbouring octaves matches Monte Carlo
+  set.seed(7)
+  sims <- replicate(400, {
+    y <- rnorm(nn)
+    vapply(c(2, 4, 8), function(mm) oav_ref(y, mm, 1), 0)
+  })
+  Rth <- cov2cor(avar_white_cov(c(2, 4, 8), nn, TRUE, 2L))
+  expect_equal(cor(t(sims))[1, 2], Rth[1, 2], tolerance = 0.2)
+  expect_equal(cor(t(sims))[2, 3], Rth[2, 3], tolerance = 0.2)
+})
+
+test_that("correlation = TRUE: exact curves, calibrated chi2 and honest SE", {
+  nn <- 2^15
+  ms <- unique(round(10^seq(0, log10(nn / 4), by = 0.1)))
+  tab <- data.frame(tau = ms / f,
+                    avar = av_model(ms / f, c(N = 0.01, gm1.sigma = 0.01,
+                                              gm1.tc = 3), f))
+  fit <- avfit(tab, c("N", "gm"), n = nn, freq = f, correlation = TRUE,
+               bias_correct = FALSE)
+  expect_equal(coef(fit), c(N = 0.01, gm1.sigma = 0.01, gm1.tc = 3),
+               tolerance = 1e-5)
+  expect_true(fit$correlation)
+  # on a dense tau grid the independent-points SE of B is too small; the
+  # correlated fit's SE matches the spread over seeds
+  res <- t(vapply(1:8, function(s) {
+    x <- avsim(nn, f, N = 0.01, B = 0.003, seed = 300 + s)
+    tb <- oav_table(x, f, ms)
+    a <- avfit(tb, c("N", "B"), n = nn, freq = f)
+    b <- avfit(tb, c("N", "B"), n = nn, freq = f, correlation = TRUE)
+    c(b$chi2, coef(b)["B"], b$se["B"], a$se["B"])
+  }, numeric(4)))
+  expect_gt(mean(res[, 1]), 0.4)
+  expect_lt(mean(res[, 1]), 2)
+  sd_b <- sd(res[, 2])
+  expect_gt(mean(res[, 3]), mean(res[, 4]))
+  expect_gt(mean(res[, 3]) / sd_b, 0.5)
+  expect_lt(mean(res[, 3]) / sd_b, 2)
+  expect_equal(as.numeric(logLik(b <- avfit(tab, c("N", "gm"), n = nn, freq = f,
+                                              correlation = TRUE))),
+               {
+                 s <- sqrt(trigamma(b$data$edf / 2))
+                 r <- log(tab$avar) - log_bias(b$data$edf) - log(fitted(b))
+                 S <- b$corr * outer(s, s)
+                 as.numeric(-0.5 * (length(r) * log(2 * pi) +
+                   determinant(S)$modulus + t(r) %*% solve(S, r)))
+               }, tolerance = 1e-6)
+})
