@@ -93,8 +93,11 @@
 #'   `Q`, `N`, `B`, `K`, `R`, `gm1.sigma`, `gm1.tc`, `sinusoid1.amp`,
 #'   `sinusoid1.f0`, ...), `se`, `vcov`, `chi2` (sum of squared
 #'   standardized residuals per degree of freedom), `rms` (RMS relative
-#'   error of the Allan deviation in percent,
-#'   \eqn{100\sqrt{\mathrm{mean}((\sqrt{AV_j/\widehat{AV}_j} - 1)^2)}}),
+#'   error of the Allan deviation in percent: the measured ADEV relative to
+#'   the model's,
+#'   \eqn{100\sqrt{\mathrm{mean}((\sqrt{\widehat{AV}_j/AV_j} - 1)^2)}}; this
+#'   direction keeps a single low estimate at the longest tau, where the EDF
+#'   is near 1, from dominating),
 #'   `objective`, `df.residual`, `nobs`, `terms`, `layout` (one row per
 #'   coefficient: name, term label, kind, parameter, role, unit, fixed),
 #'   `data` (data frame `tau`, `m`, `avar`, `edf`, `fitted`, `z`),
@@ -545,7 +548,16 @@ jacobian_lnav <- function(fit) {
   list(J = Jm, at_zero = at_zero, free = free)
 }
 
+# Pseudo-inverse of a symmetric PSD matrix, equilibrated first: parameters
+# differ by many orders of magnitude (c = K^2 ~ 1e-8 next to tc ~ 10 s).
 pinv <- function(A) {
+  dg <- sqrt(pmax(diag(A), 0))
+  dg[dg == 0] <- 1
+  As <- A / outer(dg, dg)
+  pinv_raw(As) / outer(dg, dg)
+}
+
+pinv_raw <- function(A) {
   e <- eigen((A + t(A)) / 2, symmetric = TRUE)
   d <- e$values
   keep <- d > max(d) * 1e-12
@@ -564,7 +576,7 @@ finish_fit <- function(fit, d, input, terms, cl) {
   nfree <- sum(!lay$fixed)
   dfres <- nrow(data) - nfree
   chi2 <- if (dfres > 0) objective / dfres else NA_real_
-  rms <- 100 * sqrt(mean((sqrt(fitted / data$avar) - 1)^2))
+  rms <- 100 * sqrt(mean((sqrt(data$avar / fitted) - 1)^2))
   coef <- stats::setNames(lay$value, lay$name)
   # covariance
   jj <- jacobian_lnav(fit)
