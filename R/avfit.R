@@ -435,12 +435,13 @@ whitening <- function(s, corr) {
 
 # Solve for the amplitudes at given nonlinear values; returns list with c
 # (named by free amp label), objective.
-solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL) {
+# `off`: labels of term instances left out (amplitude 0) for this solve.
+solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL, off_labels = NULL) {
   lay2 <- lay
   lay2$value[lay2$role == "nonlinear" & !lay2$fixed] <- nlv
   Bm <- term_basis_matrix(data$tau, tau0, lay2)
   amp <- lay2[lay2$role == "amp", , drop = FALSE]
-  freeamp <- amp$label[!amp$fixed]
+  freeamp <- amp$label[!amp$fixed & !amp$label %in% off_labels]
   off <- numeric(nrow(data))
   for (i in which(amp$fixed)) off <- off + amp$value[i]^2 * Bm[, amp$label[i]]
   Bf <- Bm[, freeamp, drop = FALSE]
@@ -451,7 +452,8 @@ solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL) {
     return(list(c = numeric(0), objective = obj, layout = lay2))
   }
   r <- avfit_log_nnls(Bf, off, y, W, cstart, 100L, 1e-12)
-  cc <- stats::setNames(r$c, freeamp)
+  cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$label[!amp$fixed])
+  cc[freeamp] <- r$c
   list(c = cc, objective = r$objective, layout = lay2)
 }
 
@@ -464,7 +466,9 @@ fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
   nlrows <- which(lay$role == "nonlinear" & !lay$fixed)
   nlv <- numeric(length(nlrows))
   names(nlv) <- lay$name[nlrows]
-  obj <- function(lognl) solve_amps(data, tau0, lay, exp(lognl), y, W)$objective
+  obj <- function(lognl, off_labels = NULL) {
+    solve_amps(data, tau0, lay, exp(lognl), y, W, off_labels = off_labels)$objective
+  }
   if (length(nlrows)) {
     ranges <- lapply(nlrows, function(i) nl_range(lay$kind[i], data$tau, freq))
     # initial values: start, previous fit, or grid centre
@@ -481,7 +485,12 @@ fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
     cycles <- if (length(nlrows) > 1L) 2L else 1L
     for (cy in seq_len(cycles)) {
       for (k in seq_along(nlrows)) {
-        f1 <- function(v) { l <- lognl; l[k] <- v; obj(l) }
+        # first cycle: terms not searched yet stay out of the model (greedy)
+        later <- if (cy == 1L) {
+          j <- seq_along(nlrows) > k & !has_start
+          lay$label[nlrows[j]]
+        } else NULL
+        f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
         if (cy > 1L || has_start[k]) {
           lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
         } else {
