@@ -1,3 +1,18 @@
+# The noise-model fit. Internals other files may use (stable within the
+# package):
+#   avfit(fit, terms, start = c(gm2.tc = 30))  refits an avfit's own curve
+#       with new terms; the old nonlinear estimates start the new fit.
+#   fit$data     tau, m, avar, edf, fitted, z (standardized log residual)
+#   fit$input    the normalised input (list: data, freq, n, type, edf_source)
+#   fit$layout   one row per coefficient: name, label, kind, param, role
+#                ("amp"/"nonlinear"), unit, fixed, value
+#   fit$components  each term instance's AV at the data taus
+#   log_bias(edf), log_sd(edf)   chi-square log bias and sd of ln AV-hat
+#   edf_model(m, n, type, comp, alpha)  model EDF (see the EDF section)
+#   white_corr(m, n, type)  white-noise correlation of the AV estimates
+# The catalogue helpers live in terms.R (coef_layout, check_coef,
+# term_basis_matrix, model_components, term_entry, term_labels).
+
 #' Fit a noise model to an Allan variance curve
 #'
 #' Fits a sum of noise terms from the catalogue ([av_terms()]) to an Allan

@@ -1,8 +1,11 @@
 # Timings of the noise-model fit and of the white-noise covariance kernel.
-# Run from the package root: Rscript bench/bench-avfit.R
+# Measures the installed package (compiled -O2; pkgload::load_all() builds
+# with -O0, which is several times slower for Eigen code):
+#   R CMD INSTALL . && Rscript bench/bench-avfit.R
 # Prints one row per case: what was timed, the size, and the median elapsed
 # seconds over `reps` runs (2 threads at most).
-pkgload::load_all(".", quiet = TRUE)
+library(allanvar)
+avar_white_cov <- allanvar:::avar_white_cov
 options(allanvar.threads = 2L)
 reps <- 3L
 time_it <- function(expr) {
