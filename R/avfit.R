@@ -32,7 +32,9 @@
 #' * a plain data frame with columns `tau` (s) and `avar`, and optionally
 #'   `edf`, computed elsewhere; without `edf`, give `n` and `freq` (the
 #'   estimator is taken as overlapping unless `type` says otherwise);
-#' * a previous `avfit` (its data are refitted with the new `terms`).
+#' * a previous `avfit` (its data are refitted with the new `terms`, its
+#'   nonlinear estimates as starting values and, when its EDF came from its
+#'   model, with that same EDF, so that AIC/BIC of the two fits compare).
 #'
 #' @section Model and estimation:
 #' The expected Allan variance is \eqn{AV_j = \sum_k a_k^2 b_k(\tau_j;
@@ -190,9 +192,9 @@ avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
     }
   }
   fit <- NULL
-  passes <- if (d$edf_source == "input") 1L else 2L
+  passes <- if (d$edf_source == "model") 2L else 1L
   for (pass in seq_len(passes)) {
-    if (d$edf_source != "input") {
+    if (d$edf_source == "model") {
       d$data$edf <- if (is.null(fit)) {
         edf_model(d$data$m, d$n, d$type, matrix(1, nrow(d$data), 1), 0)
       } else {
@@ -226,6 +228,15 @@ normalize_type <- function(type) {
 avfit_input <- function(av, n, freq, type, type_given, channel) {
   if (inherits(av, "avfit")) {
     d <- av$input
+    if (d$edf_source == "model") {
+      # keep the EDF of the fit being extended, so that the two fits'
+      # likelihoods (AIC, BIC) are comparable
+      tau0 <- if (is.null(d$freq)) NULL else 1 / d$freq
+      comp <- model_components(d$data$tau, tau0, av$layout)
+      d$data$edf <- edf_model(d$data$m, d$n, d$type, comp,
+                              term_alpha(av$layout, d$data$tau))
+      d$edf_source <- "previous"
+    }
     return(d)
   }
   if (!is.null(freq)) freq <- check_freq(freq)
@@ -486,16 +497,16 @@ fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
   }
   if (length(nlrows)) {
     ranges <- lapply(nlrows, function(i) nl_range(lay$kind[i], data$tau, freq))
-    # initial values: start, previous fit, or grid centre
+    # initial values: previous pass, start, or grid centre
     for (k in seq_along(nlrows)) {
       nm <- lay$name[nlrows[k]]
-      nlv[k] <- if (!is.null(start) && nm %in% names(start)) start[[nm]] else
-        if (!is.null(prev)) prev$layout$value[prev$layout$name == nm] else
+      nlv[k] <- if (!is.null(prev)) prev$layout$value[prev$layout$name == nm] else
+        if (!is.null(start) && nm %in% names(start)) start[[nm]] else
           sqrt(prod(ranges[[k]]))
     }
     # a parameter with a start (given, or from the previous pass) is refined
     # locally; the others are searched on the grid first
-    has_start <- !is.null(prev) | names(nlv) %in% names(start)
+    has_start <- names(nlv) %in% names(start)
     lognl <- log(nlv)
     cycles <- if (length(nlrows) > 1L) 2L else 1L
     for (cy in seq_len(cycles)) {
@@ -506,11 +517,15 @@ fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
           lay$label[nlrows[j]]
         } else NULL
         f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
-        if (cy > 1L || has_start[k]) {
+        if (cy > 1L || !is.null(prev)) {
           lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
         } else {
-          ng <- if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
-          g <- seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
+          # a start value: a short grid over start / 4 .. start * 4;
+          # otherwise the whole range
+          ng <- if (has_start[k]) 13L else
+            if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
+          g <- if (has_start[k]) lognl[k] + seq(-log(4), log(4), length.out = ng) else
+            seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
           vals <- vapply(g, f1, 0)
           i <- which.min(vals)
           lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
@@ -628,7 +643,7 @@ finish_fit <- function(fit, d, input, terms, cl) {
                       chi2_before = numeric(0), chi2_after = numeric(0),
                       rms_before = numeric(0), rms_after = numeric(0),
                       stringsAsFactors = FALSE)
-  input$data$edf <- if (d$edf_source == "input") input$data$edf else NA_real_
+  input$data$edf <- if (d$edf_source == "model") NA_real_ else input$data$edf
   structure(list(
     coefficients = coef, se = se, vcov = vc, chi2 = chi2, rms = rms,
     objective = objective, logdet = -2 * sum(log(diag(fit$W))),
@@ -657,7 +672,10 @@ finish_fit <- function(fit, d, input, terms, cl) {
 #' (bias-corrected) with variances \eqn{\psi'(\nu_j/2)} (and the
 #' white-noise correlation when the fit used `correlation = TRUE`); its `df` is the
 #' number of free parameters and `nobs` the number of points, so AIC() and
-#' BIC() work.
+#' BIC() work. Compare models by AIC/BIC only on the same points with the same
+#' EDF: when the EDF is derived from the model (input without `edf`), refit
+#' the candidate from the first fit, `avfit(fit, terms)`, or pass its
+#' `fit$data$edf` as an `edf` column.
 #'
 #' @param object,x An `avfit` object.
 #' @param parm Coefficients for `confint()` (names or indices; default all).
@@ -778,7 +796,8 @@ print.avfit <- function(x, ...) {
   cat("Allan variance noise-model fit:", paste(x$terms, collapse = " + "), "\n")
   cat(sprintf("%d points, tau %.3g to %.3g s, %s estimator, EDF from %s\n",
               x$nobs, min(x$data$tau), max(x$data$tau), x$type,
-              if (x$edf_source == "input") "the input" else "the model"))
+              switch(x$edf_source, input = "the input", model = "the model",
+                     previous = "the previous fit's model")))
   tab <- data.frame(estimate = signif(x$coefficients, 4),
                     se = signif(x$se, 3), unit = x$layout$unit)
   print(tab)

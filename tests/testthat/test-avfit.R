@@ -307,3 +307,27 @@ test_that("correlation = TRUE: exact curves, calibrated chi2 and honest SE", {
                    determinant(S)$modulus + t(r) %*% solve(S, r)))
                }, tolerance = 1e-6)
 })
+
+test_that("refitting an avfit keeps its EDF (comparable AIC) and its estimates", {
+  x <- avsim(n, f, N = 0.01, gm = list(sigma = 0.01, tc = 2), seed = 41)
+  tab <- oav_table(x, f)
+  fit0 <- avfit(tab, "N", n = n, freq = f)
+  fit1 <- avfit(fit0, c("N", "gm"))
+  expect_equal(fit1$data$edf, fit0$data$edf)
+  expect_equal(fit1$edf_source, "previous")
+  expect_lt(AIC(fit1), AIC(fit0) - 10)
+  # a second refit starts from gm1's estimate and finds a second GM
+  fit2 <- avfit(fit1, c("N", "gm", "gm"), start = c(gm2.tc = 100))
+  expect_named(coef(fit2), c("N", "gm1.sigma", "gm1.tc", "gm2.sigma", "gm2.tc"))
+  expect_lte(fit2$objective, fit1$objective + 1e-6)
+  # start and fixed together; unknown names rejected
+  fit3 <- avfit(tab, c("N", "gm"), n = n, freq = f, start = c(gm1.tc = 1),
+                fixed = c(N = 0.01))
+  expect_equal(unname(coef(fit3)["gm1.tc"]), 2, tolerance = 0.15)
+  expect_error(avfit(tab, "N", n = n, freq = f, fixed = c(B = 1)), "`fixed`")
+  # avari() output is overlapping
+  fit_i <- avfit(avari(cumsum(x) / f, f), c("N", "gm"), freq = f,
+                 type = "overlapping")
+  expect_equal(fit_i$type, "overlapping")
+  expect_equal(unname(coef(fit_i)["N"]), 0.01, tolerance = 0.05)
+})
