@@ -80,8 +80,9 @@
 #' \eqn{\max(1, \chi^2/\mathrm{dof})} so that misfit widens it. For an
 #' amplitude at its bound 0 the curvature is computed for \eqn{c = a^2}
 #' instead and its standard error reported as \eqn{\sqrt{SE(c)}} (the
-#' one-sigma upper reach of the amplitude). Fixed parameters have zero
-#' variance.
+#' one-sigma upper reach of the amplitude); the `tc` or `f0` of a term whose
+#' amplitude is 0 is not identified and gets `NA`. Fixed parameters have
+#' zero variance.
 #'
 #' @param av The Allan variance curve (see Input).
 #' @param terms Character vector of terms to fit (see [av_terms()]); `gm` and
@@ -507,39 +508,59 @@ fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
     # a parameter with a start (given, or from the previous pass) is refined
     # locally; the others are searched on the grid first
     has_start <- names(nlv) %in% names(start)
-    lognl <- log(nlv)
-    cycles <- if (length(nlrows) > 1L) 2L else 1L
-    for (cy in seq_len(cycles)) {
-      for (k in seq_along(nlrows)) {
-        # first cycle: terms not searched yet stay out of the model (greedy)
-        later <- if (cy == 1L) {
-          j <- seq_along(nlrows) > k & !has_start
-          lay$label[nlrows[j]]
-        } else NULL
-        f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
-        if (cy > 1L || !is.null(prev)) {
-          lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
-        } else {
-          # a start value: a short grid over start / 4 .. start * 4;
-          # otherwise the whole range
-          ng <- if (has_start[k]) 13L else
-            if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
-          g <- if (has_start[k]) lognl[k] + seq(-log(4), log(4), length.out = ng) else
-            seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
-          vals <- vapply(g, f1, 0)
-          i <- which.min(vals)
-          lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
-          lognl[k] <- g[i]
+    search <- function(order) {
+      lognl <- log(nlv)
+      cycles <- if (length(nlrows) > 1L) 2L else 1L
+      for (cy in seq_len(cycles)) {
+        for (pos in seq_along(order)) {
+          k <- order[pos]
+          # first cycle: terms not searched yet stay out of the model (greedy)
+          later <- if (cy == 1L) {
+            j <- order[seq_along(order) > pos]
+            lay$label[nlrows[j[!has_start[j]]]]
+          } else NULL
+          f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
+          if (cy > 1L || !is.null(prev)) {
+            lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
+          } else {
+            # a start value: a short grid over start / 4 .. start * 4;
+            # otherwise the whole range
+            ng <- if (has_start[k]) 13L else
+              if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
+            g <- if (has_start[k]) lognl[k] + seq(-log(4), log(4), length.out = ng) else
+              seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
+            vals <- vapply(g, f1, 0)
+            i <- which.min(vals)
+            lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
+            lognl[k] <- g[i]
+          }
+          o <- stats::optimize(f1, c(lo, hi), tol = 1e-7)
+          if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
         }
-        o <- stats::optimize(f1, c(lo, hi), tol = 1e-7)
-        if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
       }
+      if (length(nlrows) > 1L) {
+        o <- stats::optim(lognl, obj, method = "Nelder-Mead",
+                          control = list(reltol = 1e-10, maxit = 400))
+        if (o$value <= obj(lognl)) lognl <- o$par
+      }
+      list(lognl = lognl, value = obj(lognl))
     }
-    if (length(nlrows) > 1L) {
-      o <- stats::optim(lognl, obj, method = "Nelder-Mead",
-                        control = list(reltol = 1e-10, maxit = 400))
-      if (o$value <= obj(lognl)) lognl <- o$par
+    # The greedy search depends on the order in which the terms enter; with
+    # several unstarted nonlinear terms try each rotation of the order (and
+    # its reverse) and keep the best objective.
+    K <- length(nlrows)
+    orders <- list(seq_len(K))
+    if (is.null(prev) && sum(!has_start) > 1L) {
+      rot <- lapply(seq_len(K) - 1L, function(r) (seq_len(K) + r - 1L) %% K + 1L)
+      orders <- unique(c(rot, lapply(rot, rev)))
+      if (length(orders) > 6L) orders <- orders[seq_len(6L)]
     }
+    best <- NULL
+    for (ord in orders) {
+      r <- search(ord)
+      if (is.null(best) || r$value < best$value) best <- r
+    }
+    lognl <- best$lognl
     nlv[] <- exp(lognl)
   }
   sol <- solve_amps(data, tau0, lay, nlv, y, W)
@@ -635,6 +656,13 @@ finish_fit <- function(fit, d, input, terms, cl) {
     diag(vfree)[match(zn, fn)] <- sez^2
   }
   vc[fn, fn] <- vfree
+  # a nonlinear parameter of a term whose amplitude is 0 is not identified
+  for (i in which(lay$role == "nonlinear" & !lay$fixed)) {
+    a <- lay$value[lay$label == lay$label[i] & lay$role == "amp"]
+    if (!(a > 0)) {
+      vc[i, ] <- vc[, i] <- NA_real_
+    }
+  }
   se[] <- sqrt(pmax(diag(vc), 0))
   data$fitted <- fitted
   data$z <- z

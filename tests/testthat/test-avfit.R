@@ -331,3 +331,31 @@ test_that("refitting an avfit keeps its EDF (comparable AIC) and its estimates",
   expect_equal(fit_i$type, "overlapping")
   expect_equal(unname(coef(fit_i)["N"]), 0.01, tolerance = 0.05)
 })
+
+test_that("several nonlinear terms: the search finds the global optimum", {
+  nn <- 2^17
+  x <- avsim(nn, f, N = 0.01, B = 0.002, gm = list(sigma = 0.006, tc = 3),
+             sinusoid = list(amp = 0.01, f0 = 1.3), seed = 51)
+  ms <- unique(round(10^seq(0, log10(nn / 4), by = 0.05)))
+  tb <- oav_table(x, f, ms)
+  for (corr in c(FALSE, TRUE)) {
+    fit <- avfit(tb, c("N", "B", "gm", "sinusoid"), n = nn, freq = f,
+                 correlation = corr)
+    cf <- coef(fit)
+    expect_equal(unname(cf["sinusoid1.f0"]), 1.3, tolerance = 0.05)
+    expect_equal(unname(cf["sinusoid1.amp"]), 0.01, tolerance = 0.2)
+    # diagonal weights: tc = 4.1 +- 0.4 here (adjacent taus are correlated,
+    # the SE is too small); with correlation = TRUE: 3.3 +- 1.0
+    expect_equal(unname(cf["gm1.tc"]), 3, tolerance = 0.4)
+    if (corr) expect_lt(abs(cf[["gm1.tc"]] - 3), 2 * fit$se[["gm1.tc"]])
+    # started at the truth, the fit ends no better than the search did
+    st <- avfit(tb, c("N", "B", "gm", "sinusoid"), n = nn, freq = f,
+                correlation = corr, start = c(gm1.tc = 3, sinusoid1.f0 = 1.3))
+    expect_gte(st$objective, fit$objective - 1e-6 * fit$objective)
+  }
+  # a term fitted to nothing: its tc is not identified
+  x <- avsim(2^16, f, N = 0.01, seed = 52)
+  fit <- avfit(oav_table(x, f), c("N", "gm"), n = 2^16, freq = f,
+               fixed = c(gm1.sigma = 0))
+  expect_true(is.na(fit$se["gm1.tc"]))
+})
