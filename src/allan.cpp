@@ -379,6 +379,10 @@ struct Level {
 };
 
 const R_xlen_t kIdMax = 4096;  // cluster sums kept per level for noise id
+// Fewer points leave r1 too noisy (its standard error is 1/sqrt(n)): a
+// mis-identified type then shortens the interval; such taus inherit the type
+// found at the nearest shorter tau instead.
+const size_t kIdMin = 64;
 
 // Consume n dd values at level j: accumulate squared differences, keep the
 // first few for noise id, and pair them into level j+1 in place.
@@ -479,7 +483,7 @@ void detrend(std::vector<double>& v, int deg) {
 // Returns alpha (continuous) and sets alpha_int; NaN when too few points.
 double noise_id(std::vector<double> v, bool phase, int dmax, int& alpha_int) {
   alpha_int = NA_INTEGER;
-  if (v.size() < 30) return NA_REAL;
+  if (v.size() < kIdMin) return NA_REAL;
   detrend(v, phase ? 2 : 1);
   int d = 0;
   for (;;) {
