@@ -9,8 +9,8 @@ allan_reference_cpp <- function(v, m, type, rate) {
     .Call(`_allanvar_allan_reference_cpp`, v, m, type, rate)
 }
 
-avar_octave_exact <- function(values, freq) {
-    .Call(`_allanvar_avar_octave_exact`, values, freq)
+avar_octave_exact <- function(values, freq, threads) {
+    .Call(`_allanvar_avar_octave_exact`, values, freq, threads)
 }
 
 avari_octave_exact <- function(values, freq) {
@@ -19,6 +19,22 @@ avari_octave_exact <- function(values, freq) {
 
 avarn_all_exact <- function(values, freq, threads) {
     .Call(`_allanvar_avarn_all_exact`, values, freq, threads)
+}
+
+avfit_log_nnls <- function(B, offset, y, W, start, maxit, tol) {
+    .Call(`_allanvar_avfit_log_nnls`, B, offset, y, W, start, maxit, tol)
+}
+
+avfit_nnls <- function(A, b) {
+    .Call(`_allanvar_avfit_nnls`, A, b)
+}
+
+avar_white_cov <- function(m, n, overlapping, threads) {
+    .Call(`_allanvar_avar_white_cov`, m, n, overlapping, threads)
+}
+
+first_nonfinite <- function(x) {
+    .Call(`_allanvar_first_nonfinite`, x)
 }
 
 allan_edf_cpp <- function(type, m, n, L, alpha, exact) {
