@@ -113,9 +113,10 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
     a$datasheet <- datasheet(a)
     g <- imu_guidance(a)
     if (nrow(g)) {
-      warning(r$name, ": the record is short for some readings:\n",
-              paste0("  - ", g$channel, ": ", g$message, collapse = "\n"),
-              call. = FALSE)
+      msg <- paste0(r$name, ": the record is short for some readings:\n",
+                    paste0("  - ", g$channel, ": ", g$message, collapse = "\n"))
+      warning(structure(class = c("allanvar_guidance", "warning", "condition"),
+                        list(message = msg, call = NULL)))
     }
     a
   })
