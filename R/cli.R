@@ -33,17 +33,13 @@
 #' @param args Character vector of command-line arguments (default: those
 #'   after `--args`).
 #' @return Invisibly, a list with the analyses and the paths written. Errors
-#'   are printed and, outside interactive sessions, end R with status 1.
+#'   are signalled as R errors, so that `Rscript` exits with status 1.
 #' @export
 #' @examples
 #' allanvar_cli("--help")
 allanvar_cli <- function(args = commandArgs(trailingOnly = TRUE)) {
-  res <- tryCatch(cli_run(args), error = function(e) {
-    message("allanvar: error: ", conditionMessage(e))
-    if (!interactive()) quit(save = "no", status = 1L)
-    invisible(NULL)
-  })
-  invisible(res)
+  # Errors propagate: Rscript then prints "Error: ..." and exits with 1.
+  invisible(cli_run(as.character(args)))
 }
 
 cli_usage <- function() {

@@ -158,7 +158,14 @@ read_imu <- function(file, time = NULL,
       }
       ch_sensor <- unname(sensors)
     } else {
-      ch_sensor[match(names(sensors), ch_names)] <- unname(sensors)
+      idx <- match(names(sensors), ch_names)
+      by_col <- match(names(sensors), raw_names[data_cols])
+      idx[is.na(idx)] <- by_col[is.na(idx)]
+      if (anyNA(idx)) {
+        abort("`sensors` names ", paste(names(sensors)[is.na(idx)], collapse = ", "),
+              " are not among the channels (", paste(ch_names, collapse = ", "), ").")
+      }
+      ch_sensor[idx] <- unname(sensors)
     }
   }
   if (anyNA(ch_sensor)) {
@@ -440,8 +447,9 @@ record_segment <- function(x, segment = "longest") {
 }
 
 split_fields <- function(line, sep) {
-  if (identical(sep, "")) strsplit(trimws(line), "[[:space:]]+")[[1L]]
+  f <- if (identical(sep, "")) strsplit(trimws(line), "[[:space:]]+")[[1L]]
   else trimws(strsplit(line, sep, fixed = TRUE)[[1L]])
+  gsub("^[\"']|[\"']$", "", f)
 }
 
 clean_names <- function(x) {
