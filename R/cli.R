@@ -75,6 +75,8 @@ cli_parse <- function(args) {
   valued <- c("--out", "--rate", "--time-col", "--time-unit", "--gyro-cols",
               "--accel-cols", "--gyro-units", "--accel-units", "--sep",
               "--gap", "--terms", "--axis", "--workers")
+  # `Rscript -e 'allanvar::allanvar_cli()' --args ...` passes "--args" on.
+  args <- args[args != "--args"]
   opt <- list(files = character())
   i <- 1L
   while (i <= length(args)) {

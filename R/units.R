@@ -84,14 +84,20 @@ unit_kinds <- c("rate", "N", "K", "Q", "R")
 # One row per accepted spelling. Factors are written from their definitions
 # so that each can be checked by hand.
 unit_table <- function() {
+  if (is.null(unit_cache$tab)) unit_cache$tab <- build_unit_table()
+  unit_cache$tab
+}
+
+unit_cache <- new.env(parent = emptyenv())
+
+build_unit_table <- function() {
   deg <- pi / 180
   h <- 3600
   g <- 9.80665
   u <- function(unit, sensor, kind, to_si) {
-    data.frame(unit = unit, sensor = sensor, kind = kind, to_si = to_si,
-               stringsAsFactors = FALSE)
+    list(unit = unit, sensor = sensor, kind = kind, to_si = to_si)
   }
-  tab <- rbind(
+  rows <- list(
     # gyro rate
     u("rad/s", "gyro", "rate", 1),
     u("deg/s", "gyro", "rate", deg),
@@ -143,6 +149,11 @@ unit_table <- function() {
     u("m/s^3", "accel", "R", 1),
     u("ug/s", "accel", "R", g * 1e-6)
   )
+  tab <- data.frame(
+    unit = vapply(rows, `[[`, "", "unit"),
+    sensor = vapply(rows, `[[`, "", "sensor"),
+    kind = vapply(rows, `[[`, "", "kind"),
+    to_si = vapply(rows, `[[`, 0, "to_si"), stringsAsFactors = FALSE)
   si <- c(gyro.rate = "rad/s", gyro.N = "rad/s/sqrt(Hz)",
           gyro.K = "rad/s^2/sqrt(Hz)", gyro.Q = "rad", gyro.R = "rad/s^2",
           accel.rate = "m/s^2", accel.N = "m/s^2/sqrt(Hz)",
