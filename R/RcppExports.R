@@ -2,14 +2,14 @@
 # Generator token: 10BE3573-1514-4C36-9D1C-5A225CD40393
 
 avar_octave_exact <- function(values, freq) {
-    .Call('_allanvar_avar_octave_exact', PACKAGE = 'allanvar', values, freq)
+    .Call(`_allanvar_avar_octave_exact`, values, freq)
 }
 
 avari_octave_exact <- function(values, freq) {
-    .Call('_allanvar_avari_octave_exact', PACKAGE = 'allanvar', values, freq)
+    .Call(`_allanvar_avari_octave_exact`, values, freq)
 }
 
 avarn_all_exact <- function(values, freq, threads) {
-    .Call('_allanvar_avarn_all_exact', PACKAGE = 'allanvar', values, freq, threads)
+    .Call(`_allanvar_avarn_all_exact`, values, freq, threads)
 }
 
