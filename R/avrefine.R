@@ -128,6 +128,9 @@ avrefine <- function(fit, data = NULL,
         new$chi2 < 0.9 * current$chi2
       if (!pays) next
       lab <- new_label(current$terms, tr$effect)
+      # An added term that explains (almost) nothing anywhere is a refit
+      # artefact, not an effect.
+      if (max_share(new, lab) < 0.02) next
       par <- effect_params(new, lab)
       ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
       rank <- if (isTRUE(ev$support)) 0 else if (is.na(ev$support)) 1 else 2
@@ -258,6 +261,14 @@ refit_args <- function(fit) {
   tab <- data.frame(tau = d$tau, avar = d$avar)
   if (!is.null(d$edf)) tab$edf <- d$edf
   list(av = tab, n = fit$n, freq = fit$freq, type = fit$type)
+}
+
+# Largest share of the model AV carried by one term instance over the taus.
+max_share <- function(fit, label) {
+  comp <- tryCatch(av_model(fit$data$tau, stats::coef(fit), freq = fit$freq,
+                            by_term = TRUE), error = function(e) NULL)
+  if (is.null(comp) || !label %in% colnames(comp)) return(1)
+  max(comp[, label] / rowSums(comp))
 }
 
 # Label the new instance gets: "gm" -> "gm2" if one gm is already there.

@@ -193,12 +193,15 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
         t1 <- sin_peak_ratio / f0
         if (t1 < min(tau) / 2 || t1 > max(tau)) next
         add("sinusoid", t1 / 2, 2 / f0, list(f0 = f0, amp = lines$amp[j]),
-            sprintf("periodogram line at %s Hz", format_num(f0)), 2)
+            paste0(overlapping_signature(sig, t1 / 2, 2 / f0),
+                   sprintf("; proposed by a periodogram line at %s Hz", format_num(f0))), 2)
       }
     }
     if (isTRUE(raw$trend$significant)) {
       add("R", max(tau) / 10, max(tau), list(R = abs(raw$trend$slope)),
-          sprintf("linear trend %s /s", format_num(raw$trend$slope)), 1)
+          paste0(overlapping_signature(sig, max(tau) / 10, max(tau)),
+                 sprintf("; proposed by a linear trend of %s /s",
+                         format_num(raw$trend$slope))), 1)
     }
   }
   if (!length(out)) {
@@ -214,6 +217,13 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
                    stringsAsFactors = FALSE)
   df$init <- lapply(out, `[[`, "init")
   df[order(-df$score), , drop = FALSE]
+}
+
+# The strongest residual signature overlapping [from, to], as text.
+overlapping_signature <- function(sig, from, to) {
+  hit <- sig[sig$tau_to >= from & sig$tau_from <= to & sig$kind != "slope", , drop = FALSE]
+  if (!nrow(hit)) return("no residual structure in that tau range")
+  hit$description[which.max(abs(hit$strength))]
 }
 
 score_slope <- function(slope, target) {
