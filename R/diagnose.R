@@ -521,8 +521,9 @@ raw_evidence <- function(effect, init, raw, x, freq) {
       f0 <- init$f0 %||% NA_real_
       res <- attr(l, "resolution") %||% 0
       if (nrow(l) && is.finite(f0)) {
-        j <- which.min(abs(l$f0 - f0))
-        if (abs(l$f0[j] - f0) <= max(0.25 * f0, 2 * res)) {
+        near <- which(abs(l$f0 - f0) <= max(0.25 * f0, 2 * res))
+        j <- near[which.max(l$ratio[near])]
+        if (length(near)) {
           return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)",
                                      format_num(l$f0[j], 4), format_num(l$amp[j]),
                                      l$p_value[j]),
@@ -538,6 +539,18 @@ raw_evidence <- function(effect, init, raw, x, freq) {
     },
     gm = {
       tc <- init$tc %||% NA_real_
+      sigma <- init$sigma %||% NA_real_
+      if (is.finite(tc) && tc * freq < 4) {
+        # Tc of a few samples or less: the GM is the sample-to-sample
+        # correlation itself; compare its lag-1 ACF with the raw one.
+        phi <- exp(-1 / (tc * freq))
+        pred <- if (is.finite(sigma)) sigma^2 * phi / stats::var(x) else NA_real_
+        ok <- is.finite(pred) && raw$acf1_z > 3 && raw$acf1 > pred / 3 &&
+          raw$acf1 < 3 * pred
+        return(list(text = sprintf(
+          "raw lag-1 ACF %.3f (z = %.0f) against %.3f predicted by the fitted GM",
+          raw$acf1, raw$acf1_z, pred), support = ok))
+      }
       if (!is.finite(tc) || tc * freq * 40 / 8 > length(x)) {
         return(list(text = "record too short for an ACF check", support = NA))
       }
