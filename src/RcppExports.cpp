@@ -45,11 +45,40 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// avfit_log_nnls
+Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B, const Eigen::Map<Eigen::VectorXd> offset, const Eigen::Map<Eigen::VectorXd> y, const Eigen::Map<Eigen::VectorXd> s, const Eigen::Map<Eigen::VectorXd> start, int maxit, double tol);
+RcppExport SEXP _allanvar_avfit_log_nnls(SEXP BSEXP, SEXP offsetSEXP, SEXP ySEXP, SEXP sSEXP, SEXP startSEXP, SEXP maxitSEXP, SEXP tolSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::MatrixXd> >::type B(BSEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type offset(offsetSEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type s(sSEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type start(startSEXP);
+    Rcpp::traits::input_parameter< int >::type maxit(maxitSEXP);
+    Rcpp::traits::input_parameter< double >::type tol(tolSEXP);
+    rcpp_result_gen = Rcpp::wrap(avfit_log_nnls(B, offset, y, s, start, maxit, tol));
+    return rcpp_result_gen;
+END_RCPP
+}
+// avfit_nnls
+Eigen::VectorXd avfit_nnls(const Eigen::Map<Eigen::MatrixXd> A, const Eigen::Map<Eigen::VectorXd> b);
+RcppExport SEXP _allanvar_avfit_nnls(SEXP ASEXP, SEXP bSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::MatrixXd> >::type A(ASEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type b(bSEXP);
+    rcpp_result_gen = Rcpp::wrap(avfit_nnls(A, b));
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 2},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},
+    {"_allanvar_avfit_log_nnls", (DL_FUNC) &_allanvar_avfit_log_nnls, 7},
+    {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {NULL, NULL, 0}
 };
 
