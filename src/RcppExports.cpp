@@ -11,6 +11,46 @@ Rcpp::Rostream<true>&  Rcpp::Rcout = Rcpp::Rcpp_cout_get();
 Rcpp::Rostream<false>& Rcpp::Rcerr = Rcpp::Rcpp_cerr_get();
 #endif
 
+// allan_sums_cpp
+Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow, const Rcpp::NumericVector& m, const Rcpp::NumericVector& nterms, int type, bool rate, bool octave, int threads);
+RcppExport SEXP _allanvar_allan_sums_cpp(SEXP xSEXP, SEXP nrowSEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP typeSEXP, SEXP rateSEXP, SEXP octaveSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< double >::type nrow(nrowSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type nterms(ntermsSEXP);
+    Rcpp::traits::input_parameter< int >::type type(typeSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< bool >::type octave(octaveSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_sums_cpp(x, nrow, m, nterms, type, rate, octave, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
+// allan_reference_cpp
+Rcpp::List allan_reference_cpp(const Rcpp::NumericVector& v, const Rcpp::NumericVector& m, int type, bool rate);
+RcppExport SEXP _allanvar_allan_reference_cpp(SEXP vSEXP, SEXP mSEXP, SEXP typeSEXP, SEXP rateSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< int >::type type(typeSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_reference_cpp(v, m, type, rate));
+    return rcpp_result_gen;
+END_RCPP
+}
+// allan_first_nonfinite_cpp
+double allan_first_nonfinite_cpp(const Rcpp::NumericVector& x);
+RcppExport SEXP _allanvar_allan_first_nonfinite_cpp(SEXP xSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_first_nonfinite_cpp(x));
+    return rcpp_result_gen;
+END_RCPP
+}
 // avar_octave_exact
 Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values, double freq);
 RcppExport SEXP _allanvar_avar_octave_exact(SEXP valuesSEXP, SEXP freqSEXP) {
@@ -74,6 +114,9 @@ END_RCPP
 }
 
 static const R_CallMethodDef CallEntries[] = {
+    {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 8},
+    {"_allanvar_allan_reference_cpp", (DL_FUNC) &_allanvar_allan_reference_cpp, 4},
+    {"_allanvar_allan_first_nonfinite_cpp", (DL_FUNC) &_allanvar_allan_first_nonfinite_cpp, 1},
     {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 2},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},

@@ -1,0 +1,287 @@
+#' Allan variance and its relatives, with confidence intervals
+#'
+#' Computes an Allan-family variance of one or several channels at a grid of
+#' averaging times, with chi-square confidence intervals of the deviation.
+#' The estimators follow NIST SP 1065 (and agree with Stable32 and Python
+#' `allantools`); all are evaluated from compensated prefix sums, so the
+#' result is accurate to about \eqn{10^{-13}} relative even for long records
+#' with a large bias or drift.
+#'
+#' @section Estimators:
+#' With phase points \eqn{x_0, \dots, x_{L-1}} (for `input = "rate"`:
+#' \eqn{x_0 = 0}, \eqn{x_k = \tau_0 \sum_{i \le k} y_i}, \eqn{L = N + 1};
+#' for `input = "integrated"` the values themselves, \eqn{L = N}) and
+#' \eqn{\tau = m\tau_0}:
+#' * `"standard"`: non-overlapping AV, terms
+#'   \eqn{(x_{k+2m} - 2x_{k+m} + x_k)^2} at stride \eqn{m},
+#'   \eqn{n = \lfloor (L-1)/m \rfloor - 1} terms, divided by \eqn{2\tau^2 n}.
+#'   For rate input this is exactly the estimator of [avar()] (clusters from
+#'   the first sample, a trailing partial cluster dropped). Largest \eqn{m}:
+#'   \eqn{\lfloor (L-1)/2 \rfloor}.
+#' * `"overlapping"`: the same terms at stride 1, \eqn{n = L - 2m}; largest
+#'   \eqn{m}: \eqn{\lfloor (L-1)/2 \rfloor}.
+#' * `"modified"`: the square of the sum of \eqn{m} consecutive overlapping
+#'   second differences, \eqn{n = L - 3m + 1}, divided by
+#'   \eqn{2 m^2 \tau^2 n}; largest \eqn{m}: \eqn{\lfloor L/3 \rfloor}.
+#' * `"hadamard"` and `"ohadamard"`: third differences
+#'   \eqn{x_{k+3m} - 3x_{k+2m} + 3x_{k+m} - x_k} at stride \eqn{m}
+#'   (\eqn{n = \lfloor (L-1)/m \rfloor - 2}) or 1 (\eqn{n = L - 3m}), divided
+#'   by \eqn{6\tau^2 n}; largest \eqn{m}: \eqn{\lfloor (L-1)/3 \rfloor}.
+#' * `"total"`: second differences centred on every inner point of the phase
+#'   extended at both ends by point reflection,
+#'   \eqn{x^*_{-j} = 2x_0 - x_j}, \eqn{x^*_{L-1+j} = 2x_{L-1} - x_{L-1-j}}
+#'   (NIST SP 1065 eq. 25), \eqn{n = L - 2}; largest \eqn{m}: \eqn{L - 1}.
+#'
+#' Cluster sizes without a single term are dropped.
+#'
+#' @section Confidence intervals:
+#' The interval for the deviation at level `conf` is the chi-square interval
+#' \eqn{[\sqrt{\nu \hat\sigma^2/\chi^2_{1-p}(\nu)},
+#' \sqrt{\nu \hat\sigma^2/\chi^2_{p}(\nu)}]}, \eqn{p = (1 - conf)/2}, with
+#' \eqn{\nu} the equivalent degrees of freedom (`edf`). The noise type
+#' (power-law exponent \eqn{\alpha} of the rate PSD) is identified at every
+#' tau by Riley's lag-1 autocorrelation method, applied to the first 4096
+#' cluster averages (rate input, linearly detrended) or decimated phase
+#' points (integrated input, quadratically detrended), differencing at most
+#' twice (three times for Hadamard types). Where fewer than 30 points are
+#' available the type identified at the nearest shorter tau is used. Then:
+#' * for white (\eqn{\alpha = 0}) or random-walk (\eqn{\alpha = -2}) rate
+#'   noise and \eqn{m \le 64}, the EDF is exact for the discrete process,
+#'   from the Gaussian fourth moments (Isserlis) of the estimator's terms.
+#'   Greenhall's algorithm models continuous-time noise and overstates the
+#'   EDF of sampled white noise at small \eqn{m} (782 instead of 666 at
+#'   \eqn{m = 1}, \eqn{N = 1000}), which would make the intervals too short;
+#' * otherwise, Greenhall and Riley's general algorithm (2004, PTTI);
+#' * for `"total"`, the overlapping EDF, or, for \eqn{m \ge 8} and
+#'   \eqn{\alpha \in \{0, -1, -2\}}, the larger of it and NIST SP 1065's
+#'   \eqn{b (L-1)/m - c} approximation.
+#'
+#' @param x Numeric vector, `ts`, matrix or data frame of samples; one curve
+#'   per column. Rate samples (angular rate, acceleration, fractional
+#'   frequency) with `input = "rate"`; angle, velocity or clock phase with
+#'   `input = "integrated"`.
+#' @param freq Sampling frequency in Hz. Taken from `x` when it is a `ts`
+#'   and `freq` is missing.
+#' @param taus The averaging times: `"octave"` (\eqn{m = 1, 2, 4, \dots}),
+#'   `"decade"` (\eqn{m = 1, 2, 4, 10, 20, 40, \dots}), `"all"` (every
+#'   \eqn{m}; note that overlapping types then cost \eqn{O(N^2)}), a single
+#'   whole number (that many log-spaced points per decade), or a numeric
+#'   vector of tau in seconds (rounded to whole clusters; wrap a single tau
+#'   in [I()]). Reported tau is \eqn{m / freq}.
+#' @param type One of `"overlapping"` (default), `"standard"`,
+#'   `"modified"`, `"hadamard"`, `"ohadamard"`, `"total"`.
+#' @param input `"rate"` (default) or `"integrated"`.
+#' @param conf Confidence level of the interval, in (0, 1); the default
+#'   0.683 is one sigma.
+#' @return A data frame of class `c("allan", "data.frame")` with columns
+#'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
+#'   `lower` and `upper` (confidence limits of `adev`), `edf`, `alpha` (the
+#'   noise exponent used for the EDF) and, when `x` has several columns,
+#'   `channel` (rows stacked channel by channel). Attributes: `freq`, `type`,
+#'   `input`, `N` (samples per channel), `conf`.
+#' @seealso [avar()], [avarn()] and [avari()] for the results of
+#'   'allanvar' 1.1.
+#' @export
+#' @examples
+#' set.seed(1)
+#' y <- ts(rnorm(1e4, sd = 0.1), frequency = 100)
+#' av <- allan(y)
+#' av
+#' plot(av)
+#' allan(cbind(x = y, z = 2 * y), type = "modified", taus = "decade")
+allan <- function(x, freq, taus = "octave", type = "overlapping",
+                  input = "rate", conf = 0.683) {
+  check_present(missing(x), "x", "the samples")
+  if (missing(freq)) {
+    if (!stats::is.ts(x)) {
+      abort("`freq` is missing; give the sampling frequency in Hz ",
+            "(or pass `x` as a ts).")
+    }
+    freq <- stats::frequency(x)
+  }
+  freq <- check_freq(freq)
+  type <- check_choice(type, allan_types, "type")
+  input <- check_choice(input, c("rate", "integrated"), "input")
+  conf <- check_number(conf, "conf", 0, 1, open = TRUE)
+  ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)
+  N <- ch$N
+  rate <- input == "rate"
+  L <- if (rate) N + 1 else N
+  maxm <- allan_max_m(type, L)
+  m <- allan_taus(taus, freq, maxm)
+  if (length(m) == 0L) {
+    abort("No averaging time in `taus` has a term for type \"", type,
+          "\" with ", N, " samples (largest cluster size: ", maxm, ").")
+  }
+  nterms <- allan_nterms(type, m, L)
+  octave <- type == "standard" && rate && all(m == 2^round(log2(m)))
+  res <- allan_sums_cpp(ch$values, N, m, nterms, allan_type_code(type),
+                        rate, octave, allanvar_threads())
+  norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
+                 2 * m^2)
+  scale <- if (rate) 1 else freq^2
+  out <- vector("list", ch$nc)
+  for (j in seq_len(ch$nc)) {
+    av <- res$sums[, j] / (norm * nterms) * scale
+    e <- allan_edf(type, m, nterms, L, res$alpha_int[, j])
+    ci <- allan_ci(av, e$edf, conf)
+    d <- data.frame(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
+                    adev = sqrt(av), lower = ci$lower, upper = ci$upper,
+                    edf = e$edf, alpha = e$alpha)
+    if (ch$nc > 1L) d$channel <- ch$names[j]
+    out[[j]] <- d
+  }
+  out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)
+  rownames(out) <- NULL
+  structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
+            input = input, N = N, conf = conf)
+}
+
+# One of `choices`, with a message naming the argument.
+check_choice <- function(x, choices, arg) {
+  if (!is.character(x) || length(x) != 1L || is.na(x) || !x %in% choices) {
+    abort("`", arg, "` must be one of ",
+          paste0("\"", choices, "\"", collapse = ", "), "; not ",
+          if (is.character(x) && length(x) == 1L) format_value(x) else describe_type(x),
+          ".")
+  }
+  x
+}
+
+# The samples as one double vector (columns stacked; no copy for a double
+# vector or matrix), with the number of rows and the channel names.
+allan_channels <- function(x, min_n) {
+  if (is.data.frame(x)) {
+    ok <- vapply(x, function(v) is.numeric(v) && !is.factor(v), TRUE)
+    if (!all(ok)) {
+      abort("`x` must have only numeric columns; column `",
+            names(x)[!ok][1L], "` is ", describe_type(x[[which(!ok)[1L]]]), ".")
+    }
+    nm <- names(x)
+    x <- as.matrix(x)
+    colnames(x) <- nm
+  }
+  if (is.matrix(x)) {
+    if (!is.numeric(x)) {
+      abort("`x` must be numeric, not ", describe_type(x), ".")
+    }
+    nc <- ncol(x)
+    N <- nrow(x)
+    nm <- colnames(x)
+    if (is.null(nm)) nm <- paste0("V", seq_len(nc))
+    if (nc == 0L) abort("`x` has no columns.")
+  } else {
+    if (is.null(x) || is.factor(x) || is.list(x) ||
+        !(is.double(x) || is.integer(x))) {
+      abort("`x` must be a numeric vector, ts, matrix or data frame, not ",
+            describe_type(x), ".")
+    }
+    nc <- 1L
+    N <- length(x)
+    nm <- "x"
+  }
+  if (N < min_n) {
+    abort("`x` must have at least ", min_n, " samples per channel, not ", N, ".")
+  }
+  if (!is.double(x)) storage.mode(x) <- "double"
+  v <- x  # passed to C++ as is: attributes (ts, dim) cost no copy
+  bad <- allan_first_nonfinite_cpp(v)
+  if (bad > 0) {
+    col <- (bad - 1) %/% N + 1
+    row <- (bad - 1) %% N + 1
+    abort("`x` must contain only finite numbers; found ", format(v[[bad]]),
+          " at position ", row, if (nc > 1L) paste0(" of column ", col), ".")
+  }
+  list(values = v, N = N, nc = nc, names = nm)
+}
+
+#' @export
+print.allan <- function(x, digits = 4, ...) {
+  cat(allan_header(x), "\n", sep = "")
+  d <- as.data.frame(x)
+  num <- vapply(d, is.double, TRUE)
+  d[num] <- lapply(d[num], signif, digits = digits)
+  print(d, row.names = FALSE, ...)
+  invisible(x)
+}
+
+allan_header <- function(x) {
+  a <- attributes(x)
+  nch <- if ("channel" %in% names(x)) length(unique(x$channel)) else 1L
+  sprintf("<allan> %s variance of %s input: N = %s at %s Hz%s; %s%% intervals",
+          a$type, a$input, format(a$N, big.mark = ","), format(a$freq),
+          if (nch > 1L) sprintf(", %d channels", nch) else "",
+          format(100 * a$conf))
+}
+
+#' @export
+as.data.frame.allan <- function(x, ...) {
+  attr(x, "freq") <- attr(x, "type") <- attr(x, "input") <- NULL
+  attr(x, "N") <- attr(x, "conf") <- NULL
+  class(x) <- "data.frame"
+  x
+}
+
+#' @export
+summary.allan <- function(object, ...) {
+  d <- as.data.frame(object)
+  if (is.null(d$channel)) d$channel <- "x"
+  rows <- lapply(split(d, factor(d$channel, unique(d$channel))), function(s) {
+    i <- which.min(s$adev)
+    data.frame(channel = s$channel[1], points = nrow(s), tau_min = min(s$tau),
+               tau_max = max(s$tau), adev_first = s$adev[1],
+               adev_min = s$adev[i], tau_at_min = s$tau[i],
+               lower_at_min = s$lower[i], upper_at_min = s$upper[i])
+  })
+  structure(do.call(rbind, rows), header = allan_header(object),
+            class = c("summary.allan", "data.frame"))
+}
+
+#' @export
+print.summary.allan <- function(x, digits = 4, ...) {
+  cat(attr(x, "header"), "\n", sep = "")
+  d <- x
+  attr(d, "header") <- NULL
+  class(d) <- "data.frame"
+  num <- vapply(d, is.double, TRUE)
+  d[num] <- lapply(d[num], signif, digits = digits)
+  print(d, row.names = FALSE, ...)
+  invisible(x)
+}
+
+#' @export
+plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
+                       ylab = NULL, legend = TRUE, ...) {
+  d <- as.data.frame(x)
+  if (is.null(d$channel)) d$channel <- "x"
+  chans <- unique(d$channel)
+  if (is.null(col)) col <- grDevices::hcl.colors(max(2, length(chans)), "Dark 3")
+  col <- rep_len(col, length(chans))
+  type <- attr(x, "type")
+  if (is.null(ylab)) {
+    ylab <- switch(type, standard = , overlapping = "Allan deviation",
+                   modified = "modified Allan deviation",
+                   hadamard = , ohadamard = "Hadamard deviation",
+                   total = "total deviation")
+  }
+  if (is.null(main)) main <- paste0(type, " (", 100 * attr(x, "conf"), "% CI)")
+  ok <- is.finite(d$adev) & d$adev > 0
+  ylim <- range(c(d$lower[ok], d$upper[ok], d$adev[ok]), finite = TRUE)
+  graphics::plot(d$tau[ok], d$adev[ok], type = "n", log = "xy", xlab = xlab,
+                 ylab = ylab, main = main, ylim = ylim, ...)
+  graphics::grid(equilogs = FALSE)
+  for (k in seq_along(chans)) {
+    s <- d[d$channel == chans[k] & ok, ]
+    graphics::lines(s$tau, s$adev, type = "b", pch = 20, col = col[k])
+    bar <- is.finite(s$lower) & is.finite(s$upper) & s$upper > s$lower
+    if (any(bar)) {
+      graphics::arrows(s$tau[bar], s$lower[bar], s$tau[bar], s$upper[bar],
+                       angle = 90, code = 3, length = 0.03, col = col[k])
+    }
+  }
+  if (legend && length(chans) > 1L) {
+    graphics::legend("topright", legend = chans, col = col, lty = 1, pch = 20,
+                     bty = "n")
+  }
+  invisible(x)
+}

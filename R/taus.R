@@ -1,0 +1,82 @@
+# Cluster-size grids for allan(). A curve is computed at cluster sizes m
+# (tau = m / freq); every estimator has a largest m with at least one term.
+
+allan_types <- c("overlapping", "standard", "modified", "hadamard",
+                 "ohadamard", "total")
+
+# The C++ kernels' code for each type (enum Type in src/allan.cpp).
+allan_type_code <- function(type) {
+  match(type, c("standard", "overlapping", "modified", "hadamard",
+                "ohadamard", "total")) - 1L
+}
+
+# Largest cluster size with at least one term, for L phase points (L = N + 1
+# for rate input, N for integrated input).
+allan_max_m <- function(type, L) {
+  switch(type,
+    standard = ,
+    overlapping = floor((L - 1) / 2),
+    modified = floor(L / 3),
+    hadamard = ,
+    ohadamard = floor((L - 1) / 3),
+    total = if (L >= 3) L - 1 else 0
+  )
+}
+
+# Number of terms (squared differences) of each estimator at cluster size m.
+allan_nterms <- function(type, m, L) {
+  switch(type,
+    standard = floor((L - 1) / m) - 1,
+    overlapping = L - 2 * m,
+    modified = L - 3 * m + 1,
+    hadamard = floor((L - 1) / m) - 2,
+    ohadamard = L - 3 * m,
+    total = rep(L - 2, length(m))
+  )
+}
+
+# The cluster sizes m (sorted, unique, as doubles) requested by `taus`.
+allan_taus <- function(taus, freq, maxm) {
+  if (maxm < 1) return(numeric(0))
+  if (is.character(taus)) {
+    if (length(taus) != 1L || is.na(taus) ||
+        !taus %in% c("octave", "decade", "all")) {
+      abort("`taus` must be \"octave\", \"decade\", \"all\", a number of ",
+            "points per decade, or a numeric vector of tau in seconds; not ",
+            format_value(taus), ".")
+    }
+    m <- switch(taus,
+      octave = 2^(0:floor(log2(maxm) + 1e-9)),
+      decade = {
+        k <- 0:floor(log10(maxm) + 1e-9)
+        sort(as.vector(outer(c(1, 2, 4), 10^k)))
+      },
+      all = seq_len(maxm)
+    )
+    return(as.double(m[m <= maxm]))
+  }
+  if (!is.numeric(taus) || is.factor(taus) || length(taus) == 0L ||
+      anyNA(taus) || any(!is.finite(taus)) || any(taus <= 0)) {
+    abort("`taus` must be \"octave\", \"decade\", \"all\", a number of ",
+          "points per decade, or a numeric vector of positive tau in seconds; ",
+          "not ", describe_type(taus), ".")
+  }
+  if (length(taus) == 1L && !inherits(taus, "AsIs")) {
+    if (taus != round(taus) || taus > 1000) {
+      abort("A single number in `taus` is the number of points per decade ",
+            "and must be a whole number in [1, 1000], not ", format(taus),
+            ". Wrap a single tau in seconds in I(), e.g. taus = I(10).")
+    }
+    m <- unique(round(10^seq(0, log10(maxm), by = 1 / taus)))
+    return(as.double(m[m >= 1 & m <= maxm]))
+  }
+  m <- round(as.double(taus) * freq)
+  bad <- m < 1 | m > maxm
+  if (any(bad)) {
+    warning(sum(bad), " of the requested tau values lie outside [",
+            format(1 / freq), ", ", format(maxm / freq),
+            "] s (cluster sizes 1..", maxm, ") and were dropped.",
+            call. = FALSE)
+  }
+  sort(unique(m[!bad]))
+}

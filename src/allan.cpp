@@ -1,0 +1,646 @@
+// allan(): the Allan-family estimators from compensated prefix sums.
+//
+// Every estimator is a sum of squares of small integer combinations of a
+// phase sequence X (the running sum of the rate samples, or the integrated
+// input itself). X is held as hi + lo, where hi lies on a grid of step q with
+// |hi| <= 2^50 q: any combination with integer weights of total size <= 8 is
+// then exact in double, and lo (|lo| <= q/2) carries the rest. Differences of
+// huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
+// drift or length of the record.
+#include "parallel.h"
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace {
+
+enum Type { STANDARD = 0, OVERLAPPING, MODIFIED, HADAMARD, OHADAMARD, TOTAL };
+
+// a + b = s + e exactly (Knuth's TwoSum).
+inline void two_sum(double a, double b, double& s, double& e) {
+  s = a + b;
+  const double bb = s - a;
+  e = (a - (s - bb)) + (b - bb);
+}
+
+// Sum of many squares: four interleaved chains, folded into a compensated
+// total block by block, keep the rounding far below 1e-15 relative.
+struct Acc {
+  double s = 0, c = 0;
+  void add(double v) {
+    double t, e;
+    two_sum(s, v, t, e);
+    s = t;
+    c += e;
+  }
+  double value() const { return s + c; }
+};
+
+struct Split {
+  std::vector<double> hi, lo;
+};
+
+// Grid step q = 2^k with bound <= 2^50 q.
+inline double grid_step(double bound) {
+  if (!(bound > 0) || !std::isfinite(bound)) return 1.0;
+  int e;
+  std::frexp(bound, &e);
+  return std::ldexp(1.0, e - 50);
+}
+
+// Prefix sums with a leading zero of (v - c): levels = 1 gives X (n + 1
+// points), levels = 2 the prefix sums of X (n + 2 points). `bound` bounds
+// |v - c|.
+void build_prefix(const double* v, R_xlen_t n, double c, double bound,
+                  int levels, Split& out) {
+  const R_xlen_t len = n + levels;
+  out.hi.assign(len, 0.0);
+  out.lo.assign(len, 0.0);
+  double* hi = out.hi.data();
+  double* lo = out.lo.data();
+  double b = bound * static_cast<double>(n) * (1 + 1e-9);
+  if (levels == 2) b *= static_cast<double>(n + 1);
+  const double q = grid_step(b);
+  const double C = 1.5 * q * 4503599627370496.0;  // 1.5 q 2^52: ulp(C) = q
+  double s1 = 0, e1 = 0, s2 = 0, e2 = 0;
+  for (R_xlen_t i = 0; i < n; ++i) {
+    double r, re, t, te;
+    two_sum(v[i], -c, r, re);
+    if (levels == 1) {
+      two_sum(s1, r, t, te);
+      s1 = t;
+      e1 += te + re;
+      const double h = (s1 + C) - C;
+      hi[i + 1] = h;
+      lo[i + 1] = (s1 - h) + e1;
+    } else {
+      // P_{i+1} = P_i + X_i, then X_{i+1} = X_i + r_i.
+      two_sum(s2, s1, t, te);
+      s2 = t;
+      e2 += te + e1;
+      const double h = (s2 + C) - C;
+      hi[i + 1] = h;
+      lo[i + 1] = (s2 - h) + e2;
+      two_sum(s1, r, t, te);
+      s1 = t;
+      e1 += te + re;
+    }
+  }
+  if (levels == 2) {
+    double t, te;
+    two_sum(s2, s1, t, te);
+    s2 = t;
+    e2 += te + e1;
+    const double h = (s2 + C) - C;
+    hi[n + 1] = h;
+    lo[n + 1] = (s2 - h) + e2;
+  }
+}
+
+// The input itself split on a grid (integrated input, levels = 0).
+void build_split(const double* v, R_xlen_t n, double c, double bound,
+                 Split& out) {
+  out.hi.assign(n, 0.0);
+  out.lo.assign(n, 0.0);
+  const double q = grid_step(bound * (1 + 1e-9));
+  const double C = 1.5 * q * 4503599627370496.0;
+  for (R_xlen_t i = 0; i < n; ++i) {
+    double r, re;
+    two_sum(v[i], -c, r, re);
+    const double h = (r + C) - C;
+    out.hi[i] = h;
+    out.lo[i] = (r - h) + re;
+  }
+}
+
+// Second difference X[k+2m] - 2X[k+m] + X[k]; the hi part is exact.
+struct Diff2 {
+  const double *h, *l;
+  R_xlen_t m;
+  inline double operator()(R_xlen_t k) const {
+    const double dh = (h[k + 2 * m] + h[k]) - 2.0 * h[k + m];
+    const double dl = (l[k + 2 * m] + l[k]) - 2.0 * l[k + m];
+    return dh + dl;
+  }
+};
+
+// Third difference X[k+3m] - 3X[k+2m] + 3X[k+m] - X[k].
+struct Diff3 {
+  const double *h, *l;
+  R_xlen_t m;
+  inline double operator()(R_xlen_t k) const {
+    const double dh = (h[k + 3 * m] - h[k]) + 3.0 * (h[k + m] - h[k + 2 * m]);
+    const double dl = (l[k + 3 * m] - l[k]) + 3.0 * (l[k + m] - l[k + 2 * m]);
+    return dh + dl;
+  }
+};
+
+// Sum of f(k)^2 for k = k0, k0 + s, ... < k1, with four chains.
+template <class F>
+inline double sumsq(const F& f, R_xlen_t k0, R_xlen_t k1, R_xlen_t s) {
+  double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+  R_xlen_t k = k0;
+  if (s == 1) {
+    for (; k + 4 <= k1; k += 4) {
+      const double d0 = f(k), d1 = f(k + 1), d2 = f(k + 2), d3 = f(k + 3);
+      a0 += d0 * d0;
+      a1 += d1 * d1;
+      a2 += d2 * d2;
+      a3 += d3 * d3;
+    }
+  } else {
+    for (; k + 4 * s <= k1; k += 4 * s) {
+      const double d0 = f(k), d1 = f(k + s), d2 = f(k + 2 * s),
+                   d3 = f(k + 3 * s);
+      a0 += d0 * d0;
+      a1 += d1 * d1;
+      a2 += d2 * d2;
+      a3 += d3 * d3;
+    }
+  }
+  for (; k < k1; k += s) {
+    const double d = f(k);
+    a0 += d * d;
+  }
+  return (a0 + a1) + (a2 + a3);
+}
+
+// Runs f(i) for i in [0, n): in parallel from the main thread, serially (no
+// R API at all) inside a worker.
+template <class F>
+void run_items(R_xlen_t n, int threads, bool main, F f) {
+  if (main && threads > 1) {
+    allanvar::parallel_for(n, threads, [&](R_xlen_t i, int) { f(i); });
+  } else {
+    for (R_xlen_t i = 0; i < n; ++i) f(i);
+  }
+}
+
+const R_xlen_t kBlock = 2048;  // terms per cache block
+const R_xlen_t kChunk = 1 << 17;  // terms per parallel item
+
+// Stride-1 estimators: out[j] = sum over k < nterms[j] of f_j(k)^2. The k
+// range is cut into fixed chunks (so the result does not depend on the
+// thread count); inside a chunk every tau walks the same cache-resident
+// block before the next block is loaded.
+template <class D>
+void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
+                const std::vector<R_xlen_t>& nterms, int threads, bool main,
+                double* out) {
+  const size_t nt = ms.size();
+  R_xlen_t K = 0;
+  for (size_t j = 0; j < nt; ++j) K = std::max(K, nterms[j]);
+  const R_xlen_t nchunks = (K + kChunk - 1) / kChunk;
+  std::vector<double> part(static_cast<size_t>(nchunks) * nt, 0.0);
+  run_items(nchunks, threads, main, [&](R_xlen_t c) {
+    const R_xlen_t c0 = c * kChunk, c1 = std::min(K, c0 + kChunk);
+    double* p = part.data() + c * nt;
+    for (R_xlen_t b0 = c0; b0 < c1; b0 += kBlock) {
+      const R_xlen_t b1 = std::min(c1, b0 + kBlock);
+      for (size_t j = 0; j < nt; ++j) {
+        const R_xlen_t e = std::min(b1, nterms[j]);
+        if (e <= b0) continue;
+        const D f{X.hi.data(), X.lo.data(), ms[j]};
+        p[j] += sumsq(f, b0, e, 1);
+      }
+    }
+  });
+  for (size_t j = 0; j < nt; ++j) {
+    Acc a;
+    for (R_xlen_t c = 0; c < nchunks; ++c) a.add(part[c * nt + j]);
+    out[j] = a.value();
+  }
+}
+
+// Stride-m estimators (standard, Hadamard): one item per tau.
+template <class D>
+void strided(const Split& X, const std::vector<R_xlen_t>& ms,
+             const std::vector<R_xlen_t>& nterms, int threads, bool main,
+             double* out) {
+  run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
+    const R_xlen_t m = ms[j];
+    const D f{X.hi.data(), X.lo.data(), m};
+    Acc a;
+    const R_xlen_t end = nterms[j] * m;
+    const R_xlen_t step = kChunk * m;
+    for (R_xlen_t k = 0; k < end; k += step) {
+      a.add(sumsq(f, k, std::min(end, k + step), m));
+    }
+    out[j] = a.value();
+  });
+}
+
+// Total variance (NIST SP 1065 eq. 25): second differences centred on
+// i = 1 .. L-2 of the phase extended by point reflection at both ends,
+// x*(-j) = 2x(0) - x(j), x*(L-1+j) = 2x(L-1) - x(L-1-j).
+void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
+           bool main, double* out) {
+  const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
+  const double* h = X.hi.data();
+  const double* l = X.lo.data();
+  run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
+    const R_xlen_t m = ms[j];
+    // weights of one term on at most 5 points; all in the exact hi grid
+    Acc a;
+    double s = 0;
+    R_xlen_t cnt = 0;
+    for (R_xlen_t i = 1; i <= L - 2; ++i) {
+      double dh = -2.0 * h[i], dl = -2.0 * l[i];
+      R_xlen_t a0 = i - m;
+      if (a0 >= 0) {
+        dh += h[a0];
+        dl += l[a0];
+      } else {
+        dh += 2.0 * h[0] - h[-a0];
+        dl += 2.0 * l[0] - l[-a0];
+      }
+      R_xlen_t a1 = i + m;
+      if (a1 <= L - 1) {
+        dh += h[a1];
+        dl += l[a1];
+      } else {
+        const R_xlen_t r = 2 * (L - 1) - a1;
+        dh += 2.0 * h[L - 1] - h[r];
+        dl += 2.0 * l[L - 1] - l[r];
+      }
+      const double d = dh + dl;
+      s += d * d;
+      if (++cnt == kBlock) {
+        a.add(s);
+        s = 0;
+        cnt = 0;
+      }
+    }
+    a.add(s);
+    out[j] = a.value();
+  });
+}
+
+// Non-overlapping AV at m = 2^j straight from the rate samples: cluster sums
+// are built pairwise in double-double, level by level, inside cache-sized
+// blocks, so the data are read once. `lev` carries, per level, the last
+// cluster sum and the running sum of squared differences.
+struct Level {
+  double ph = 0, pl = 0;
+  bool has = false;
+  Acc acc;
+  double s = 0;
+  R_xlen_t cnt = 0;
+  std::vector<double> idh, idl;  // first cluster sums, for noise id
+};
+
+const R_xlen_t kIdMax = 4096;  // cluster sums kept per level for noise id
+
+// Consume n dd values at level j: accumulate squared differences, keep the
+// first few for noise id, and pair them into level j+1 in place.
+inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
+                           bool pair) {
+  double s = 0;
+  R_xlen_t i = 0;
+  if (!L.has && n > 0) {
+    L.ph = h[0];
+    L.pl = l[0];
+    L.has = true;
+    i = 1;
+  }
+  double ph = L.ph, pl = L.pl;
+  for (; i < n; ++i) {
+    const double d = (h[i] - ph) + (l[i] - pl);
+    s += d * d;
+    ph = h[i];
+    pl = l[i];
+  }
+  L.ph = ph;
+  L.pl = pl;
+  L.acc.add(s);
+  for (R_xlen_t k = 0; k < n && static_cast<R_xlen_t>(L.idh.size()) < kIdMax;
+       ++k) {
+    L.idh.push_back(h[k]);
+    L.idl.push_back(l[k]);
+  }
+  if (!pair) return 0;
+  const R_xlen_t n2 = n / 2;
+  for (R_xlen_t k = 0; k < n2; ++k) {
+    double t, e;
+    two_sum(h[2 * k], h[2 * k + 1], t, e);
+    e += l[2 * k] + l[2 * k + 1];
+    const double hh = t + e;
+    l[k] = e - (hh - t);
+    h[k] = hh;
+  }
+  return n2;
+}
+
+void standard_octave(const double* y, R_xlen_t N, double c, int J,
+                     std::vector<Level>& lev) {
+  const int b = 11;
+  const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
+  lev.assign(J + 1, Level());
+  std::vector<double> h(B), l(B), th, tl;
+  const int jin = std::min(J, b - 1);  // levels handled inside blocks
+  for (R_xlen_t s0 = 0; s0 < N; s0 += B) {
+    const R_xlen_t n = std::min(B, N - s0);
+    for (R_xlen_t i = 0; i < n; ++i) two_sum(y[s0 + i], -c, h[i], l[i]);
+    R_xlen_t cur = n;
+    for (int j = 0; j <= jin; ++j)
+      cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
+    if (J >= b && cur == 1) {
+      th.push_back(h[0]);
+      tl.push_back(l[0]);
+    }
+  }
+  if (J >= b) {
+    R_xlen_t cur = static_cast<R_xlen_t>(th.size());
+    for (int j = b; j <= J; ++j)
+      cur = level_step(th.data(), tl.data(), cur, lev[j], j < J);
+  }
+}
+
+// ---- noise identification (Riley's lag-1 autocorrelation method) ----
+
+// Residuals of v after a least-squares polynomial of degree deg (Gram-Schmidt
+// on 1, t, t^2).
+void detrend(std::vector<double>& v, int deg) {
+  const size_t n = v.size();
+  std::vector<std::vector<double> > basis;
+  for (int p = 0; p <= deg; ++p) {
+    std::vector<double> b(n);
+    const double mid = 0.5 * (static_cast<double>(n) - 1);
+    for (size_t i = 0; i < n; ++i) {
+      const double t = (static_cast<double>(i) - mid) / (mid + 1);
+      b[i] = std::pow(t, p);
+    }
+    for (auto& q : basis) {
+      double dot = 0;
+      for (size_t i = 0; i < n; ++i) dot += b[i] * q[i];
+      for (size_t i = 0; i < n; ++i) b[i] -= dot * q[i];
+    }
+    double nn = 0;
+    for (size_t i = 0; i < n; ++i) nn += b[i] * b[i];
+    nn = std::sqrt(nn);
+    if (nn > 0)
+      for (size_t i = 0; i < n; ++i) b[i] /= nn;
+    double dot = 0;
+    for (size_t i = 0; i < n; ++i) dot += v[i] * b[i];
+    for (size_t i = 0; i < n; ++i) v[i] -= dot * b[i];
+    basis.push_back(b);
+  }
+}
+
+// Returns alpha (continuous) and sets alpha_int; NaN when too few points.
+double noise_id(std::vector<double> v, bool phase, int dmax, int& alpha_int) {
+  alpha_int = NA_INTEGER;
+  if (v.size() < 30) return NA_REAL;
+  detrend(v, phase ? 2 : 1);
+  int d = 0;
+  for (;;) {
+    const size_t n = v.size();
+    double mu = 0;
+    for (double x : v) mu += x;
+    mu /= static_cast<double>(n);
+    double a = 0, b = 0;
+    for (size_t i = 0; i < n; ++i) {
+      b += (v[i] - mu) * (v[i] - mu);
+      if (i + 1 < n) a += (v[i] - mu) * (v[i + 1] - mu);
+    }
+    const double r1 = b > 0 ? a / b : 0.0;
+    const double rho = r1 / (1.0 + r1);
+    if (rho < 0.25 || d >= dmax || n < 4) {
+      const double add = phase ? 2.0 : 0.0;
+      alpha_int = static_cast<int>(-std::nearbyint(2 * rho) - 2.0 * d + add);
+      return -2.0 * (rho + d) + add;
+    }
+    for (size_t i = 0; i + 1 < n; ++i) v[i] = v[i + 1] - v[i];
+    v.pop_back();
+    ++d;
+  }
+}
+
+// X value at index k from a split.
+inline double xval(const Split& X, R_xlen_t k) { return X.hi[k] + X.lo[k]; }
+
+struct Channel {
+  std::vector<double> sums, alpha;
+  std::vector<int> alpha_int;
+};
+
+// One channel: sums of squares for every m, and the noise id per m.
+void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
+                 const std::vector<R_xlen_t>& nterms, int type, bool rate,
+                 bool octave, int threads, bool main, Channel& out) {
+  const size_t nt = ms.size();
+  out.sums.assign(nt, 0.0);
+  out.alpha.assign(nt, NA_REAL);
+  out.alpha_int.assign(nt, NA_INTEGER);
+  const int dmax = (type == HADAMARD || type == OHADAMARD) ? 3 : 2;
+  // centre and bound of the data
+  long double s = 0;
+  double vmin = v[0], vmax = v[0];
+  for (R_xlen_t i = 0; i < N; ++i) {
+    s += v[i];
+    vmin = std::min(vmin, v[i]);
+    vmax = std::max(vmax, v[i]);
+  }
+  const double c = rate ? static_cast<double>(s / N) : 0.5 * (vmin + vmax);
+  const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
+
+  if (type == STANDARD && rate && octave) {
+    int J = 0;
+    while ((static_cast<R_xlen_t>(1) << (J + 1)) <= ms.back()) ++J;
+    std::vector<Level> lev;
+    standard_octave(v, N, c, J, lev);
+    for (size_t j = 0; j < nt; ++j) {
+      int lj = 0;
+      while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
+      out.sums[j] = lev[lj].acc.value();
+      std::vector<double> id(lev[lj].idh.size());
+      for (size_t i = 0; i < id.size(); ++i) id[i] = lev[lj].idh[i] + lev[lj].idl[i];
+      out.alpha[j] = noise_id(id, false, dmax, out.alpha_int[j]);
+    }
+    return;
+  }
+
+  Split X;
+  const int level = type == MODIFIED ? (rate ? 2 : 1) : (rate ? 1 : 0);
+  if (level == 0) {
+    build_split(v, N, c, bound, X);
+  } else {
+    build_prefix(v, N, c, bound, level, X);
+  }
+  double* o = out.sums.data();
+  switch (type) {
+    case STANDARD: strided<Diff2>(X, ms, nterms, threads, main, o); break;
+    case OVERLAPPING: overlapped<Diff2>(X, ms, nterms, threads, main, o); break;
+    case MODIFIED: overlapped<Diff3>(X, ms, nterms, threads, main, o); break;
+    case HADAMARD: strided<Diff3>(X, ms, nterms, threads, main, o); break;
+    case OHADAMARD: overlapped<Diff3>(X, ms, nterms, threads, main, o); break;
+    case TOTAL: total(X, ms, threads, main, o); break;
+  }
+  // Noise id: cluster sums (rate) or decimated phase (integrated) of the
+  // first kIdMax clusters. With MODIFIED, X holds one more level of sums.
+  const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
+  for (size_t j = 0; j < nt; ++j) {
+    const R_xlen_t m = ms[j];
+    std::vector<double> id;
+    const bool two = (type == MODIFIED);
+    for (R_xlen_t i = 0; i < kIdMax; ++i) {
+      if (rate) {
+        // cluster sum over samples [i m, (i+1) m)
+        const R_xlen_t a = i * m, b = (i + 1) * m;
+        if (b > N) break;
+        if (two) {
+          const double dh = (X.hi[b + 1] - X.hi[b]) - (X.hi[a + 1] - X.hi[a]);
+          const double dl = (X.lo[b + 1] - X.lo[b]) - (X.lo[a + 1] - X.lo[a]);
+          id.push_back(dh + dl);
+        } else {
+          id.push_back((X.hi[b] - X.hi[a]) + (X.lo[b] - X.lo[a]));
+        }
+      } else {
+        const R_xlen_t a = i * m;
+        if (a >= N) break;
+        if (two) {
+          id.push_back((X.hi[a + 1] - X.hi[a]) + (X.lo[a + 1] - X.lo[a]));
+        } else {
+          id.push_back(xval(X, a));
+        }
+      }
+    }
+    (void)L;
+    out.alpha[j] = noise_id(id, !rate, dmax, out.alpha_int[j]);
+  }
+}
+
+}  // namespace
+
+// Sums of squared differences (the estimator numerators) for every channel
+// (column of x, nrow samples each) and cluster size m, with the noise id.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
+                          const Rcpp::NumericVector& m,
+                          const Rcpp::NumericVector& nterms, int type,
+                          bool rate, bool octave, int threads) {
+  const R_xlen_t N = static_cast<R_xlen_t>(nrow);
+  const R_xlen_t nc = x.size() / N;
+  const size_t nt = m.size();
+  std::vector<R_xlen_t> ms(nt), nts(nt);
+  for (size_t j = 0; j < nt; ++j) {
+    ms[j] = static_cast<R_xlen_t>(m[j]);
+    nts[j] = static_cast<R_xlen_t>(nterms[j]);
+  }
+  std::vector<Channel> ch(nc);
+  const double* p = x.begin();
+  if (nc == 1) {
+    one_channel(p, N, ms, nts, type, rate, octave, threads, true, ch[0]);
+  } else {
+    allanvar::parallel_for(nc, threads, [&](R_xlen_t i, int) {
+      one_channel(p + i * N, N, ms, nts, type, rate, octave, 1, false, ch[i]);
+    });
+  }
+  Rcpp::NumericMatrix sums(nt, nc), alpha(nt, nc);
+  Rcpp::IntegerMatrix alpha_int(nt, nc);
+  for (R_xlen_t i = 0; i < nc; ++i)
+    for (size_t j = 0; j < nt; ++j) {
+      sums(j, i) = ch[i].sums[j];
+      alpha(j, i) = ch[i].alpha[j];
+      alpha_int(j, i) = ch[i].alpha_int[j];
+    }
+  return Rcpp::List::create(Rcpp::Named("sums") = sums,
+                            Rcpp::Named("alpha") = alpha,
+                            Rcpp::Named("alpha_int") = alpha_int);
+}
+
+// ---- test reference: direct evaluation in quadruple precision ----
+#if defined(__SIZEOF_FLOAT128__) && !defined(__clang__)
+__extension__ typedef __float128 ref_real;
+const bool kRefQuad = true;
+#else
+typedef long double ref_real;
+const bool kRefQuad = false;
+#endif
+
+// The same estimator numerators (sums of squares) by their textbook
+// formulas, in quadruple precision where the compiler offers it (else long
+// double). Used only by the tests, as the exact reference.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List allan_reference_cpp(const Rcpp::NumericVector& v,
+                               const Rcpp::NumericVector& m, int type,
+                               bool rate) {
+  const R_xlen_t N = v.size();
+  ref_real mean = 0;
+  for (R_xlen_t i = 0; i < N; ++i) mean += static_cast<ref_real>(v[i]);
+  mean /= static_cast<ref_real>(N);
+  // phase x: rate -> [0, cumsum(y - mean)], integrated -> the input
+  const R_xlen_t L = rate ? N + 1 : N;
+  std::vector<ref_real> x(L);
+  if (rate) {
+    x[0] = 0;
+    for (R_xlen_t i = 0; i < N; ++i) x[i + 1] = x[i] + (static_cast<ref_real>(v[i]) - mean);
+  } else {
+    for (R_xlen_t i = 0; i < N; ++i) x[i] = static_cast<ref_real>(v[i]) - mean;
+  }
+  std::vector<ref_real> P;
+  if (type == MODIFIED) {
+    P.assign(L + 1, 0);
+    for (R_xlen_t i = 0; i < L; ++i) P[i + 1] = P[i] + x[i];
+  }
+  Rcpp::NumericVector out(m.size()), cnt(m.size());
+  for (R_xlen_t j = 0; j < m.size(); ++j) {
+    const R_xlen_t mm = static_cast<R_xlen_t>(m[j]);
+    ref_real s = 0;
+    R_xlen_t n = 0;
+    auto xs = [&](R_xlen_t i) -> ref_real {  // reflected phase for TOTAL
+      if (i < 0) return 2 * x[0] - x[-i];
+      if (i > L - 1) return 2 * x[L - 1] - x[2 * (L - 1) - i];
+      return x[i];
+    };
+    switch (type) {
+      case STANDARD:
+      case OVERLAPPING: {
+        const R_xlen_t st = type == STANDARD ? mm : 1;
+        for (R_xlen_t k = 0; k + 2 * mm <= L - 1; k += st, ++n) {
+          const ref_real d = x[k + 2 * mm] - 2 * x[k + mm] + x[k];
+          s += d * d;
+        }
+        break;
+      }
+      case HADAMARD:
+      case OHADAMARD: {
+        const R_xlen_t st = type == HADAMARD ? mm : 1;
+        for (R_xlen_t k = 0; k + 3 * mm <= L - 1; k += st, ++n) {
+          const ref_real d = x[k + 3 * mm] - 3 * x[k + 2 * mm] + 3 * x[k + mm] - x[k];
+          s += d * d;
+        }
+        break;
+      }
+      case MODIFIED: {
+        for (R_xlen_t k = 0; k + 3 * mm <= L; ++k, ++n) {
+          const ref_real d = P[k + 3 * mm] - 3 * P[k + 2 * mm] + 3 * P[k + mm] - P[k];
+          s += d * d;
+        }
+        break;
+      }
+      case TOTAL: {
+        for (R_xlen_t i = 1; i <= L - 2; ++i, ++n) {
+          const ref_real d = xs(i - mm) - 2 * x[i] + xs(i + mm);
+          s += d * d;
+        }
+        break;
+      }
+    }
+    out[j] = static_cast<double>(s);
+    cnt[j] = static_cast<double>(n);
+  }
+  return Rcpp::List::create(Rcpp::Named("sums") = out, Rcpp::Named("n") = cnt,
+                            Rcpp::Named("quad") = kRefQuad);
+}
+
+// 1-based position of the first NA/NaN/Inf in x, 0 when all are finite (one
+// pass, no allocation: cheaper than is.finite() on long records).
+// [[Rcpp::export(rng = false)]]
+double allan_first_nonfinite_cpp(const Rcpp::NumericVector& x) {
+  const R_xlen_t n = x.size();
+  const double* p = x.begin();
+  for (R_xlen_t i = 0; i < n; ++i)
+    if (!std::isfinite(p[i])) return static_cast<double>(i + 1);
+  return 0;
+}
