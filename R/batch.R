@@ -12,13 +12,17 @@
 #' default, `multisession`, a cluster, ...), with `future.seed = TRUE`:
 #' results do not depend on the plan.
 #'
-#' Readings: N is the fitted white-noise coefficient (the -1/2 line's value
-#' at tau = 1 s), K the fitted rate random walk (the +1/2 line's value at
-#' tau = 3 s) and B the fitted bias instability, reported with the tau of
-#' the minimum Allan deviation (the flat region). When a fit fails or
-#' [avfit()] is unavailable, the IEEE 952 slope-line reading is used
-#' instead (and said so in the `method` column): N and K from the tangent
-#' lines of slope -1/2 and +1/2, B = min ADEV / 0.664.
+#' Readings (the `method` column says which rule gave each number): N is
+#' the fitted white-noise coefficient, the -1/2 line's value at tau = 1 s;
+#' Gauss-Markov terms the refinement added with Tc < 0.1 s are white noise
+#' at tau >= 1 s (their AV tends to 2 sigma^2 Tc / tau) and are folded in,
+#' N = sqrt(N^2 + sum 2 sigma^2 Tc). K is the fitted rate random walk (the
+#' +1/2 line's value at tau = 3 s) and B the fitted bias instability,
+#' reported with the tau of the minimum Allan deviation (the flat region).
+#' A term the fit lacks or sets to 0 is read by the IEEE 952 slope lines
+#' instead: N and K from the tangent lines of slope -1/2 and +1/2,
+#' B = min ADEV / 0.664; with no +1/2 region, K is given as the upper bound
+#' min over tau of upper(tau) sqrt(3 / tau) (see [imu_guidance()]).
 #'
 #' @param x An [imu_record()] (from [read_imu()]), a list of them, or a
 #'   character vector of file paths (read with [read_imu()] and `read_args`).
@@ -130,26 +134,21 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
 # arguments and the package's namespace.
 analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
-  curve <- channel_curve(job$x, job$freq, opts$taus, opts$type)
+  curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
   fit <- NULL
   fit_error <- NULL
-  avfit_fun <- package_fun("avfit")
-  if (!is.null(avfit_fun)) {
-    fit <- tryCatch(
-      do.call(avfit_fun, c(list(curve, terms = opts$terms), opts$fit_args)),
-      error = function(e) {
-        fit_error <<- conditionMessage(e)
-        NULL
-      })
-    refine_fun <- package_fun("avrefine")
-    if (!is.null(fit) && opts$refine && !is.null(refine_fun)) {
-      fit <- tryCatch(refine_fun(fit), error = function(e) {
-        fit_error <<- paste("avrefine():", conditionMessage(e))
-        fit
-      })
-    }
-  } else {
-    fit_error <- "avfit() is not available"
+  fit <- tryCatch(
+    do.call(avfit, c(list(curve, terms = opts$terms), opts$fit_args)),
+    error = function(e) {
+      fit_error <<- conditionMessage(e)
+      NULL
+    })
+  if (!is.null(fit) && opts$refine) {
+    # The raw series lets avrefine() confirm an effect in the data itself.
+    fit <- tryCatch(avrefine(fit, data = job$x), error = function(e) {
+      fit_error <<- paste("avrefine():", conditionMessage(e))
+      fit
+    })
   }
   coef <- if (is.null(fit)) numeric() else fit$coefficients
   readings <- channel_readings(curve, coef, job$sensor)
@@ -158,32 +157,6 @@ analyze_channel <- function(job, opts) {
               fit_error = fit_error, coef = coef, readings = readings)
   res$guidance <- imu_guidance(res)
   res
-}
-
-# The Allan deviation curve: allan() (branch allan), in the interface's
-# columns tau, adev, lower, upper, edf.
-channel_curve <- function(x, freq, taus, type) {
-  allan_fun <- package_fun("allan")
-  if (!is.null(allan_fun)) {
-    return(allan_fun(x, freq, taus = taus, type = type))
-  }
-  # Until allan() is merged: the non-overlapping octave estimator, with the
-  # interface's columns (edf of white noise, 2M^2/(3M-1)).
-  av <- avar(x, freq)
-  m <- round(av$time * freq)
-  M <- floor(length(x) / m) - 1
-  edf <- 2 * M^2 / (3 * M - 1)
-  adev <- sqrt(av$av)
-  q <- (1 - 0.683) / 2
-  data.frame(tau = av$time, m = as.integer(m), n = as.integer(M),
-             avar = av$av, adev = adev,
-             lower = adev * sqrt(edf / stats::qchisq(1 - q, edf)),
-             upper = adev * sqrt(edf / stats::qchisq(q, edf)), edf = edf)
-}
-
-package_fun <- function(name) {
-  get0(name, envir = asNamespace("allanvar"), mode = "function",
-       inherits = FALSE)
 }
 
 # N, B, K as a datasheet reads them: from the fit when it has them, else
@@ -199,8 +172,25 @@ channel_readings <- function(curve, coef, sensor) {
   tau_b <- tau[i_min]
   get <- function(nm) if (nm %in% names(coef)) unname(coef[[nm]]) else NA_real_
   fitted <- c(N = get("N"), B = get("B"), K = get("K"))
+  method <- c(N = "fit", B = "fit", K = "fit")
+  # A Gauss-Markov term with Tc well below 1 s is white noise at every
+  # tau >= 1 s (its AV tends to 2 sigma^2 Tc / tau): the datasheet N, the
+  # -1/2 line at tau = 1 s, includes it.
+  gm <- white_like_gm(coef)
+  if (gm > 0) {
+    fitted[["N"]] <- sqrt((if (is.finite(fitted[["N"]])) fitted[["N"]]^2 else 0) + gm)
+    method[["N"]] <- "fit + white-like GM (Tc < 0.1 s)"
+  }
+  # A term the fit set to 0 is not read from it.
+  fitted[!is.finite(fitted) | fitted <= 0] <- NA_real_
   value <- ifelse(is.na(fitted), lines$value, fitted)
-  method <- ifelse(is.na(fitted), lines$method, "fit")
+  method <- ifelse(is.na(fitted), lines$method, method)
+  # With a fit, a K it sets to 0 is not replaced by a +1/2 tangent: that
+  # slope may belong to a bump the model explains otherwise.
+  if (length(coef) && is.na(fitted[["K"]])) value[["K"]] <- NA_real_
+  if ("B" %in% names(coef) && is.na(fitted[["B"]])) {
+    method[["B"]] <- paste0(method[["B"]], " (fit B = 0)")
+  }
   if (!is.finite(value[["K"]]) || value[["K"]] <= 0) {
     # No +1/2 region: every term adds to the AV, so K^2 tau / 3 <= AV(tau)
     # at each tau; the upper confidence limit makes the bound conservative.
@@ -214,6 +204,18 @@ channel_readings <- function(curve, coef, sensor) {
                       si_unit(sensor, "K")),
              tau = c(1, tau_b, 3), method = unname(method),
              stringsAsFactors = FALSE)
+}
+
+white_like_gm <- function(coef) {
+  j <- 1L
+  out <- 0
+  while (paste0("gm", j, ".sigma") %in% names(coef)) {
+    sig <- coef[[paste0("gm", j, ".sigma")]]
+    tc <- coef[[paste0("gm", j, ".tc")]]
+    if (is.finite(tc) && tc < 0.1) out <- out + 2 * sig^2 * tc
+    j <- j + 1L
+  }
+  out
 }
 
 # IEEE 952 slope-line readings. The local slope between successive taus;

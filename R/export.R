@@ -144,7 +144,9 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
 #'   sample's white noise (rad/s or m/s^2);
 #' * rate random walk K: `sigma_bd = K * sqrt(dt)`, the standard deviation
 #'   of the bias increment per step, `b[k] = b[k-1] + sigma_bd * w[k]`;
-#' * each Gauss-Markov term (sigma, Tc) fitted by [avfit()]/[avrefine()]:
+#' * each Gauss-Markov term (sigma, Tc) fitted by [avfit()]/[avrefine()]
+#'   (for an analysis, those with Tc < 0.1 s are already part of its N and
+#'   are not repeated):
 #'   `phi = exp(-dt / Tc)` and the driving-noise variance
 #'   `q_d = sigma^2 * (1 - phi^2)`, for `x[k] = phi * x[k-1] + w[k]`,
 #'   `Var(w[k]) = q_d` (so that the stationary variance is sigma^2);
@@ -178,7 +180,7 @@ filter_params <- function(x, dt = NULL, bias_instability = c("gm", "omit"),
     rows <- lapply(x$channels, function(ch) {
       rd <- ch$readings
       cf <- ch$coef
-      cf <- cf[grepl("^gm[0-9]+\\.(sigma|tc)$", names(cf))]
+      cf <- gm_terms(cf, drop_white = grepl("white-like GM", rd$method[rd$term == "N"]))
       cf[c("N", "B", "K")] <- rd$value[match(c("N", "B", "K"), rd$term)]
       tb <- rd$tau[rd$term == "B"]
       discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability, tb,
@@ -204,6 +206,23 @@ filter_params <- function(x, dt = NULL, bias_instability = c("gm", "omit"),
                          if (is.null(tau_B)) NA_real_ else tau_B)
   }
   rownames(out) <- NULL
+  out
+}
+
+# The GM coefficients, renumbered; without those already folded into N.
+gm_terms <- function(cf, drop_white = FALSE) {
+  out <- numeric()
+  j <- 1L
+  k <- 1L
+  while (paste0("gm", j, ".sigma") %in% names(cf)) {
+    sig <- cf[[paste0("gm", j, ".sigma")]]
+    tc <- cf[[paste0("gm", j, ".tc")]]
+    if (!(drop_white && tc < 0.1)) {
+      out[paste0("gm", k, c(".sigma", ".tc"))] <- c(sig, tc)
+      k <- k + 1L
+    }
+    j <- j + 1L
+  }
   out
 }
 
