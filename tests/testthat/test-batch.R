@@ -85,3 +85,37 @@ test_that("plot() draws both sensors with units and reading markers", {
   expect_gt(file.size(f), 1000)
   expect_error(plot(a, sensor = "mag"), "`sensor`")
 })
+
+test_that("effects the closed loop adds reach the datasheet", {
+  x <- avsim(2e4, 100, N = 1e-3, K = 1e-3, gm = list(sigma = 0.02, tc = 2), seed = 1)
+  r <- imu_record(cbind(gyro_x = as.numeric(x)), freq = 100)
+  a <- suppressWarnings(analyze_imu(r, progress = FALSE))
+  st <- a$channels$gyro_x$fit$steps
+  expect_true("gm" %in% st$effect)
+  expect_match(a$datasheet$gyro$effects, "gm \\(Tc = ")
+  # the GM (Tc near 2 s, not white-like) goes to the filter as phi, q_d
+  fp <- filter_params(a)
+  tc <- a$channels$gyro_x$coef[["gm1.tc"]]
+  sig <- a$channels$gyro_x$coef[["gm1.sigma"]]
+  expect_equal(fp$value[fp$term == "gm1" & fp$parameter == "phi"], exp(-0.01 / tc))
+  expect_equal(fp$value[fp$term == "gm1" & fp$parameter == "q_d"],
+               sig^2 * (1 - exp(-0.02 / tc)))
+})
+
+test_that("white-like Gauss-Markov terms are folded into N, once", {
+  curve <- data.frame(tau = 2^(0:8) / 100, adev = 1e-3 / sqrt(2^(0:8) / 100),
+                      upper = 1.1e-3 / sqrt(2^(0:8) / 100))
+  cf <- c(N = 3e-4, B = 0, K = 0, gm1.sigma = 5e-3, gm1.tc = 0.005,
+          gm2.sigma = 1e-3, gm2.tc = 20)
+  rd <- allanvar:::channel_readings(curve, cf, "gyro")
+  # N^2 + 2 sigma^2 Tc (gm1 only; gm2 has Tc = 20 s)
+  expect_equal(rd$value[rd$term == "N"], sqrt(3e-4^2 + 2 * 5e-3^2 * 0.005))
+  expect_match(rd$method[rd$term == "N"], "white-like GM")
+  # B = 0 in the fit: min ADEV / 0.664 at the minimum's tau
+  expect_equal(rd$value[rd$term == "B"], min(curve$adev) / sqrt(2 * log(2) / pi))
+  expect_equal(rd$tau[rd$term == "B"], 2.56)
+  expect_match(rd$method[rd$term == "K"], "upper bound")
+  g <- allanvar:::gm_terms(cf, drop_white = TRUE)
+  expect_identical(names(g), c("gm1.sigma", "gm1.tc"))
+  expect_equal(unname(g), c(1e-3, 20))
+})
