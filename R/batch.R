@@ -19,7 +19,8 @@
 #' N = sqrt(N^2 + sum 2 sigma^2 Tc). K is the fitted rate random walk (the
 #' +1/2 line's value at tau = 3 s) and B the fitted bias instability,
 #' reported with the tau of the minimum Allan deviation (the flat region).
-#' A term the fit lacks or sets to 0 is read by the IEEE 952 slope lines
+#' A term the fit lacks or sets to 0 (for K: or whose standard error
+#' exceeds it) is read by the IEEE 952 slope lines
 #' instead: N and K from the tangent lines of slope -1/2 and +1/2,
 #' B = min ADEV / 0.664; with no +1/2 region, K is given as the upper bound
 #' min over tau of upper(tau) sqrt(3 / tau) (see [imu_guidance()]).
@@ -151,7 +152,7 @@ analyze_channel <- function(job, opts) {
     })
   }
   coef <- if (is.null(fit)) numeric() else fit$coefficients
-  readings <- channel_readings(curve, coef, job$sensor)
+  readings <- channel_readings(curve, coef, job$sensor, se = fit_se(fit))
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = fit_error, coef = coef, readings = readings)
@@ -161,7 +162,7 @@ analyze_channel <- function(job, opts) {
 
 # N, B, K as a datasheet reads them: from the fit when it has them, else
 # from the IEEE 952 slope lines.
-channel_readings <- function(curve, coef, sensor) {
+channel_readings <- function(curve, coef, sensor, se = NULL) {
   tau <- curve$tau
   adev <- curve$adev
   ok <- is.finite(adev) & adev > 0
@@ -181,8 +182,13 @@ channel_readings <- function(curve, coef, sensor) {
     fitted[["N"]] <- sqrt((if (is.finite(fitted[["N"]])) fitted[["N"]]^2 else 0) + gm)
     method[["N"]] <- "fit + white-like GM (Tc < 0.1 s)"
   }
-  # A term the fit set to 0 is not read from it.
+  # A term the fit set to 0 is not read from it; nor a K whose standard
+  # error exceeds it (not distinguishable from 0: bounded instead).
   fitted[!is.finite(fitted) | fitted <= 0] <- NA_real_
+  if (!is.null(se) && "K" %in% names(se) && is.finite(fitted[["K"]]) &&
+      is.finite(se[["K"]]) && se[["K"]] > fitted[["K"]]) {
+    fitted[["K"]] <- NA_real_
+  }
   value <- ifelse(is.na(fitted), lines$value, fitted)
   method <- ifelse(is.na(fitted), lines$method, method)
   # With a fit, a K it sets to 0 is not replaced by a +1/2 tangent: that
@@ -204,6 +210,16 @@ channel_readings <- function(curve, coef, sensor) {
                       si_unit(sensor, "K")),
              tau = c(1, tau_b, 3), method = unname(method),
              stringsAsFactors = FALSE)
+}
+
+fit_se <- function(fit) {
+  if (is.null(fit)) return(NULL)
+  se <- fit$se
+  if (is.null(se) && !is.null(fit$vcov)) {
+    se <- sqrt(pmax(diag(as.matrix(fit$vcov)), 0))
+    names(se) <- names(fit$coefficients)
+  }
+  se
 }
 
 white_like_gm <- function(coef) {
