@@ -212,21 +212,55 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
   }
 }
 
+// Stride-m sum of squared differences of order D (2 or 3) over n terms: each
+// term loads one new point and reuses the previous ones.
+template <int D>
+double strided_sum(const double* h, const double* l, R_xlen_t m, R_xlen_t n) {
+  Acc a;
+  double s0 = 0, s1 = 0;
+  double h0 = h[0], l0 = l[0], h1 = h[m], l1 = l[m];
+  double h2 = D == 3 ? h[2 * m] : 0, l2 = D == 3 ? l[2 * m] : 0;
+  const double* ph = h + D * m;
+  const double* pl = l + D * m;
+  for (R_xlen_t i = 0; i < n; ++i, ph += m, pl += m) {
+    const double hn = *ph, ln = *pl;
+    double d;
+    if (D == 2) {
+      d = ((hn + h0) - 2.0 * h1) + ((ln + l0) - 2.0 * l1);
+      h0 = h1;
+      l0 = l1;
+      h1 = hn;
+      l1 = ln;
+    } else {
+      d = ((hn - h0) + 3.0 * (h1 - h2)) + ((ln - l0) + 3.0 * (l1 - l2));
+      h0 = h1;
+      l0 = l1;
+      h1 = h2;
+      l1 = l2;
+      h2 = hn;
+      l2 = ln;
+    }
+    if (i & 1) {
+      s1 += d * d;
+    } else {
+      s0 += d * d;
+    }
+    if ((i & 16383) == 16383) {
+      a.add(s0 + s1);
+      s0 = s1 = 0;
+    }
+  }
+  a.add(s0 + s1);
+  return a.value();
+}
+
 // Stride-m estimators (standard, Hadamard): one item per tau.
-template <class D>
+template <int D>
 void strided(const Split& X, const std::vector<R_xlen_t>& ms,
              const std::vector<R_xlen_t>& nterms, int threads, bool main,
              double* out) {
   run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
-    const R_xlen_t m = ms[j];
-    const D f{X.hi.data(), X.lo.data(), m};
-    Acc a;
-    const R_xlen_t end = nterms[j] * m;
-    const R_xlen_t step = kChunk * m;
-    for (R_xlen_t k = 0; k < end; k += step) {
-      a.add(sumsq(f, k, std::min(end, k + step), m));
-    }
-    out[j] = a.value();
+    out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), ms[j], nterms[j]);
   });
 }
 
@@ -426,12 +460,13 @@ struct Channel {
 
 // One channel: sums of squares for every m, and the noise id per m.
 void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
-                 const std::vector<R_xlen_t>& nterms, int type, bool rate,
+                 const std::vector<R_xlen_t>& nterms,
+                 const std::vector<R_xlen_t>& mid, int type, bool rate,
                  bool octave, int threads, bool main, Channel& out) {
-  const size_t nt = ms.size();
+  const size_t nt = ms.size(), ni = mid.size();
   out.sums.assign(nt, 0.0);
-  out.alpha.assign(nt, NA_REAL);
-  out.alpha_int.assign(nt, NA_INTEGER);
+  out.alpha.assign(ni, NA_REAL);
+  out.alpha_int.assign(ni, NA_INTEGER);
   const int dmax = (type == HADAMARD || type == OHADAMARD) ? 3 : 2;
   // centre and bound of the data
   long double s = 0;
@@ -453,6 +488,10 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       int lj = 0;
       while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
       out.sums[j] = lev[lj].acc.value();
+    }
+    for (size_t j = 0; j < ni; ++j) {
+      int lj = 0;
+      while ((static_cast<R_xlen_t>(1) << lj) < mid[j]) ++lj;
       std::vector<double> id(lev[lj].idh.size());
       for (size_t i = 0; i < id.size(); ++i) id[i] = lev[lj].idh[i] + lev[lj].idl[i];
       out.alpha[j] = noise_id(id, false, dmax, out.alpha_int[j]);
@@ -469,18 +508,18 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   }
   double* o = out.sums.data();
   switch (type) {
-    case STANDARD: strided<Diff2>(X, ms, nterms, threads, main, o); break;
+    case STANDARD: strided<2>(X, ms, nterms, threads, main, o); break;
     case OVERLAPPING: overlapped<Diff2>(X, ms, nterms, threads, main, o); break;
     case MODIFIED: overlapped<Diff3>(X, ms, nterms, threads, main, o); break;
-    case HADAMARD: strided<Diff3>(X, ms, nterms, threads, main, o); break;
+    case HADAMARD: strided<3>(X, ms, nterms, threads, main, o); break;
     case OHADAMARD: overlapped<Diff3>(X, ms, nterms, threads, main, o); break;
     case TOTAL: total(X, ms, threads, main, o); break;
   }
   // Noise id: cluster sums (rate) or decimated phase (integrated) of the
   // first kIdMax clusters. With MODIFIED, X holds one more level of sums.
   const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
-  for (size_t j = 0; j < nt; ++j) {
-    const R_xlen_t m = ms[j];
+  for (size_t j = 0; j < ni; ++j) {
+    const R_xlen_t m = mid[j];
     std::vector<double> id;
     const bool two = (type == MODIFIED);
     for (R_xlen_t i = 0; i < kIdMax; ++i) {
@@ -513,37 +552,42 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
 }  // namespace
 
 // Sums of squared differences (the estimator numerators) for every channel
-// (column of x, nrow samples each) and cluster size m, with the noise id.
+// (column of x, nrow samples each) and cluster size m, and the noise id at
+// the cluster sizes `mid`.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
                           const Rcpp::NumericVector& m,
-                          const Rcpp::NumericVector& nterms, int type,
+                          const Rcpp::NumericVector& nterms,
+                          const Rcpp::NumericVector& mid, int type,
                           bool rate, bool octave, int threads) {
   const R_xlen_t N = static_cast<R_xlen_t>(nrow);
   const R_xlen_t nc = x.size() / N;
   const size_t nt = m.size();
-  std::vector<R_xlen_t> ms(nt), nts(nt);
+  const size_t ni = mid.size();
+  std::vector<R_xlen_t> ms(nt), nts(nt), mids(ni);
   for (size_t j = 0; j < nt; ++j) {
     ms[j] = static_cast<R_xlen_t>(m[j]);
     nts[j] = static_cast<R_xlen_t>(nterms[j]);
   }
+  for (size_t j = 0; j < ni; ++j) mids[j] = static_cast<R_xlen_t>(mid[j]);
   std::vector<Channel> ch(nc);
   const double* p = x.begin();
   if (nc == 1) {
-    one_channel(p, N, ms, nts, type, rate, octave, threads, true, ch[0]);
+    one_channel(p, N, ms, nts, mids, type, rate, octave, threads, true, ch[0]);
   } else {
     allanvar::parallel_for(nc, threads, [&](R_xlen_t i, int) {
-      one_channel(p + i * N, N, ms, nts, type, rate, octave, 1, false, ch[i]);
+      one_channel(p + i * N, N, ms, nts, mids, type, rate, octave, 1, false, ch[i]);
     });
   }
-  Rcpp::NumericMatrix sums(nt, nc), alpha(nt, nc);
-  Rcpp::IntegerMatrix alpha_int(nt, nc);
-  for (R_xlen_t i = 0; i < nc; ++i)
-    for (size_t j = 0; j < nt; ++j) {
-      sums(j, i) = ch[i].sums[j];
+  Rcpp::NumericMatrix sums(nt, nc), alpha(ni, nc);
+  Rcpp::IntegerMatrix alpha_int(ni, nc);
+  for (R_xlen_t i = 0; i < nc; ++i) {
+    for (size_t j = 0; j < nt; ++j) sums(j, i) = ch[i].sums[j];
+    for (size_t j = 0; j < ni; ++j) {
       alpha(j, i) = ch[i].alpha[j];
       alpha_int(j, i) = ch[i].alpha_int[j];
     }
+  }
   return Rcpp::List::create(Rcpp::Named("sums") = sums,
                             Rcpp::Named("alpha") = alpha,
                             Rcpp::Named("alpha_int") = alpha_int);
