@@ -108,13 +108,13 @@
 #' @importFrom stats coef vcov fitted residuals confint predict logLik nobs AIC BIC
 #' @export
 #' @examples
-#' x <- avsim(2e5, freq = 100, N = 0.01, B = 0.002, K = 1e-4, seed = 1)
+#' x <- avsim(1e5, freq = 100, N = 0.01, B = 0.002, K = 1e-4, seed = 1)
 #' av <- avar(x, 100)
 #' fit <- avfit(av, c("N", "B", "K"), freq = 100)
 #' fit
 #' # a table computed elsewhere: tau, avar (and n, freq for the EDF)
 #' tab <- data.frame(tau = av$time, avar = av$av)
-#' coef(avfit(tab, c("N", "B", "K"), n = 2e5, freq = 100,
+#' coef(avfit(tab, c("N", "B", "K"), n = 1e5, freq = 100,
 #'            type = "non-overlapping"))
 avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
                   type = "overlapping", channel = NULL, start = NULL,

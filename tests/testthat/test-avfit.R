@@ -239,6 +239,27 @@ test_that("white-noise covariance kernel: exact values, strided sums, Monte Carl
                brute(1500, 1100, 12000), tolerance = 2e-3)
   expect_equal(avar_white_cov(c(3, 5), 500, TRUE, 1L)[1, 2], brute(3, 5, 500),
                tolerance = 1e-12)
+  # explicit weight matrices, both estimators, pairs that take every branch
+  wmat <- function(m, n, stride) {
+    M <- if (stride == 1) n - 2 * m + 1 else floor(n / m) - 1
+    t <- 0:(n - 1)
+    vapply(0:(M - 1), function(a) {
+      k <- a * stride
+      ifelse(t >= k & t < k + m, -1 / m, ifelse(t >= k + m & t < k + 2 * m, 1 / m, 0))
+    }, numeric(n))
+  }
+  ref <- function(mi, mj, n, ov) {
+    Wi <- wmat(mi, n, if (ov) 1 else mi)
+    Wj <- wmat(mj, n, if (ov) 1 else mj)
+    sum(crossprod(Wi, Wj)^2) / (2 * ncol(Wi) * ncol(Wj))
+  }
+  for (p in list(c(1, 1, 300), c(2, 3, 400), c(1, 40, 700), c(6, 10, 900),
+                 c(2, 300, 1200))) {
+    for (ov in c(TRUE, FALSE)) {
+      expect_equal(avar_white_cov(p[1:2], p[3], ov, 1L)[1, 2],
+                   ref(p[1], p[2], p[3], ov), tolerance = 1e-12)
+    }
+  }
   # correlation between neighbouring octaves matches Monte Carlo
   set.seed(7)
   sims <- replicate(400, {
