@@ -23,10 +23,12 @@
 #' Every candidate kind in `candidates` that is not already in the model
 #' (gm and sinusoid may repeat) is refitted at each step; the residual
 #' signature and the raw data supply the initial values, the tau range and
-#' the evidence, and break ties: among candidates that pay, one supported by
-#' the raw data is preferred over one the data cannot judge, and that over
-#' one the data contradict. An accepted effect that the raw data contradict
-#' is kept (it pays on the curve) but flagged `confirmed = FALSE`.
+#' the evidence. Candidates traced from a signature (or proposed by the raw
+#' data) are tried first, the others only when none of those pays. Among
+#' the candidates that pay, the one with the lowest criterion wins, where
+#' raw-data support counts as a gain of `min_gain` and a contradiction as a
+#' loss of `min_gain`. An accepted effect that the raw data contradict is
+#' kept (it pays on the curve) but flagged `confirmed = FALSE`.
 #'
 #' @param fit An [avfit()] result.
 #' @param data Optional raw rate series (numeric vector or `ts`) at the
@@ -118,26 +120,35 @@ avrefine <- function(fit, data = NULL,
     if (!nrow(trials)) break
     c0 <- crit(current)
     best <- NULL
-    for (i in seq_len(nrow(trials))) {
-      tr <- trials[i, ]
-      init <- tr$init[[1L]]
-      new <- refit_with(current, c(current$terms, tr$effect), tr$effect, init, ...)
-      if (is.null(new)) next
-      c1 <- crit(new)
-      pays <- is.finite(c1) && c1 < c0 - min_gain &&
-        new$chi2 < 0.9 * current$chi2
-      if (!pays) next
-      lab <- new_label(current$terms, tr$effect)
-      # An added term that explains (almost) nothing anywhere is a refit
-      # artefact, not an effect.
-      if (max_share(new, lab) < 0.02) next
-      par <- effect_params(new, lab)
-      ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
-      rank <- if (isTRUE(ev$support)) 0 else if (is.na(ev$support)) 1 else 2
-      cand <- list(fit = new, crit = c1, rank = rank, trial = tr, label = lab,
-                   params = par, ev = ev)
-      if (is.null(best) || rank < best$rank ||
-          (rank == best$rank && c1 < best$crit)) best <- cand
+    # Traced candidates first; the others only when none of those pays.
+    for (tier in list(which(trials$traced), which(!trials$traced))) {
+      for (i in tier) {
+        tr <- trials[i, ]
+        init <- tr$init[[1L]]
+        new <- refit_with(current, c(current$terms, tr$effect), tr$effect, init, ...,
+                          good_enough = function(f) crit(f) < c0 - min_gain)
+        if (tr$effect == "sinusoid" && isTRUE(tr$from_raw)) {
+          alt <- refit_fixed_f0(current, c(current$terms, tr$effect), init$f0, ...)
+          if (!is.null(alt) && (is.null(new) || crit(alt) < crit(new))) new <- alt
+        }
+        if (is.null(new)) next
+        c1 <- crit(new)
+        pays <- is.finite(c1) && c1 < c0 - min_gain &&
+          new$chi2 < 0.9 * current$chi2
+        if (!pays) next
+        lab <- new_label(current$terms, tr$effect)
+        # An added term that explains (almost) nothing anywhere is a refit
+        # artefact, not an effect.
+        if (max_share(new, lab) < 0.02) next
+        par <- effect_params(new, lab)
+        ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
+        # Raw-data support or contradiction weighs min_gain criterion units.
+        adj <- c1 - min_gain * (isTRUE(ev$support) - isFALSE(ev$support))
+        cand <- list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
+                     params = par, ev = ev)
+        if (is.null(best) || adj < best$adj) best <- cand
+      }
+      if (!is.null(best)) break
     }
     if (is.null(best)) break
     tr <- best$trial
@@ -226,12 +237,13 @@ candidate_trials <- function(traced, present, candidates, sig) {
     if (nrow(t)) {
       # gm and sinusoid: try up to two distinct starts (signature and raw data).
       take <- if (k %in% c("gm", "sinusoid")) seq_len(min(2L, nrow(t))) else 1L
+      t$traced <- rep(TRUE, nrow(t))
       rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
     } else {
       rows[[length(rows) + 1L]] <- data.frame(
         effect = k, tau_from = strongest$tau_from, tau_to = strongest$tau_to,
         signature = paste0(strongest$description, " (no signature specific to ", k, ")"),
-        score = 0, stringsAsFactors = FALSE)
+        score = 0, from_raw = FALSE, traced = FALSE, stringsAsFactors = FALSE)
       rows[[length(rows)]]$init <- list(list())
     }
   }
@@ -239,28 +251,38 @@ candidate_trials <- function(traced, present, candidates, sig) {
   do.call(rbind, rows)
 }
 
-# Refit the curve with one more term. avfit profiles the nonlinear
-# parameters itself; the traced starting values are offered through `start`
-# and dropped if avfit does not take them. NULL when the fit fails.
-refit_with <- function(fit, terms, effect, init, ...) {
-  args <- refit_args(fit)
-  args$terms <- terms
-  dots <- list(...)
-  args[names(dots)] <- dots
-  res <- tryCatch(suppressWarnings(do.call(avfit, args)), error = function(e) NULL)
-  if (is.null(res) || !is.finite(res$chi2)) return(NULL)
-  res
+# Refit the curve with one more term. avfit() profiles the nonlinear
+# parameters on its own grid; when the tracing gives a starting Tc or f0 the
+# refit is also tried from there, and the better of the two is kept. NULL
+# when both fail.
+refit_with <- function(fit, terms, effect, init, ..., good_enough = NULL) {
+  one <- function(start) {
+    args <- c(list(av = fit, terms = terms), list(...))
+    if (length(start)) args$start <- c(args$start, start)
+    res <- tryCatch(suppressWarnings(do.call(avfit, args)),
+                    error = function(e) NULL)
+    if (is.null(res) || !is.finite(res$chi2)) NULL else res
+  }
+  best <- one(NULL)
+  if (!is.null(best) && !is.null(good_enough) && good_enough(best)) return(best)
+  lab <- new_label(fit$terms, effect)
+  nl <- c(gm = "tc", sinusoid = "f0")[effect]
+  if (!is.na(nl) && is.finite(init[[nl]] %||% NA_real_) && init[[nl]] > 0) {
+    st <- stats::setNames(init[[nl]], paste0(lab, ".", nl))
+    alt <- one(st)
+    if (!is.null(alt) && (is.null(best) || alt$objective < best$objective)) best <- alt
+  }
+  best
 }
 
-# avfit() arguments that reproduce `fit`'s curve.
-refit_args <- function(fit) {
-  if (!is.null(fit$av)) {
-    return(list(av = fit$av, n = fit$n, freq = fit$freq, type = fit$type))
-  }
-  d <- fit$data
-  tab <- data.frame(tau = d$tau, avar = d$avar)
-  if (!is.null(d$edf)) tab$edf <- d$edf
-  list(av = tab, n = fit$n, freq = fit$freq, type = fit$type)
+# A sinusoid whose line the raw periodogram resolves: its f0 is known far
+# better from the data than from the curve, so also try it held fixed there.
+refit_fixed_f0 <- function(fit, terms, f0, ...) {
+  lab <- new_label(fit$terms, "sinusoid")
+  args <- c(list(av = fit, terms = terms), list(...))
+  args$fixed <- c(args$fixed, stats::setNames(f0, paste0(lab, ".f0")))
+  res <- tryCatch(suppressWarnings(do.call(avfit, args)), error = function(e) NULL)
+  if (is.null(res) || !is.finite(res$chi2)) NULL else res
 }
 
 # Largest share of the model AV carried by one term instance over the taus.

@@ -140,12 +140,12 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
                              raw = NULL) {
   excess <- avar - fitted
   out <- list()
-  add <- function(effect, from, to, init, signature, score) {
+  add <- function(effect, from, to, init, signature, score, from_raw = FALSE) {
     if (!effect %in% candidates) return(invisible())
     if (effect %in% c("Q", "N", "B", "K", "R") && effect %in% present) return(invisible())
     out[[length(out) + 1L]] <<- list(effect = effect, tau_from = from, tau_to = to,
                                      init = init, signature = signature,
-                                     score = score)
+                                     score = score, from_raw = from_raw)
   }
   for (i in seq_len(nrow(sig))) {
     s <- sig[i, ]
@@ -207,13 +207,15 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
   if (!length(out)) {
     return(data.frame(effect = character(), tau_from = numeric(),
                       tau_to = numeric(), signature = character(),
-                      score = numeric(), stringsAsFactors = FALSE))
+                      score = numeric(), from_raw = logical(),
+                      stringsAsFactors = FALSE))
   }
   df <- data.frame(effect = vapply(out, `[[`, "", "effect"),
                    tau_from = vapply(out, `[[`, 0, "tau_from"),
                    tau_to = vapply(out, `[[`, 0, "tau_to"),
                    signature = vapply(out, `[[`, "", "signature"),
                    score = vapply(out, `[[`, 0, "score"),
+                   from_raw = vapply(out, `[[`, FALSE, "from_raw"),
                    stringsAsFactors = FALSE)
   df$init <- lapply(out, `[[`, "init")
   df[order(-df$score), , drop = FALSE]
@@ -339,9 +341,13 @@ acf_exponential <- function(x, freq, tc) {
   if (nb < 40L) return(list(tc = NA_real_, r1 = NA_real_, z = NA_real_, m = m))
   t <- seq_len(nb)
   b <- stats::residuals(stats::lm.fit(cbind(1, t), b))
-  max_lag <- min(nb - 2L, 40L)
+  max_lag <- min(nb - 2L, 48L)
   r <- acf_fft(b, max_lag)[-1L]
   lag <- seq_len(max_lag)
+  # Slow processes (flicker, random walk) add a nearly constant ACF over a
+  # few Tc: subtract the level at 4-6 Tc before fitting the exponential.
+  far <- lag * m / freq >= 4 * tc
+  if (sum(far) >= 3L) r <- r - mean(r[far])
   # Fit only while the ACF is well above its noise and within e^-2 of lag 1,
   # so that the selected noisy tail does not flatten the slope.
   thr <- max(3 / sqrt(nb), r[1L] * exp(-2))
