@@ -25,6 +25,18 @@ avarn_all_exact <- function(values, freq, threads) {
     .Call(`_allanvar_avarn_all_exact`, values, freq, threads)
 }
 
+avfit_log_nnls <- function(B, offset, y, W, start, maxit, tol) {
+    .Call(`_allanvar_avfit_log_nnls`, B, offset, y, W, start, maxit, tol)
+}
+
+avfit_nnls <- function(A, b) {
+    .Call(`_allanvar_avfit_nnls`, A, b)
+}
+
+avar_white_cov <- function(m, n, overlapping, threads) {
+    .Call(`_allanvar_avar_white_cov`, m, n, overlapping, threads)
+}
+
 allan_edf_cpp <- function(type, m, n, L, alpha, exact) {
     .Call(`_allanvar_allan_edf_cpp`, type, m, n, L, alpha, exact)
 }

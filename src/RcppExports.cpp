@@ -86,6 +86,46 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// avfit_log_nnls
+Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B, const Eigen::Map<Eigen::VectorXd> offset, const Eigen::Map<Eigen::VectorXd> y, const Eigen::Map<Eigen::MatrixXd> W, const Eigen::Map<Eigen::VectorXd> start, int maxit, double tol);
+RcppExport SEXP _allanvar_avfit_log_nnls(SEXP BSEXP, SEXP offsetSEXP, SEXP ySEXP, SEXP WSEXP, SEXP startSEXP, SEXP maxitSEXP, SEXP tolSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::MatrixXd> >::type B(BSEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type offset(offsetSEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::MatrixXd> >::type W(WSEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type start(startSEXP);
+    Rcpp::traits::input_parameter< int >::type maxit(maxitSEXP);
+    Rcpp::traits::input_parameter< double >::type tol(tolSEXP);
+    rcpp_result_gen = Rcpp::wrap(avfit_log_nnls(B, offset, y, W, start, maxit, tol));
+    return rcpp_result_gen;
+END_RCPP
+}
+// avfit_nnls
+Eigen::VectorXd avfit_nnls(const Eigen::Map<Eigen::MatrixXd> A, const Eigen::Map<Eigen::VectorXd> b);
+RcppExport SEXP _allanvar_avfit_nnls(SEXP ASEXP, SEXP bSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::MatrixXd> >::type A(ASEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type b(bSEXP);
+    rcpp_result_gen = Rcpp::wrap(avfit_nnls(A, b));
+    return rcpp_result_gen;
+END_RCPP
+}
+// avar_white_cov
+Rcpp::NumericMatrix avar_white_cov(const Rcpp::NumericVector& m, double n, bool overlapping, int threads);
+RcppExport SEXP _allanvar_avar_white_cov(SEXP mSEXP, SEXP nSEXP, SEXP overlappingSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type n(nSEXP);
+    Rcpp::traits::input_parameter< bool >::type overlapping(overlappingSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(avar_white_cov(m, n, overlapping, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
 // allan_edf_cpp
 Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m, const Rcpp::NumericVector& n, double L, const Rcpp::IntegerVector& alpha, const Rcpp::LogicalVector& exact);
 RcppExport SEXP _allanvar_allan_edf_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP LSEXP, SEXP alphaSEXP, SEXP exactSEXP) {
@@ -109,6 +149,9 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 2},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},
+    {"_allanvar_avfit_log_nnls", (DL_FUNC) &_allanvar_avfit_log_nnls, 7},
+    {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
+    {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {NULL, NULL, 0}
 };
