@@ -54,7 +54,7 @@
 #' @examples
 #' \donttest{
 #' set.seed(1)
-#' m <- cbind(gyro_x = rnorm(2e4, sd = 0.01), accel_x = rnorm(2e4, sd = 0.002))
+#' m <- cbind(gyro_x = rnorm(1e4, sd = 0.01), accel_x = rnorm(1e4, sd = 0.002))
 #' r <- imu_record(m, freq = 100)
 #' a <- analyze_imu(r, refine = FALSE, progress = FALSE)
 #' a

@@ -141,7 +141,9 @@ added_effects <- function(fit) {
 }
 
 #' @export
-as.data.frame.imu_datasheet <- function(x, ...) x$long
+as.data.frame.imu_datasheet <- function(x, row.names = NULL, optional = FALSE, ...) {
+  x$long
+}
 
 #' @export
 print.imu_datasheet <- function(x, digits = 3, ...) {

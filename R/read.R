@@ -68,11 +68,13 @@
 #' f <- tempfile(fileext = ".csv")
 #' set.seed(1)
 #' n <- 1000
-#' d <- data.frame(timestamp = 1.6e18 + (0:(n - 1)) * 5e6,
+#' k <- 0:(n - 1)   # 200 Hz stamps in ns, written as exact integers
+#' d <- data.frame(timestamp = sprintf("%d%09d", 1600000000L + k %/% 200L,
+#'                                     (k %% 200L) * 5000000L),
 #'                 omega_x = rnorm(n, sd = 1e-3), omega_y = rnorm(n, sd = 1e-3),
 #'                 omega_z = rnorm(n, sd = 1e-3), alpha_x = rnorm(n, sd = 1e-2),
 #'                 alpha_y = rnorm(n, sd = 1e-2), alpha_z = 9.8 + rnorm(n, sd = 1e-2))
-#' write.csv(format(d, digits = 15), f, row.names = FALSE, quote = FALSE)
+#' write.csv(d, f, row.names = FALSE, quote = FALSE)
 #' r <- read_imu(f)
 #' r
 #' unlink(f)
