@@ -18,7 +18,9 @@
 #' at tau >= 1 s (their AV tends to 2 sigma^2 Tc / tau) and are folded in,
 #' N = sqrt(N^2 + sum 2 sigma^2 Tc). K is the fitted rate random walk (the
 #' +1/2 line's value at tau = 3 s) and B the fitted bias instability,
-#' reported with the tau of the minimum Allan deviation (the flat region).
+#' reported with the tau where it is read: the minimum of the fitted Allan
+#' deviation (the flat region), or without a fit the minimum of the
+#' measured one among the taus with at least 10 degrees of freedom.
 #' A term the fit lacks or sets to 0 (for K: or whose standard error
 #' exceeds it) is read by the IEEE 952 slope lines
 #' instead: N and K from the tangent lines of slope -1/2 and +1/2,
@@ -152,7 +154,8 @@ analyze_channel <- function(job, opts) {
     })
   }
   coef <- if (is.null(fit)) numeric() else fit$coefficients
-  readings <- channel_readings(curve, coef, job$sensor, se = fit_se(fit))
+  readings <- channel_readings(curve, coef, job$sensor, se = fit_se(fit),
+                               fitted = if (!is.null(fit)) fit$data)
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = fit_error, coef = coef, readings = readings)
@@ -162,15 +165,21 @@ analyze_channel <- function(job, opts) {
 
 # N, B, K as a datasheet reads them: from the fit when it has them, else
 # from the IEEE 952 slope lines.
-channel_readings <- function(curve, coef, sensor, se = NULL) {
+channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL) {
   tau <- curve$tau
   adev <- curve$adev
   ok <- is.finite(adev) & adev > 0
+  # The flat minimum is looked for where the curve is reliable (edf >= 10).
+  rel <- if (is.null(curve$edf)) ok else ok & !is.na(curve$edf) & curve$edf >= 10
+  if (!any(rel)) rel <- ok
+  lines <- slope_readings(curve$tau[rel], adev[rel])
+  tau_b <- curve$tau[rel][which.min(adev[rel])]
+  # With a fit, B is read where the fitted model is flattest (its minimum).
+  if (!is.null(fitted) && !is.null(fitted$fitted) && any(is.finite(fitted$fitted))) {
+    tau_b <- fitted$tau[which.min(fitted$fitted)]
+  }
   tau <- tau[ok]
   adev <- adev[ok]
-  lines <- slope_readings(tau, adev)
-  i_min <- which.min(adev)
-  tau_b <- tau[i_min]
   get <- function(nm) if (nm %in% names(coef)) unname(coef[[nm]]) else NA_real_
   fitted <- c(N = get("N"), B = get("B"), K = get("K"))
   method <- c(N = "fit", B = "fit", K = "fit")

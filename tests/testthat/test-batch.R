@@ -114,6 +114,16 @@ test_that("white-like Gauss-Markov terms are folded into N, once", {
   # B = 0 in the fit: min ADEV / 0.664 at the minimum's tau
   expect_equal(rd$value[rd$term == "B"], min(curve$adev) / sqrt(2 * log(2) / pi))
   expect_equal(rd$tau[rd$term == "B"], 2.56)
+  # with a fitted curve, B is read at its minimum; without, only reliable
+  # taus (edf >= 10) count
+  rd2 <- allanvar:::channel_readings(curve, cf, "gyro",
+                                     fitted = data.frame(tau = curve$tau,
+                                                         fitted = (curve$tau - 0.3)^2 + 1))
+  expect_equal(rd2$tau[rd2$term == "B"], 0.32)
+  curve$edf <- c(rep(50, 6), 5, 2, 1)
+  rd3 <- allanvar:::channel_readings(curve, c(N = 1e-3), "gyro")
+  expect_equal(rd3$tau[rd3$term == "B"], 0.32)
+  expect_equal(rd3$value[rd3$term == "B"], curve$adev[6] / sqrt(2 * log(2) / pi))
   expect_match(rd$method[rd$term == "K"], "upper bound")
   g <- allanvar:::gm_terms(cf, drop_white = TRUE)
   expect_identical(names(g), c("gm1.sigma", "gm1.tc"))

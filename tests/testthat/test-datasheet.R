@@ -23,9 +23,9 @@ test_that("the datasheet has one row per axis, SI and datasheet units agree", {
   expect_equal(acc[["B [ug]"]], acc[["B [m/s^2]"]] / 9.80665e-6)
   expect_equal(acc[["B [mg]"]], acc[["B [m/s^2]"]] / 9.80665e-3)
   expect_equal(acc[["K [m/s/h^(3/2)]"]], acc[["K [m/s^3/sqrt(Hz)]"]] * 3600^1.5)
-  # B is reported with the tau of the minimum Allan deviation
-  cv <- a$channels$gyro_y$curve
-  expect_equal(g[["tau_B [s]"]][2], cv$tau[which.min(cv$adev)])
+  # B is reported with the tau where it is read: the fitted curve's minimum
+  fd <- a$channels$gyro_y$fit$data
+  expect_equal(g[["tau_B [s]"]][2], fd$tau[which.min(fd$fitted)])
   # the values are the per-axis readings, never averaged
   expect_equal(g[["N [rad/s/sqrt(Hz)]"]],
                unname(vapply(a$channels[1:2], function(c) c$readings$value[1], 0)))
