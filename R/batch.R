@@ -91,10 +91,10 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
       }
       ch <- channels
     }
-    for (c in ch) {
+    for (chn in ch) {
       jobs[[length(jobs) + 1L]] <- list(
-        record = i, name = r$name, channel = c, sensor = r$sensors[[c]],
-        unit = r$si_units[[c]], x = r$data[, c], freq = r$freq)
+        record = i, name = r$name, channel = chn, sensor = r$sensors[[chn]],
+        unit = r$si_units[[chn]], x = r$data[, chn], freq = r$freq)
     }
   }
   n_jobs <- length(jobs)
