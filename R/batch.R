@@ -310,8 +310,8 @@ print.imu_analysis <- function(x, ...) {
         " (see $record$problems)\n", sep = "")
   }
   print(x$datasheet)
-  g <- unlist(lapply(x$channels, function(c) if (length(c$guidance))
-    paste0(c$channel, ": ", c$guidance)))
+  g <- unlist(lapply(x$channels, function(cc) if (length(cc$guidance))
+    paste0(cc$channel, ": ", cc$guidance)))
   if (length(g)) {
     cat("\nGuidance:\n")
     cat(paste0("  - ", g, "\n"), sep = "")
@@ -353,7 +353,7 @@ print.imu_analysis_list <- function(x, ...) {
 #' }
 plot.imu_analysis <- function(x, sensor = NULL, units = c("SI", "datasheet"), ...) {
   units <- match.arg(units)
-  sensors <- unique(vapply(x$channels, function(c) c$sensor, ""))
+  sensors <- unique(vapply(x$channels, function(cc) cc$sensor, ""))
   if (!is.null(sensor)) sensors <- intersect(sensors, match_sensor(sensor))
   if (!length(sensors)) abort("no ", sensor, " channels in this analysis.")
   if (length(sensors) > 1L) {
@@ -365,14 +365,14 @@ plot.imu_analysis <- function(x, sensor = NULL, units = c("SI", "datasheet"), ..
 }
 
 plot_sensor <- function(x, s, units, ...) {
-  chans <- Filter(function(c) c$sensor == s, x$channels)
+  chans <- Filter(function(cc) cc$sensor == s, x$channels)
   u <- if (units == "SI") si_unit(s, "rate") else if (s == "gyro") "deg/h" else "ug"
   k <- convert_units(1, si_unit(s, "rate"), u)
   cols <- grDevices::hcl.colors(max(3L, length(chans)), "Dark 3")[seq_along(chans)]
-  rng_x <- range(unlist(lapply(chans, function(c) c$curve$tau)))
-  rng_y <- range(unlist(lapply(chans, function(c) {
-    v <- c(c$curve$adev, c$curve$lower, c$curve$upper)
-    rd <- c$readings
+  rng_x <- range(unlist(lapply(chans, function(cc) cc$curve$tau)))
+  rng_y <- range(unlist(lapply(chans, function(cc) {
+    v <- c(cc$curve$adev, cc$curve$lower, cc$curve$upper)
+    rd <- cc$readings
     v <- c(v, rd$value[rd$term == "N"],
            rd$value[rd$term == "B"] * sqrt(2 * log(2) / pi))
     if (!grepl("upper bound", rd$method[rd$term == "K"])) {
@@ -419,7 +419,7 @@ plot_sensor <- function(x, s, units, ...) {
     }
   }
   graphics::legend("topright", bty = "n", cex = 0.75,
-                   legend = c(vapply(chans, function(c) c$channel, ""),
+                   legend = c(vapply(chans, function(cc) cc$channel, ""),
                               "fitted model", "-1/2 and +1/2 lines",
                               "N: -1/2 line at tau = 1 s",
                               "B: flat minimum (ADEV = 0.664 B)",

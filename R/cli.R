@@ -160,7 +160,7 @@ cli_run <- function(args) {
     prefix <- if (several) paste0(sub("\\.[^.]*$", "", basename(f)), "_") else ""
     path <- function(name) file.path(out, paste0(prefix, name))
     png_file <- path("allan_deviation.png")
-    n_s <- length(unique(vapply(a$channels, function(c) c$sensor, "")))
+    n_s <- length(unique(vapply(a$channels, function(cc) cc$sensor, "")))
     grDevices::png(png_file, width = 700 * n_s, height = 600, res = 96)
     tryCatch(plot(a), finally = grDevices::dev.off())
     ds <- datasheet(a, average = isTRUE(opt$average))

@@ -52,10 +52,10 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
     for (k in keys) {
       sensor <- if (startsWith(k, "gyro")) "gyro" else "accel"
       term <- if (endsWith(k, "noise_density")) "N" else "K"
-      rows <- lapply(Filter(function(c) c$sensor == sensor, x$channels),
-                     function(c) {
-                       r <- c$readings[c$readings$term == term, ]
-                       data.frame(axis = c$channel, value = r$value,
+      rows <- lapply(Filter(function(cc) cc$sensor == sensor, x$channels),
+                     function(cc) {
+                       r <- cc$readings[cc$readings$term == term, ]
+                       data.frame(axis = cc$channel, value = r$value,
                                   method = r$method, stringsAsFactors = FALSE)
                      })
       if (!length(rows)) {
