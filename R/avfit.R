@@ -1,3 +1,18 @@
+# The noise-model fit. Internals other files may use (stable within the
+# package):
+#   avfit(fit, terms, start = c(gm2.tc = 30))  refits an avfit's own curve
+#       with new terms; the old nonlinear estimates start the new fit.
+#   fit$data     tau, m, avar, edf, fitted, z (standardized log residual)
+#   fit$input    the normalised input (list: data, freq, n, type, edf_source)
+#   fit$layout   one row per coefficient: name, label, kind, param, role
+#                ("amp"/"nonlinear"), unit, fixed, value
+#   fit$components  each term instance's AV at the data taus
+#   log_bias(edf), log_sd(edf)   chi-square log bias and sd of ln AV-hat
+#   edf_model(m, n, type, comp, alpha)  model EDF (see the EDF section)
+#   white_corr(m, n, type)  white-noise correlation of the AV estimates
+# The catalogue helpers live in terms.R (coef_layout, check_coef,
+# term_basis_matrix, model_components, term_entry, term_labels).
+
 #' Fit a noise model to an Allan variance curve
 #'
 #' Fits a sum of noise terms from the catalogue ([av_terms()]) to an Allan
@@ -17,7 +32,9 @@
 #' * a plain data frame with columns `tau` (s) and `avar`, and optionally
 #'   `edf`, computed elsewhere; without `edf`, give `n` and `freq` (the
 #'   estimator is taken as overlapping unless `type` says otherwise);
-#' * a previous `avfit` (its data are refitted with the new `terms`).
+#' * a previous `avfit` (its data are refitted with the new `terms`, its
+#'   nonlinear estimates as starting values and, when its EDF came from its
+#'   model, with that same EDF, so that AIC/BIC of the two fits compare).
 #'
 #' @section Model and estimation:
 #' The expected Allan variance is \eqn{AV_j = \sum_k a_k^2 b_k(\tau_j;
@@ -63,8 +80,9 @@
 #' \eqn{\max(1, \chi^2/\mathrm{dof})} so that misfit widens it. For an
 #' amplitude at its bound 0 the curvature is computed for \eqn{c = a^2}
 #' instead and its standard error reported as \eqn{\sqrt{SE(c)}} (the
-#' one-sigma upper reach of the amplitude). Fixed parameters have zero
-#' variance.
+#' one-sigma upper reach of the amplitude); the `tc` or `f0` of a term whose
+#' amplitude is 0 is not identified and gets `NA`. Fixed parameters have
+#' zero variance.
 #'
 #' @param av The Allan variance curve (see Input).
 #' @param terms Character vector of terms to fit (see [av_terms()]); `gm` and
@@ -175,9 +193,9 @@ avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
     }
   }
   fit <- NULL
-  passes <- if (d$edf_source == "input") 1L else 2L
+  passes <- if (d$edf_source == "model") 2L else 1L
   for (pass in seq_len(passes)) {
-    if (d$edf_source != "input") {
+    if (d$edf_source == "model") {
       d$data$edf <- if (is.null(fit)) {
         edf_model(d$data$m, d$n, d$type, matrix(1, nrow(d$data), 1), 0)
       } else {
@@ -211,6 +229,15 @@ normalize_type <- function(type) {
 avfit_input <- function(av, n, freq, type, type_given, channel) {
   if (inherits(av, "avfit")) {
     d <- av$input
+    if (d$edf_source == "model") {
+      # keep the EDF of the fit being extended, so that the two fits'
+      # likelihoods (AIC, BIC) are comparable
+      tau0 <- if (is.null(d$freq)) NULL else 1 / d$freq
+      comp <- model_components(d$data$tau, tau0, av$layout)
+      d$data$edf <- edf_model(d$data$m, d$n, d$type, comp,
+                              term_alpha(av$layout, d$data$tau))
+      d$edf_source <- "previous"
+    }
     return(d)
   }
   if (!is.null(freq)) freq <- check_freq(freq)
@@ -435,12 +462,13 @@ whitening <- function(s, corr) {
 
 # Solve for the amplitudes at given nonlinear values; returns list with c
 # (named by free amp label), objective.
-solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL) {
+# `off`: labels of term instances left out (amplitude 0) for this solve.
+solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL, off_labels = NULL) {
   lay2 <- lay
   lay2$value[lay2$role == "nonlinear" & !lay2$fixed] <- nlv
   Bm <- term_basis_matrix(data$tau, tau0, lay2)
   amp <- lay2[lay2$role == "amp", , drop = FALSE]
-  freeamp <- amp$label[!amp$fixed]
+  freeamp <- amp$label[!amp$fixed & !amp$label %in% off_labels]
   off <- numeric(nrow(data))
   for (i in which(amp$fixed)) off <- off + amp$value[i]^2 * Bm[, amp$label[i]]
   Bf <- Bm[, freeamp, drop = FALSE]
@@ -451,7 +479,8 @@ solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL) {
     return(list(c = numeric(0), objective = obj, layout = lay2))
   }
   r <- avfit_log_nnls(Bf, off, y, W, cstart, 100L, 1e-12)
-  cc <- stats::setNames(r$c, freeamp)
+  cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$label[!amp$fixed])
+  cc[freeamp] <- r$c
   list(c = cc, objective = r$objective, layout = lay2)
 }
 
@@ -464,43 +493,74 @@ fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
   nlrows <- which(lay$role == "nonlinear" & !lay$fixed)
   nlv <- numeric(length(nlrows))
   names(nlv) <- lay$name[nlrows]
-  obj <- function(lognl) solve_amps(data, tau0, lay, exp(lognl), y, W)$objective
+  obj <- function(lognl, off_labels = NULL) {
+    solve_amps(data, tau0, lay, exp(lognl), y, W, off_labels = off_labels)$objective
+  }
   if (length(nlrows)) {
     ranges <- lapply(nlrows, function(i) nl_range(lay$kind[i], data$tau, freq))
-    # initial values: start, previous fit, or grid centre
+    # initial values: previous pass, start, or grid centre
     for (k in seq_along(nlrows)) {
       nm <- lay$name[nlrows[k]]
-      nlv[k] <- if (!is.null(start) && nm %in% names(start)) start[[nm]] else
-        if (!is.null(prev)) prev$layout$value[prev$layout$name == nm] else
+      nlv[k] <- if (!is.null(prev)) prev$layout$value[prev$layout$name == nm] else
+        if (!is.null(start) && nm %in% names(start)) start[[nm]] else
           sqrt(prod(ranges[[k]]))
     }
     # a parameter with a start (given, or from the previous pass) is refined
     # locally; the others are searched on the grid first
-    has_start <- !is.null(prev) | names(nlv) %in% names(start)
-    lognl <- log(nlv)
-    cycles <- if (length(nlrows) > 1L) 2L else 1L
-    for (cy in seq_len(cycles)) {
-      for (k in seq_along(nlrows)) {
-        f1 <- function(v) { l <- lognl; l[k] <- v; obj(l) }
-        if (cy > 1L || has_start[k]) {
-          lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
-        } else {
-          ng <- if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
-          g <- seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
-          vals <- vapply(g, f1, 0)
-          i <- which.min(vals)
-          lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
-          lognl[k] <- g[i]
+    has_start <- names(nlv) %in% names(start)
+    search <- function(order) {
+      lognl <- log(nlv)
+      cycles <- if (length(nlrows) > 1L) 2L else 1L
+      for (cy in seq_len(cycles)) {
+        for (pos in seq_along(order)) {
+          k <- order[pos]
+          # first cycle: terms not searched yet stay out of the model (greedy)
+          later <- if (cy == 1L) {
+            j <- order[seq_along(order) > pos]
+            lay$label[nlrows[j[!has_start[j]]]]
+          } else NULL
+          f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
+          if (cy > 1L || !is.null(prev)) {
+            lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
+          } else {
+            # a start value: a short grid over start / 4 .. start * 4;
+            # otherwise the whole range
+            ng <- if (has_start[k]) 13L else
+              if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
+            g <- if (has_start[k]) lognl[k] + seq(-log(4), log(4), length.out = ng) else
+              seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
+            vals <- vapply(g, f1, 0)
+            i <- which.min(vals)
+            lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
+            lognl[k] <- g[i]
+          }
+          o <- stats::optimize(f1, c(lo, hi), tol = 1e-7)
+          if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
         }
-        o <- stats::optimize(f1, c(lo, hi), tol = 1e-7)
-        if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
       }
+      if (length(nlrows) > 1L) {
+        o <- stats::optim(lognl, obj, method = "Nelder-Mead",
+                          control = list(reltol = 1e-10, maxit = 400))
+        if (o$value <= obj(lognl)) lognl <- o$par
+      }
+      list(lognl = lognl, value = obj(lognl))
     }
-    if (length(nlrows) > 1L) {
-      o <- stats::optim(lognl, obj, method = "Nelder-Mead",
-                        control = list(reltol = 1e-10, maxit = 400))
-      if (o$value <= obj(lognl)) lognl <- o$par
+    # The greedy search depends on the order in which the terms enter; with
+    # several unstarted nonlinear terms try each rotation of the order (and
+    # its reverse) and keep the best objective.
+    K <- length(nlrows)
+    orders <- list(seq_len(K))
+    if (is.null(prev) && sum(!has_start) > 1L) {
+      rot <- lapply(seq_len(K) - 1L, function(r) (seq_len(K) + r - 1L) %% K + 1L)
+      orders <- unique(c(rot, lapply(rot, rev)))
+      if (length(orders) > 6L) orders <- orders[seq_len(6L)]
     }
+    best <- NULL
+    for (ord in orders) {
+      r <- search(ord)
+      if (is.null(best) || r$value < best$value) best <- r
+    }
+    lognl <- best$lognl
     nlv[] <- exp(lognl)
   }
   sol <- solve_amps(data, tau0, lay, nlv, y, W)
@@ -596,6 +656,13 @@ finish_fit <- function(fit, d, input, terms, cl) {
     diag(vfree)[match(zn, fn)] <- sez^2
   }
   vc[fn, fn] <- vfree
+  # a nonlinear parameter of a term whose amplitude is 0 is not identified
+  for (i in which(lay$role == "nonlinear" & !lay$fixed)) {
+    a <- lay$value[lay$label == lay$label[i] & lay$role == "amp"]
+    if (!(a > 0)) {
+      vc[i, ] <- vc[, i] <- NA_real_
+    }
+  }
   se[] <- sqrt(pmax(diag(vc), 0))
   data$fitted <- fitted
   data$z <- z
@@ -604,7 +671,7 @@ finish_fit <- function(fit, d, input, terms, cl) {
                       chi2_before = numeric(0), chi2_after = numeric(0),
                       rms_before = numeric(0), rms_after = numeric(0),
                       stringsAsFactors = FALSE)
-  input$data$edf <- if (d$edf_source == "input") input$data$edf else NA_real_
+  input$data$edf <- if (d$edf_source == "model") NA_real_ else input$data$edf
   structure(list(
     coefficients = coef, se = se, vcov = vc, chi2 = chi2, rms = rms,
     objective = objective, logdet = -2 * sum(log(diag(fit$W))),
@@ -633,7 +700,10 @@ finish_fit <- function(fit, d, input, terms, cl) {
 #' (bias-corrected) with variances \eqn{\psi'(\nu_j/2)} (and the
 #' white-noise correlation when the fit used `correlation = TRUE`); its `df` is the
 #' number of free parameters and `nobs` the number of points, so AIC() and
-#' BIC() work.
+#' BIC() work. Compare models by AIC/BIC only on the same points with the same
+#' EDF: when the EDF is derived from the model (input without `edf`), refit
+#' the candidate from the first fit, `avfit(fit, terms)`, or pass its
+#' `fit$data$edf` as an `edf` column.
 #'
 #' @param object,x An `avfit` object.
 #' @param parm Coefficients for `confint()` (names or indices; default all).
@@ -754,7 +824,8 @@ print.avfit <- function(x, ...) {
   cat("Allan variance noise-model fit:", paste(x$terms, collapse = " + "), "\n")
   cat(sprintf("%d points, tau %.3g to %.3g s, %s estimator, EDF from %s\n",
               x$nobs, min(x$data$tau), max(x$data$tau), x$type,
-              if (x$edf_source == "input") "the input" else "the model"))
+              switch(x$edf_source, input = "the input", model = "the model",
+                     previous = "the previous fit's model")))
   tab <- data.frame(estimate = signif(x$coefficients, 4),
                     se = signif(x$se, 3), unit = x$layout$unit)
   print(tab)

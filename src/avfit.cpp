@@ -38,6 +38,7 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500) {
     }
     if (t < 0) break;
     passive[t] = true;
+    const VectorXd x_prev = x;
     for (int inner = 0; inner < 3 * p + 3; ++inner) {
       std::vector<int> idx;
       for (int k = 0; k < p; ++k) if (passive[k]) idx.push_back(k);
@@ -68,6 +69,9 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500) {
         }
       }
     }
+    // Degenerate step (the variable just added was dropped again and x did
+    // not move): Lawson-Hanson would cycle; x is optimal to rounding.
+    if ((x - x_prev).norm() <= 1e-14 * (1.0 + x.norm())) break;
   }
   for (int k = 0; k < p; ++k) x(k) /= scale(k);
   return x;

@@ -307,3 +307,55 @@ test_that("correlation = TRUE: exact curves, calibrated chi2 and honest SE", {
                    determinant(S)$modulus + t(r) %*% solve(S, r)))
                }, tolerance = 1e-6)
 })
+
+test_that("refitting an avfit keeps its EDF (comparable AIC) and its estimates", {
+  x <- avsim(n, f, N = 0.01, gm = list(sigma = 0.01, tc = 2), seed = 41)
+  tab <- oav_table(x, f)
+  fit0 <- avfit(tab, "N", n = n, freq = f)
+  fit1 <- avfit(fit0, c("N", "gm"))
+  expect_equal(fit1$data$edf, fit0$data$edf)
+  expect_equal(fit1$edf_source, "previous")
+  expect_lt(AIC(fit1), AIC(fit0) - 10)
+  # a second refit starts from gm1's estimate and finds a second GM
+  fit2 <- avfit(fit1, c("N", "gm", "gm"), start = c(gm2.tc = 100))
+  expect_named(coef(fit2), c("N", "gm1.sigma", "gm1.tc", "gm2.sigma", "gm2.tc"))
+  expect_lte(fit2$objective, fit1$objective + 1e-6)
+  # start and fixed together; unknown names rejected
+  fit3 <- avfit(tab, c("N", "gm"), n = n, freq = f, start = c(gm1.tc = 1),
+                fixed = c(N = 0.01))
+  expect_equal(unname(coef(fit3)["gm1.tc"]), 2, tolerance = 0.15)
+  expect_error(avfit(tab, "N", n = n, freq = f, fixed = c(B = 1)), "`fixed`")
+  # avari() output is overlapping
+  fit_i <- avfit(avari(cumsum(x) / f, f), c("N", "gm"), freq = f,
+                 type = "overlapping")
+  expect_equal(fit_i$type, "overlapping")
+  expect_equal(unname(coef(fit_i)["N"]), 0.01, tolerance = 0.05)
+})
+
+test_that("several nonlinear terms: the search finds the global optimum", {
+  nn <- 2^17
+  x <- avsim(nn, f, N = 0.01, B = 0.002, gm = list(sigma = 0.006, tc = 3),
+             sinusoid = list(amp = 0.01, f0 = 1.3), seed = 51)
+  ms <- unique(round(10^seq(0, log10(nn / 4), by = 0.05)))
+  tb <- oav_table(x, f, ms)
+  for (corr in c(FALSE, TRUE)) {
+    fit <- avfit(tb, c("N", "B", "gm", "sinusoid"), n = nn, freq = f,
+                 correlation = corr)
+    cf <- coef(fit)
+    expect_equal(unname(cf["sinusoid1.f0"]), 1.3, tolerance = 0.05)
+    expect_equal(unname(cf["sinusoid1.amp"]), 0.01, tolerance = 0.2)
+    # diagonal weights: tc = 4.1 +- 0.4 here (adjacent taus are correlated,
+    # the SE is too small); with correlation = TRUE: 3.3 +- 1.0
+    expect_equal(unname(cf["gm1.tc"]), 3, tolerance = 0.4)
+    if (corr) expect_lt(abs(cf[["gm1.tc"]] - 3), 2 * fit$se[["gm1.tc"]])
+    # started at the truth, the fit ends no better than the search did
+    st <- avfit(tb, c("N", "B", "gm", "sinusoid"), n = nn, freq = f,
+                correlation = corr, start = c(gm1.tc = 3, sinusoid1.f0 = 1.3))
+    expect_gte(st$objective, fit$objective - 1e-6 * fit$objective)
+  }
+  # a term fitted to nothing: its tc is not identified
+  x <- avsim(2^16, f, N = 0.01, seed = 52)
+  fit <- avfit(oav_table(x, f), c("N", "gm"), n = 2^16, freq = f,
+               fixed = c(gm1.sigma = 0))
+  expect_true(is.na(fit$se["gm1.tc"]))
+})
