@@ -127,19 +127,30 @@ avrefine <- function(fit, data = NULL,
     # screened fit is put on the all-free scale by charging the held ones.
     nl_now <- stats::coef(current)[current$layout$role == "nonlinear"]
     pen <- if (criterion == "BIC") log(current$nobs) else 2
-    crit_s <- function(f) crit(f) + pen * (length(nl_now) - length(known))
+    crit_s <- function(f) crit(f) + pen * (length(hold_now) - length(known))
     best <- NULL
-    # Traced candidates first; the others only when none of those pays.
-    for (tier in list(which(trials$traced), which(!trials$traced))) {
+    # When screening finds nothing, the candidates are tried once more with
+    # all nonlinear parameters free (slower, but catches effects that only
+    # pay once the others may move). Traced candidates first; the others
+    # only when none of those pays.
+    holds <- if (length(nl_now) > length(known)) list(nl_now, known) else list(known)
+    passes <- list()
+    for (h in holds) {
+      passes[[length(passes) + 1L]] <- list(hold = h, tier = which(trials$traced))
+      passes[[length(passes) + 1L]] <- list(hold = h, tier = which(!trials$traced))
+    }
+    for (pass in passes) {
+      hold_now <- pass$hold
+      tier <- pass$tier
       for (i in tier) {
         tr <- trials[i, ]
         init <- tr$init[[1L]]
         new <- refit_with(current, c(current$terms, tr$effect), tr$effect, init, ...,
-                          hold = nl_now,
+                          hold = hold_now,
                           good_enough = function(f) crit_s(f) < c0 - min_gain)
         if (tr$effect == "sinusoid" && isTRUE(tr$from_raw)) {
           alt <- refit_fixed_f0(current, c(current$terms, tr$effect), init$f0, ...,
-                                hold = nl_now)
+                                hold = hold_now)
           if (!is.null(alt) && (is.null(new) || crit_s(alt) < crit_s(new))) new <- alt
         }
         if (is.null(new)) next
@@ -164,7 +175,7 @@ avrefine <- function(fit, data = NULL,
     if (is.null(best)) break
     # Refit the winner with the held nonlinear parameters free again (the new
     # one starts where screening put it).
-    if (length(nl_now)) {
+    if (length(hold_now) > length(known)) {
       lay <- best$fit$layout
       start <- stats::coef(best$fit)[lay$role == "nonlinear"]
       f0_held <- lay$name[lay$fixed & lay$param == "f0" & lay$label == best$label]
