@@ -27,8 +27,10 @@
 #' data) are tried first, the others only when none of those pays. Among
 #' the candidates that pay, the one with the lowest criterion wins, where
 #' raw-data support counts as a gain of `min_gain` and a contradiction as a
-#' loss of `min_gain`. An accepted effect that the raw data contradict is
-#' kept (it pays on the curve) but flagged `confirmed = FALSE`.
+#' loss of `min_gain` (so an effect the raw data contradict must lower the
+#' criterion by twice `min_gain`). An accepted effect that the raw data
+#' contradict is kept (it pays on the curve) but flagged
+#' `confirmed = FALSE`.
 #'
 #' @param fit An [avfit()] result.
 #' @param data Optional raw rate series (numeric vector or `ts`) at the
@@ -55,15 +57,16 @@
 #'   `rms_before`, `rms_after` (RMS relative ADEV error, percent),
 #'   `crit_before`, `crit_after` (the criterion). `refine` holds the
 #'   arguments, the raw-data diagnostics ([avdiagnose()]) and the
-#'   signatures left when the loop stopped.
+#'   signatures left when the loop stopped. The object keeps class `avfit`
+#'   (with `avrefine` in front, whose print method lists the steps), so
+#'   every avfit method applies.
 #' @seealso [avfit()], [avdiagnose()], [avsim()]
 #' @export
 #' @examples
-#' x <- avsim(1e5, 100, N = 0.01, K = 1e-4, gm = list(sigma = 0.005, tc = 5),
-#'            seed = 1)
-#' av <- allan(x, 100, taus = "decade")
-#' fit <- avfit(av, terms = c("N", "K"))
-#' ref <- avrefine(fit, data = x, candidates = c("gm", "sinusoid", "B"))
+#' # White noise plus a Gauss-Markov process, fitted as white noise only:
+#' x <- avsim(3e4, 100, N = 0.01, gm = list(sigma = 0.01, tc = 1), seed = 1)
+#' fit <- avfit(allan(x, 100, taus = 5), terms = "N")
+#' ref <- avrefine(fit, candidates = c("gm", "K"), max_steps = 1)
 #' ref$steps[, c("effect", "params", "chi2_before", "chi2_after")]
 avrefine <- function(fit, data = NULL,
                      candidates = c("Q", "N", "B", "K", "R", "gm", "sinusoid"),
@@ -164,8 +167,10 @@ avrefine <- function(fit, data = NULL,
         if (max_share(new, lab) < 0.02) next
         par <- effect_params(new, lab)
         ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
-        # Raw-data support or contradiction weighs min_gain criterion units.
+        # Raw-data support or contradiction weighs min_gain criterion units;
+        # an effect the raw data contradict must pay twice the margin.
         adj <- c1 - min_gain * (isTRUE(ev$support) - isFALSE(ev$support))
+        if (isFALSE(ev$support) && !(adj < c0 - min_gain)) next
         cand <- list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
                      params = par, ev = ev)
         if (is.null(best) || adj < best$adj) best <- cand
