@@ -27,8 +27,10 @@
 #' data) are tried first, the others only when none of those pays. Among
 #' the candidates that pay, the one with the lowest criterion wins, where
 #' raw-data support counts as a gain of `min_gain` and a contradiction as a
-#' loss of `min_gain`. An accepted effect that the raw data contradict is
-#' kept (it pays on the curve) but flagged `confirmed = FALSE`.
+#' loss of `min_gain` (so an effect the raw data contradict must lower the
+#' criterion by twice `min_gain`). An accepted effect that the raw data
+#' contradict is kept (it pays on the curve) but flagged
+#' `confirmed = FALSE`.
 #'
 #' @param fit An [avfit()] result.
 #' @param data Optional raw rate series (numeric vector or `ts`) at the
@@ -55,15 +57,16 @@
 #'   `rms_before`, `rms_after` (RMS relative ADEV error, percent),
 #'   `crit_before`, `crit_after` (the criterion). `refine` holds the
 #'   arguments, the raw-data diagnostics ([avdiagnose()]) and the
-#'   signatures left when the loop stopped.
+#'   signatures left when the loop stopped. The object keeps class `avfit`
+#'   (with `avrefine` in front, whose print method lists the steps), so
+#'   every avfit method applies.
 #' @seealso [avfit()], [avdiagnose()], [avsim()]
 #' @export
 #' @examples
-#' x <- avsim(1e5, 100, N = 0.01, K = 1e-4, gm = list(sigma = 0.005, tc = 5),
-#'            seed = 1)
-#' av <- allan(x, 100, taus = "decade")
-#' fit <- avfit(av, terms = c("N", "K"))
-#' ref <- avrefine(fit, data = x, candidates = c("gm", "sinusoid", "B"))
+#' # White noise plus a Gauss-Markov process, fitted as white noise only:
+#' x <- avsim(3e4, 100, N = 0.01, gm = list(sigma = 0.01, tc = 1), seed = 1)
+#' fit <- avfit(allan(x, 100, taus = 5), terms = "N")
+#' ref <- avrefine(fit, candidates = c("gm", "K"), max_steps = 1)
 #' ref$steps[, c("effect", "params", "chi2_before", "chi2_after")]
 avrefine <- function(fit, data = NULL,
                      candidates = c("Q", "N", "B", "K", "R", "gm", "sinusoid"),
@@ -107,6 +110,8 @@ avrefine <- function(fit, data = NULL,
 
   steps <- list()
   current <- fit
+  # Sinusoid frequencies taken from the raw periodogram stay held.
+  known <- numeric(0)
   sig <- NULL
   for (step in seq_len(max_steps)) {
     tau <- current$data$tau
@@ -119,20 +124,40 @@ avrefine <- function(fit, data = NULL,
     trials <- candidate_trials(traced, current$terms, candidates, sig)
     if (!nrow(trials)) break
     c0 <- crit(current)
+    # Screening: the model's existing nonlinear parameters are held at their
+    # current values while candidates are compared (one 1-D profile each);
+    # the winner is then refitted with everything free. The criterion of a
+    # screened fit is put on the all-free scale by charging the held ones.
+    nl_now <- stats::coef(current)[current$layout$role == "nonlinear"]
+    pen <- if (criterion == "BIC") log(current$nobs) else 2
+    crit_s <- function(f) crit(f) + pen * (length(hold_now) - length(known))
     best <- NULL
-    # Traced candidates first; the others only when none of those pays.
-    for (tier in list(which(trials$traced), which(!trials$traced))) {
+    # When screening finds nothing, the candidates are tried once more with
+    # all nonlinear parameters free (slower, but catches effects that only
+    # pay once the others may move). Traced candidates first; the others
+    # only when none of those pays.
+    holds <- if (length(nl_now) > length(known)) list(nl_now, known) else list(known)
+    passes <- list()
+    for (h in holds) {
+      passes[[length(passes) + 1L]] <- list(hold = h, tier = which(trials$traced))
+      passes[[length(passes) + 1L]] <- list(hold = h, tier = which(!trials$traced))
+    }
+    for (pass in passes) {
+      hold_now <- pass$hold
+      tier <- pass$tier
       for (i in tier) {
         tr <- trials[i, ]
         init <- tr$init[[1L]]
         new <- refit_with(current, c(current$terms, tr$effect), tr$effect, init, ...,
-                          good_enough = function(f) crit(f) < c0 - min_gain)
+                          hold = hold_now,
+                          good_enough = function(f) crit_s(f) < c0 - min_gain)
         if (tr$effect == "sinusoid" && isTRUE(tr$from_raw)) {
-          alt <- refit_fixed_f0(current, c(current$terms, tr$effect), init$f0, ...)
-          if (!is.null(alt) && (is.null(new) || crit(alt) < crit(new))) new <- alt
+          alt <- refit_fixed_f0(current, c(current$terms, tr$effect), init$f0, ...,
+                                hold = hold_now)
+          if (!is.null(alt) && (is.null(new) || crit_s(alt) < crit_s(new))) new <- alt
         }
         if (is.null(new)) next
-        c1 <- crit(new)
+        c1 <- crit_s(new)
         pays <- is.finite(c1) && c1 < c0 - min_gain &&
           new$chi2 < 0.9 * current$chi2
         if (!pays) next
@@ -142,8 +167,10 @@ avrefine <- function(fit, data = NULL,
         if (max_share(new, lab) < 0.02) next
         par <- effect_params(new, lab)
         ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
-        # Raw-data support or contradiction weighs min_gain criterion units.
+        # Raw-data support or contradiction weighs min_gain criterion units;
+        # an effect the raw data contradict must pay twice the margin.
         adj <- c1 - min_gain * (isTRUE(ev$support) - isFALSE(ev$support))
+        if (isFALSE(ev$support) && !(adj < c0 - min_gain)) next
         cand <- list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
                      params = par, ev = ev)
         if (is.null(best) || adj < best$adj) best <- cand
@@ -151,7 +178,27 @@ avrefine <- function(fit, data = NULL,
       if (!is.null(best)) break
     }
     if (is.null(best)) break
+    # Refit the winner with the held nonlinear parameters free again (the new
+    # one starts where screening put it).
+    if (length(hold_now) > length(known)) {
+      lay <- best$fit$layout
+      start <- stats::coef(best$fit)[lay$role == "nonlinear"]
+      f0_held <- lay$name[lay$fixed & lay$param == "f0" & lay$label == best$label]
+      hold <- c(known, stats::coef(best$fit)[f0_held])
+      start <- start[!names(start) %in% names(hold)]
+      args <- c(list(av = current, terms = best$fit$terms, start = start), list(...))
+      if (length(hold)) args$fixed <- c(args$fixed, hold)
+      full <- tryCatch(suppressWarnings(do.call(avfit, args)), error = function(e) NULL)
+      if (!is.null(full) && is.finite(full$chi2) && crit(full) <= best$crit + 1e-6) {
+        best$fit <- full
+        best$crit <- crit(full)
+        best$params <- effect_params(full, best$label)
+      }
+    }
     tr <- best$trial
+    lay <- best$fit$layout
+    f0_held <- lay$name[lay$fixed & lay$param == "f0" & lay$label == best$label]
+    if (length(f0_held)) known <- c(known, stats::coef(best$fit)[f0_held])
     evidence <- tr$signature
     if (nzchar(best$ev$text)) {
       evidence <- paste0(evidence, "; raw data: ", best$ev$text,
@@ -160,7 +207,8 @@ avrefine <- function(fit, data = NULL,
     steps[[length(steps) + 1L]] <- data.frame(
       effect = tr$effect, label = best$label,
       tau_from = tr$tau_from, tau_to = tr$tau_to,
-      params = format_params(best$params, tr$effect),
+      params = paste0(format_params(best$params, tr$effect),
+                      if (length(f0_held)) " (f0 from the periodogram)"),
       evidence = evidence, confirmed = best$ev$support,
       chi2_before = current$chi2, chi2_after = best$fit$chi2,
       rms_before = current$rms, rms_after = best$fit$rms,
@@ -184,24 +232,6 @@ avrefine <- function(fit, data = NULL,
 
 #' @export
 print.avrefine <- function(x, ...) {
-  NextMethod()
-  cat("\n")
-  print_steps(x)
-  invisible(x)
-}
-
-#' @export
-summary.avrefine <- function(object, ...) {
-  s <- NextMethod()
-  s <- if (is.list(s)) s else list(summary = s)
-  s$steps <- object$steps
-  s$refine <- object$refine
-  class(s) <- unique(c("summary.avrefine", class(s)))
-  s
-}
-
-#' @export
-print.summary.avrefine <- function(x, ...) {
   NextMethod()
   cat("\n")
   print_steps(x)
@@ -255,10 +285,12 @@ candidate_trials <- function(traced, present, candidates, sig) {
 # parameters on its own grid; when the tracing gives a starting Tc or f0 the
 # refit is also tried from there, and the better of the two is kept. NULL
 # when both fail.
-refit_with <- function(fit, terms, effect, init, ..., good_enough = NULL) {
+refit_with <- function(fit, terms, effect, init, ..., hold = NULL,
+                       good_enough = NULL) {
   one <- function(start) {
     args <- c(list(av = fit, terms = terms), list(...))
     if (length(start)) args$start <- c(args$start, start)
+    if (length(hold)) args$fixed <- c(args$fixed, hold)
     res <- tryCatch(suppressWarnings(do.call(avfit, args)),
                     error = function(e) NULL)
     if (is.null(res) || !is.finite(res$chi2)) NULL else res
@@ -277,10 +309,10 @@ refit_with <- function(fit, terms, effect, init, ..., good_enough = NULL) {
 
 # A sinusoid whose line the raw periodogram resolves: its f0 is known far
 # better from the data than from the curve, so also try it held fixed there.
-refit_fixed_f0 <- function(fit, terms, f0, ...) {
+refit_fixed_f0 <- function(fit, terms, f0, ..., hold = NULL) {
   lab <- new_label(fit$terms, "sinusoid")
   args <- c(list(av = fit, terms = terms), list(...))
-  args$fixed <- c(args$fixed, stats::setNames(f0, paste0(lab, ".f0")))
+  args$fixed <- c(args$fixed, hold, stats::setNames(f0, paste0(lab, ".f0")))
   res <- tryCatch(suppressWarnings(do.call(avfit, args)), error = function(e) NULL)
   if (is.null(res) || !is.finite(res$chi2)) NULL else res
 }
