@@ -44,7 +44,7 @@
 #'   named with the channel names to use (e.g.
 #'   `c(gyro_x = "gx", gyro_y = "gy")`).
 #' @param units Units of the input: `NULL` (from the header's brackets,
-#'   else SI), a vector named by sensor (`c(gyro = "deg/s", accel = "g")`) or
+#'   else SI, with a message), a vector named by sensor (`c(gyro = "deg/s", accel = "g")`) or
 #'   by channel, or a single unit for every channel of its sensor. See
 #'   [av_units()].
 #' @param sep Field separator (`""` for white space).
@@ -184,6 +184,9 @@ read_imu <- function(file, time = NULL,
     if (layout %in% c("kalibr", "euroc") || all(!is.na(hu))) {
       units <- ifelse(is.na(hu), ifelse(ch_sensor == "gyro", "rad/s", "m/s^2"), hu)
       names(units) <- ch_names
+    } else {
+      message("read_imu(): no units given for ", basename(file), "; assuming ",
+              "rad/s for gyroscopes and m/s^2 for accelerometers (set `units`).")
     }
   }
 

@@ -57,15 +57,17 @@ test_that("other layouts: columns, units and time unit by argument", {
   expect_equal(unname(r$data[, "gyro_y"]), d$gy * pi / 180)
   expect_equal(unname(r$data[, "accel_z"]), d$az * 9.80665e-3)
   # ms picked automatically from the step (10) too
-  r2 <- read_imu(f, time = 2, sep = ";", columns = 3:6,
-                 sensors = c("gyro", "gyro", "accel", "accel"))
+  expect_message(r2 <- read_imu(f, time = 2, sep = ";", columns = 3:6,
+                                sensors = c("gyro", "gyro", "accel", "accel")),
+                 "no units given")
   expect_identical(r2$time_unit, "ms")
   expect_equal(r2$freq, 100)
   # no time column: freq required
   expect_error(read_imu(f, time = FALSE, sep = ";", columns = 3:4,
                         sensors = c("gyro", "gyro")), "freq")
-  r3 <- read_imu(f, time = FALSE, sep = ";", columns = 3:4,
-                 sensors = c("gyro", "gyro"), freq = 50)
+  expect_message(r3 <- read_imu(f, time = FALSE, sep = ";", columns = 3:4,
+                                sensors = c("gyro", "gyro"), freq = 50),
+                 "assuming rad/s")
   expect_equal(r3$freq, 50)
   expect_error(read_imu(f, time = 2, sep = ";", columns = "nope"), "not found")
   expect_error(read_imu(f, time = 2, sep = ";", columns = "temp"), "sensor type")
