@@ -103,8 +103,11 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
                                                         jobs[[k]]$channel)
   opts <- list(taus = taus, type = type, terms = terms, refine = refine,
                progress = progress, fit_args = list(...))
+  # One future per axis: axes differ in cost (the refinement), so this
+  # balances the workers, and progress arrives as each axis finishes.
   results <- future.apply::future_lapply(jobs, analyze_channel, opts = opts,
-                                         future.seed = TRUE)
+                                         future.seed = TRUE,
+                                         future.scheduling = Inf)
 
   out <- lapply(seq_along(records), function(i) {
     r <- records[[i]]
