@@ -9,10 +9,6 @@ allan_reference_cpp <- function(v, m, type, rate) {
     .Call(`_allanvar_allan_reference_cpp`, v, m, type, rate)
 }
 
-allan_first_nonfinite_cpp <- function(x) {
-    .Call(`_allanvar_allan_first_nonfinite_cpp`, x)
-}
-
 avar_octave_exact <- function(values, freq) {
     .Call(`_allanvar_avar_octave_exact`, values, freq)
 }

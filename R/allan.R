@@ -114,10 +114,18 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
           "\" with ", N, " samples (largest cluster size: ", maxm, ").")
   }
   nterms <- allan_nterms(type, m, L)
-  octave <- type == "standard" && rate && all(m == 2^round(log2(m)))
+  octave <- type == "standard" && rate && length(m) <= 64L &&
+    all(m == 2^round(log2(m)))
   sub <- allan_subset(m)
   res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub], allan_type_code(type),
                         rate, octave, allanvar_threads())
+  if (any(res$bad > 0)) {
+    col <- which(res$bad > 0)[1L]
+    row <- res$bad[col]
+    abort("`x` must contain only finite numbers; found ",
+          format(ch$values[[(col - 1) * N + row]]), " at position ", row,
+          if (ch$nc > 1L) paste0(" of column ", col), ".")
+  }
   norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
                  2 * m^2)
   scale <- if (rate) 1 else freq^2
@@ -126,14 +134,15 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     av <- res$sums[, j] / (norm * nterms) * scale
     e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
     ci <- allan_ci(av, e$edf, conf)
-    d <- data.frame(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
-                    adev = sqrt(av), lower = ci$lower, upper = ci$upper,
-                    edf = e$edf, alpha = e$alpha)
-    if (ch$nc > 1L) d$channel <- ch$names[j]
-    out[[j]] <- d
+    d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
+              adev = sqrt(av), lower = ci$lower, upper = ci$upper,
+              edf = e$edf, alpha = e$alpha)
+    if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
+    out[[j]] <- structure(d, class = "data.frame",
+                          row.names = .set_row_names(length(m)))
   }
   out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)
-  rownames(out) <- NULL
+  if (ch$nc > 1L) rownames(out) <- NULL
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf)
 }
@@ -185,15 +194,9 @@ allan_channels <- function(x, min_n) {
     abort("`x` must have at least ", min_n, " samples per channel, not ", N, ".")
   }
   if (!is.double(x)) storage.mode(x) <- "double"
-  v <- x  # passed to C++ as is: attributes (ts, dim) cost no copy
-  bad <- allan_first_nonfinite_cpp(v)
-  if (bad > 0) {
-    col <- (bad - 1) %/% N + 1
-    row <- (bad - 1) %% N + 1
-    abort("`x` must contain only finite numbers; found ", format(v[[bad]]),
-          " at position ", row, if (nc > 1L) paste0(" of column ", col), ".")
-  }
-  list(values = v, N = N, nc = nc, names = nm)
+  # passed to C++ as is (attributes such as ts or dim cost no copy); the
+  # kernel checks finiteness in the pass it makes anyway
+  list(values = x, N = N, nc = nc, names = nm)
 }
 
 #' @export

@@ -49,16 +49,18 @@ allan_edf <- function(type, m, n, L, alpha_int, sub = seq_along(m)) {
   }
   lm <- log(m)
   ls <- lm[sub]
-  lo <- pmax(1L, findInterval(lm, ls))
-  hi <- pmin(length(sub), lo + 1L)
-  near <- ifelse(lm - ls[lo] <= ls[hi] - lm, lo, hi)
-  alpha <- a[near]
-  edf <- es[near]
-  same <- a[lo] == a[hi] & hi > lo
+  les <- log(es)
+  lo <- findInterval(lm, ls)  # m[1] is always in sub: lo >= 1
+  hi <- lo + (lo < length(sub))
   w <- (lm - ls[lo]) / (ls[hi] - ls[lo])
-  edf[same] <- exp((1 - w[same]) * log(es[lo][same]) + w[same] * log(es[hi][same]))
-  edf[sub] <- es
-  alpha[sub] <- a
+  w[hi == lo] <- 0
+  up <- w > 0.5
+  near <- lo
+  near[up] <- hi[up]
+  alpha <- a[near]
+  edf <- exp(les[lo] + w * (les[hi] - les[lo]))
+  jump <- a[lo] != a[hi]
+  edf[jump] <- es[near[jump]]
   list(edf = pmax(edf, 1e-3), alpha = alpha)
 }
 
@@ -93,8 +95,7 @@ allan_ci <- function(avar, edf, conf) {
   p <- (1 - conf) / 2
   fac <- function(e) cbind(log(e / stats::qchisq(1 - p, e)),
                            log(e / stats::qchisq(p, e)))
-  u <- unique(edf)
-  if (length(u) <= 2000L) {
+  if (length(edf) <= 2000L) {
     f <- fac(edf)
   } else {
     g <- exp(seq(log(min(edf)), log(max(edf)), length.out = 2000L))

@@ -42,16 +42,6 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// allan_first_nonfinite_cpp
-double allan_first_nonfinite_cpp(const Rcpp::NumericVector& x);
-RcppExport SEXP _allanvar_allan_first_nonfinite_cpp(SEXP xSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
-    rcpp_result_gen = Rcpp::wrap(allan_first_nonfinite_cpp(x));
-    return rcpp_result_gen;
-END_RCPP
-}
 // avar_octave_exact
 Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values, double freq);
 RcppExport SEXP _allanvar_avar_octave_exact(SEXP valuesSEXP, SEXP freqSEXP) {
@@ -145,7 +135,6 @@ END_RCPP
 static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 9},
     {"_allanvar_allan_reference_cpp", (DL_FUNC) &_allanvar_allan_reference_cpp, 4},
-    {"_allanvar_allan_first_nonfinite_cpp", (DL_FUNC) &_allanvar_allan_first_nonfinite_cpp, 1},
     {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 2},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},

@@ -236,3 +236,16 @@ test_that("print, summary and plot work and leave par() alone", {
   grDevices::dev.off()
   unlink(f)
 })
+
+test_that("the thread count changes nothing but the last bits", {
+  set.seed(13)
+  y <- 3 + cumsum(rnorm(2e5))
+  for (type in c("standard", "overlapping", "hadamard")) {
+    old <- options(allanvar.threads = 1)
+    a1 <- allan(y, 1, type = type)
+    options(allanvar.threads = 2)
+    a2 <- allan(y, 1, type = type)
+    options(old)
+    expect_equal(a2$avar, a1$avar, tolerance = 1e-14, info = type)
+  }
+})
