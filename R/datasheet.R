@@ -1,0 +1,206 @@
+#' Datasheet table of an IMU analysis
+#'
+#' One table per sensor, one row per axis: white noise N (angle / velocity
+#' random walk), bias instability B with the tau where the Allan deviation
+#' is minimal (the flat region where B is read), rate random walk K, each in
+#' SI and in datasheet units, how each was obtained, and the effects the
+#' closed-loop refinement ([avrefine()]) added to the model. Axes are never
+#' averaged unless `average = TRUE`, which appends a row with the arithmetic
+#' mean of the axes.
+#'
+#' Units (see [av_units()]): gyroscope N in rad/s/sqrt(Hz) and deg/sqrt(h),
+#' B in rad/s and deg/h, K in rad/s^2/sqrt(Hz) and deg/h/sqrt(h);
+#' accelerometer N in m/s^2/sqrt(Hz), m/s/sqrt(h) and ug/sqrt(Hz), B in
+#' m/s^2, ug and mg, K in m/s^3/sqrt(Hz) and m/s/h^(3/2).
+#'
+#' @param x An `imu_analysis` or `imu_analysis_list` ([analyze_imu()]).
+#' @param average Append the mean of the axes per sensor (logical).
+#' @param ... Unused.
+#' @return An object of class `"imu_datasheet"`: a list with one wide data
+#'   frame per sensor (`gyro`, `accel`; columns named with their units) and
+#'   `long`, the same numbers as a long data frame (`record`, `sensor`,
+#'   `axis`, `term`, `value`, `unit`, `tau`, `method`, `effects`), which is
+#'   what `as.data.frame()` returns and [write_datasheet()] writes.
+#' @export
+#' @examples
+#' \donttest{
+#' set.seed(1)
+#' m <- cbind(gyro_x = rnorm(2e4, sd = 0.01), gyro_y = rnorm(2e4, sd = 0.02))
+#' a <- analyze_imu(imu_record(m, freq = 100), refine = FALSE, progress = FALSE)
+#' datasheet(a)
+#' datasheet(a, average = TRUE)$gyro
+#' }
+datasheet <- function(x, average = FALSE, ...) UseMethod("datasheet")
+
+#' @export
+datasheet.imu_analysis_list <- function(x, average = FALSE, ...) {
+  parts <- lapply(x, datasheet, average = average)
+  out <- list(long = do.call(rbind, lapply(parts, function(p) p$long)))
+  for (s in c("gyro", "accel")) {
+    tabs <- lapply(parts, function(p) p[[s]])
+    tabs <- tabs[!vapply(tabs, is.null, logical(1))]
+    if (length(tabs)) out[[s]] <- do.call(rbind, tabs)
+  }
+  rownames(out$long) <- NULL
+  class(out) <- "imu_datasheet"
+  out
+}
+
+#' @export
+datasheet.imu_analysis <- function(x, average = FALSE, ...) {
+  if (!is.logical(average) || length(average) != 1L || is.na(average)) {
+    abort("`average` must be TRUE or FALSE, not ", format_value(average), ".")
+  }
+  long <- list()
+  for (ch in x$channels) {
+    rd <- ch$readings
+    eff <- added_effects(ch$fit)
+    for (term in c("N", "B", "K")) {
+      r <- rd[rd$term == term, ]
+      kind <- if (term == "B") "rate" else term
+      si <- si_unit(ch$sensor, kind)
+      us <- c(si, datasheet_units(ch$sensor)[[term]])
+      long[[length(long) + 1L]] <- data.frame(
+        record = x$name, sensor = ch$sensor, axis = ch$channel, term = term,
+        value = vapply(us, function(u) convert_units(r$value, si, u), 0),
+        unit = us, tau = r$tau, method = r$method, effects = eff,
+        stringsAsFactors = FALSE)
+    }
+  }
+  long <- do.call(rbind, long)
+  rownames(long) <- NULL
+  if (average) {
+    avg <- stats::aggregate(value ~ record + sensor + term + unit, data = long,
+                            FUN = mean)
+    tau_avg <- stats::aggregate(tau ~ record + sensor + term + unit, data = long,
+                                FUN = mean)
+    avg$tau <- tau_avg$tau
+    avg$axis <- "mean of axes"
+    avg$method <- "arithmetic mean of the axes"
+    avg$effects <- ""
+    long <- rbind(long, avg[names(long)])
+  }
+  out <- list(long = long)
+  for (s in c("gyro", "accel")) {
+    l <- long[long$sensor == s, ]
+    if (nrow(l)) out[[s]] <- wide_table(l)
+  }
+  class(out) <- "imu_datasheet"
+  out
+}
+
+# One row per axis; one column per (term, unit), plus tau_B, method, effects.
+wide_table <- function(l) {
+  axes <- unique(l$axis)
+  key <- unique(l[c("term", "unit")])
+  cols <- list(record = vapply(axes, function(a) l$record[l$axis == a][1L], ""),
+               axis = axes)
+  for (i in seq_len(nrow(key))) {
+    nm <- sprintf("%s [%s]", key$term[i], key$unit[i])
+    cols[[nm]] <- vapply(axes, function(a) {
+      v <- l$value[l$axis == a & l$term == key$term[i] & l$unit == key$unit[i]]
+      if (length(v)) v[1L] else NA_real_
+    }, 0)
+    if (key$term[i] == "B" && !"tau_B [s]" %in% names(cols)) {
+      cols[["tau_B [s]"]] <- vapply(axes, function(a)
+        l$tau[l$axis == a & l$term == "B"][1L], 0)
+    }
+  }
+  cols$method <- vapply(axes, function(a) {
+    r <- l[l$axis == a, ]
+    r <- r[!duplicated(r$term), ]
+    if (length(unique(r$method)) == 1L) r$method[1L]
+    else paste0(r$term, ": ", r$method, collapse = "; ")
+  }, "")
+  cols$effects <- vapply(axes, function(a) l$effects[l$axis == a][1L], "")
+  df <- as.data.frame(cols, stringsAsFactors = FALSE, check.names = FALSE)
+  rownames(df) <- NULL
+  df
+}
+
+added_effects <- function(fit) {
+  st <- fit$steps
+  if (is.null(st) || !nrow(st)) return("none")
+  eff <- as.character(st$effect)
+  cf <- fit$coefficients
+  lab <- vapply(seq_along(eff), function(i) {
+    e <- eff[i]
+    if (e == "gm") {
+      tc <- cf[grepl("^gm[0-9]+\\.tc$", names(cf))]
+      if (length(tc)) return(sprintf("gm (Tc = %s s)",
+                                     paste(signif(tc, 3), collapse = ", ")))
+    }
+    if (e == "sinusoid") {
+      f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+      if (length(f0)) return(sprintf("sinusoid (f0 = %s Hz)",
+                                     paste(signif(f0, 3), collapse = ", ")))
+    }
+    e
+  }, "")
+  paste(unique(lab), collapse = ", ")
+}
+
+#' @export
+as.data.frame.imu_datasheet <- function(x, row.names = NULL, optional = FALSE, ...) {
+  x$long
+}
+
+#' @export
+print.imu_datasheet <- function(x, digits = 3, ...) {
+  for (s in c("gyro", "accel")) {
+    tab <- x[[s]]
+    if (is.null(tab)) next
+    cat(if (s == "gyro") "Gyroscopes" else "Accelerometers", "\n", sep = "")
+    show <- tab
+    num <- vapply(show, is.numeric, logical(1))
+    show[num] <- lapply(show[num], function(v) formatC(v, digits = digits,
+                                                       format = "g"))
+    if (length(unique(show$record)) == 1L) show$record <- NULL
+    print(show, row.names = FALSE, right = TRUE)
+    cat("\n")
+  }
+  invisible(x)
+}
+
+#' Write a datasheet table to CSV
+#'
+#' @param x An `imu_datasheet` ([datasheet()]), or an `imu_analysis` /
+#'   `imu_analysis_list` whose datasheet is written.
+#' @param file Path of the CSV file.
+#' @param format `"long"` (one row per axis, term and unit: `record`,
+#'   `sensor`, `axis`, `term`, `value`, `unit`, `tau`, `method`, `effects`)
+#'   or `"wide"` (the printed tables, one block per sensor, stacked).
+#' @return `file`, invisibly.
+#' @export
+#' @examples
+#' \donttest{
+#' set.seed(1)
+#' m <- cbind(gyro_x = rnorm(2e4, sd = 0.01))
+#' a <- analyze_imu(imu_record(m, freq = 100), refine = FALSE, progress = FALSE)
+#' f <- tempfile(fileext = ".csv")
+#' write_datasheet(a, f)
+#' read.csv(f)
+#' }
+write_datasheet <- function(x, file, format = c("long", "wide")) {
+  format <- match.arg(format)
+  if (inherits(x, c("imu_analysis", "imu_analysis_list"))) x <- datasheet(x)
+  if (!inherits(x, "imu_datasheet")) {
+    abort("`x` must be an imu_datasheet or imu_analysis, not ",
+          describe_type(x), ".")
+  }
+  if (format == "long") {
+    utils::write.csv(x$long, file, row.names = FALSE)
+  } else {
+    con <- file(file, "w")
+    on.exit(close(con))
+    first <- TRUE
+    for (s in c("gyro", "accel")) {
+      if (is.null(x[[s]])) next
+      if (!first) writeLines("", con)
+      first <- FALSE
+      tab <- cbind(sensor = s, x[[s]])
+      utils::write.csv(tab, con, row.names = FALSE)
+    }
+  }
+  invisible(file)
+}

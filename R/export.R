@@ -1,0 +1,279 @@
+#' Write a Kalibr imu.yaml from an IMU analysis
+#'
+#' Writes the four noise parameters Kalibr (and VINS, OpenVINS, ...) read
+#' from `imu.yaml`, with their continuous-time units in comments:
+#' * `gyroscope_noise_density`: gyroscope N, rad/s/sqrt(Hz) (= rad/sqrt(s));
+#' * `gyroscope_random_walk`: gyroscope K, rad/s^2/sqrt(Hz);
+#' * `accelerometer_noise_density`: accelerometer N, m/s^2/sqrt(Hz);
+#' * `accelerometer_random_walk`: accelerometer K, m/s^3/sqrt(Hz);
+#' * `update_rate`: the sampling rate in Hz, which Kalibr uses to discretize
+#'   (sigma_d = N / sqrt(dt), sigma_bd = K * sqrt(dt); see [filter_params()]).
+#'
+#' Kalibr takes one number per sensor, so by default the worst (largest)
+#' axis is written (`axis = "max"`); the per-axis values and the axis used
+#' are listed in comments. When K could not be read (the +1/2 region was not
+#' reached), the value written is the upper bound from the longest tau (see
+#' [imu_guidance()]) and the comment says so. Kalibr's documentation
+#' advises inflating the values for real use; `inflate` multiplies all four
+#' (default 1, stated in the file).
+#'
+#' @param x An `imu_analysis` ([analyze_imu()]), or a named list or vector
+#'   with `gyroscope_noise_density`, `gyroscope_random_walk`,
+#'   `accelerometer_noise_density`, `accelerometer_random_walk` (SI) and
+#'   `update_rate` (Hz).
+#' @param file Path of the yaml file to write.
+#' @param axis `"max"` (worst axis, default) or `"mean"` of the axes.
+#' @param rostopic The `rostopic` entry.
+#' @param inflate A factor applied to the four noise values (>= 1).
+#' @return `file`, invisibly; the values written are in attribute `values`.
+#' @export
+#' @examples
+#' f <- tempfile(fileext = ".yaml")
+#' write_kalibr_yaml(list(gyroscope_noise_density = 1.7e-4,
+#'                        gyroscope_random_walk = 2e-5,
+#'                        accelerometer_noise_density = 2e-3,
+#'                        accelerometer_random_walk = 3e-3,
+#'                        update_rate = 200), f)
+#' cat(readLines(f), sep = "\n")
+write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
+                              rostopic = "/imu0", inflate = 1) {
+  check_present(missing(x), "x", "an imu_analysis or the four noise values")
+  axis <- match.arg(axis)
+  inflate <- check_number(inflate, "inflate", lo = 1)
+  if (!is.character(rostopic) || length(rostopic) != 1L) {
+    abort("`rostopic` must be a single string.")
+  }
+  keys <- c("accelerometer_noise_density", "accelerometer_random_walk",
+            "gyroscope_noise_density", "gyroscope_random_walk")
+  notes <- stats::setNames(rep("", 4L), keys)
+  header <- character()
+  if (inherits(x, "imu_analysis")) {
+    vals <- numeric()
+    for (k in keys) {
+      sensor <- if (startsWith(k, "gyro")) "gyro" else "accel"
+      term <- if (endsWith(k, "noise_density")) "N" else "K"
+      rows <- lapply(Filter(function(cc) cc$sensor == sensor, x$channels),
+                     function(cc) {
+                       r <- cc$readings[cc$readings$term == term, ]
+                       data.frame(axis = cc$channel, value = r$value,
+                                  method = r$method, stringsAsFactors = FALSE)
+                     })
+      if (!length(rows)) {
+        vals[k] <- NA_real_
+        notes[k] <- paste("no", sensor, "channel in the record")
+        next
+      }
+      rows <- do.call(rbind, rows)
+      if (axis == "max") {
+        i <- which.max(rows$value)
+        vals[k] <- rows$value[i]
+        notes[k] <- sprintf("worst axis (%s)", rows$axis[i])
+        bound <- grepl("upper bound", rows$method[i])
+      } else {
+        vals[k] <- mean(rows$value)
+        notes[k] <- "mean of the axes"
+        bound <- any(grepl("upper bound", rows$method))
+      }
+      if (bound) notes[k] <- paste0(notes[k], "; UPPER BOUND, +1/2 region not reached")
+      header <- c(header, sprintf("#   %-28s %s", k, paste(sprintf(
+        "%s = %.4e", rows$axis, rows$value), collapse = ", ")))
+    }
+    rate <- x$freq
+    src <- sprintf("# Source: %s, %d samples at %.6g Hz (%.3g h), Allan deviation per axis.",
+                   x$name, x$n, x$freq, x$duration / 3600)
+    header <- c(src, paste0("# Kalibr takes one value per sensor; written: ",
+                            if (axis == "max") "the worst (largest) axis."
+                            else "the mean of the axes.",
+                            " Per axis:"), header)
+  } else if (is.list(x) || is.numeric(x)) {
+    x <- as.list(x)
+    miss <- setdiff(c(keys, "update_rate"), names(x))
+    if (length(miss)) {
+      abort("`x` lacks ", paste(miss, collapse = ", "), ".")
+    }
+    vals <- vapply(keys, function(k) check_number(x[[k]], k, lo = 0), 0)
+    rate <- check_freq(x[["update_rate"]], "update_rate")
+  } else {
+    abort("`x` must be an imu_analysis or a named list of the noise values, not ",
+          describe_type(x), ".")
+  }
+  vals <- vals * inflate
+  units <- c(accelerometer_noise_density = "m/s^2/sqrt(Hz)",
+             accelerometer_random_walk = "m/s^3/sqrt(Hz)",
+             gyroscope_noise_density = "rad/s/sqrt(Hz)",
+             gyroscope_random_walk = "rad/s^2/sqrt(Hz)")
+  what <- c(accelerometer_noise_density = "white noise N, continuous time",
+            accelerometer_random_walk = "bias random walk K, continuous time",
+            gyroscope_noise_density = "white noise N, continuous time",
+            gyroscope_random_walk = "bias random walk K, continuous time")
+  line <- function(k) {
+    v <- if (is.na(vals[[k]])) ".nan" else sprintf("%.6e", vals[[k]])
+    sprintf("%-28s %-14s # [%s] %s%s", paste0(k, ":"), v, units[[k]], what[[k]],
+            if (nzchar(notes[[k]])) paste0("; ", notes[[k]]) else "")
+  }
+  out <- c(
+    sprintf("# Kalibr IMU noise model, written by allanvar %s on %s.",
+            utils::packageVersion("allanvar"), format(Sys.Date())),
+    "# Noise densities and random walks are continuous-time IEEE 952 coefficients in SI;",
+    "# Kalibr discretizes them with update_rate: sigma_d = N / sqrt(dt), sigma_bd = K * sqrt(dt).",
+    if (inflate != 1) sprintf("# All four values multiplied by inflate = %g.", inflate),
+    header,
+    "",
+    "#Accelerometers",
+    line("accelerometer_noise_density"),
+    line("accelerometer_random_walk"),
+    "",
+    "#Gyroscopes",
+    line("gyroscope_noise_density"),
+    line("gyroscope_random_walk"),
+    "",
+    sprintf("%-28s %-14s # the IMU ROS topic", "rostopic:", rostopic),
+    sprintf("%-28s %-14s # [Hz] sampling rate, used by Kalibr to discretize",
+            "update_rate:", format(rate, nsmall = 1))
+  )
+  writeLines(out, file)
+  invisible(structure(file, values = c(vals, update_rate = rate)))
+}
+
+#' Discrete-time filter parameters from an IMU analysis
+#'
+#' Converts the continuous-time noise coefficients into the numbers a
+#' discrete Kalman filter with step `dt` uses, with the convention written
+#' next to each number:
+#' * white noise N: `sigma_d = N / sqrt(dt)`, the standard deviation of each
+#'   sample's white noise (rad/s or m/s^2);
+#' * rate random walk K: `sigma_bd = K * sqrt(dt)`, the standard deviation
+#'   of the bias increment per step, `b[k] = b[k-1] + sigma_bd * w[k]`;
+#' * each Gauss-Markov term (sigma, Tc) fitted by [avfit()]/[avrefine()]
+#'   (for an analysis, those with Tc < 0.1 s are already part of its N and
+#'   are not repeated):
+#'   `phi = exp(-dt / Tc)` and the driving-noise variance
+#'   `q_d = sigma^2 * (1 - phi^2)`, for `x[k] = phi * x[k-1] + w[k]`,
+#'   `Var(w[k]) = q_d` (so that the stationary variance is sigma^2);
+#' * bias instability B (flicker noise) has no exact finite-state model;
+#'   with `bias_instability = "gm"` it is approximated by one Gauss-Markov
+#'   term whose Allan deviation peak (0.6174 sigma at tau = 1.893 Tc) sits
+#'   on the flat minimum: `Tc = tau_B / 1.893`, `sigma = 0.664 B / 0.6174`,
+#'   then `phi` and `q_d` as above. `"omit"` leaves it out.
+#'
+#' @param x An `imu_analysis` ([analyze_imu()]), an `avfit` object, or a
+#'   named numeric vector of coefficients (`N`, `K`, `B`, `gm1.sigma`,
+#'   `gm1.tc`, ..., in the rate unit, e.g. SI).
+#' @param dt The filter step in seconds; default `1 / freq` of the analysis
+#'   (required for a plain vector without `freq`).
+#' @param bias_instability `"gm"` or `"omit"`, see above.
+#' @param tau_B For a vector or `avfit`: the tau (s) of the flat minimum,
+#'   used by `bias_instability = "gm"`.
+#' @return A data frame with one row per parameter: `channel`, `sensor`,
+#'   `term`, `parameter`, `value`, `unit`, `continuous` (the coefficient it
+#'   comes from), `continuous_unit`, `dt` and `convention`.
+#' @export
+#' @examples
+#' filter_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
+filter_params <- function(x, dt = NULL, bias_instability = c("gm", "omit"),
+                          tau_B = NULL) {
+  check_present(missing(x), "x", "an imu_analysis, an avfit or coefficients")
+  bias_instability <- match.arg(bias_instability)
+  if (inherits(x, "imu_analysis")) {
+    if (is.null(dt)) dt <- 1 / x$freq
+    dt <- check_number(dt, "dt", lo = 0, open = TRUE)
+    rows <- lapply(x$channels, function(ch) {
+      rd <- ch$readings
+      cf <- ch$coef
+      cf <- gm_terms(cf, drop_white = grepl("white-like GM", rd$method[rd$term == "N"]))
+      cf[c("N", "B", "K")] <- rd$value[match(c("N", "B", "K"), rd$term)]
+      tb <- rd$tau[rd$term == "B"]
+      discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability, tb,
+                    k_bound = grepl("upper bound", rd$method[rd$term == "K"]))
+    })
+    out <- do.call(rbind, rows)
+  } else {
+    sensor <- NA_character_
+    if (inherits(x, "avfit")) {
+      if (is.null(dt) && !is.null(x$freq)) dt <- 1 / x$freq
+      if (is.null(tau_B) && !is.null(x$data)) {
+        tau_B <- x$data$tau[which.min(x$data$avar)]
+      }
+      x <- x$coefficients
+    }
+    if (!is.numeric(x) || is.null(names(x))) {
+      abort("`x` must be an imu_analysis, an avfit or a named numeric vector ",
+            "of coefficients, not ", describe_type(x), ".")
+    }
+    if (is.null(dt)) abort("`dt` is missing; give the filter step in seconds.")
+    dt <- check_number(dt, "dt", lo = 0, open = TRUE)
+    out <- discrete_rows(x, dt, "x", sensor, bias_instability,
+                         if (is.null(tau_B)) NA_real_ else tau_B)
+  }
+  rownames(out) <- NULL
+  out
+}
+
+# The GM coefficients, renumbered; without those already folded into N.
+gm_terms <- function(cf, drop_white = FALSE) {
+  out <- numeric()
+  j <- 1L
+  k <- 1L
+  while (paste0("gm", j, ".sigma") %in% names(cf)) {
+    sig <- cf[[paste0("gm", j, ".sigma")]]
+    tc <- cf[[paste0("gm", j, ".tc")]]
+    if (!(drop_white && tc < 0.1)) {
+      out[paste0("gm", k, c(".sigma", ".tc"))] <- c(sig, tc)
+      k <- k + 1L
+    }
+    j <- j + 1L
+  }
+  out
+}
+
+discrete_rows <- function(cf, dt, channel, sensor, bi, tau_b, k_bound = FALSE) {
+  u <- if (is.na(sensor)) "u" else si_unit(sensor, "rate")
+  un <- if (is.na(sensor)) "u*sqrt(s)" else si_unit(sensor, "N")
+  uk <- if (is.na(sensor)) "u/sqrt(s)" else si_unit(sensor, "K")
+  rows <- list()
+  add <- function(term, parameter, value, unit, cont, cont_unit, conv) {
+    rows[[length(rows) + 1L]] <<- data.frame(
+      channel = channel, sensor = sensor, term = term, parameter = parameter,
+      value = value, unit = unit, continuous = cont,
+      continuous_unit = cont_unit, dt = dt, convention = conv,
+      stringsAsFactors = FALSE)
+  }
+  get <- function(nm) if (nm %in% names(cf)) unname(cf[[nm]]) else NA_real_
+  n <- get("N")
+  if (is.finite(n)) {
+    add("N", "sigma_d", n / sqrt(dt), u, n, un,
+        "white noise per sample: y[k] = sigma_d * w[k], sigma_d = N / sqrt(dt)")
+  }
+  k <- get("K")
+  if (is.finite(k)) {
+    add("K", "sigma_bd", k * sqrt(dt), u, k, uk, paste0(
+      "bias random walk: b[k] = b[k-1] + sigma_bd * w[k], sigma_bd = K * sqrt(dt)",
+      if (k_bound) " (K is an upper bound: +1/2 region not reached)" else ""))
+  }
+  gm_gm <- function(term, sigma, tc, how) {
+    phi <- exp(-dt / tc)
+    add(term, "phi", phi, "1", tc, "s",
+        paste0(how, "Gauss-Markov: x[k] = phi * x[k-1] + w[k], phi = exp(-dt / Tc)"))
+    add(term, "q_d", sigma^2 * (1 - phi^2), paste0("(", u, ")^2"), sigma, u,
+        paste0(how, "driving-noise variance Var(w[k]) = q_d = sigma^2 * (1 - phi^2)"))
+  }
+  b <- get("B")
+  if (bi == "gm" && is.finite(b) && b > 0 && is.finite(tau_b)) {
+    gm_gm("B", 0.664 * b / 0.6174, tau_b / 1.893,
+          "bias instability approximated (Tc = tau_B / 1.893, sigma = 0.664 B / 0.6174) by ")
+  }
+  j <- 1L
+  while (is.finite(get(paste0("gm", j, ".sigma")))) {
+    gm_gm(paste0("gm", j), get(paste0("gm", j, ".sigma")),
+          get(paste0("gm", j, ".tc")), "")
+    j <- j + 1L
+  }
+  if (!length(rows)) {
+    return(data.frame(channel = character(), sensor = character(),
+                      term = character(), parameter = character(),
+                      value = numeric(), unit = character(),
+                      continuous = numeric(), continuous_unit = character(),
+                      dt = numeric(), convention = character()))
+  }
+  do.call(rbind, rows)
+}

@@ -1,0 +1,145 @@
+#' Is the record long enough? Guidance per axis
+#'
+#' Checks, for every axis of an analysis, whether the record resolves what
+#' was asked and, when not, how long a record would be needed. The rules:
+#' * **reliable range**: a tau is reliable when its Allan variance rests on
+#'   at least 10 equivalent degrees of freedom (`edf` from [allan()]);
+#'   `tau_rel` is the largest such tau. Taus beyond it are flagged ("a
+#'   handful of terms").
+#' * **K** (rate random walk, the +1/2 region): call `tau_x` the tau where
+#'   the +1/2 line meets the rest of the model, i.e. where
+#'   K^2 tau / 3 = N^2 / tau + (2 ln 2 / pi) B^2. K is resolved when
+#'   `tau_rel >= 3 tau_x` (there the K term is at least 3/4 of the Allan
+#'   variance). Since `tau_rel` grows in proportion to the record length T,
+#'   the record needed is `T * 3 tau_x / tau_rel`. When no +1/2 region is
+#'   seen at all, K is bounded by min over tau of upper(tau) * sqrt(3 / tau)
+#'   and the record needed to resolve a K that large is given (smaller K need
+#'   longer records).
+#' * **B**: the flat minimum must lie inside the reliable range, at
+#'   `tau_B <= tau_rel / 3`; otherwise the curve may still fall and B is an
+#'   upper bound; a record at least `T * 3 tau_B / tau_rel` long is needed.
+#' * **N**: a -1/2 region (or a fitted N) must exist.
+#' * **any fitted term** whose relative standard error (from the fit's
+#'   `vcov`) exceeds 50% is reported as not resolvable.
+#'
+#' [analyze_imu()] runs these checks and warns when any fails.
+#'
+#' @param x An `imu_analysis` ([analyze_imu()]).
+#' @return A data frame with columns `record`, `channel`, `message` (empty
+#'   when every check passes).
+#' @export
+#' @examples
+#' \donttest{
+#' set.seed(1)
+#' m <- cbind(gyro_x = rnorm(5000, sd = 0.01))
+#' a <- suppressWarnings(analyze_imu(imu_record(m, freq = 100),
+#'                                   refine = FALSE, progress = FALSE))
+#' imu_guidance(a)
+#' }
+imu_guidance <- function(x) {
+  if (inherits(x, "imu_analysis")) {
+    rows <- lapply(x$channels, function(ch) {
+      if (!length(ch$guidance)) return(NULL)
+      data.frame(record = x$name, channel = ch$channel, message = ch$guidance,
+                 stringsAsFactors = FALSE)
+    })
+    rows <- rows[!vapply(rows, is.null, logical(1))]
+    if (!length(rows)) {
+      return(data.frame(record = character(), channel = character(),
+                        message = character()))
+    }
+    out <- do.call(rbind, rows)
+    rownames(out) <- NULL
+    return(out)
+  }
+  if (inherits(x, "imu_analysis_list")) {
+    out <- do.call(rbind, lapply(x, imu_guidance))
+    rownames(out) <- NULL
+    return(out)
+  }
+  if (is.list(x) && !is.null(x$curve) && !is.null(x$readings)) {
+    return(channel_guidance(x))
+  }
+  abort("`x` must be an imu_analysis, not ", describe_type(x), ".")
+}
+
+channel_guidance <- function(ch) {
+  cv <- ch$curve
+  T <- ch$n / ch$freq
+  msg <- character()
+  hours <- function(s) if (s >= 3600) sprintf("%.3g h", s / 3600) else
+    sprintf("%.4g s", s)
+  edf <- cv$edf
+  rel <- if (is.null(edf) || all(is.na(edf))) cv$tau <= T / 10 else
+    !is.na(edf) & edf >= 10
+  if (!any(rel)) {
+    return(sprintf("no tau has 10 degrees of freedom: the record (%s) is too short for any reading.",
+                   hours(T)))
+  }
+  tau_rel <- max(cv$tau[rel])
+  few <- cv$tau > tau_rel
+  if (any(few)) {
+    msg <- c(msg, sprintf(
+      "the %d largest tau (%s to %s) rest on fewer than 10 degrees of freedom (edf down to %.2g): do not read terms from them alone.",
+      sum(few), hours(min(cv$tau[few])), hours(max(cv$tau[few])),
+      if (is.null(edf)) NA else min(edf[few], na.rm = TRUE)))
+  }
+  rd <- ch$readings
+  val <- function(t) rd$value[rd$term == t]
+  N <- val("N")
+  B <- val("B")
+  K <- val("K")
+  n2 <- if (is.finite(N)) N^2 else 0
+  b2 <- if (is.finite(B)) B^2 else 0
+  need <- function(tau) T * 3 * tau / tau_rel
+  kmeth <- rd$method[rd$term == "K"]
+  if (grepl("upper bound", kmeth)) {
+    tx <- tau_cross(n2, b2, K)
+    msg <- c(msg, sprintf(
+      "the +1/2 (rate random walk) region is never reached up to tau = %s: K <= %.3g %s only; resolving a K that large needs a record of at least %s (this one is %s), a smaller K a longer one.",
+      hours(tau_rel), K, rd$unit[rd$term == "K"], hours(need(tx)), hours(T)))
+  } else if (is.finite(K) && K > 0) {
+    tx <- tau_cross(n2, b2, K)
+    if (tau_rel < 3 * tx) {
+      msg <- c(msg, sprintf(
+        "K = %.3g %s is read beyond the reliable range: the +1/2 line meets the rest at tau = %s, so tau up to %s (a record of %s) is needed; this record is %s.",
+        K, rd$unit[rd$term == "K"], hours(tx), hours(3 * tx), hours(need(tx)),
+        hours(T)))
+    }
+  }
+  tau_b <- rd$tau[rd$term == "B"]
+  if (is.finite(tau_b) && tau_b > tau_rel / 3) {
+    msg <- c(msg, sprintf(
+      "the Allan deviation minimum (tau = %s) is not inside the reliable range (up to %s / 3): B = %.3g %s may be an overestimate of the flat region; a record of at least %s is needed (this one is %s).",
+      hours(tau_b), hours(tau_rel), B, rd$unit[rd$term == "B"],
+      hours(need(tau_b)), hours(T)))
+  }
+  if (!is.finite(N)) {
+    msg <- c(msg, "no -1/2 (white noise) region found: N not read; a higher sampling rate shows more of the short-tau region.")
+  }
+  fit <- ch$fit
+  if (!is.null(fit) && !is.null(fit$vcov) && length(fit$coefficients)) {
+    cf <- fit$coefficients
+    se <- suppressWarnings(sqrt(pmax(diag(as.matrix(fit$vcov)), 0)))
+    if (length(se) == length(cf)) {
+      names(se) <- names(cf)
+      bad <- names(cf)[is.finite(se) & cf != 0 & se / abs(cf) > 0.5]
+      for (b in bad) {
+        msg <- c(msg, sprintf("term %s is not resolvable from this record (relative standard error %.0f%%).",
+                              b, 100 * se[[b]] / abs(cf[[b]])))
+      }
+    }
+  }
+  if (!is.null(ch$fit_error)) {
+    msg <- c(msg, paste0("fit not used (", ch$fit_error,
+                         "): values read from the slope lines."))
+  }
+  msg
+}
+
+# tau where K^2 tau / 3 = N^2 / tau + (2 ln2 / pi) B^2 (positive root).
+tau_cross <- function(n2, b2, K) {
+  a <- K^2 / 3
+  c0 <- 2 * log(2) / pi * b2
+  (c0 + sqrt(c0^2 + 4 * a * n2)) / (2 * a)
+}

@@ -1,0 +1,224 @@
+#' Units of inertial sensors and of their noise coefficients
+#'
+#' `av_units()` lists every unit that [read_imu()], [convert_units()],
+#' [datasheet()] and the exporters understand, with its factor to SI.
+#' `convert_units()` converts numbers between two units of the same kind.
+#'
+#' Internally everything is SI: angular rate in rad/s, acceleration in
+#' m/s^2, with standard gravity g = 9.80665 m/s^2 (exact, CGPM 1901),
+#' 1 deg = pi/180 rad and 1 h = 3600 s. The noise coefficients follow the
+#' IEEE Std 952 convention (two-sided PSD), with u the rate unit:
+#'
+#' | kind | coefficient | SI, gyro | SI, accel | datasheet units |
+#' |---|---|---|---|---|
+#' | `rate` | B, GM sigma, sinusoid amplitude, raw samples | rad/s | m/s^2 | deg/h; ug, mg |
+#' | `N` | white noise (ARW / VRW), u*sqrt(s) | rad/sqrt(s) = rad/s/sqrt(Hz) | m/s/sqrt(s) = m/s^2/sqrt(Hz) | deg/sqrt(h); m/s/sqrt(h), ug/sqrt(Hz) |
+#' | `K` | rate random walk, u/sqrt(s) | rad/s/sqrt(s) = rad/s^2/sqrt(Hz) | m/s^2/sqrt(s) = m/s^3/sqrt(Hz) | deg/h/sqrt(h); m/s/h^(3/2) |
+#' | `Q` | quantization, u*s | rad | m/s | deg, arcsec |
+#' | `R` | rate ramp, u/s | rad/s^2 | m/s^3 | deg/h^2 |
+#'
+#' Spellings that denote the same SI unit (`rad/s/sqrt(Hz)` and
+#' `rad/sqrt(s)`, `m/s^3/sqrt(Hz)` and `m/s^2/sqrt(s)`) have factor 1: a
+#' noise density in u/sqrt(Hz) is numerically the same as u*sqrt(s).
+#' Kalibr's `*_noise_density` is N and `*_random_walk` is K, both in SI.
+#' Accelerometer K has no single datasheet convention; it is given in
+#' m/s^3/sqrt(Hz) (Kalibr's unit) and in m/s/h^(3/2), the analogue of the
+#' gyroscope's deg/h/sqrt(h).
+#'
+#' @param sensor Optional filter: `"gyro"` or `"accel"`.
+#' @param kind Optional filter: one or more of `"rate"`, `"N"`, `"K"`,
+#'   `"Q"`, `"R"`.
+#' @return `av_units()`: a data frame with columns `unit`, `sensor`, `kind`,
+#'   `to_si` (multiply a value in `unit` by this to get SI) and `si` (the SI
+#'   unit of that kind).
+#' @export
+#' @examples
+#' av_units("gyro", "N")
+#' # 0.15 deg/sqrt(h) angle random walk in rad/s/sqrt(Hz)
+#' convert_units(0.15, "deg/sqrt(h)", "rad/s/sqrt(Hz)")
+#' # 1 g in m/s^2, and 10 deg/h in rad/s
+#' convert_units(1, "g", "m/s^2")
+#' convert_units(10, "deg/h", "rad/s")
+av_units <- function(sensor = NULL, kind = NULL) {
+  tab <- unit_table()
+  if (!is.null(sensor)) {
+    sensor <- match_sensor(sensor)
+    tab <- tab[tab$sensor == sensor, ]
+  }
+  if (!is.null(kind)) {
+    if (!is.character(kind) || !all(kind %in% unit_kinds)) {
+      abort("`kind` must be one or more of ",
+            paste0('"', unit_kinds, '"', collapse = ", "), ", not ",
+            format_value(kind), ".")
+    }
+    tab <- tab[tab$kind %in% kind, ]
+  }
+  rownames(tab) <- NULL
+  tab
+}
+
+#' @rdname av_units
+#' @param x Numeric values to convert.
+#' @param from,to Unit names as listed by `av_units()` (for example
+#'   `"deg/s"`, `"g"`, `"deg/sqrt(h)"`). They must be of the same sensor and
+#'   kind; spaces are ignored, and `"m/s2"` is read as `"m/s^2"`, `"µg"` as
+#'   `"ug"`.
+#' @return `convert_units()`: `x` expressed in `to`.
+#' @export
+convert_units <- function(x, from, to) {
+  if (!is.numeric(x)) {
+    abort("`x` must be numeric, not ", describe_type(x), ".")
+  }
+  f <- lookup_unit(from, "from")
+  t <- lookup_unit(to, "to")
+  if (f$sensor != t$sensor || f$kind != t$kind) {
+    abort("cannot convert from \"", from, "\" (", f$sensor, " ", f$kind,
+          ") to \"", to, "\" (", t$sensor, " ", t$kind, "); both units must ",
+          "measure the same quantity. See av_units().")
+  }
+  x * (f$to_si / t$to_si)
+}
+
+unit_kinds <- c("rate", "N", "K", "Q", "R")
+
+# One row per accepted spelling. Factors are written from their definitions
+# so that each can be checked by hand.
+unit_table <- function() {
+  if (is.null(unit_cache$tab)) unit_cache$tab <- build_unit_table()
+  unit_cache$tab
+}
+
+unit_cache <- new.env(parent = emptyenv())
+
+build_unit_table <- function() {
+  deg <- pi / 180
+  h <- 3600
+  g <- 9.80665
+  u <- function(unit, sensor, kind, to_si) {
+    list(unit = unit, sensor = sensor, kind = kind, to_si = to_si)
+  }
+  rows <- list(
+    # gyro rate
+    u("rad/s", "gyro", "rate", 1),
+    u("deg/s", "gyro", "rate", deg),
+    u("deg/h", "gyro", "rate", deg / h),
+    u("rad/h", "gyro", "rate", 1 / h),
+    u("mrad/s", "gyro", "rate", 1e-3),
+    u("rpm", "gyro", "rate", 2 * pi / 60),
+    # gyro N (angle random walk)
+    u("rad/sqrt(s)", "gyro", "N", 1),
+    u("rad/s/sqrt(Hz)", "gyro", "N", 1),
+    u("deg/sqrt(s)", "gyro", "N", deg),
+    u("deg/s/sqrt(Hz)", "gyro", "N", deg),
+    u("deg/sqrt(h)", "gyro", "N", deg / sqrt(h)),
+    u("deg/h/sqrt(Hz)", "gyro", "N", deg / h),
+    # gyro K (rate random walk)
+    u("rad/s/sqrt(s)", "gyro", "K", 1),
+    u("rad/s^2/sqrt(Hz)", "gyro", "K", 1),
+    u("deg/s/sqrt(s)", "gyro", "K", deg),
+    u("deg/h/sqrt(h)", "gyro", "K", deg / h / sqrt(h)),
+    u("deg/h^(3/2)", "gyro", "K", deg / h^1.5),
+    # gyro Q and R
+    u("rad", "gyro", "Q", 1),
+    u("deg", "gyro", "Q", deg),
+    u("arcsec", "gyro", "Q", deg / 3600),
+    u("rad/s^2", "gyro", "R", 1),
+    u("deg/s^2", "gyro", "R", deg),
+    u("deg/h^2", "gyro", "R", deg / h^2),
+    # accel rate
+    u("m/s^2", "accel", "rate", 1),
+    u("g", "accel", "rate", g),
+    u("mg", "accel", "rate", g * 1e-3),
+    u("ug", "accel", "rate", g * 1e-6),
+    u("m/s/h", "accel", "rate", 1 / h),
+    # accel N (velocity random walk)
+    u("m/s/sqrt(s)", "accel", "N", 1),
+    u("m/s^2/sqrt(Hz)", "accel", "N", 1),
+    u("m/s/sqrt(h)", "accel", "N", 1 / sqrt(h)),
+    u("ug/sqrt(Hz)", "accel", "N", g * 1e-6),
+    u("mg/sqrt(Hz)", "accel", "N", g * 1e-3),
+    u("g/sqrt(Hz)", "accel", "N", g),
+    # accel K
+    u("m/s^2/sqrt(s)", "accel", "K", 1),
+    u("m/s^3/sqrt(Hz)", "accel", "K", 1),
+    u("m/s/h^(3/2)", "accel", "K", 1 / h^1.5),
+    u("ug/sqrt(s)", "accel", "K", g * 1e-6),
+    u("mg/sqrt(h)", "accel", "K", g * 1e-3 / sqrt(h)),
+    # accel Q and R
+    u("m/s", "accel", "Q", 1),
+    u("m/s^3", "accel", "R", 1),
+    u("ug/s", "accel", "R", g * 1e-6)
+  )
+  tab <- data.frame(
+    unit = vapply(rows, `[[`, "", "unit"),
+    sensor = vapply(rows, `[[`, "", "sensor"),
+    kind = vapply(rows, `[[`, "", "kind"),
+    to_si = vapply(rows, `[[`, 0, "to_si"), stringsAsFactors = FALSE)
+  si <- c(gyro.rate = "rad/s", gyro.N = "rad/s/sqrt(Hz)",
+          gyro.K = "rad/s^2/sqrt(Hz)", gyro.Q = "rad", gyro.R = "rad/s^2",
+          accel.rate = "m/s^2", accel.N = "m/s^2/sqrt(Hz)",
+          accel.K = "m/s^3/sqrt(Hz)", accel.Q = "m/s", accel.R = "m/s^3")
+  tab$si <- unname(si[paste(tab$sensor, tab$kind, sep = ".")])
+  tab
+}
+
+# Normalise a spelling: no spaces, "s2" -> "s^2", micro sign -> u.
+normalize_unit <- function(x) {
+  x <- gsub("[[:space:]]", "", x)
+  x <- gsub("\u00b5|\u03bc", "u", x)
+  x <- gsub("s2$", "s^2", x)
+  x <- gsub("s2/", "s^2/", x, fixed = TRUE)
+  x <- gsub("s3/", "s^3/", x, fixed = TRUE)
+  x <- sub("^(deg|rad)/sec$", "\\1/s", x)
+  x <- sub("^dps$", "deg/s", x)
+  x <- sub("^G$", "g", x)
+  x <- sub("^m/s/s$", "m/s^2", x)
+  x <- sub("^rt", "sqrt", x)
+  x
+}
+
+lookup_unit <- function(unit, arg = "unit", sensor = NULL, kind = NULL) {
+  if (!is.character(unit) || length(unit) != 1L || is.na(unit)) {
+    abort("`", arg, "` must be a single unit name (see av_units()), not ",
+          describe_type(unit), ".")
+  }
+  tab <- unit_table()
+  row <- tab[tab$unit == normalize_unit(unit), ]
+  if (!is.null(sensor)) row <- row[row$sensor == sensor, ]
+  if (!is.null(kind)) row <- row[row$kind == kind, ]
+  if (nrow(row) != 1L) {
+    cand <- tab$unit
+    if (!is.null(sensor)) cand <- tab$unit[tab$sensor == sensor]
+    if (!is.null(kind)) cand <- tab$unit[tab$unit %in% cand & tab$kind == kind]
+    abort("`", arg, "` = \"", unit, "\" is not a known ",
+          if (!is.null(sensor)) paste0(sensor, " "),
+          if (!is.null(kind)) paste0(kind, " "), "unit; use one of ",
+          paste0('"', unique(cand), '"', collapse = ", "), ".")
+  }
+  as.list(row)
+}
+
+match_sensor <- function(sensor, arg = "sensor") {
+  if (!is.character(sensor) || length(sensor) != 1L ||
+      !sensor %in% c("gyro", "accel")) {
+    abort("`", arg, "` must be \"gyro\" or \"accel\", not ",
+          format_value(sensor), ".")
+  }
+  sensor
+}
+
+# Datasheet units for each coefficient, by sensor: what datasheet() shows
+# beside SI. More than one per coefficient where the field uses several.
+datasheet_units <- function(sensor) {
+  if (sensor == "gyro") {
+    list(N = "deg/sqrt(h)", B = "deg/h", K = "deg/h/sqrt(h)")
+  } else {
+    list(N = c("m/s/sqrt(h)", "ug/sqrt(Hz)"), B = c("ug", "mg"),
+         K = "m/s/h^(3/2)")
+  }
+}
+
+si_unit <- function(sensor, kind) {
+  tab <- unit_table()
+  tab$si[tab$sensor == sensor & tab$kind == kind][1L]
+}

@@ -1,0 +1,131 @@
+two_records <- function() {
+  n <- 2e4
+  r1 <- imu_record(cbind(gyro_x = avsim(n, 100, N = 1e-3, K = 1e-3, seed = 1),
+                         accel_x = avsim(n, 100, N = 1e-2, K = 1e-2, seed = 2)),
+                   freq = 100, name = "rec1")
+  r2 <- imu_record(cbind(gyro_x = avsim(n, 100, N = 2e-3, K = 1e-3, seed = 3),
+                         accel_x = avsim(n, 100, N = 3e-2, K = 1e-2, seed = 4)),
+                   freq = 100, name = "rec2")
+  list(r1, r2)
+}
+
+test_that("every axis gets its own curve on one tau grid, fit and readings", {
+  recs <- two_records()
+  a <- suppressWarnings(analyze_imu(recs[[1]], progress = FALSE))
+  expect_s3_class(a, "imu_analysis")
+  expect_identical(names(a$channels), c("gyro_x", "accel_x"))
+  expect_identical(a$channels$gyro_x$curve$tau, a$channels$accel_x$curve$tau)
+  expect_identical(a$channels$gyro_x$unit, "rad/s")
+  expect_identical(a$channels$accel_x$unit, "m/s^2")
+  expect_identical(a$channels$gyro_x$readings$term, c("N", "B", "K"))
+  expect_equal(a$n, 2e4)
+  expect_output(print(a), "imu_analysis")
+})
+
+test_that("several recordings through future multisession equal the sequential run", {
+  skip_if_not(installed_allanvar(), "needs the installed package on the workers")
+  skip_if_not_installed("future")
+  recs <- two_records()
+  future::plan(future::sequential)
+  seq_run <- suppressWarnings(analyze_imu(recs, progress = FALSE))
+  old <- future::plan(future::multisession, workers = 2)
+  on.exit(future::plan(future::sequential), add = TRUE)
+  par_run <- suppressWarnings(analyze_imu(recs, progress = FALSE))
+  future::plan(future::sequential)
+  expect_s3_class(par_run, "imu_analysis_list")
+  expect_identical(names(par_run), c("rec1", "rec2"))
+  expect_identical(datasheet(par_run)$long, datasheet(seq_run)$long)
+  for (i in 1:2) for (ch in c("gyro_x", "accel_x")) {
+    expect_identical(par_run[[i]]$channels[[ch]]$curve, seq_run[[i]]$channels[[ch]]$curve)
+    expect_identical(par_run[[i]]$channels[[ch]]$coef, seq_run[[i]]$channels[[ch]]$coef)
+  }
+})
+
+test_that("progress is reported per axis and can be silenced", {
+  r <- two_records()[[1]]
+  msg <- capture_messages(suppressWarnings(analyze_imu(r, progress = TRUE)))
+  expect_length(msg, 2)
+  expect_match(msg[1], "analysing \\[1/2\\] rec1: gyro_x")
+  expect_match(msg[2], "analysing \\[2/2\\] rec1: accel_x")
+  expect_silent(suppressWarnings(analyze_imu(r, progress = FALSE)))
+  expect_error(analyze_imu(r, progress = NA), "`progress`")
+})
+
+test_that("segments: the longest by default, or each on its own", {
+  set.seed(1)
+  x <- cbind(gyro_x = rnorm(2900, sd = 1e-3))
+  t <- c(0:999, 1100:2999) / 100
+  expect_warning(r <- imu_record(x, time = t), "gap")
+  a <- suppressWarnings(analyze_imu(r, progress = FALSE))
+  expect_equal(a$n, 1900)
+  al <- suppressWarnings(analyze_imu(r, segment = "each", progress = FALSE))
+  expect_s3_class(al, "imu_analysis_list")
+  expect_equal(vapply(al, function(z) z$n, 0), c(1000, 1900), ignore_attr = TRUE)
+  expect_error(analyze_imu(r, segment = 5), "segment")
+})
+
+test_that("file paths are read and analysed; bad input is refused", {
+  m <- cbind(matrix(rnorm(3 * 4000, sd = 1e-3), 4000), matrix(rnorm(3 * 4000), 4000))
+  f <- write_kalibr_csv(m, tempfile(fileext = ".csv"))
+  on.exit(unlink(f))
+  a <- suppressWarnings(analyze_imu(f, progress = FALSE))
+  expect_length(a$channels, 6)
+  expect_error(analyze_imu(1), "imu_record")
+  expect_error(analyze_imu(two_records()[[1]], channels = "gyro_q"), "not in")
+})
+
+test_that("plot() draws both sensors with units and reading markers", {
+  a <- suppressWarnings(analyze_imu(two_records()[[1]], progress = FALSE))
+  f <- tempfile(fileext = ".png")
+  on.exit(unlink(f))
+  grDevices::png(f, width = 1000, height = 500)
+  expect_invisible(plot(a))
+  plot(a, sensor = "gyro", units = "datasheet")
+  grDevices::dev.off()
+  expect_gt(file.size(f), 1000)
+  expect_error(plot(a, sensor = "mag"), "`sensor`")
+})
+
+test_that("effects the closed loop adds reach the datasheet", {
+  x <- avsim(2e4, 100, N = 1e-3, K = 1e-3, gm = list(sigma = 0.02, tc = 2), seed = 1)
+  r <- imu_record(cbind(gyro_x = as.numeric(x)), freq = 100)
+  a <- suppressWarnings(analyze_imu(r, progress = FALSE))
+  st <- a$channels$gyro_x$fit$steps
+  expect_true("gm" %in% st$effect)
+  expect_match(a$datasheet$gyro$effects, "gm \\(Tc = ")
+  # the GM (Tc near 2 s, not white-like) goes to the filter as phi, q_d
+  fp <- filter_params(a)
+  tc <- a$channels$gyro_x$coef[["gm1.tc"]]
+  sig <- a$channels$gyro_x$coef[["gm1.sigma"]]
+  expect_equal(fp$value[fp$term == "gm1" & fp$parameter == "phi"], exp(-0.01 / tc))
+  expect_equal(fp$value[fp$term == "gm1" & fp$parameter == "q_d"],
+               sig^2 * (1 - exp(-0.02 / tc)))
+})
+
+test_that("white-like Gauss-Markov terms are folded into N, once", {
+  curve <- data.frame(tau = 2^(0:8) / 100, adev = 1e-3 / sqrt(2^(0:8) / 100),
+                      upper = 1.1e-3 / sqrt(2^(0:8) / 100))
+  cf <- c(N = 3e-4, B = 0, K = 0, gm1.sigma = 5e-3, gm1.tc = 0.005,
+          gm2.sigma = 1e-3, gm2.tc = 20)
+  rd <- allanvar:::channel_readings(curve, cf, "gyro")
+  # N^2 + 2 sigma^2 Tc (gm1 only; gm2 has Tc = 20 s)
+  expect_equal(rd$value[rd$term == "N"], sqrt(3e-4^2 + 2 * 5e-3^2 * 0.005))
+  expect_match(rd$method[rd$term == "N"], "white-like GM")
+  # B = 0 in the fit: min ADEV / 0.664 at the minimum's tau
+  expect_equal(rd$value[rd$term == "B"], min(curve$adev) / sqrt(2 * log(2) / pi))
+  expect_equal(rd$tau[rd$term == "B"], 2.56)
+  # with a fitted curve, B is read at its minimum; without, only reliable
+  # taus (edf >= 10) count
+  rd2 <- allanvar:::channel_readings(curve, cf, "gyro",
+                                     fitted = data.frame(tau = curve$tau,
+                                                         fitted = (curve$tau - 0.3)^2 + 1))
+  expect_equal(rd2$tau[rd2$term == "B"], 0.32)
+  curve$edf <- c(rep(50, 6), 5, 2, 1)
+  rd3 <- allanvar:::channel_readings(curve, c(N = 1e-3), "gyro")
+  expect_equal(rd3$tau[rd3$term == "B"], 0.32)
+  expect_equal(rd3$value[rd3$term == "B"], curve$adev[6] / sqrt(2 * log(2) / pi))
+  expect_match(rd$method[rd$term == "K"], "upper bound")
+  g <- allanvar:::gm_terms(cf, drop_white = TRUE)
+  expect_identical(names(g), c("gm1.sigma", "gm1.tc"))
+  expect_equal(unname(g), c(1e-3, 20))
+})

@@ -1,0 +1,68 @@
+sim_analysis <- function() {
+  n <- 4e4
+  m <- cbind(gyro_x = avsim(n, 100, N = 1e-3, K = 1e-4, seed = 1),
+             gyro_y = avsim(n, 100, N = 2e-3, K = 1e-4, seed = 2),
+             accel_z = avsim(n, 100, N = 1e-2, K = 1e-3, seed = 3))
+  suppressWarnings(analyze_imu(imu_record(m, freq = 100), progress = FALSE))
+}
+
+test_that("the datasheet has one row per axis, SI and datasheet units agree", {
+  a <- sim_analysis()
+  ds <- datasheet(a)
+  expect_s3_class(ds, "imu_datasheet")
+  g <- ds$gyro
+  expect_identical(g$axis, c("gyro_x", "gyro_y"))
+  expect_identical(ds$accel$axis, "accel_z")
+  # hand-computed factors: deg/sqrt(h) = rad/sqrt(s) * (180/pi) * 60, ...
+  expect_equal(g[["N [deg/sqrt(h)]"]], g[["N [rad/s/sqrt(Hz)]"]] * 180 / pi * 60)
+  expect_equal(g[["B [deg/h]"]], g[["B [rad/s]"]] * 180 / pi * 3600)
+  expect_equal(g[["K [deg/h/sqrt(h)]"]], g[["K [rad/s^2/sqrt(Hz)]"]] * 180 / pi * 3600 * 60)
+  acc <- ds$accel
+  expect_equal(acc[["N [m/s/sqrt(h)]"]], acc[["N [m/s^2/sqrt(Hz)]"]] * 60)
+  expect_equal(acc[["N [ug/sqrt(Hz)]"]], acc[["N [m/s^2/sqrt(Hz)]"]] / 9.80665e-6)
+  expect_equal(acc[["B [ug]"]], acc[["B [m/s^2]"]] / 9.80665e-6)
+  expect_equal(acc[["B [mg]"]], acc[["B [m/s^2]"]] / 9.80665e-3)
+  expect_equal(acc[["K [m/s/h^(3/2)]"]], acc[["K [m/s^3/sqrt(Hz)]"]] * 3600^1.5)
+  # B is reported with the tau where it is read: the fitted curve's minimum
+  fd <- a$channels$gyro_y$fit$data
+  expect_equal(g[["tau_B [s]"]][2], fd$tau[which.min(fd$fitted)])
+  # the values are the per-axis readings, never averaged
+  expect_equal(g[["N [rad/s/sqrt(Hz)]"]],
+               unname(vapply(a$channels[1:2], function(c) c$readings$value[1], 0)))
+  expect_equal(g[["N [rad/s/sqrt(Hz)]"]], c(1e-3, 2e-3), tolerance = 0.15)
+  expect_false(any(ds$long$axis == "mean of axes"))
+  expect_output(print(ds), "Gyroscopes")
+  expect_output(print(ds), "Accelerometers")
+})
+
+test_that("average = TRUE appends the mean of the axes, and only then", {
+  a <- sim_analysis()
+  ds <- datasheet(a, average = TRUE)
+  g <- ds$gyro
+  expect_identical(g$axis, c("gyro_x", "gyro_y", "mean of axes"))
+  expect_equal(g[["N [deg/sqrt(h)]"]][3], mean(g[["N [deg/sqrt(h)]"]][1:2]))
+  expect_error(datasheet(a, average = NA), "`average`")
+})
+
+test_that("the effects the closed loop added are listed", {
+  fit <- list(steps = data.frame(effect = c("Q", "gm", "sinusoid")),
+              coefficients = c(N = 1, gm1.sigma = 2, gm1.tc = 12.34,
+                               sinusoid1.amp = 1, sinusoid1.f0 = 0.25))
+  expect_identical(allanvar:::added_effects(fit),
+                   "Q, gm (Tc = 12.3 s), sinusoid (f0 = 0.25 Hz)")
+  expect_identical(allanvar:::added_effects(NULL), "none")
+})
+
+test_that("write_datasheet() writes the long and wide CSV", {
+  a <- sim_analysis()
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  write_datasheet(a, f)
+  d <- utils::read.csv(f)
+  expect_identical(names(d), c("record", "sensor", "axis", "term", "value",
+                               "unit", "tau", "method", "effects"))
+  expect_equal(d$value, datasheet(a)$long$value)
+  write_datasheet(datasheet(a), f, format = "wide")
+  expect_true(any(grepl("N \\[deg/sqrt\\(h\\)\\]", readLines(f))))
+  expect_error(write_datasheet(1, f), "imu_datasheet")
+})

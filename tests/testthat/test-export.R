@@ -1,0 +1,112 @@
+test_that("filter_params() follows the stated discrete-time conventions", {
+  dt <- 0.01
+  fp <- filter_params(c(N = 0.01, K = 1e-4, B = 0.002, gm1.sigma = 0.5,
+                        gm1.tc = 10), dt = dt, tau_B = 50)
+  get <- function(term, par) fp$value[fp$term == term & fp$parameter == par]
+  expect_equal(get("N", "sigma_d"), 0.1)               # 0.01 / sqrt(0.01)
+  expect_equal(get("K", "sigma_bd"), 1e-5)             # 1e-4 * sqrt(0.01)
+  expect_equal(get("gm1", "phi"), exp(-0.001))         # exp(-0.01 / 10)
+  expect_equal(get("gm1", "q_d"), 0.25 * (1 - exp(-0.002)))
+  # bias instability as a GM whose ADEV peak sits on the flat minimum
+  expect_equal(get("B", "phi"), exp(-0.01 / (50 / 1.893)))
+  expect_equal(get("B", "q_d"), (0.664 * 0.002 / 0.6174)^2 *
+                 (1 - exp(-0.02 / (50 / 1.893))))
+  expect_match(fp$convention[fp$parameter == "sigma_d"], "N / sqrt(dt)", fixed = TRUE)
+  expect_match(fp$convention[fp$parameter == "sigma_bd"], "K * sqrt(dt)", fixed = TRUE)
+  expect_match(fp$convention[fp$term == "gm1" & fp$parameter == "q_d"],
+               "sigma^2 * (1 - phi^2)", fixed = TRUE)
+  expect_true(all(fp$dt == dt))
+  expect_equal(fp$continuous[fp$parameter == "sigma_d"], 0.01)
+  fp2 <- filter_params(c(N = 0.01, B = 0.002), dt = dt, bias_instability = "omit")
+  expect_identical(fp2$parameter, "sigma_d")
+  expect_error(filter_params(c(N = 1)), "`dt`")
+  expect_error(filter_params(c(N = 1), dt = -1), "`dt`")
+})
+
+test_that("simulating the discrete parameters gives back the continuous model", {
+  # Independent check of the conventions: white noise of std sigma_d and a
+  # random walk with steps sigma_bd have AV = N^2/tau + K^2 tau/3 (+ the
+  # discrete K^2 dt^2/(6 tau)); the AR(1) has stationary variance sigma^2.
+  dt <- 0.01
+  N <- 2e-3
+  K <- 5e-4
+  fp <- filter_params(c(N = N, K = K, gm1.sigma = 0.3, gm1.tc = 0.5), dt = dt)
+  get <- function(term, par) fp$value[fp$term == term & fp$parameter == par]
+  set.seed(11)
+  n <- 4e5
+  y <- get("N", "sigma_d") * rnorm(n) + cumsum(get("K", "sigma_bd") * rnorm(n))
+  av <- avar(y, 1 / dt)
+  sel <- av$time >= 0.1 & av$time <= 50
+  expect_av <- N^2 / av$time + K^2 * av$time / 3 + K^2 * dt^2 / (6 * av$time)
+  expect_lt(max(abs(av$av[sel] / expect_av[sel] - 1)), 0.25)
+  expect_lt(abs(mean(av$av[sel] / expect_av[sel]) - 1), 0.06)
+  phi <- get("gm1", "phi")
+  w <- rnorm(n, sd = sqrt(get("gm1", "q_d")))
+  x <- stats::filter(w, phi, method = "recursive")
+  expect_equal(var(x[-(1:1000)]), 0.3^2, tolerance = 0.05)
+})
+
+test_that("write_kalibr_yaml() writes Kalibr's keys with units in comments", {
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  vals <- list(gyroscope_noise_density = 1.7e-4, gyroscope_random_walk = 2e-5,
+               accelerometer_noise_density = 2e-3,
+               accelerometer_random_walk = 3e-3, update_rate = 200)
+  out <- write_kalibr_yaml(vals, f)
+  txt <- readLines(f)
+  expect_true(any(grepl("^gyroscope_noise_density: +1.700000e-04 +# \\[rad/s/sqrt\\(Hz\\)\\]", txt)))
+  expect_true(any(grepl("^gyroscope_random_walk: .*\\[rad/s\\^2/sqrt\\(Hz\\)\\]", txt)))
+  expect_true(any(grepl("^accelerometer_noise_density: .*\\[m/s\\^2/sqrt\\(Hz\\)\\]", txt)))
+  expect_true(any(grepl("^accelerometer_random_walk: .*\\[m/s\\^3/sqrt\\(Hz\\)\\]", txt)))
+  expect_true(any(grepl("continuous time", txt)))
+  skip_if_not_installed("yaml")
+  y <- yaml::read_yaml(f)
+  expect_equal(y$gyroscope_noise_density, 1.7e-4)
+  expect_equal(y$accelerometer_random_walk, 3e-3)
+  expect_equal(y$update_rate, 200)
+  expect_identical(y$rostopic, "/imu0")
+  write_kalibr_yaml(vals, f, inflate = 2)
+  y2 <- yaml::read_yaml(f)
+  expect_equal(y2$gyroscope_random_walk, 4e-5)
+  expect_equal(y2$update_rate, 200)
+  expect_error(write_kalibr_yaml(vals[-1], f), "lacks gyroscope_noise_density")
+  expect_error(write_kalibr_yaml(vals, f, inflate = 0.5), "`inflate`")
+})
+
+test_that("write_kalibr_yaml() takes the worst axis of an analysis and says so", {
+  skip_if_not_installed("yaml")
+  n <- 4e4
+  m <- cbind(gyro_x = avsim(n, 100, N = 1e-3, K = 1e-4, seed = 1),
+             gyro_y = avsim(n, 100, N = 3e-3, K = 1e-4, seed = 2),
+             accel_x = avsim(n, 100, N = 2e-2, K = 1e-3, seed = 3),
+             accel_y = avsim(n, 100, N = 1e-2, K = 4e-3, seed = 4))
+  a <- suppressWarnings(analyze_imu(imu_record(m, freq = 100), progress = FALSE))
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  write_kalibr_yaml(a, f)
+  y <- yaml::read_yaml(f)
+  val <- function(ch, term) {
+    r <- a$channels[[ch]]$readings
+    r$value[r$term == term]
+  }
+  expect_equal(y$gyroscope_noise_density, max(val("gyro_x", "N"), val("gyro_y", "N")),
+               tolerance = 1e-6)
+  expect_equal(y$accelerometer_random_walk,
+               max(val("accel_x", "K"), val("accel_y", "K")), tolerance = 1e-6)
+  expect_equal(y$update_rate, 100)
+  txt <- readLines(f)
+  expect_true(any(grepl("gyroscope_noise_density.*worst axis \\(gyro_y\\)", txt)))
+  expect_true(any(grepl("accelerometer_random_walk.*worst axis \\(accel_y\\)", txt)))
+  # the white-noise level is recovered to within 15%
+  expect_equal(y$gyroscope_noise_density, 3e-3, tolerance = 0.15)
+  write_kalibr_yaml(a, f, axis = "mean")
+  y2 <- yaml::read_yaml(f)
+  expect_equal(y2$gyroscope_noise_density, mean(c(val("gyro_x", "N"), val("gyro_y", "N"))),
+               tolerance = 1e-6)
+  # filter parameters of the same analysis: sigma_d = N / sqrt(dt) per axis
+  fp <- filter_params(a)
+  expect_equal(fp$value[fp$channel == "gyro_y" & fp$parameter == "sigma_d"],
+               val("gyro_y", "N") / sqrt(0.01))
+  expect_identical(unique(fp$unit[fp$sensor == "accel" & fp$parameter == "sigma_d"]),
+                   "m/s^2")
+})

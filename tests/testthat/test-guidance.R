@@ -1,0 +1,51 @@
+test_that("tau_cross() solves K^2 tau/3 = N^2/tau + (2 ln2/pi) B^2", {
+  tc <- allanvar:::tau_cross
+  expect_equal(tc(1e-6, 0, 1e-4), sqrt(3) * 1e-3 / 1e-4)
+  expect_equal(tc(0, 4e-6, 1e-4), 3 * (2 * log(2) / pi) * 4e-6 / 1e-8)
+  t <- tc(1e-6, 4e-6, 1e-4)
+  expect_equal(1e-8 * t / 3, 1e-6 / t + 2 * log(2) / pi * 4e-6)
+})
+
+test_that("the record length needed for K follows the stated rule", {
+  ch <- list(
+    channel = "gyro_x", n = 1e5, freq = 100,
+    curve = data.frame(tau = 2^(0:6), adev = 1e-3 / sqrt(2^(0:6)),
+                       upper = 1.1e-3 / sqrt(2^(0:6)),
+                       edf = c(100, 50, 25, 12, 6, 3, 1.5)),
+    readings = data.frame(term = c("N", "B", "K"), value = c(1e-3, NA, 1e-4),
+                          unit = c("rad/s/sqrt(Hz)", "rad/s", "rad/s^2/sqrt(Hz)"),
+                          tau = c(1, 64, 3), method = "fit"),
+    fit = NULL, fit_error = NULL)
+  msg <- imu_guidance(ch)
+  # reliable up to tau = 8 s (edf >= 10); tau_x = sqrt(3) * 10 = 17.32 s;
+  # needed: T * 3 tau_x / tau_rel = 1000 * 3 * 17.32 / 8 = 6495 s = 1.8 h
+  expect_match(msg, "3 largest tau \\(16 s to 64 s\\)", all = FALSE)
+  expect_match(msg, "meets the rest at tau = 17.32 s", all = FALSE)
+  expect_match(msg, "a record of 1.8 h", all = FALSE)
+  # B read at 64 s > 8 / 3: flagged, needs 1000 * 3 * 64 / 8 s = 6.67 h
+  expect_match(msg, "minimum \\(tau = 64 s\\).*at least 6.67 h", all = FALSE)
+})
+
+test_that("a record without a +1/2 region warns and bounds K", {
+  x <- avsim(2e4, 100, N = 1e-3, seed = 5)
+  r <- imu_record(cbind(gyro_x = as.numeric(x)), freq = 100)
+  expect_warning(a <- analyze_imu(r, progress = FALSE), class = "allanvar_guidance")
+  rd <- a$channels$gyro_x$readings
+  expect_match(rd$method[rd$term == "K"], "upper bound")
+  cv <- a$channels$gyro_x$curve
+  ok <- is.finite(cv$upper)
+  expect_equal(rd$value[rd$term == "K"], min(cv$upper[ok] * sqrt(3 / cv$tau[ok])))
+  g <- imu_guidance(a)
+  expect_match(g$message, "never reached.*K <=", all = FALSE)
+  expect_identical(unique(g$channel), "gyro_x")
+})
+
+test_that("a record long enough for K gives no K or B guidance", {
+  x <- avsim(1e5, 100, N = 1e-2, K = 1e-2, seed = 6)
+  a <- suppressWarnings(analyze_imu(imu_record(cbind(gyro_x = as.numeric(x)), freq = 100),
+                                    progress = FALSE))
+  g <- imu_guidance(a)
+  expect_false(any(grepl("K =|K <=|minimum", g$message)))
+  rd <- a$channels$gyro_x$readings
+  expect_equal(rd$value[rd$term == "K"], 1e-2, tolerance = 0.3)
+})
