@@ -20,6 +20,14 @@
 #'    least 10 percent;
 #' 4. repeats until nothing pays or `max_steps` effects were added.
 #'
+#' For speed, candidates are first screened with the nonlinear parameters
+#' already in the model (`tc`, `f0`) held at their current values, and the
+#' winner is refitted with all of them free; only when screening finds
+#' nothing are the candidates tried again with everything free. A sinusoid
+#' whose frequency the raw periodogram resolves is also tried with `f0`
+#' held at the periodogram value (one parameter fewer), and such a
+#' frequency stays held in later steps.
+#'
 #' Every candidate kind in `candidates` that is not already in the model
 #' (gm and sinusoid may repeat) is refitted at each step; the residual
 #' signature and the raw data supply the initial values, the tau range and
