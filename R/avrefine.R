@@ -20,6 +20,14 @@
 #'    least 10 percent;
 #' 4. repeats until nothing pays or `max_steps` effects were added.
 #'
+#' For speed, candidates are first screened with the nonlinear parameters
+#' already in the model (`tc`, `f0`) held at their current values, and the
+#' winner is refitted with all of them free; only when screening finds
+#' nothing are the candidates tried again with everything free. A sinusoid
+#' whose frequency the raw periodogram resolves is also tried with `f0`
+#' held at the periodogram value (one parameter fewer), and such a
+#' frequency stays held in later steps.
+#'
 #' Every candidate kind in `candidates` that is not already in the model
 #' (gm and sinusoid may repeat) is refitted at each step; the residual
 #' signature and the raw data supply the initial values, the tau range and
@@ -199,7 +207,12 @@ avrefine <- function(fit, data = NULL,
     lay <- best$fit$layout
     f0_held <- lay$name[lay$fixed & lay$param == "f0" & lay$label == best$label]
     if (length(f0_held)) known <- c(known, stats::coef(best$fit)[f0_held])
-    evidence <- tr$signature
+    # Describe the effect where the fitted term actually sits, which may
+    # differ from where the trial started.
+    loc <- locate_signature(sig, best$fit, best$label, tr)
+    tr$tau_from <- loc$tau_from
+    tr$tau_to <- loc$tau_to
+    evidence <- loc$text
     if (nzchar(best$ev$text)) {
       evidence <- paste0(evidence, "; raw data: ", best$ev$text,
                          if (isFALSE(best$ev$support)) " (NOT supported by the raw data)")
@@ -315,6 +328,48 @@ refit_fixed_f0 <- function(fit, terms, f0, ..., hold = NULL) {
   args$fixed <- c(args$fixed, hold, stats::setNames(f0, paste0(lab, ".f0")))
   res <- tryCatch(suppressWarnings(do.call(avfit, args)), error = function(e) NULL)
   if (is.null(res) || !is.finite(res$chi2)) NULL else res
+}
+
+# The residual signature that matches an accepted term: the one whose tau
+# range holds (or lies nearest, within a factor 3) the term's characteristic
+# tau (GM ADEV peak 1.893 Tc, sinusoid first peak 0.371 / f0, otherwise the
+# tau where the term's share of the model is largest). Without one, the tau
+# range is where the term carries over a quarter of the model AV.
+locate_signature <- function(sig, fit, label, trial) {
+  tau <- fit$data$tau
+  comp <- tryCatch(av_model(tau, stats::coef(fit), freq = fit$freq, by_term = TRUE),
+                   error = function(e) NULL)
+  share <- if (!is.null(comp) && label %in% colnames(comp))
+    comp[, label] / rowSums(comp) else rep(NA_real_, length(tau))
+  cf <- stats::coef(fit)
+  tchar <- if (startsWith(label, "gm")) gm_peak_ratio * cf[[paste0(label, ".tc")]]
+    else if (startsWith(label, "sinusoid")) sin_peak_ratio / cf[[paste0(label, ".f0")]]
+    else if (all(is.na(share))) NA_real_ else tau[which.max(share)]
+  big <- which(share > 0.25)
+  range <- if (length(big)) range(tau[big]) else range(tau)
+  s <- sig[sig$kind != "slope" & sig$kind != "oscillation", , drop = FALSE]
+  if (is.finite(tchar) && nrow(s)) {
+    dist <- ifelse(tchar < s$tau_from, log(s$tau_from / tchar),
+                   ifelse(tchar > s$tau_to, log(tchar / s$tau_to), 0))
+    dist <- dist - 0.01 * (s$sign > 0)       # prefer a positive run on ties
+    j <- which.min(dist)
+    if (dist[j] < log(3)) {
+      txt <- s$description[j]
+      if (isTRUE(trial$from_raw) && grepl("periodogram", trial$signature) &&
+          startsWith(label, "sinusoid")) {
+        f0 <- cf[[paste0(label, ".f0")]]
+        lf <- trial$init[[1L]]$f0
+        if (abs(f0 - lf) < 0.25 * lf) {
+          txt <- paste0(txt, sprintf("; proposed by a periodogram line at %s Hz",
+                                     format_num(lf)))
+        }
+      }
+      return(list(tau_from = s$tau_from[j], tau_to = s$tau_to[j], text = txt))
+    }
+  }
+  list(tau_from = range[1L], tau_to = range[2L],
+       text = sprintf("no residual signature near tau = %s s (the term carries >25%% of the model AV over tau %s-%s s)",
+                      format_num(tchar), format_num(range[1L]), format_num(range[2L])))
 }
 
 # Largest share of the model AV carried by one term instance over the taus.

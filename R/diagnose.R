@@ -288,7 +288,8 @@ spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 5L) {
   pval <- stats::pchisq(ratio * nu, nu, lower.tail = FALSE)
   padj <- pmin(1, pval * (nb - 2))
   cand <- which(padj < alpha)
-  cand <- cand[cand > 2 & cand < nb - 1]
+  # The lowest bins carry the red-noise roll-off, not resolvable lines.
+  cand <- cand[cand > 4 & cand < nb - 1]
   lines <- data.frame(f0 = numeric(), amp = numeric(), ratio = numeric(),
                       p_value = numeric(), significance = numeric())
   if (length(cand)) {

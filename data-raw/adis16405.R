@@ -1,0 +1,99 @@
+# Derived figures of the measured ADIS16405 recordings (issue 4, item 6).
+#
+# Reads the three static 100 Hz recordings (1e6 x 6 each; gyro deg/s,
+# accel g) from ../shared/data, which are NOT shipped, and saves only derived
+# figures: the overlapping Allan variance tables (10 points per decade), the
+# raw-data diagnostics (quantization grid, lag-1 ACF, trend, spectral lines,
+# lag-1 noise identification), the datasheet fit (N, B, K) and the closed
+# loop's steps and refined coefficients.
+#
+# Data: Department of Geomatics Engineering, University of Calgary, as
+# published in the imudata R package (S. Guerrier, G. Bakalli et al.),
+# licensed CC BY-NC-SA 4.0.
+#
+# Run from the package root:  Rscript data-raw/adis16405.R
+# (about 10 minutes on one core).
+
+pkgload::load_all(".", quiet = TRUE)
+
+shared <- Sys.getenv("ALLANVAR_SHARED_DATA", "../shared/data")
+if (!dir.exists(shared)) shared <- "/work/shared/data"
+stopifnot(dir.exists(shared))
+options(allanvar.threads = 1L)
+
+units <- c(gyro = "deg/s", accel = "g")
+av_rows <- list(); diag_rows <- list(); line_rows <- list()
+coef_rows <- list(); step_rows <- list(); fit_rows <- list(); noise_rows <- list()
+fits <- list()
+
+for (k in 1:3) {
+  m <- readRDS(file.path(shared, sprintf("adis16405_unit%d.rds", k)))
+  freq <- attr(m, "freq")
+  for (axis in colnames(m)) {
+    t0 <- Sys.time()
+    x <- m[, axis]
+    sensor <- sub("_.*$", "", axis)
+    id <- sprintf("unit%d/%s", k, axis)
+    av <- allan(x, freq, taus = 10, type = "overlapping")
+    dg <- avdiagnose(x, freq)
+    fit0 <- avfit(av, terms = c("N", "B", "K"))
+    ref <- avrefine(fit0, data = x, max_steps = 5)
+    key <- data.frame(unit = k, axis = axis, sensor = sensor,
+                      rate_unit = units[[sensor]], stringsAsFactors = FALSE)
+    av_rows[[id]] <- cbind(key[rep(1, nrow(av)), ], as.data.frame(av)[
+      c("tau", "m", "n", "avar", "adev", "lower", "upper", "edf")], row.names = NULL)
+    g <- dg$grid
+    top <- if (nrow(dg$lines)) dg$lines[1, ] else
+      data.frame(f0 = NA, amp = NA, ratio = NA, p_value = NA, significance = NA)
+    diag_rows[[id]] <- cbind(key, data.frame(
+      n = dg$n, freq = freq, sd = sd(x), lsb = g$step, levels = g$levels,
+      on_grid = g$on_grid, sd_lsb = g$sd_lsb, acf1 = dg$acf1,
+      trend = dg$trend$slope, trend_t = dg$trend$t, n_lines = nrow(dg$lines),
+      line_f0 = top$f0, line_amp = top$amp, line_ratio = top$ratio,
+      line_p = top$p_value))
+    if (nrow(dg$lines)) line_rows[[id]] <- cbind(key[rep(1, nrow(dg$lines)), ],
+                                                 dg$lines, row.names = NULL)
+    noise_rows[[id]] <- cbind(key[rep(1, nrow(dg$noise_id)), ], dg$noise_id,
+                              row.names = NULL)
+    for (stage in c("datasheet", "refined")) {
+      f <- if (stage == "datasheet") fit0 else ref
+      coef_rows[[paste(id, stage)]] <- cbind(key[rep(1, length(coef(f))), ],
+        data.frame(stage = stage, name = names(coef(f)), value = unname(coef(f)),
+                   se = unname(f$se[names(coef(f))]), stringsAsFactors = FALSE),
+        row.names = NULL)
+    }
+    st <- ref$steps
+    if (nrow(st)) step_rows[[id]] <- cbind(key[rep(1, nrow(st)), ],
+                                           step = seq_len(nrow(st)), st, row.names = NULL)
+    fit_rows[[id]] <- cbind(key, data.frame(
+      chi2_before = fit0$chi2, rms_before = fit0$rms,
+      chi2_after = ref$chi2, rms_after = ref$rms, n_steps = nrow(st),
+      effects = if (nrow(st)) paste(st$effect, collapse = ", ") else "",
+      unconfirmed = sum(isFALSE(st$confirmed) | st$confirmed %in% FALSE),
+      final_terms = paste(ref$terms, collapse = ","),
+      stringsAsFactors = FALSE))
+    fits[[id]] <- list(datasheet = fit0, refined = ref)
+    cat(sprintf("%-14s chi2 %8.1f -> %7.2f  rms %5.1f%% -> %5.1f%%  [%s]  %.0f s\n", id,
+                fit0$chi2, ref$chi2, fit0$rms, ref$rms,
+                fit_rows[[id]]$effects, as.numeric(Sys.time() - t0, units = "secs")))
+  }
+}
+
+bind <- function(l) { out <- do.call(rbind, l); rownames(out) <- NULL; out }
+adis16405_av <- list(
+  av = bind(av_rows), diagnostics = bind(diag_rows), lines = bind(line_rows),
+  noise_id = bind(noise_rows), fits = bind(fit_rows), coef = bind(coef_rows),
+  steps = bind(step_rows),
+  source = paste("ADIS16405 static recordings, 3 units x 6 axes, 100 Hz, 1e6",
+                 "samples each. Department of Geomatics Engineering, University",
+                 "of Calgary, via the imudata R package; CC BY-NC-SA 4.0."))
+# Drop the raw-data-free parts the fits do not need to keep the file small.
+slim <- function(f) { f$call <- NULL; f }
+fits <- lapply(fits, function(p) lapply(p, slim))
+
+dir.create("data", showWarnings = FALSE)
+save(adis16405_av, file = "data/adis16405_av.rda", compress = "xz")
+dir.create("inst/extdata", recursive = TRUE, showWarnings = FALSE)
+saveRDS(fits, "inst/extdata/adis16405_refine.rds", compress = "xz")
+print(adis16405_av$fits[, c("unit", "axis", "chi2_before", "chi2_after",
+                            "rms_before", "rms_after", "effects")])
