@@ -38,6 +38,9 @@
 #' @source Department of Geomatics Engineering, University of Calgary, as
 #'   published in the imudata R package (S. Guerrier, G. Bakalli et al.),
 #'   licensed CC BY-NC-SA 4.0. Only derived figures are included here.
+#' @usage data(adis16405_av)
+#' @docType data
+#' @keywords datasets
 #' @examples
 #' data(adis16405_av)
 #' adis16405_av$fits[, c("unit", "axis", "chi2_before", "chi2_after", "effects")]

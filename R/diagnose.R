@@ -87,7 +87,7 @@ residual_signatures <- function(tau, z, level = 3.5, z0 = 1) {
   fit <- stats::lm(z ~ log10(tau))
   cf <- summary(fit)$coefficients
   if (nrow(cf) == 2L && is.finite(cf[2L, 3L])) {
-    t_slope <- cf[2L, 1L] * sd(log10(tau)) * sqrt(n) / sqrt(max(n / 4, 1))
+    t_slope <- cf[2L, 1L] * stats::sd(log10(tau)) * sqrt(n) / sqrt(max(n / 4, 1))
     if (abs(t_slope) > 2 * level) {
       out <- rbind(out, data.frame(
         kind = "slope", tau_from = tau[1L], tau_to = tau[n],

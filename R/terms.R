@@ -31,15 +31,12 @@ flicker_table <- list(
         2.111055904, 2.298556211, 2.486057692, 2.673563682)
 )
 flicker_c <- local({
-  f <- NULL
-  function(m) {
-    if (is.null(f)) {
-      f <<- stats::splinefun(log(flicker_table$m), flicker_table$c,
+  spline <- stats::splinefun(log(flicker_table$m), flicker_table$c,
                              method = "monoH.FC")
-    }
+  function(m) {
     big <- m > 4096
     out <- numeric(length(m))
-    out[!big] <- f(log(m[!big]))
+    out[!big] <- spline(log(m[!big]))
     out[big] <- 2.673563682 + 3 / (16 * log(2)) * log(m[big] / 4096)
     out
   }
