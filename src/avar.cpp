@@ -14,12 +14,10 @@ Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values,
   for (int i = 0; i <= p; ++i) sizes[i] = static_cast<R_xlen_t>(1) << i;
   // Every level re-sums all N samples; levels are shared between threads.
   if (threads > p + 1) threads = p + 1;
-  std::vector<std::vector<double> > sums(threads, std::vector<double>(N));
   const double* x = values.begin();
   double* avp = av.begin();
-  allanvar::parallel_for(p + 1, threads, [&](R_xlen_t i, int worker) {
-    allanvar::cluster_avars(x, N, &sizes[i], 1, avp + i, sums[worker].data(),
-                            [] {});
+  allanvar::parallel_for(p + 1, threads, [&](R_xlen_t i, int) {
+    allanvar::cluster_avars(x, N, &sizes[i], 1, avp + i, [] {});
   });
   for (int i = 0; i <= p; ++i) {
     const double c = std::ldexp(1.0, i);

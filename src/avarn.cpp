@@ -21,12 +21,11 @@ Rcpp::DataFrame avarn_all_exact(const Rcpp::NumericVector& values, double freq,
   const R_xlen_t blocks = (n + block - 1) / block;
   std::vector<R_xlen_t> sizes(n);
   for (R_xlen_t i = 0; i < n; ++i) sizes[i] = i + 1;
-  std::vector<std::vector<double> > sums(threads, std::vector<double>(N));
-  allanvar::parallel_for(blocks, threads, [&](R_xlen_t b, int worker) {
+  allanvar::parallel_for(blocks, threads, [&](R_xlen_t b, int) {
     const R_xlen_t from = b * block;
     const R_xlen_t count = std::min(block, n - from);
     allanvar::cluster_avars(x, N, sizes.data() + from, count, avp + from,
-                            sums[worker].data(), [] {});
+                            [] {});
   });
   for (R_xlen_t i = 0; i < n; ++i) {
     const double c = static_cast<double>(i + 1);

@@ -96,14 +96,13 @@ class ClusterLevel {
       : c_(static_cast<double>(c)), M_(M), S_(0.0), prev_(0.0),
         has_prev_(false), tail_count_(0) {}
 
-  // Cluster sums in order; the last clusters may come later via tail().
-  void add_sums(const double* sums, R_xlen_t count) {
-    for (R_xlen_t k = 0; k < count; ++k) add_mean(sums[k] / c_);
-  }
-  // Room for a cluster sum that is computed later (by sum_chains).
+  // The next cluster sum, in order.
+  void add_sum(double sum) { add_mean(sum / c_); }
+  // Room for the sum of one of the last clusters, filled in later (by
+  // sum_chains) and folded in by finish_tail().
   double* tail() { return &tail_[tail_count_++]; }
   void finish_tail() {
-    for (int k = 0; k < tail_count_; ++k) add_mean(tail_[k] / c_);
+    for (int k = 0; k < tail_count_; ++k) add_sum(tail_[k]);
     tail_count_ = 0;
   }
   double av() const { return S_ / (2.0 * (static_cast<double>(M_) - 1.0)); }
@@ -123,36 +122,46 @@ class ClusterLevel {
   double S_, prev_;
   bool has_prev_;
   int tail_count_;
-  double tail_[4];
+  double tail_[6];
 };
 
-// Sums of the M consecutive clusters of size c at x, four clusters at a time,
-// into sums[0 .. 4 floor(M/4)); the last M mod 4 clusters are queued on
-// `later` (into level.tail()) so that they overlap with other levels' last
-// clusters. Returns the number of sums written.
-inline R_xlen_t cluster_sums(const double* x, R_xlen_t c, R_xlen_t M,
-                             double* sums, ClusterLevel& level,
-                             std::vector<Chain>& later) {
+// Feeds the sums of the M consecutive clusters of size c at x to `level`,
+// six clusters at a time (six independent x87 chains measured fastest here:
+// 14 ms against 18 ms with four for the octave sizes of 1e6 samples); the
+// last M mod 6 clusters are queued on `later` so that they overlap with other
+// sizes' last clusters.
+inline void cluster_sums(const double* x, R_xlen_t c, R_xlen_t M,
+                         ClusterLevel& level, std::vector<Chain>& later) {
   R_xlen_t k = 0;
-  for (; k + 4 <= M; k += 4) {
+  if (c == 1) {
+    // A one-sample sum is the sample itself (0 + x is exact).
+    for (; k < M; ++k) level.add_sum(r_sum_result(x[k]));
+    return;
+  }
+  for (; k + 6 <= M; k += 6) {
     const double* p0 = x + k * c;
     const double* p1 = p0 + c;
     const double* p2 = p1 + c;
     const double* p3 = p2 + c;
-    long double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    const double* p4 = p3 + c;
+    const double* p5 = p4 + c;
+    long double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0;
     for (R_xlen_t j = 0; j < c; ++j) {
       s0 += p0[j];
       s1 += p1[j];
       s2 += p2[j];
       s3 += p3[j];
+      s4 += p4[j];
+      s5 += p5[j];
     }
-    sums[k] = r_sum_result(s0);
-    sums[k + 1] = r_sum_result(s1);
-    sums[k + 2] = r_sum_result(s2);
-    sums[k + 3] = r_sum_result(s3);
+    level.add_sum(r_sum_result(s0));
+    level.add_sum(r_sum_result(s1));
+    level.add_sum(r_sum_result(s2));
+    level.add_sum(r_sum_result(s3));
+    level.add_sum(r_sum_result(s4));
+    level.add_sum(r_sum_result(s5));
   }
-  for (R_xlen_t j = k; j < M; ++j) later.push_back({x + j * c, c, level.tail()});
-  return k;
+  for (; k < M; ++k) later.push_back({x + k * c, c, level.tail()});
 }
 
 // The `error` column of allanvar 1.1: 1/sqrt(2 (N/c - 1)).
@@ -168,20 +177,17 @@ inline int octave_count(R_xlen_t N) {
 }
 
 // Non-overlapping Allan variances, allanvar 1.1's way, for the cluster sizes
-// sizes[0 .. count): av[i] for sizes[i]. `sums` is scratch of length N.
+// sizes[0 .. count): av[i] for sizes[i].
 template <class Check>
 inline void cluster_avars(const double* x, R_xlen_t N, const R_xlen_t* sizes,
-                          R_xlen_t count, double* av, double* sums,
-                          Check check) {
+                          R_xlen_t count, double* av, Check check) {
   std::vector<ClusterLevel> levels;
   levels.reserve(count);
   std::vector<Chain> later;
   for (R_xlen_t i = 0; i < count; ++i) {
     const R_xlen_t c = sizes[i];
-    const R_xlen_t M = N / c;
-    levels.emplace_back(c, M);
-    const R_xlen_t done = cluster_sums(x, c, M, sums, levels.back(), later);
-    levels.back().add_sums(sums, done);
+    levels.emplace_back(c, N / c);
+    cluster_sums(x, c, N / c, levels.back(), later);
     check();
   }
   sum_chains(later);
