@@ -115,7 +115,8 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   }
   nterms <- allan_nterms(type, m, L)
   octave <- type == "standard" && rate && all(m == 2^round(log2(m)))
-  res <- allan_sums_cpp(ch$values, N, m, nterms, allan_type_code(type),
+  sub <- allan_subset(m)
+  res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub], allan_type_code(type),
                         rate, octave, allanvar_threads())
   norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
                  2 * m^2)
@@ -123,7 +124,7 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {
     av <- res$sums[, j] / (norm * nterms) * scale
-    e <- allan_edf(type, m, nterms, L, res$alpha_int[, j])
+    e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
     ci <- allan_ci(av, e$edf, conf)
     d <- data.frame(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
                     adev = sqrt(av), lower = ci$lower, upper = ci$upper,

@@ -38,7 +38,15 @@ avarn <- function(values, freq, exact = TRUE) {
   avarn_fast(values, freq)
 }
 
-# The O(N log N) path for avarn(exact = FALSE); replaced by allan()'s engine.
+# The O(N log N) path for avarn(exact = FALSE): allan()'s non-overlapping
+# kernel (compensated prefix sums) at every cluster size, no noise id or EDF.
 avarn_fast <- function(values, freq) {
-  abort("`exact = FALSE` needs allan()'s engine, which is not built yet.")
+  N <- length(values)
+  cs <- seq_len(ceiling((N - 1) / 2))
+  nterms <- allan_nterms("standard", cs, N + 1)
+  res <- allan_sums_cpp(values, N, cs, nterms, numeric(0),
+                        allan_type_code("standard"), TRUE, FALSE,
+                        allanvar_threads())
+  data.frame(time = cs * (1 / freq), av = res$sums[, 1] / (2 * cs^2 * nterms),
+             error = 1 / sqrt(2 * ((N / cs) - 1)))
 }

@@ -1,3 +1,18 @@
+# The noise-model fit. Internals other files may use (stable within the
+# package):
+#   avfit(fit, terms, start = c(gm2.tc = 30))  refits an avfit's own curve
+#       with new terms; the old nonlinear estimates start the new fit.
+#   fit$data     tau, m, avar, edf, fitted, z (standardized log residual)
+#   fit$input    the normalised input (list: data, freq, n, type, edf_source)
+#   fit$layout   one row per coefficient: name, label, kind, param, role
+#                ("amp"/"nonlinear"), unit, fixed, value
+#   fit$components  each term instance's AV at the data taus
+#   log_bias(edf), log_sd(edf)   chi-square log bias and sd of ln AV-hat
+#   edf_model(m, n, type, comp, alpha)  model EDF (see the EDF section)
+#   white_corr(m, n, type)  white-noise correlation of the AV estimates
+# The catalogue helpers live in terms.R (coef_layout, check_coef,
+# term_basis_matrix, model_components, term_entry, term_labels).
+
 #' Fit a noise model to an Allan variance curve
 #'
 #' Fits a sum of noise terms from the catalogue ([av_terms()]) to an Allan
@@ -17,7 +32,9 @@
 #' * a plain data frame with columns `tau` (s) and `avar`, and optionally
 #'   `edf`, computed elsewhere; without `edf`, give `n` and `freq` (the
 #'   estimator is taken as overlapping unless `type` says otherwise);
-#' * a previous `avfit` (its data are refitted with the new `terms`).
+#' * a previous `avfit` (its data are refitted with the new `terms`, its
+#'   nonlinear estimates as starting values and, when its EDF came from its
+#'   model, with that same EDF, so that AIC/BIC of the two fits compare).
 #'
 #' @section Model and estimation:
 #' The expected Allan variance is \eqn{AV_j = \sum_k a_k^2 b_k(\tau_j;
@@ -29,8 +46,15 @@
 #' standardized residuals
 #' \deqn{z_j = \frac{\ln\widehat{AV}_j - \ln AV_j - [\psi(\nu_j/2) -
 #'   \ln(\nu_j/2)]}{\sqrt{\psi'(\nu_j/2)}}.}
-#' The correlation between the estimates at different \eqn{\tau} is not
-#' modelled (octave-spaced points are the least correlated choice).
+#' By default the estimates at different \eqn{\tau} are taken as
+#' independent (octave-spaced points are the least correlated choice); with
+#' `correlation = TRUE` the objective is the generalised
+#' \eqn{r^\top\Sigma^{-1}r} with \eqn{\Sigma = D_s R D_s},
+#' \eqn{D_s = \mathrm{diag}(\sqrt{\psi'(\nu_j/2)})} and \eqn{R} the exact
+#' correlation of the AV estimates for white rate noise (Isserlis' theorem,
+#' computed in C++ for the estimator type). It is exact for white noise and
+#' an approximation otherwise; the correlation of the log estimates is taken
+#' as that of the estimates.
 #' For fixed nonlinear parameters the squared amplitudes \eqn{c_k = a_k^2}
 #' are found by Gauss-Newton steps, each a non-negative least-squares
 #' problem (C++); the nonlinear parameters are profiled on a log grid
@@ -56,8 +80,9 @@
 #' \eqn{\max(1, \chi^2/\mathrm{dof})} so that misfit widens it. For an
 #' amplitude at its bound 0 the curvature is computed for \eqn{c = a^2}
 #' instead and its standard error reported as \eqn{\sqrt{SE(c)}} (the
-#' one-sigma upper reach of the amplitude). Fixed parameters have zero
-#' variance.
+#' one-sigma upper reach of the amplitude); the `tc` or `f0` of a term whose
+#' amplitude is 0 is not identified and gets `NA`. Fixed parameters have
+#' zero variance.
 #'
 #' @param av The Allan variance curve (see Input).
 #' @param terms Character vector of terms to fit (see [av_terms()]); `gm` and
@@ -78,13 +103,19 @@
 #'   the chi-square log bias \eqn{\psi(\nu/2) - \ln(\nu/2)} is removed
 #'   from \eqn{\ln\widehat{AV}}; set `FALSE` to fit a noise-free
 #'   theoretical curve.
+#' @param correlation If `TRUE`, account for the correlation between the
+#'   estimates at different tau (white-noise correlation; needs `n` and
+#'   `freq`). `chi2` is then \eqn{r^\top\Sigma^{-1}r} per degree of freedom.
 #' @param ... Unused.
 #' @return An object of class `"avfit"`: a list with `coefficients` (named:
 #'   `Q`, `N`, `B`, `K`, `R`, `gm1.sigma`, `gm1.tc`, `sinusoid1.amp`,
 #'   `sinusoid1.f0`, ...), `se`, `vcov`, `chi2` (sum of squared
 #'   standardized residuals per degree of freedom), `rms` (RMS relative
-#'   error of the Allan deviation in percent,
-#'   \eqn{100\sqrt{\mathrm{mean}((\sqrt{AV_j/\widehat{AV}_j} - 1)^2)}}),
+#'   error of the Allan deviation in percent: the measured ADEV relative to
+#'   the model's,
+#'   \eqn{100\sqrt{\mathrm{mean}((\sqrt{\widehat{AV}_j/AV_j} - 1)^2)}}; this
+#'   direction keeps a single low estimate at the longest tau, where the EDF
+#'   is near 1, from dominating),
 #'   `objective`, `df.residual`, `nobs`, `terms`, `layout` (one row per
 #'   coefficient: name, term label, kind, parameter, role, unit, fixed),
 #'   `data` (data frame `tau`, `m`, `avar`, `edf`, `fitted`, `z`),
@@ -95,25 +126,30 @@
 #' @importFrom stats coef vcov fitted residuals confint predict logLik nobs AIC BIC
 #' @export
 #' @examples
-#' x <- avsim(2e5, freq = 100, N = 0.01, B = 0.002, K = 1e-4, seed = 1)
+#' x <- avsim(1e5, freq = 100, N = 0.01, B = 0.002, K = 1e-4, seed = 1)
 #' av <- avar(x, 100)
 #' fit <- avfit(av, c("N", "B", "K"), freq = 100)
 #' fit
 #' # a table computed elsewhere: tau, avar (and n, freq for the EDF)
 #' tab <- data.frame(tau = av$time, avar = av$av)
-#' coef(avfit(tab, c("N", "B", "K"), n = 2e5, freq = 100,
+#' coef(avfit(tab, c("N", "B", "K"), n = 1e5, freq = 100,
 #'            type = "non-overlapping"))
 avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
                   type = "overlapping", channel = NULL, start = NULL,
-                  fixed = NULL, tau_range = NULL, bias_correct = TRUE, ...) {
+                  fixed = NULL, tau_range = NULL, bias_correct = TRUE,
+                  correlation = FALSE, ...) {
   cl <- match.call()
   if (!isTRUE(bias_correct) && !isFALSE(bias_correct)) {
     abort("`bias_correct` must be TRUE or FALSE.")
+  }
+  if (!isTRUE(correlation) && !isFALSE(correlation)) {
+    abort("`correlation` must be TRUE or FALSE.")
   }
   check_present(missing(av), "av", "an Allan variance curve")
   terms <- check_terms(terms)
   if (inherits(av, "avfit")) {
     if (missing(bias_correct)) bias_correct <- isTRUE(av$bias_correct)
+    if (missing(correlation)) correlation <- isTRUE(av$correlation)
     # previous nonlinear estimates start the refit
     old <- av$coefficients[av$layout$role == "nonlinear"]
     old <- old[names(old) %in% coef_layout(terms)$name]
@@ -143,10 +179,23 @@ avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
           " free parameters of terms ", paste(terms, collapse = ", "), ".")
   }
   tau0 <- if (is.null(d$freq)) NULL else 1 / d$freq
+  corr <- NULL
+  if (correlation) {
+    if (is.null(d$freq) || is.null(d$n)) {
+      abort("`correlation = TRUE` needs `n` and `freq` (the cluster sizes ",
+            "and the record length).")
+    }
+    corr <- if (inherits(av, "avfit") && !is.null(av$corr) &&
+                is.null(tau_range) && nrow(av$corr) == nrow(d$data)) {
+      av$corr
+    } else {
+      white_corr(d$data$m, d$n, d$type)
+    }
+  }
   fit <- NULL
-  passes <- if (d$edf_source == "input") 1L else 2L
+  passes <- if (d$edf_source == "model") 2L else 1L
   for (pass in seq_len(passes)) {
-    if (d$edf_source != "input") {
+    if (d$edf_source == "model") {
       d$data$edf <- if (is.null(fit)) {
         edf_model(d$data$m, d$n, d$type, matrix(1, nrow(d$data), 1), 0)
       } else {
@@ -156,7 +205,7 @@ avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
       }
     }
     fit <- fit_core(d$data, tau0, lay, start, if (is.null(fit)) NULL else fit,
-                    bias_correct)
+                    bias_correct, corr)
   }
   finish_fit(fit, d, input, terms, cl)
 }
@@ -180,6 +229,15 @@ normalize_type <- function(type) {
 avfit_input <- function(av, n, freq, type, type_given, channel) {
   if (inherits(av, "avfit")) {
     d <- av$input
+    if (d$edf_source == "model") {
+      # keep the EDF of the fit being extended, so that the two fits'
+      # likelihoods (AIC, BIC) are comparable
+      tau0 <- if (is.null(d$freq)) NULL else 1 / d$freq
+      comp <- model_components(d$data$tau, tau0, av$layout)
+      d$data$edf <- edf_model(d$data$m, d$n, d$type, comp,
+                              term_alpha(av$layout, d$data$tau))
+      d$edf_source <- "previous"
+    }
     return(d)
   }
   if (!is.null(freq)) freq <- check_freq(freq)
@@ -374,80 +432,143 @@ nl_range <- function(kind, tau, freq) {
   c(min(0.2 / max(tau), hi / 10), hi)
 }
 
+# Correlation matrix of the AV estimates at cluster sizes m for white rate
+# noise (exact Gaussian moments, C++).
+white_corr <- function(m, n, type) {
+  C <- avar_white_cov(as.double(round(m)), as.double(n),
+                      type == "overlapping", allanvar_threads())
+  d <- sqrt(diag(C))
+  R <- C / outer(d, d)
+  R[!is.finite(R)] <- 0
+  diag(R) <- 1
+  R
+}
+
+# Whitening matrix W with ||W r||^2 = r' Sigma^-1 r, Sigma = diag(s) R diag(s).
+whitening <- function(s, corr) {
+  if (is.null(corr)) return(diag(1 / s, length(s)))
+  Sig <- corr * outer(s, s)
+  U <- tryCatch(chol(Sig), error = function(e) NULL)
+  # nearly coincident taus can make Sigma numerically singular: add a ridge
+  ridge <- 1e-10
+  while (is.null(U) && ridge < 1e-2) {
+    U <- tryCatch(chol(Sig + diag(ridge * s^2, length(s))),
+                  error = function(e) NULL)
+    ridge <- ridge * 100
+  }
+  if (is.null(U)) return(diag(1 / s, length(s)))
+  t(backsolve(U, diag(length(s))))
+}
+
 # Solve for the amplitudes at given nonlinear values; returns list with c
 # (named by free amp label), objective.
-solve_amps <- function(data, tau0, lay, nlv, y, s, cstart = NULL) {
+# `off`: labels of term instances left out (amplitude 0) for this solve.
+solve_amps <- function(data, tau0, lay, nlv, y, W, cstart = NULL, off_labels = NULL) {
   lay2 <- lay
   lay2$value[lay2$role == "nonlinear" & !lay2$fixed] <- nlv
   Bm <- term_basis_matrix(data$tau, tau0, lay2)
   amp <- lay2[lay2$role == "amp", , drop = FALSE]
-  freeamp <- amp$label[!amp$fixed]
+  freeamp <- amp$label[!amp$fixed & !amp$label %in% off_labels]
   off <- numeric(nrow(data))
   for (i in which(amp$fixed)) off <- off + amp$value[i]^2 * Bm[, amp$label[i]]
   Bf <- Bm[, freeamp, drop = FALSE]
   if (is.null(cstart)) cstart <- numeric(length(freeamp))
   if (length(freeamp) == 0L) {
     av <- off
-    obj <- if (all(av > 0)) sum(((y - log(av)) / s)^2) else Inf
+    obj <- if (all(av > 0)) sum((W %*% (y - log(av)))^2) else Inf
     return(list(c = numeric(0), objective = obj, layout = lay2))
   }
-  r <- avfit_log_nnls(Bf, off, y, s, cstart, 100L, 1e-12)
-  cc <- stats::setNames(r$c, freeamp)
+  r <- avfit_log_nnls(Bf, off, y, W, cstart, 100L, 1e-12)
+  cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$label[!amp$fixed])
+  cc[freeamp] <- r$c
   list(c = cc, objective = r$objective, layout = lay2)
 }
 
-fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE) {
+fit_core <- function(data, tau0, lay, start, prev, bias_correct = TRUE,
+                     corr = NULL) {
   y <- log(data$avar) - if (bias_correct) log_bias(data$edf) else 0
   s <- log_sd(data$edf)
+  W <- whitening(s, corr)
   freq <- if (is.null(tau0)) NULL else 1 / tau0
   nlrows <- which(lay$role == "nonlinear" & !lay$fixed)
   nlv <- numeric(length(nlrows))
   names(nlv) <- lay$name[nlrows]
-  obj <- function(lognl) solve_amps(data, tau0, lay, exp(lognl), y, s)$objective
+  obj <- function(lognl, off_labels = NULL) {
+    solve_amps(data, tau0, lay, exp(lognl), y, W, off_labels = off_labels)$objective
+  }
   if (length(nlrows)) {
     ranges <- lapply(nlrows, function(i) nl_range(lay$kind[i], data$tau, freq))
-    # initial values: start, previous fit, or grid centre
+    # initial values: previous pass, start, or grid centre
     for (k in seq_along(nlrows)) {
       nm <- lay$name[nlrows[k]]
-      nlv[k] <- if (!is.null(start) && nm %in% names(start)) start[[nm]] else
-        if (!is.null(prev)) prev$layout$value[prev$layout$name == nm] else
+      nlv[k] <- if (!is.null(prev)) prev$layout$value[prev$layout$name == nm] else
+        if (!is.null(start) && nm %in% names(start)) start[[nm]] else
           sqrt(prod(ranges[[k]]))
     }
     # a parameter with a start (given, or from the previous pass) is refined
     # locally; the others are searched on the grid first
-    has_start <- !is.null(prev) | names(nlv) %in% names(start)
-    lognl <- log(nlv)
-    cycles <- if (length(nlrows) > 1L) 2L else 1L
-    for (cy in seq_len(cycles)) {
-      for (k in seq_along(nlrows)) {
-        f1 <- function(v) { l <- lognl; l[k] <- v; obj(l) }
-        if (cy > 1L || has_start[k]) {
-          lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
-        } else {
-          ng <- if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
-          g <- seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
-          vals <- vapply(g, f1, 0)
-          i <- which.min(vals)
-          lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
-          lognl[k] <- g[i]
+    has_start <- names(nlv) %in% names(start)
+    search <- function(order) {
+      lognl <- log(nlv)
+      cycles <- if (length(nlrows) > 1L) 2L else 1L
+      for (cy in seq_len(cycles)) {
+        for (pos in seq_along(order)) {
+          k <- order[pos]
+          # first cycle: terms not searched yet stay out of the model (greedy)
+          later <- if (cy == 1L) {
+            j <- order[seq_along(order) > pos]
+            lay$label[nlrows[j[!has_start[j]]]]
+          } else NULL
+          f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
+          if (cy > 1L || !is.null(prev)) {
+            lo <- lognl[k] - log(1.5); hi <- lognl[k] + log(1.5)
+          } else {
+            # a start value: a short grid over start / 4 .. start * 4;
+            # otherwise the whole range
+            ng <- if (has_start[k]) 13L else
+              if (lay$kind[nlrows[k]] == "sinusoid") 120L else 40L
+            g <- if (has_start[k]) lognl[k] + seq(-log(4), log(4), length.out = ng) else
+              seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
+            vals <- vapply(g, f1, 0)
+            i <- which.min(vals)
+            lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
+            lognl[k] <- g[i]
+          }
+          o <- stats::optimize(f1, c(lo, hi), tol = 1e-7)
+          if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
         }
-        o <- stats::optimize(f1, c(lo, hi), tol = 1e-7)
-        if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
       }
+      if (length(nlrows) > 1L) {
+        o <- stats::optim(lognl, obj, method = "Nelder-Mead",
+                          control = list(reltol = 1e-10, maxit = 400))
+        if (o$value <= obj(lognl)) lognl <- o$par
+      }
+      list(lognl = lognl, value = obj(lognl))
     }
-    if (length(nlrows) > 1L) {
-      o <- stats::optim(lognl, obj, method = "Nelder-Mead",
-                        control = list(reltol = 1e-10, maxit = 400))
-      if (o$value <= obj(lognl)) lognl <- o$par
+    # The greedy search depends on the order in which the terms enter; with
+    # several unstarted nonlinear terms try each rotation of the order (and
+    # its reverse) and keep the best objective.
+    K <- length(nlrows)
+    orders <- list(seq_len(K))
+    if (is.null(prev) && sum(!has_start) > 1L) {
+      rot <- lapply(seq_len(K) - 1L, function(r) (seq_len(K) + r - 1L) %% K + 1L)
+      orders <- unique(c(rot, lapply(rot, rev)))
+      if (length(orders) > 6L) orders <- orders[seq_len(6L)]
     }
+    best <- NULL
+    for (ord in orders) {
+      r <- search(ord)
+      if (is.null(best) || r$value < best$value) best <- r
+    }
+    lognl <- best$lognl
     nlv[] <- exp(lognl)
   }
-  sol <- solve_amps(data, tau0, lay, nlv, y, s)
+  sol <- solve_amps(data, tau0, lay, nlv, y, W)
   lay2 <- sol$layout
   amprows <- which(lay2$role == "amp" & !lay2$fixed)
   lay2$value[amprows] <- sqrt(pmax(sol$c[lay2$label[amprows]], 0))
-  list(layout = lay2, objective = sol$objective, y = y, s = s, data = data,
-       tau0 = tau0, bias_correct = bias_correct)
+  list(layout = lay2, objective = sol$objective, y = y, s = s, W = W,
+       corr = corr, data = data, tau0 = tau0, bias_correct = bias_correct)
 }
 
 # Jacobian of ln AV with respect to the free parameters (amplitudes, or c for
@@ -487,7 +608,16 @@ jacobian_lnav <- function(fit) {
   list(J = Jm, at_zero = at_zero, free = free)
 }
 
+# Pseudo-inverse of a symmetric PSD matrix, equilibrated first: parameters
+# differ by many orders of magnitude (c = K^2 ~ 1e-8 next to tc ~ 10 s).
 pinv <- function(A) {
+  dg <- sqrt(pmax(diag(A), 0))
+  dg[dg == 0] <- 1
+  As <- A / outer(dg, dg)
+  pinv_raw(As) / outer(dg, dg)
+}
+
+pinv_raw <- function(A) {
   e <- eigen((A + t(A)) / 2, symmetric = TRUE)
   d <- e$values
   keep <- d > max(d) * 1e-12
@@ -502,14 +632,15 @@ finish_fit <- function(fit, d, input, terms, cl) {
   comp <- model_components(data$tau, tau0, lay)
   fitted <- rowSums(comp)
   z <- (fit$y - log(fitted)) / fit$s
+  objective <- sum((fit$W %*% (fit$y - log(fitted)))^2)
   nfree <- sum(!lay$fixed)
   dfres <- nrow(data) - nfree
-  chi2 <- if (dfres > 0) sum(z^2) / dfres else NA_real_
-  rms <- 100 * sqrt(mean((sqrt(fitted / data$avar) - 1)^2))
+  chi2 <- if (dfres > 0) objective / dfres else NA_real_
+  rms <- 100 * sqrt(mean((sqrt(data$avar / fitted) - 1)^2))
   coef <- stats::setNames(lay$value, lay$name)
   # covariance
   jj <- jacobian_lnav(fit)
-  Js <- jj$J / fit$s
+  Js <- -fit$W %*% jj$J
   V <- pinv(crossprod(Js)) * max(1, if (is.na(chi2)) 1 else chi2)
   vc <- matrix(0, nrow(lay), nrow(lay), dimnames = list(lay$name, lay$name))
   se <- stats::setNames(numeric(nrow(lay)), lay$name)
@@ -525,6 +656,13 @@ finish_fit <- function(fit, d, input, terms, cl) {
     diag(vfree)[match(zn, fn)] <- sez^2
   }
   vc[fn, fn] <- vfree
+  # a nonlinear parameter of a term whose amplitude is 0 is not identified
+  for (i in which(lay$role == "nonlinear" & !lay$fixed)) {
+    a <- lay$value[lay$label == lay$label[i] & lay$role == "amp"]
+    if (!(a > 0)) {
+      vc[i, ] <- vc[, i] <- NA_real_
+    }
+  }
   se[] <- sqrt(pmax(diag(vc), 0))
   data$fitted <- fitted
   data$z <- z
@@ -533,13 +671,15 @@ finish_fit <- function(fit, d, input, terms, cl) {
                       chi2_before = numeric(0), chi2_after = numeric(0),
                       rms_before = numeric(0), rms_after = numeric(0),
                       stringsAsFactors = FALSE)
-  input$data$edf <- if (d$edf_source == "input") input$data$edf else NA_real_
+  input$data$edf <- if (d$edf_source == "model") NA_real_ else input$data$edf
   structure(list(
     coefficients = coef, se = se, vcov = vc, chi2 = chi2, rms = rms,
-    objective = sum(z^2), df.residual = dfres, nobs = nrow(data),
+    objective = objective, logdet = -2 * sum(log(diag(fit$W))),
+    df.residual = dfres, nobs = nrow(data),
     npar = nfree, terms = terms, layout = lay, data = data,
     components = comp, freq = d$freq, n = d$n, type = d$type,
-    edf_source = d$edf_source, bias_correct = fit$bias_correct, steps = steps,
+    edf_source = d$edf_source, bias_correct = fit$bias_correct,
+    correlation = !is.null(fit$corr), corr = fit$corr, steps = steps,
     input = input, call = cl),
     class = "avfit")
 }
@@ -557,9 +697,13 @@ finish_fit <- function(fit, d, input, terms, cl) {
 #' `confint()` gives Wald intervals: for amplitudes on the linear scale,
 #' truncated at 0; for `tc` and `f0` on the log scale.
 #' `logLik()` is the Gaussian log-likelihood of \eqn{\ln\widehat{AV}_j}
-#' (bias-corrected) with variances \eqn{\psi'(\nu_j/2)}; its `df` is the
+#' (bias-corrected) with variances \eqn{\psi'(\nu_j/2)} (and the
+#' white-noise correlation when the fit used `correlation = TRUE`); its `df` is the
 #' number of free parameters and `nobs` the number of points, so AIC() and
-#' BIC() work.
+#' BIC() work. Compare models by AIC/BIC only on the same points with the same
+#' EDF: when the EDF is derived from the model (input without `edf`), refit
+#' the candidate from the first fit, `avfit(fit, terms)`, or pass its
+#' `fit$data$edf` as an `edf` column.
 #'
 #' @param object,x An `avfit` object.
 #' @param parm Coefficients for `confint()` (names or indices; default all).
@@ -664,7 +808,9 @@ predict.avfit <- function(object, newdata = NULL, type = c("avar", "adev"),
 logLik.avfit <- function(object, ...) {
   d <- object$data
   s <- log_sd(d$edf)
-  ll <- sum(stats::dnorm(d$z * s, sd = s, log = TRUE))
+  # -1/2 [J ln(2 pi) + ln det Sigma + r' Sigma^-1 r], Sigma = diag(s) R diag(s)
+  ldet <- if (!is.null(object$logdet)) object$logdet else 2 * sum(log(s))
+  ll <- -0.5 * (length(s) * log(2 * pi) + ldet + object$objective)
   structure(ll, df = object$npar, nobs = object$nobs, class = "logLik")
 }
 
@@ -678,7 +824,8 @@ print.avfit <- function(x, ...) {
   cat("Allan variance noise-model fit:", paste(x$terms, collapse = " + "), "\n")
   cat(sprintf("%d points, tau %.3g to %.3g s, %s estimator, EDF from %s\n",
               x$nobs, min(x$data$tau), max(x$data$tau), x$type,
-              if (x$edf_source == "input") "the input" else "the model"))
+              switch(x$edf_source, input = "the input", model = "the model",
+                     previous = "the previous fit's model")))
   tab <- data.frame(estimate = signif(x$coefficients, 4),
                     se = signif(x$se, 3), unit = x$layout$unit)
   print(tab)
@@ -753,7 +900,8 @@ plot.avfit <- function(x, terms = TRUE, residuals = TRUE, ...) {
   comp <- predict(x, tt, by_term = TRUE)
   tot <- rowSums(comp)
   yl <- range(c(lo, hi, sqrt(tot)), finite = TRUE)
-  yl[1] <- max(yl[1], yl[2] * 1e-6)
+  # room below the data for the terms' curves (down to half their peak)
+  yl[1] <- max(min(yl[1], 0.5 * apply(sqrt(comp), 2, max)), yl[2] * 1e-4)
   graphics::plot(d$tau, sqrt(d$avar), log = "xy", ylim = yl, pch = 19,
                  cex = 0.7, xlab = if (residuals) "" else "tau [s]",
                  ylab = "Allan deviation", xaxt = if (residuals) "n" else "s",

@@ -12,19 +12,20 @@ Rcpp::Rostream<false>& Rcpp::Rcerr = Rcpp::Rcpp_cerr_get();
 #endif
 
 // allan_sums_cpp
-Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow, const Rcpp::NumericVector& m, const Rcpp::NumericVector& nterms, int type, bool rate, bool octave, int threads);
-RcppExport SEXP _allanvar_allan_sums_cpp(SEXP xSEXP, SEXP nrowSEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP typeSEXP, SEXP rateSEXP, SEXP octaveSEXP, SEXP threadsSEXP) {
+Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow, const Rcpp::NumericVector& m, const Rcpp::NumericVector& nterms, const Rcpp::NumericVector& mid, int type, bool rate, bool octave, int threads);
+RcppExport SEXP _allanvar_allan_sums_cpp(SEXP xSEXP, SEXP nrowSEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP midSEXP, SEXP typeSEXP, SEXP rateSEXP, SEXP octaveSEXP, SEXP threadsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
     Rcpp::traits::input_parameter< double >::type nrow(nrowSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type nterms(ntermsSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type mid(midSEXP);
     Rcpp::traits::input_parameter< int >::type type(typeSEXP);
     Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
     Rcpp::traits::input_parameter< bool >::type octave(octaveSEXP);
     Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(allan_sums_cpp(x, nrow, m, nterms, type, rate, octave, threads));
+    rcpp_result_gen = Rcpp::wrap(allan_sums_cpp(x, nrow, m, nterms, mid, type, rate, octave, threads));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -86,18 +87,18 @@ BEGIN_RCPP
 END_RCPP
 }
 // avfit_log_nnls
-Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B, const Eigen::Map<Eigen::VectorXd> offset, const Eigen::Map<Eigen::VectorXd> y, const Eigen::Map<Eigen::VectorXd> s, const Eigen::Map<Eigen::VectorXd> start, int maxit, double tol);
-RcppExport SEXP _allanvar_avfit_log_nnls(SEXP BSEXP, SEXP offsetSEXP, SEXP ySEXP, SEXP sSEXP, SEXP startSEXP, SEXP maxitSEXP, SEXP tolSEXP) {
+Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B, const Eigen::Map<Eigen::VectorXd> offset, const Eigen::Map<Eigen::VectorXd> y, const Eigen::Map<Eigen::MatrixXd> W, const Eigen::Map<Eigen::VectorXd> start, int maxit, double tol);
+RcppExport SEXP _allanvar_avfit_log_nnls(SEXP BSEXP, SEXP offsetSEXP, SEXP ySEXP, SEXP WSEXP, SEXP startSEXP, SEXP maxitSEXP, SEXP tolSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Eigen::Map<Eigen::MatrixXd> >::type B(BSEXP);
     Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type offset(offsetSEXP);
     Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type y(ySEXP);
-    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type s(sSEXP);
+    Rcpp::traits::input_parameter< const Eigen::Map<Eigen::MatrixXd> >::type W(WSEXP);
     Rcpp::traits::input_parameter< const Eigen::Map<Eigen::VectorXd> >::type start(startSEXP);
     Rcpp::traits::input_parameter< int >::type maxit(maxitSEXP);
     Rcpp::traits::input_parameter< double >::type tol(tolSEXP);
-    rcpp_result_gen = Rcpp::wrap(avfit_log_nnls(B, offset, y, s, start, maxit, tol));
+    rcpp_result_gen = Rcpp::wrap(avfit_log_nnls(B, offset, y, W, start, maxit, tol));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -112,9 +113,37 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// avar_white_cov
+Rcpp::NumericMatrix avar_white_cov(const Rcpp::NumericVector& m, double n, bool overlapping, int threads);
+RcppExport SEXP _allanvar_avar_white_cov(SEXP mSEXP, SEXP nSEXP, SEXP overlappingSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type n(nSEXP);
+    Rcpp::traits::input_parameter< bool >::type overlapping(overlappingSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(avar_white_cov(m, n, overlapping, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
+// allan_edf_cpp
+Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m, const Rcpp::NumericVector& n, double L, const Rcpp::IntegerVector& alpha, const Rcpp::LogicalVector& exact);
+RcppExport SEXP _allanvar_allan_edf_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP LSEXP, SEXP alphaSEXP, SEXP exactSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< int >::type type(typeSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type n(nSEXP);
+    Rcpp::traits::input_parameter< double >::type L(LSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type alpha(alphaSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::LogicalVector& >::type exact(exactSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_edf_cpp(type, m, n, L, alpha, exact));
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
-    {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 8},
+    {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 9},
     {"_allanvar_allan_reference_cpp", (DL_FUNC) &_allanvar_allan_reference_cpp, 4},
     {"_allanvar_allan_first_nonfinite_cpp", (DL_FUNC) &_allanvar_allan_first_nonfinite_cpp, 1},
     {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 2},
@@ -122,6 +151,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},
     {"_allanvar_avfit_log_nnls", (DL_FUNC) &_allanvar_avfit_log_nnls, 7},
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
+    {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
+    {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {NULL, NULL, 0}
 };
 

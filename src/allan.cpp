@@ -10,7 +10,13 @@
 #include "parallel.h"
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <new>
 #include <vector>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace {
 
@@ -36,8 +42,46 @@ struct Acc {
   double value() const { return s + c; }
 };
 
+// A large double buffer, uninitialised. On Linux it is 2 MiB aligned and
+// marked for transparent huge pages: a fresh 100 MB prefix array otherwise
+// costs tens of thousands of page faults, more than the sums themselves.
+class Buffer {
+ public:
+  Buffer() {}
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+  ~Buffer() { std::free(p_); }
+  void resize(R_xlen_t n) {
+    std::free(p_);
+    p_ = nullptr;
+    n_ = n;
+    const size_t bytes = static_cast<size_t>(n > 0 ? n : 1) * sizeof(double);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    const size_t align = static_cast<size_t>(1) << 21;
+    if (bytes >= align) {
+      void* q = nullptr;
+      if (posix_memalign(&q, align, bytes) == 0) {
+        madvise(q, bytes, MADV_HUGEPAGE);
+        p_ = static_cast<double*>(q);
+      }
+    }
+#endif
+    if (!p_) p_ = static_cast<double*>(std::malloc(bytes));
+    if (!p_) throw std::bad_alloc();
+  }
+  double* data() { return p_; }
+  const double* data() const { return p_; }
+  double& operator[](R_xlen_t i) { return p_[i]; }
+  const double& operator[](R_xlen_t i) const { return p_[i]; }
+  R_xlen_t size() const { return n_; }
+
+ private:
+  double* p_ = nullptr;
+  R_xlen_t n_ = 0;
+};
+
 struct Split {
-  std::vector<double> hi, lo;
+  Buffer hi, lo;
 };
 
 // Grid step q = 2^k with bound <= 2^50 q.
@@ -54,10 +98,12 @@ inline double grid_step(double bound) {
 void build_prefix(const double* v, R_xlen_t n, double c, double bound,
                   int levels, Split& out) {
   const R_xlen_t len = n + levels;
-  out.hi.assign(len, 0.0);
-  out.lo.assign(len, 0.0);
+  out.hi.resize(len);
+  out.lo.resize(len);
   double* hi = out.hi.data();
   double* lo = out.lo.data();
+  hi[0] = lo[0] = 0;
+  if (levels == 2) hi[1] = lo[1] = 0;
   double b = bound * static_cast<double>(n) * (1 + 1e-9);
   if (levels == 2) b *= static_cast<double>(n + 1);
   const double q = grid_step(b);
@@ -100,8 +146,8 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
 // The input itself split on a grid (integrated input, levels = 0).
 void build_split(const double* v, R_xlen_t n, double c, double bound,
                  Split& out) {
-  out.hi.assign(n, 0.0);
-  out.lo.assign(n, 0.0);
+  out.hi.resize(n);
+  out.lo.resize(n);
   const double q = grid_step(bound * (1 + 1e-9));
   const double C = 1.5 * q * 4503599627370496.0;
   for (R_xlen_t i = 0; i < n; ++i) {
@@ -113,56 +159,66 @@ void build_split(const double* v, R_xlen_t n, double c, double bound,
   }
 }
 
-// Second difference X[k+2m] - 2X[k+m] + X[k]; the hi part is exact.
-struct Diff2 {
-  const double *h, *l;
-  R_xlen_t m;
-  inline double operator()(R_xlen_t k) const {
-    const double dh = (h[k + 2 * m] + h[k]) - 2.0 * h[k + m];
-    const double dl = (l[k + 2 * m] + l[k]) - 2.0 * l[k + m];
-    return dh + dl;
-  }
-};
+// Sum of squared second (D = 2) or third (D = 3) differences at stride 1,
+// for k in [k0, k1): two terms per vector (GCC/Clang vector extensions,
+// plain SSE2 on x86-64), two independent accumulators.
+#if defined(__GNUC__)
+typedef double v2d __attribute__((vector_size(16)));
+inline v2d ld2(const double* p) {
+  v2d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+#endif
 
-// Third difference X[k+3m] - 3X[k+2m] + 3X[k+m] - X[k].
-struct Diff3 {
-  const double *h, *l;
-  R_xlen_t m;
-  inline double operator()(R_xlen_t k) const {
-    const double dh = (h[k + 3 * m] - h[k]) + 3.0 * (h[k + m] - h[k + 2 * m]);
-    const double dl = (l[k + 3 * m] - l[k]) + 3.0 * (l[k + m] - l[k + 2 * m]);
-    return dh + dl;
+template <int D>
+inline double diff_at(const double* h, const double* l, R_xlen_t m, R_xlen_t k) {
+  if (D == 2) {
+    return ((h[k + 2 * m] + h[k]) - 2.0 * h[k + m]) +
+           ((l[k + 2 * m] + l[k]) - 2.0 * l[k + m]);
   }
-};
+  return ((h[k + 3 * m] - h[k]) + 3.0 * (h[k + m] - h[k + 2 * m])) +
+         ((l[k + 3 * m] - l[k]) + 3.0 * (l[k + m] - l[k + 2 * m]));
+}
 
-// Sum of f(k)^2 for k = k0, k0 + s, ... < k1, with four chains.
-template <class F>
-inline double sumsq(const F& f, R_xlen_t k0, R_xlen_t k1, R_xlen_t s) {
-  double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+template <int D>
+inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
+                     R_xlen_t k1) {
+  double tail = 0;
   R_xlen_t k = k0;
-  if (s == 1) {
-    for (; k + 4 <= k1; k += 4) {
-      const double d0 = f(k), d1 = f(k + 1), d2 = f(k + 2), d3 = f(k + 3);
-      a0 += d0 * d0;
-      a1 += d1 * d1;
-      a2 += d2 * d2;
-      a3 += d3 * d3;
+#if defined(__GNUC__)
+  v2d a0 = {0, 0}, a1 = {0, 0};
+  const double* h1 = h + m;
+  const double* h2 = h + 2 * m;
+  const double* h3 = h + 3 * m;
+  const double* l1 = l + m;
+  const double* l2 = l + 2 * m;
+  const double* l3 = l + 3 * m;
+  for (; k + 4 <= k1; k += 4) {
+    v2d d0, d1;
+    if (D == 2) {
+      d0 = ((ld2(h2 + k) + ld2(h + k)) - 2.0 * ld2(h1 + k)) +
+           ((ld2(l2 + k) + ld2(l + k)) - 2.0 * ld2(l1 + k));
+      d1 = ((ld2(h2 + k + 2) + ld2(h + k + 2)) - 2.0 * ld2(h1 + k + 2)) +
+           ((ld2(l2 + k + 2) + ld2(l + k + 2)) - 2.0 * ld2(l1 + k + 2));
+    } else {
+      d0 = ((ld2(h3 + k) - ld2(h + k)) + 3.0 * (ld2(h1 + k) - ld2(h2 + k))) +
+           ((ld2(l3 + k) - ld2(l + k)) + 3.0 * (ld2(l1 + k) - ld2(l2 + k)));
+      d1 = ((ld2(h3 + k + 2) - ld2(h + k + 2)) +
+            3.0 * (ld2(h1 + k + 2) - ld2(h2 + k + 2))) +
+           ((ld2(l3 + k + 2) - ld2(l + k + 2)) +
+            3.0 * (ld2(l1 + k + 2) - ld2(l2 + k + 2)));
     }
-  } else {
-    for (; k + 4 * s <= k1; k += 4 * s) {
-      const double d0 = f(k), d1 = f(k + s), d2 = f(k + 2 * s),
-                   d3 = f(k + 3 * s);
-      a0 += d0 * d0;
-      a1 += d1 * d1;
-      a2 += d2 * d2;
-      a3 += d3 * d3;
-    }
+    a0 += d0 * d0;
+    a1 += d1 * d1;
   }
-  for (; k < k1; k += s) {
-    const double d = f(k);
-    a0 += d * d;
+  tail = (a0[0] + a1[0]) + (a0[1] + a1[1]);
+#endif
+  for (; k < k1; ++k) {
+    const double d = diff_at<D>(h, l, m, k);
+    tail += d * d;
   }
-  return (a0 + a1) + (a2 + a3);
+  return tail;
 }
 
 // Runs f(i) for i in [0, n): in parallel from the main thread, serially (no
@@ -183,7 +239,7 @@ const R_xlen_t kChunk = 1 << 17;  // terms per parallel item
 // range is cut into fixed chunks (so the result does not depend on the
 // thread count); inside a chunk every tau walks the same cache-resident
 // block before the next block is loaded.
-template <class D>
+template <int D>
 void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
                 const std::vector<R_xlen_t>& nterms, int threads, bool main,
                 double* out) {
@@ -200,8 +256,7 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
       for (size_t j = 0; j < nt; ++j) {
         const R_xlen_t e = std::min(b1, nterms[j]);
         if (e <= b0) continue;
-        const D f{X.hi.data(), X.lo.data(), ms[j]};
-        p[j] += sumsq(f, b0, e, 1);
+        p[j] += sumsq1<D>(X.hi.data(), X.lo.data(), ms[j], b0, e);
       }
     }
   });
@@ -212,21 +267,55 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
   }
 }
 
+// Stride-m sum of squared differences of order D (2 or 3) over n terms: each
+// term loads one new point and reuses the previous ones.
+template <int D>
+double strided_sum(const double* h, const double* l, R_xlen_t m, R_xlen_t n) {
+  Acc a;
+  double s0 = 0, s1 = 0;
+  double h0 = h[0], l0 = l[0], h1 = h[m], l1 = l[m];
+  double h2 = D == 3 ? h[2 * m] : 0, l2 = D == 3 ? l[2 * m] : 0;
+  const double* ph = h + D * m;
+  const double* pl = l + D * m;
+  for (R_xlen_t i = 0; i < n; ++i, ph += m, pl += m) {
+    const double hn = *ph, ln = *pl;
+    double d;
+    if (D == 2) {
+      d = ((hn + h0) - 2.0 * h1) + ((ln + l0) - 2.0 * l1);
+      h0 = h1;
+      l0 = l1;
+      h1 = hn;
+      l1 = ln;
+    } else {
+      d = ((hn - h0) + 3.0 * (h1 - h2)) + ((ln - l0) + 3.0 * (l1 - l2));
+      h0 = h1;
+      l0 = l1;
+      h1 = h2;
+      l1 = l2;
+      h2 = hn;
+      l2 = ln;
+    }
+    if (i & 1) {
+      s1 += d * d;
+    } else {
+      s0 += d * d;
+    }
+    if ((i & 16383) == 16383) {
+      a.add(s0 + s1);
+      s0 = s1 = 0;
+    }
+  }
+  a.add(s0 + s1);
+  return a.value();
+}
+
 // Stride-m estimators (standard, Hadamard): one item per tau.
-template <class D>
+template <int D>
 void strided(const Split& X, const std::vector<R_xlen_t>& ms,
              const std::vector<R_xlen_t>& nterms, int threads, bool main,
              double* out) {
   run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
-    const R_xlen_t m = ms[j];
-    const D f{X.hi.data(), X.lo.data(), m};
-    Acc a;
-    const R_xlen_t end = nterms[j] * m;
-    const R_xlen_t step = kChunk * m;
-    for (R_xlen_t k = 0; k < end; k += step) {
-      a.add(sumsq(f, k, std::min(end, k + step), m));
-    }
-    out[j] = a.value();
+    out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), ms[j], nterms[j]);
   });
 }
 
@@ -290,6 +379,10 @@ struct Level {
 };
 
 const R_xlen_t kIdMax = 4096;  // cluster sums kept per level for noise id
+// Fewer points leave r1 too noisy (its standard error is 1/sqrt(n)): a
+// mis-identified type then shortens the interval; such taus inherit the type
+// found at the nearest shorter tau instead.
+const size_t kIdMin = 64;
 
 // Consume n dd values at level j: accumulate squared differences, keep the
 // first few for noise id, and pair them into level j+1 in place.
@@ -390,7 +483,7 @@ void detrend(std::vector<double>& v, int deg) {
 // Returns alpha (continuous) and sets alpha_int; NaN when too few points.
 double noise_id(std::vector<double> v, bool phase, int dmax, int& alpha_int) {
   alpha_int = NA_INTEGER;
-  if (v.size() < 30) return NA_REAL;
+  if (v.size() < kIdMin) return NA_REAL;
   detrend(v, phase ? 2 : 1);
   int d = 0;
   for (;;) {
@@ -426,12 +519,13 @@ struct Channel {
 
 // One channel: sums of squares for every m, and the noise id per m.
 void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
-                 const std::vector<R_xlen_t>& nterms, int type, bool rate,
+                 const std::vector<R_xlen_t>& nterms,
+                 const std::vector<R_xlen_t>& mid, int type, bool rate,
                  bool octave, int threads, bool main, Channel& out) {
-  const size_t nt = ms.size();
+  const size_t nt = ms.size(), ni = mid.size();
   out.sums.assign(nt, 0.0);
-  out.alpha.assign(nt, NA_REAL);
-  out.alpha_int.assign(nt, NA_INTEGER);
+  out.alpha.assign(ni, NA_REAL);
+  out.alpha_int.assign(ni, NA_INTEGER);
   const int dmax = (type == HADAMARD || type == OHADAMARD) ? 3 : 2;
   // centre and bound of the data
   long double s = 0;
@@ -453,6 +547,10 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       int lj = 0;
       while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
       out.sums[j] = lev[lj].acc.value();
+    }
+    for (size_t j = 0; j < ni; ++j) {
+      int lj = 0;
+      while ((static_cast<R_xlen_t>(1) << lj) < mid[j]) ++lj;
       std::vector<double> id(lev[lj].idh.size());
       for (size_t i = 0; i < id.size(); ++i) id[i] = lev[lj].idh[i] + lev[lj].idl[i];
       out.alpha[j] = noise_id(id, false, dmax, out.alpha_int[j]);
@@ -469,18 +567,18 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   }
   double* o = out.sums.data();
   switch (type) {
-    case STANDARD: strided<Diff2>(X, ms, nterms, threads, main, o); break;
-    case OVERLAPPING: overlapped<Diff2>(X, ms, nterms, threads, main, o); break;
-    case MODIFIED: overlapped<Diff3>(X, ms, nterms, threads, main, o); break;
-    case HADAMARD: strided<Diff3>(X, ms, nterms, threads, main, o); break;
-    case OHADAMARD: overlapped<Diff3>(X, ms, nterms, threads, main, o); break;
+    case STANDARD: strided<2>(X, ms, nterms, threads, main, o); break;
+    case OVERLAPPING: overlapped<2>(X, ms, nterms, threads, main, o); break;
+    case MODIFIED: overlapped<3>(X, ms, nterms, threads, main, o); break;
+    case HADAMARD: strided<3>(X, ms, nterms, threads, main, o); break;
+    case OHADAMARD: overlapped<3>(X, ms, nterms, threads, main, o); break;
     case TOTAL: total(X, ms, threads, main, o); break;
   }
   // Noise id: cluster sums (rate) or decimated phase (integrated) of the
   // first kIdMax clusters. With MODIFIED, X holds one more level of sums.
   const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
-  for (size_t j = 0; j < nt; ++j) {
-    const R_xlen_t m = ms[j];
+  for (size_t j = 0; j < ni; ++j) {
+    const R_xlen_t m = mid[j];
     std::vector<double> id;
     const bool two = (type == MODIFIED);
     for (R_xlen_t i = 0; i < kIdMax; ++i) {
@@ -513,37 +611,42 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
 }  // namespace
 
 // Sums of squared differences (the estimator numerators) for every channel
-// (column of x, nrow samples each) and cluster size m, with the noise id.
+// (column of x, nrow samples each) and cluster size m, and the noise id at
+// the cluster sizes `mid`.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
                           const Rcpp::NumericVector& m,
-                          const Rcpp::NumericVector& nterms, int type,
+                          const Rcpp::NumericVector& nterms,
+                          const Rcpp::NumericVector& mid, int type,
                           bool rate, bool octave, int threads) {
   const R_xlen_t N = static_cast<R_xlen_t>(nrow);
   const R_xlen_t nc = x.size() / N;
   const size_t nt = m.size();
-  std::vector<R_xlen_t> ms(nt), nts(nt);
+  const size_t ni = mid.size();
+  std::vector<R_xlen_t> ms(nt), nts(nt), mids(ni);
   for (size_t j = 0; j < nt; ++j) {
     ms[j] = static_cast<R_xlen_t>(m[j]);
     nts[j] = static_cast<R_xlen_t>(nterms[j]);
   }
+  for (size_t j = 0; j < ni; ++j) mids[j] = static_cast<R_xlen_t>(mid[j]);
   std::vector<Channel> ch(nc);
   const double* p = x.begin();
   if (nc == 1) {
-    one_channel(p, N, ms, nts, type, rate, octave, threads, true, ch[0]);
+    one_channel(p, N, ms, nts, mids, type, rate, octave, threads, true, ch[0]);
   } else {
     allanvar::parallel_for(nc, threads, [&](R_xlen_t i, int) {
-      one_channel(p + i * N, N, ms, nts, type, rate, octave, 1, false, ch[i]);
+      one_channel(p + i * N, N, ms, nts, mids, type, rate, octave, 1, false, ch[i]);
     });
   }
-  Rcpp::NumericMatrix sums(nt, nc), alpha(nt, nc);
-  Rcpp::IntegerMatrix alpha_int(nt, nc);
-  for (R_xlen_t i = 0; i < nc; ++i)
-    for (size_t j = 0; j < nt; ++j) {
-      sums(j, i) = ch[i].sums[j];
+  Rcpp::NumericMatrix sums(nt, nc), alpha(ni, nc);
+  Rcpp::IntegerMatrix alpha_int(ni, nc);
+  for (R_xlen_t i = 0; i < nc; ++i) {
+    for (size_t j = 0; j < nt; ++j) sums(j, i) = ch[i].sums[j];
+    for (size_t j = 0; j < ni; ++j) {
       alpha(j, i) = ch[i].alpha[j];
       alpha_int(j, i) = ch[i].alpha_int[j];
     }
+  }
   return Rcpp::List::create(Rcpp::Named("sums") = sums,
                             Rcpp::Named("alpha") = alpha,
                             Rcpp::Named("alpha_int") = alpha_int);

@@ -7,6 +7,7 @@
 #include <RcppEigen.h>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 using Eigen::MatrixXd;
@@ -37,6 +38,7 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500) {
     }
     if (t < 0) break;
     passive[t] = true;
+    const VectorXd x_prev = x;
     for (int inner = 0; inner < 3 * p + 3; ++inner) {
       std::vector<int> idx;
       for (int k = 0; k < p; ++k) if (passive[k]) idx.push_back(k);
@@ -67,49 +69,54 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500) {
         }
       }
     }
+    // Degenerate step (the variable just added was dropped again and x did
+    // not move): Lawson-Hanson would cycle; x is optimal to rounding.
+    if ((x - x_prev).norm() <= 1e-14 * (1.0 + x.norm())) break;
   }
   for (int k = 0; k < p; ++k) x(k) /= scale(k);
   return x;
 }
 
+// S = || W (y - ln AV) ||^2; W whitens the log-AV errors (diag(1/s) when
+// the points are taken as independent, the inverse Cholesky factor of their
+// covariance otherwise).
 double objective(const MatrixXd& B, const VectorXd& offset, const VectorXd& y,
-                 const VectorXd& s, const VectorXd& c) {
+                 const MatrixXd& W, const VectorXd& c) {
   VectorXd av = offset + B * c;
-  double S = 0.0;
+  VectorXd r(av.size());
   for (R_xlen_t j = 0; j < av.size(); ++j) {
     if (!(av(j) > 0)) return std::numeric_limits<double>::infinity();
-    double r = (y(j) - std::log(av(j))) / s(j);
-    S += r * r;
+    r(j) = y(j) - std::log(av(j));
   }
-  return S;
+  return (W * r).squaredNorm();
 }
 
 }  // namespace
 
 // Squared amplitudes c >= 0 minimising the log-domain weighted objective.
-// y = ln(AV-hat) minus the chi-square log bias; s = sqrt(psi'(edf/2)).
+// y = ln(AV-hat) minus the chi-square log bias; W the whitening matrix.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
                           const Eigen::Map<Eigen::VectorXd> offset,
                           const Eigen::Map<Eigen::VectorXd> y,
-                          const Eigen::Map<Eigen::VectorXd> s,
+                          const Eigen::Map<Eigen::MatrixXd> W,
                           const Eigen::Map<Eigen::VectorXd> start,
                           int maxit, double tol) {
   const R_xlen_t J = B.rows();
   const int p = static_cast<int>(B.cols());
   VectorXd c = start;
-  double S = objective(B, offset, y, s, c);
+  double S = objective(B, offset, y, W, c);
   if (!std::isfinite(S) || c.sum() <= 0) {
-    // Linear-domain start: min sum ((offset + B c) / AV-hat - 1)^2 / s^2.
+    // Linear-domain start: min || W ((offset + B c) / AV-hat - 1) ||^2.
     MatrixXd A(J, p);
     VectorXd t(J);
     for (R_xlen_t j = 0; j < J; ++j) {
       double avh = std::exp(y(j));
-      A.row(j) = B.row(j) / (avh * s(j));
-      t(j) = (1.0 - offset(j) / avh) / s(j);
+      A.row(j) = B.row(j) / avh;
+      t(j) = 1.0 - offset(j) / avh;
     }
-    c = nnls(A, t);
-    S = objective(B, offset, y, s, c);
+    c = nnls(W * A, W * t);
+    S = objective(B, offset, y, W, c);
     if (!std::isfinite(S)) {
       // Keep every term slightly on so that ln AV is finite everywhere.
       for (int k = 0; k < p; ++k) {
@@ -117,7 +124,7 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
         double floor_k = bk > 0 ? 1e-8 * std::exp(y.maxCoeff()) / bk : 0.0;
         if (c(k) < floor_k) c(k) = floor_k;
       }
-      S = objective(B, offset, y, s, c);
+      S = objective(B, offset, y, W, c);
     }
   }
   int it = 0;
@@ -128,15 +135,15 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
     MatrixXd A(J, p);
     VectorXd t(J);
     for (R_xlen_t j = 0; j < J; ++j) {
-      A.row(j) = B.row(j) / (av(j) * s(j));
-      t(j) = (y(j) - std::log(av(j)) + bc(j) / av(j)) / s(j);
+      A.row(j) = B.row(j) / av(j);
+      t(j) = y(j) - std::log(av(j)) + bc(j) / av(j);
     }
-    VectorXd cn = nnls(A, t);
+    VectorXd cn = nnls(W * A, W * t);
     VectorXd d = cn - c;
-    double lambda = 1.0, Sn = objective(B, offset, y, s, c + d);
+    double lambda = 1.0, Sn = objective(B, offset, y, W, c + d);
     while (!(Sn <= S) && lambda > 1e-10) {
       lambda *= 0.5;
-      Sn = objective(B, offset, y, s, c + lambda * d);
+      Sn = objective(B, offset, y, W, c + lambda * d);
     }
     if (!(Sn <= S)) { converged = true; break; }  // no descent: at optimum
     c += lambda * d;
@@ -155,4 +162,131 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
 Eigen::VectorXd avfit_nnls(const Eigen::Map<Eigen::MatrixXd> A,
                            const Eigen::Map<Eigen::VectorXd> b) {
   return nnls(A, b);
+}
+
+// ---- covariance of Allan variance estimates for white rate noise ------------
+// D_{m,k} = (mean of y over [k+m, k+2m)) - (mean over [k, k+m)); AV-hat_m =
+// sum_k D^2 / (2 M). For i.i.d. y of unit variance, by Isserlis,
+//   Cov(AV-hat_i, AV-hat_j) = 1/(2 M_i M_j) sum_k sum_l X_ij(l - k)^2,
+// where X_ij(h) = sum_t w_i(t) w_j(t - h) is the cross-correlation of the
+// two difference-of-boxcar kernels, computed in closed form from interval
+// overlaps. Overlapping: k = 0..M-1, M = n - 2m + 1; non-overlapping:
+// k = 0, m, .., (M-1)m, M = floor(n/m) - 1.
+#include "parallel.h"
+
+namespace {
+
+inline double overlap(double a1, double b1, double a2, double b2) {
+  double lo = a1 > a2 ? a1 : a2, hi = b1 < b2 ? b1 : b2;
+  return hi > lo ? hi - lo : 0.0;
+}
+
+// X_ij(h), kernel i at 0, kernel j shifted by h.
+inline double kernel_xcorr(double mi, double mj, double h) {
+  double s = overlap(0, mi, h, h + mj) - overlap(0, mi, h + mj, h + 2 * mj) -
+             overlap(mi, 2 * mi, h, h + mj) + overlap(mi, 2 * mi, h + mj, h + 2 * mj);
+  return s / (mi * mj);
+}
+
+// X(h) is nonzero only while one of the three jumps of the longer kernel
+// (at h, h + mj, h + 2 mj) lies inside the shorter one ([0, 2 mi)), so only
+// h near those jumps are visited: O(mi) work per pair instead of O(mj).
+double white_cov_pair(double mi, double mj, double n, bool overlapping) {
+  if (mi > mj) std::swap(mi, mj);  // the covariance is symmetric in (i, j)
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (overlapping) {
+    const double Mi = n - 2 * mi + 1, Mj = n - 2 * mj + 1;
+    if (Mi < 1 || Mj < 1) return nan;
+    auto term = [&](double h) {
+      // pairs (k, l = k + h) with 0 <= k < Mi, 0 <= l < Mj
+      double lo = h < 0 ? -h : 0.0;
+      double hi = Mi < Mj - h ? Mi : Mj - h;
+      double cnt = hi - lo;
+      if (cnt <= 0) return 0.0;
+      double x = kernel_xcorr(mi, mj, h);
+      return cnt * x * x;
+    };
+    // X is piecewise linear in h with pieces >= ~mi long: a stride of mi/200
+    // keeps the sum accurate to ~1e-4 (checked against the full sum).
+    const double st = mi >= 400 ? std::floor(mi / 200) : 1.0;
+    double sum = 0.0;
+    auto range = [&](double a, double b) {
+      if (a < -2 * mj + 1) a = -2 * mj + 1;
+      if (b > 2 * mi - 1) b = 2 * mi - 1;
+      for (double h = a; h <= b; h += st) sum += st * term(h);
+    };
+    if (mj <= 4 * mi + 8) {
+      range(-2 * mj + 1, 2 * mi - 1);
+    } else {
+      for (int c = 0; c < 3; ++c) range(-c * mj - 2, 2 * mi - c * mj + 2);
+    }
+    return sum / (2 * Mi * Mj);
+  }
+  const double Mi = std::floor(n / mi) - 1, Mj = std::floor(n / mj) - 1;
+  if (Mi < 1 || Mj < 1) return nan;
+  // Outer loop over the (fewer) long clusters b, inner over the short
+  // clusters a with -2 mj < b mj - a mi < 2 mi (exact sums).
+  auto inner = [&](double b) {
+    const double k = b * mj;
+    double amin = std::floor((k - 2 * mi) / mi) + 1;
+    double amax = std::ceil((k + 2 * mj) / mi) - 1;
+    if (amin < 0) amin = 0;
+    if (amax > Mi - 1) amax = Mi - 1;
+    double sum = 0.0;
+    auto add = [&](double a0, double a1) {
+      if (a0 < amin) a0 = amin;
+      if (a1 > amax) a1 = amax;
+      for (double a = a0; a <= a1; a += 1.0) {
+        double x = kernel_xcorr(mi, mj, k - a * mi);
+        sum += x * x;
+      }
+    };
+    if (amax - amin <= 64) {
+      add(amin, amax);
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        double centre = (k + c * mj) / mi;
+        add(std::floor(centre) - 3, std::ceil(centre) + 1);
+      }
+    }
+    return sum;
+  };
+  // Away from the ends the inner sum depends only on b mj mod mi, which has
+  // period Q = mi / gcd(mi, mj) in b: sum one period and multiply.
+  long long gi = static_cast<long long>(mi), gj = static_cast<long long>(mj);
+  while (gj) { long long t = gi % gj; gi = gj; gj = t; }
+  const double Q = mi / static_cast<double>(gi);
+  const double edge = 4;
+  double sum = 0.0;
+  if (Mj <= 2 * edge + 2 * Q) {
+    for (double b = 0; b < Mj; b += 1.0) sum += inner(b);
+  } else {
+    for (double b = 0; b < edge; b += 1.0) sum += inner(b) + inner(Mj - 1 - b);
+    const double q = std::floor((Mj - 2 * edge) / Q);
+    double per = 0.0;
+    for (double b = edge; b < edge + Q; b += 1.0) per += inner(b);
+    sum += q * per;
+    for (double b = edge + q * Q; b < Mj - edge; b += 1.0) sum += inner(b);
+  }
+  return sum / (2 * Mi * Mj);
+}
+
+}  // namespace
+
+// Covariance matrix of AV-hat at cluster sizes m (whole numbers) for n
+// i.i.d. unit-variance rate samples. Rows are independent: parallel.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericMatrix avar_white_cov(const Rcpp::NumericVector& m, double n,
+                                   bool overlapping, int threads) {
+  const R_xlen_t J = m.size();
+  Rcpp::NumericMatrix out(J, J);
+  std::vector<double> mm(m.begin(), m.end()), res(J * J, 0.0);
+  allanvar::parallel_for(J, threads, [&](R_xlen_t i, int) {
+    for (R_xlen_t j = i; j < J; ++j) {
+      res[i * J + j] = white_cov_pair(mm[i], mm[j], n, overlapping);
+    }
+  });
+  for (R_xlen_t i = 0; i < J; ++i)
+    for (R_xlen_t j = i; j < J; ++j) out(i, j) = out(j, i) = res[i * J + j];
+  return out;
 }

@@ -125,7 +125,19 @@ test_that("avfit accepts allan(), avar() and plain tables", {
   expect_equal(coef(fit_al), coef(fit_plain), tolerance = 0.05)
   expect_equal(fit_al$edf_source, "input")
   expect_equal(fit_al$freq, f)
-  # multi-channel allan object
+  # the real allan(): single and multi-channel, standard (non-overlapping)
+  a <- allan(x, f)
+  fit_a <- avfit(a, c("N", "B"))
+  expect_equal(fit_a$n, n)
+  expect_equal(unname(coef(fit_a)["N"]), 0.01, tolerance = 0.02)
+  expect_equal(unname(coef(fit_a)["B"]), 0.002, tolerance = 0.3)
+  a2 <- allan(cbind(u = x, v = 2 * x), f, type = "standard")
+  expect_error(avfit(a2, c("N", "B")), "channel")
+  fit_v <- avfit(a2, c("N", "B"), channel = "v")
+  expect_equal(fit_v$type, "non-overlapping")
+  expect_equal(unname(coef(fit_v)["N"]), 0.02, tolerance = 0.03)
+  expect_error(avfit(allan(x, f, type = "modified"), "N"), "`type`")
+  # multi-channel allan-like object built to the contract
   al2 <- rbind(fake_allan(tab, n, f, "x"), fake_allan(tab, n, f, "y"))
   attributes(al2)[c("freq", "N", "type")] <- list(f, n, "overlapping")
   expect_error(avfit(al2, c("N", "B")), "channel")
@@ -168,7 +180,8 @@ test_that("methods: coef, vcov, confint, predict, logLik, AIC, BIC, print, plot"
   expect_equal(ncol(predict(fit, 1, by_term = TRUE)), 2)
   z <- residuals(fit)
   expect_equal(fit$chi2, sum(z^2) / (nrow(tab) - 3))
-  expect_equal(fit$rms, 100 * sqrt(mean((sqrt(fitted(fit) / tab$avar) - 1)^2)))
+  expect_equal(fit$rms, 100 * sqrt(mean((sqrt(tab$avar / fitted(fit)) - 1)^2)))
+  expect_equal(residuals(fit, "relative"), sqrt(tab$avar / fitted(fit)) - 1)
   s <- sqrt(trigamma(fit$data$edf / 2))
   expect_equal(as.numeric(logLik(fit)),
                sum(-0.5 * log(2 * pi * s^2) - 0.5 * z^2))
@@ -199,4 +212,150 @@ test_that("bad input errors name the argument", {
   expect_error(avfit(tab, "N", n = n, freq = f, start = c(X = 1)), "`start`")
   expect_error(avfit(tab, "N", n = n, freq = f, tau_range = 1), "`tau_range`")
   expect_error(avfit(tab[1:2, ], c("N", "B", "K"), n = n, freq = f), "free parameters")
+})
+
+test_that("white-noise covariance kernel: exact values, strided sums, Monte Carlo", {
+  nn <- 4096
+  m <- c(1, 2, 4, 16, 64, 256, 1000)
+  C <- avar_white_cov(m, nn, FALSE, 2L)
+  M <- floor(nn / m) - 1
+  expect_equal(2 / m^2 / diag(C), 2 * M^2 / (3 * M - 1))
+  Co <- avar_white_cov(m, nn, TRUE, 2L)
+  expect_equal(2 / m^2 / diag(Co), edf_simple_oavar(m, nn + 1, 0), tolerance = 0.02)
+  # brute-force R sum for a long pair (the C++ sum is strided there)
+  brute <- function(mi, mj, n) {
+    w <- function(t, mm) ifelse(t >= 0 & t < mm, -1 / mm,
+                                ifelse(t >= mm & t < 2 * mm, 1 / mm, 0))
+    Mi <- n - 2 * mi + 1; Mj <- n - 2 * mj + 1
+    t <- 0:(2 * mi - 1)
+    tot <- 0
+    for (h in (-2 * mj + 1):(2 * mi - 1)) {
+      cnt <- min(Mi, Mj - h) - max(0, -h)
+      if (cnt > 0) tot <- tot + cnt * sum(w(t, mi) * w(t - h, mj))^2
+    }
+    tot / (2 * Mi * Mj)
+  }
+  expect_equal(avar_white_cov(c(1500, 1100), 12000, TRUE, 1L)[1, 2],
+               brute(1500, 1100, 12000), tolerance = 2e-3)
+  expect_equal(avar_white_cov(c(3, 5), 500, TRUE, 1L)[1, 2], brute(3, 5, 500),
+               tolerance = 1e-12)
+  # explicit weight matrices, both estimators, pairs that take every branch
+  wmat <- function(m, n, stride) {
+    M <- if (stride == 1) n - 2 * m + 1 else floor(n / m) - 1
+    t <- 0:(n - 1)
+    vapply(0:(M - 1), function(a) {
+      k <- a * stride
+      ifelse(t >= k & t < k + m, -1 / m, ifelse(t >= k + m & t < k + 2 * m, 1 / m, 0))
+    }, numeric(n))
+  }
+  ref <- function(mi, mj, n, ov) {
+    Wi <- wmat(mi, n, if (ov) 1 else mi)
+    Wj <- wmat(mj, n, if (ov) 1 else mj)
+    sum(crossprod(Wi, Wj)^2) / (2 * ncol(Wi) * ncol(Wj))
+  }
+  for (p in list(c(1, 1, 300), c(2, 3, 400), c(1, 40, 700), c(6, 10, 900),
+                 c(2, 300, 1200))) {
+    for (ov in c(TRUE, FALSE)) {
+      expect_equal(avar_white_cov(p[1:2], p[3], ov, 1L)[1, 2],
+                   ref(p[1], p[2], p[3], ov), tolerance = 1e-12)
+    }
+  }
+  # correlation between neighbouring octaves matches Monte Carlo
+  set.seed(7)
+  sims <- replicate(400, {
+    y <- rnorm(nn)
+    vapply(c(2, 4, 8), function(mm) oav_ref(y, mm, 1), 0)
+  })
+  Rth <- cov2cor(avar_white_cov(c(2, 4, 8), nn, TRUE, 2L))
+  expect_equal(cor(t(sims))[1, 2], Rth[1, 2], tolerance = 0.2)
+  expect_equal(cor(t(sims))[2, 3], Rth[2, 3], tolerance = 0.2)
+})
+
+test_that("correlation = TRUE: exact curves, calibrated chi2 and honest SE", {
+  nn <- 2^15
+  ms <- unique(round(10^seq(0, log10(nn / 4), by = 0.1)))
+  tab <- data.frame(tau = ms / f,
+                    avar = av_model(ms / f, c(N = 0.01, gm1.sigma = 0.01,
+                                              gm1.tc = 3), f))
+  fit <- avfit(tab, c("N", "gm"), n = nn, freq = f, correlation = TRUE,
+               bias_correct = FALSE)
+  expect_equal(coef(fit), c(N = 0.01, gm1.sigma = 0.01, gm1.tc = 3),
+               tolerance = 1e-5)
+  expect_true(fit$correlation)
+  # on a dense tau grid the independent-points SE of B is too small; the
+  # correlated fit's SE matches the spread over seeds
+  res <- t(vapply(1:8, function(s) {
+    x <- avsim(nn, f, N = 0.01, B = 0.003, seed = 300 + s)
+    tb <- oav_table(x, f, ms)
+    a <- avfit(tb, c("N", "B"), n = nn, freq = f)
+    b <- avfit(tb, c("N", "B"), n = nn, freq = f, correlation = TRUE)
+    c(b$chi2, coef(b)["B"], b$se["B"], a$se["B"])
+  }, numeric(4)))
+  expect_gt(mean(res[, 1]), 0.4)
+  expect_lt(mean(res[, 1]), 2)
+  sd_b <- sd(res[, 2])
+  expect_gt(mean(res[, 3]), mean(res[, 4]))
+  expect_gt(mean(res[, 3]) / sd_b, 0.5)
+  expect_lt(mean(res[, 3]) / sd_b, 2)
+  expect_equal(as.numeric(logLik(b <- avfit(tab, c("N", "gm"), n = nn, freq = f,
+                                              correlation = TRUE))),
+               {
+                 s <- sqrt(trigamma(b$data$edf / 2))
+                 r <- log(tab$avar) - log_bias(b$data$edf) - log(fitted(b))
+                 S <- b$corr * outer(s, s)
+                 as.numeric(-0.5 * (length(r) * log(2 * pi) +
+                   determinant(S)$modulus + t(r) %*% solve(S, r)))
+               }, tolerance = 1e-6)
+})
+
+test_that("refitting an avfit keeps its EDF (comparable AIC) and its estimates", {
+  x <- avsim(n, f, N = 0.01, gm = list(sigma = 0.01, tc = 2), seed = 41)
+  tab <- oav_table(x, f)
+  fit0 <- avfit(tab, "N", n = n, freq = f)
+  fit1 <- avfit(fit0, c("N", "gm"))
+  expect_equal(fit1$data$edf, fit0$data$edf)
+  expect_equal(fit1$edf_source, "previous")
+  expect_lt(AIC(fit1), AIC(fit0) - 10)
+  # a second refit starts from gm1's estimate and finds a second GM
+  fit2 <- avfit(fit1, c("N", "gm", "gm"), start = c(gm2.tc = 100))
+  expect_named(coef(fit2), c("N", "gm1.sigma", "gm1.tc", "gm2.sigma", "gm2.tc"))
+  expect_lte(fit2$objective, fit1$objective + 1e-6)
+  # start and fixed together; unknown names rejected
+  fit3 <- avfit(tab, c("N", "gm"), n = n, freq = f, start = c(gm1.tc = 1),
+                fixed = c(N = 0.01))
+  expect_equal(unname(coef(fit3)["gm1.tc"]), 2, tolerance = 0.15)
+  expect_error(avfit(tab, "N", n = n, freq = f, fixed = c(B = 1)), "`fixed`")
+  # avari() output is overlapping
+  fit_i <- avfit(avari(cumsum(x) / f, f), c("N", "gm"), freq = f,
+                 type = "overlapping")
+  expect_equal(fit_i$type, "overlapping")
+  expect_equal(unname(coef(fit_i)["N"]), 0.01, tolerance = 0.05)
+})
+
+test_that("several nonlinear terms: the search finds the global optimum", {
+  nn <- 2^17
+  x <- avsim(nn, f, N = 0.01, B = 0.002, gm = list(sigma = 0.006, tc = 3),
+             sinusoid = list(amp = 0.01, f0 = 1.3), seed = 51)
+  ms <- unique(round(10^seq(0, log10(nn / 4), by = 0.05)))
+  tb <- oav_table(x, f, ms)
+  for (corr in c(FALSE, TRUE)) {
+    fit <- avfit(tb, c("N", "B", "gm", "sinusoid"), n = nn, freq = f,
+                 correlation = corr)
+    cf <- coef(fit)
+    expect_equal(unname(cf["sinusoid1.f0"]), 1.3, tolerance = 0.05)
+    expect_equal(unname(cf["sinusoid1.amp"]), 0.01, tolerance = 0.2)
+    # diagonal weights: tc = 4.1 +- 0.4 here (adjacent taus are correlated,
+    # the SE is too small); with correlation = TRUE: 3.3 +- 1.0
+    expect_equal(unname(cf["gm1.tc"]), 3, tolerance = 0.4)
+    if (corr) expect_lt(abs(cf[["gm1.tc"]] - 3), 2 * fit$se[["gm1.tc"]])
+    # started at the truth, the fit ends no better than the search did
+    st <- avfit(tb, c("N", "B", "gm", "sinusoid"), n = nn, freq = f,
+                correlation = corr, start = c(gm1.tc = 3, sinusoid1.f0 = 1.3))
+    expect_gte(st$objective, fit$objective - 1e-6 * fit$objective)
+  }
+  # a term fitted to nothing: its tc is not identified
+  x <- avsim(2^16, f, N = 0.01, seed = 52)
+  fit <- avfit(oav_table(x, f), c("N", "gm"), n = 2^16, freq = f,
+               fixed = c(gm1.sigma = 0))
+  expect_true(is.na(fit$se["gm1.tc"]))
 })

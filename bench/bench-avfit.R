@@ -1,0 +1,46 @@
+# Timings of the noise-model fit and of the white-noise covariance kernel.
+# Measures the installed package (compiled -O2; pkgload::load_all() builds
+# with -O0, which is several times slower for Eigen code):
+#   R CMD INSTALL . && Rscript bench/bench-avfit.R
+# Prints one row per case: what was timed, the size, and the median elapsed
+# seconds over `reps` runs (2 threads at most).
+library(allanvar)
+avar_white_cov <- allanvar:::avar_white_cov
+options(allanvar.threads = 2L)
+reps <- 3L
+time_it <- function(expr) {
+  e <- substitute(expr)
+  env <- parent.frame()
+  median(vapply(seq_len(reps), function(i) system.time(eval(e, env))[["elapsed"]], 0))
+}
+rows <- list()
+add <- function(case, size, sec) {
+  rows[[length(rows) + 1L]] <<- data.frame(case = case, size = size,
+                                           seconds = signif(sec, 3))
+}
+f <- 100
+for (n in c(1e5, 1e6)) {
+  m_oct <- 2^(0:floor(log2(n / 3)))
+  m_dense <- unique(round(10^seq(0, log10(n / 3), by = 0.05)))
+  for (ov in c(TRUE, FALSE)) {
+    add(sprintf("white covariance, %s, octave", if (ov) "overlapping" else "non-overlapping"),
+        sprintf("n=%g, %d taus", n, length(m_oct)),
+        time_it(avar_white_cov(m_oct, n, ov, 2L)))
+    add(sprintf("white covariance, %s, 20/decade", if (ov) "overlapping" else "non-overlapping"),
+        sprintf("n=%g, %d taus", n, length(m_dense)),
+        time_it(avar_white_cov(m_dense, n, ov, 2L)))
+  }
+}
+n <- 2^18
+x <- avsim(n, f, N = 0.01, B = 0.002, K = 1e-4,
+           gm = data.frame(sigma = c(0.01, 0.004), tc = c(0.5, 40)),
+           sinusoid = list(amp = 0.01, f0 = 1.3), seed = 1)
+a <- allan(x, f)
+for (tm in list(c("N", "B", "K"), c("N", "B", "K", "gm"), c("N", "gm", "gm"),
+                c("N", "B", "sinusoid"), c("N", "B", "K", "gm", "gm", "sinusoid"))) {
+  add(paste("avfit", paste(tm, collapse = "+")), sprintf("%d taus", nrow(a)),
+      time_it(avfit(a, tm)))
+  add(paste("avfit", paste(tm, collapse = "+"), "correlation = TRUE"),
+      sprintf("%d taus", nrow(a)), time_it(avfit(a, tm, correlation = TRUE)))
+}
+print(do.call(rbind, rows), row.names = FALSE)

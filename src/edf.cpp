@@ -1,0 +1,199 @@
+// Equivalent degrees of freedom of the allan() estimators.
+//  * Greenhall & Riley (2004), "Uncertainty of stability variances based on
+//    finite differences" (PTTI), the general algorithm, eqs. (7)-(13) and
+//    Tables 1-3;
+//  * exact Gaussian moments (Isserlis) for discrete white or random-walk
+//    rate noise, where the continuous-time model of Greenhall overstates the
+//    EDF at small m.
+#include <Rcpp.h>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace {
+
+const double kInf = std::numeric_limits<double>::infinity();
+
+double sw(double t, int alpha) {
+  const double a = std::fabs(t);
+  const double lg = t == 0 ? 0.0 : std::log(a);
+  switch (alpha) {
+    case 2: return -a;
+    case 1: return t * t * lg;
+    case 0: return a * a * a;
+    case -1: return -t * t * t * t * lg;
+    case -2: return -a * a * a * a * a;
+    case -3: return std::pow(t, 6) * lg;
+    case -4: return std::pow(a, 7);
+  }
+  return NA_REAL;
+}
+
+double sx(double t, double F, int alpha) {
+  if (std::isinf(F)) return sw(t, alpha + 2);
+  return F * F * (2 * sw(t, alpha) - sw(t - 1 / F, alpha) - sw(t + 1 / F, alpha));
+}
+
+double sz(double t, double F, int alpha, int d) {
+  auto x = [&](double u) { return sx(u, F, alpha); };
+  switch (d) {
+    case 1: return 2 * x(t) - x(t - 1) - x(t + 1);
+    case 2: return 6 * x(t) - 4 * (x(t - 1) + x(t + 1)) + x(t - 2) + x(t + 2);
+    default:
+      return 20 * x(t) - 15 * (x(t - 1) + x(t + 1)) + 6 * (x(t - 2) + x(t + 2)) -
+             x(t - 3) - x(t + 3);
+  }
+}
+
+double basic_sum(double J, double M, double S, double F, int alpha, int d) {
+  const double z0 = sz(0, F, alpha, d), zJ = sz(J / S, F, alpha, d);
+  double s = z0 * z0 + (1 - J / M) * zJ * zJ;
+  for (int j = 1; j < static_cast<int>(J); ++j) {
+    const double z = sz(j / S, F, alpha, d);
+    s += 2 * (1 - j / M) * z * z;
+  }
+  return s;
+}
+
+// Tables 1 and 2 of Greenhall & Riley: (a0, a1) by alpha (2..-4) and d.
+const double kTable1[7][6] = {
+    {2. / 3, 1. / 3, 7. / 9, 1. / 2, 22. / 25, 2. / 3},
+    {0.840, 0.345, 0.997, 0.616, 1.141, 0.843},
+    {1.079, 0.368, 1.033, 0.607, 1.184, 0.848},
+    {NAN, NAN, 1.048, 0.534, 1.180, 0.816},
+    {NAN, NAN, 1.302, 0.535, 1.175, 0.777},
+    {NAN, NAN, NAN, NAN, 1.194, 0.703},
+    {NAN, NAN, NAN, NAN, 1.489, 0.702}};
+const double kTable2[7][6] = {
+    {3. / 2, 1. / 2, 35. / 18, 1, 231. / 100, 3. / 2},
+    {78.6, 25.2, 790, 410, 9950, 6520},
+    {2. / 3, 1. / 6, 2. / 3, 1. / 3, 7. / 9, 1. / 2},
+    {NAN, NAN, 0.852, 0.375, 0.997, 0.617},
+    {NAN, NAN, 1.079, 0.368, 1.033, 0.607},
+    {NAN, NAN, NAN, NAN, 1.053, 0.553},
+    {NAN, NAN, NAN, NAN, 1.302, 0.535}};
+const double kTable3[3][2] = {{6, 4}, {15.23, 12}, {47.8, 40}};
+
+double greenhall(int alpha, int d, double m, double N, bool overlapping,
+                 bool modified) {
+  const double F = modified ? 1 : m;
+  const double S = overlapping ? m : 1;
+  const double L = m / F + m * d;
+  const double M = 1 + std::floor(S * (N - L) / m);
+  if (M < 1) return NA_REAL;
+  const double J = std::min(M, (d + 1) * S);
+  const double Jmax = 100;
+  const double r = M / S;
+  const int row = 2 - alpha, col = 2 * (d - 1);
+  auto eq13 = [&](double Fp) {
+    const double z = sz(0, Fp, alpha, d);
+    return M * z * z / basic_sum(J, M, S, Fp, alpha, d);
+  };
+  if (modified) {
+    if (J <= Jmax) return eq13(1);
+    if (r > d + 1) {
+      const double a0 = kTable1[row][col], a1 = kTable1[row][col + 1];
+      return r / (a0 - a1 / r);
+    }
+    const double z = sz(0, 1, alpha, d);
+    return Jmax * z * z / basic_sum(Jmax, Jmax, Jmax / r, 1, alpha, d);
+  }
+  if (alpha <= 0) {
+    if (J <= Jmax) return eq13(m * (d + 1) <= Jmax ? m : kInf);
+    if (r > d + 1) {
+      const double a0 = kTable2[row][col], a1 = kTable2[row][col + 1];
+      return r / (a0 - a1 / r);
+    }
+    const double z = sz(0, kInf, alpha, d);
+    return Jmax * z * z / basic_sum(Jmax, Jmax, Jmax / r, kInf, alpha, d);
+  }
+  if (alpha == 1) {
+    if (J <= Jmax) return eq13(m);
+    const double b = kTable3[d - 1][0] + kTable3[d - 1][1] * std::log(m);
+    if (r > d + 1) {
+      const double a0 = kTable2[row][col], a1 = kTable2[row][col + 1];
+      return b * b * r / (a0 - a1 / r);
+    }
+    return Jmax * b * b / basic_sum(Jmax, Jmax, Jmax / r, Jmax / r, 1, d);
+  }
+  // alpha = 2
+  if (std::ceil(r) > d) {
+    const double a0 = (d == 1 ? 6.0 / 4 : d == 2 ? 70.0 / 36 : 924.0 / 400);
+    return M / (a0 - d / 2.0 / r);
+  }
+  return eq13(m);
+}
+
+// Weights of one term on the innovations of discrete white (rw = false) or
+// random-walk (rw = true) rate noise: types 0/1/5 second differences of
+// cluster sums, 3/4 third differences, 2 the modified (sum of m shifted
+// second differences).
+std::vector<double> weights(int type, long m, bool rw) {
+  std::vector<double> g;
+  if (type == 3 || type == 4) {
+    g.assign(3 * m, 1.0);
+    for (long i = m; i < 2 * m; ++i) g[i] = -2.0;
+  } else {
+    std::vector<double> p(2 * m, 1.0);
+    for (long i = 0; i < m; ++i) p[i] = -1.0;
+    if (type == 2) {
+      g.assign(3 * m - 1, 0.0);
+      for (long i = 0; i < 2 * m; ++i)
+        for (long j = 0; j < m; ++j) g[i + j] += p[i];
+    } else {
+      g = p;
+    }
+  }
+  if (rw) {  // y = cumsum(w): tail sums of the weights (they sum to zero)
+    std::vector<double> t(g.size() - 1);
+    double s = 0;
+    for (long i = static_cast<long>(g.size()) - 1; i >= 1; --i) {
+      s += g[i];
+      t[i - 1] = s;
+    }
+    g.swap(t);
+  }
+  return g;
+}
+
+// edf = 2 E[AV]^2 / Var[AV] = n^2 c(0)^2 / sum_{|h|<n} (n - |h|) c(h s)^2,
+// with c the autocovariance of the term weights and s the term spacing.
+double discrete(int type, long m, double n, bool rw) {
+  const std::vector<double> g = weights(type, m, rw);
+  const long G = static_cast<long>(g.size());
+  const long s = (type == 0 || type == 3) ? m : 1;
+  double c0 = 0;
+  for (long t = 0; t < G; ++t) c0 += g[t] * g[t];
+  double den = n * c0 * c0;
+  for (long h = 1; h < n && h * s < G; ++h) {
+    double c = 0;
+    for (long t = 0; t + h * s < G; ++t) c += g[t] * g[t + h * s];
+    den += 2 * (n - h) * c * c;
+  }
+  return n * n * c0 * c0 / den;
+}
+
+}  // namespace
+
+// EDF per row: type code (0 standard, 1 overlapping, 2 modified, 3 hadamard,
+// 4 ohadamard), cluster size m, number of terms n, phase points L, noise
+// exponent alpha; exact discrete moments when `exact` (white or random-walk
+// rate noise at small m), Greenhall otherwise.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m,
+                                  const Rcpp::NumericVector& n, double L,
+                                  const Rcpp::IntegerVector& alpha,
+                                  const Rcpp::LogicalVector& exact) {
+  const R_xlen_t k = m.size();
+  Rcpp::NumericVector out(k);
+  const int d = (type == 3 || type == 4) ? 3 : 2;
+  const bool ov = type == 1 || type == 2 || type == 4;
+  for (R_xlen_t i = 0; i < k; ++i) {
+    if (exact[i]) {
+      out[i] = discrete(type, static_cast<long>(m[i]), n[i], alpha[i] == -2);
+    } else {
+      out[i] = greenhall(alpha[i], d, m[i], L, ov, type == 2);
+    }
+  }
+  return out;
+}

@@ -1,0 +1,238 @@
+# allan(): estimators against published NIST values, an exact
+# quadruple-precision reference, and the compatibility functions.
+
+nbs14_1000 <- function() {
+  n <- numeric(1000)
+  n[1] <- 1234567890
+  for (i in 2:1000) n[i] <- (16807 * n[i - 1]) %% 2147483647
+  n / 2147483647
+}
+
+# Relative error of allan()'s avar against the exact reference numerators.
+ref_rel_error <- function(y, type, input = "rate", taus = "octave") {
+  a <- allan(y, 1, taus = taus, type = type, input = input)
+  r <- allan_reference_cpp(y, a$m, allan_type_code(type), input == "rate")
+  norm <- switch(type, modified = 2 * a$m^4, hadamard = , ohadamard = 6 * a$m^2,
+                 2 * a$m^2)
+  expect_equal(a$n, r$n)
+  max(abs(a$avar / (r$sums / (norm * r$n)) - 1))
+}
+
+test_that("NBS14 1000-point set: every published digit of NIST SP 1065", {
+  y <- nbs14_1000()
+  expect_equal(y[2:4] * 2147483647, c(395529916, 1209410747, 633705974))
+  expect_equal(signif(mean(y), 7), 0.4897745)
+  published <- list(
+    standard = c(2.922319e-01, 9.965736e-02, 3.897804e-02),
+    overlapping = c(2.922319e-01, 9.159953e-02, 3.241343e-02),
+    modified = c(2.922319e-01, 6.172376e-02, 2.170921e-02),
+    total = c(2.922319e-01, 9.134743e-02, 3.406530e-02),
+    hadamard = c(2.943883e-01, 1.052754e-01, 3.910860e-02),
+    ohadamard = c(2.943883e-01, 9.581083e-02, 3.237638e-02)
+  )
+  for (type in names(published)) {
+    a <- allan(y, 1, taus = c(1, 10, 100), type = type)
+    expect_equal(a$tau, c(1, 10, 100))
+    got <- signif(a$adev, 7)
+    want <- published[[type]]
+    if (type == "hadamard") {
+      # The exact HDEV(100) is 0.039108605597 (it matches the quadruple-
+      # precision reference to 1e-15), which rounds to 3.910861e-2; the
+      # published 3.910860e-2 is 0.56 units of its 7th digit away.
+      expect_equal(got[1:2], want[1:2], tolerance = 0, info = type)
+      expect_equal(signif(a$adev[3], 6), signif(want[3], 6))
+      expect_lt(abs(a$adev[3] / want[3] - 1), 1.5e-7)
+    } else {
+      expect_equal(got, want, tolerance = 0, info = type)
+    }
+  }
+})
+
+test_that("NBS14 10-point set", {
+  y <- c(892, 809, 823, 798, 671, 644, 883, 903, 677)
+  expect_equal(signif(allan(y, 1, taus = c(1, 2), type = "standard")$adev, 7),
+               c(91.22945, 115.8082), tolerance = 0)
+  expect_equal(signif(allan(y, 1, taus = c(1, 2))$adev, 7),
+               c(91.22945, 85.95287), tolerance = 0)
+  expect_equal(signif(allan(y, 1, taus = I(2), type = "modified")$adev, 7),
+               74.78849, tolerance = 0)
+})
+
+test_that("standard octave equals avar() to 1e-13 on several inputs", {
+  set.seed(11)
+  inputs <- list(
+    white = rnorm(5000),
+    biased_walk = 100 + cumsum(rnorm(4097)),
+    odd = rnorm(1001, sd = 1e-3),
+    integer = sample(-1000:1000, 3000, replace = TRUE)
+  )
+  for (nm in names(inputs)) {
+    y <- inputs[[nm]]
+    a <- allan(y, 10, type = "standard")
+    b <- avar(y, 10)
+    expect_equal(nrow(a), nrow(b), info = nm)
+    expect_equal(a$tau, b$time, info = nm)
+    expect_lt(max(abs(a$avar / b$av - 1)), 1e-13)
+  }
+})
+
+test_that("standard octave equals avar() on gyroz", {
+  skip_if_no_shared()
+  g <- readRDS(shared_file("gyroz.rds"))
+  a <- allan(g, frequency(g), type = "standard")
+  b <- avar(g, frequency(g))
+  expect_equal(a$tau, b$time)
+  expect_lt(max(abs(a$avar / b$av - 1)), 1e-13)
+})
+
+test_that("every type is exact to 1e-12 with a large bias and drift (1e6 samples)", {
+  set.seed(3)
+  N <- 1e6
+  y <- 1e6 + 1e-3 * seq_len(N) + rnorm(N)  # bias 1e6 sigma, drift 1e3 sigma
+  taus <- c(1, 3, 10, 100, 1000, 1e4, 1e5, 3e5)
+  ref <- allan_reference_cpp(1, 1, 0L, TRUE)
+  skip_if_not(ref$quad, "no quadruple precision for the reference")
+  for (type in allan_types) {
+    expect_lt(ref_rel_error(y, type, taus = taus), 1e-12)
+  }
+  # the standard octave path (pairwise cluster sums) too
+  expect_lt(ref_rel_error(y, "standard"), 1e-12)
+  # integrated input with a huge offset and slope
+  theta <- 1e9 + cumsum(y)
+  for (type in c("overlapping", "standard", "modified", "hadamard", "total")) {
+    expect_lt(ref_rel_error(theta, type, "integrated", taus = taus), 1e-12)
+  }
+})
+
+test_that("a random walk of 1e6 samples is exact to 1e-12 for every type", {
+  skip_if_not(allan_reference_cpp(1, 1, 0L, TRUE)$quad)
+  set.seed(4)
+  y <- 5e3 + cumsum(rnorm(1e6))
+  for (type in allan_types) {
+    expect_lt(ref_rel_error(y, type, taus = c(1, 2, 10, 1000, 1e5)), 1e-12)
+  }
+})
+
+test_that("overlapping at 1e7 samples with bias and drift is exact to 1e-12", {
+  skip_if_not(allan_reference_cpp(1, 1, 0L, TRUE)$quad)
+  set.seed(5)
+  N <- 1e7
+  y <- 1e6 + 1e-4 * seq_len(N) + rnorm(N)
+  expect_lt(ref_rel_error(y, "overlapping", taus = c(1, 1000, 1e6)), 1e-12)
+})
+
+test_that("integrated input equals rate input on the same phase", {
+  set.seed(6)
+  y <- rnorm(3000, 2)
+  theta <- c(0, cumsum(y)) / 50
+  for (type in allan_types) {
+    a <- allan(y, 50, type = type)
+    b <- allan(theta, 50, type = type, input = "integrated")
+    expect_equal(b$m, a$m)
+    expect_equal(b$avar, a$avar, tolerance = 1e-12)
+  }
+})
+
+test_that("integrated overlapping equals avari()", {
+  set.seed(7)
+  theta <- cumsum(rnorm(2000)) / 100
+  b <- avari(theta, 100)
+  a <- allan(theta, 100, taus = b$time, input = "integrated")
+  expect_equal(a$tau, b$time)
+  expect_lt(max(abs(a$avar / b$av - 1)), 1e-12)
+})
+
+test_that("avarn(exact = FALSE) gives avarn()'s rows through the engine", {
+  set.seed(8)
+  for (y in list(rnorm(1500), 3 + cumsum(rnorm(999)), rnorm(2))) {
+    e <- avarn(y, 20)
+    f <- avarn(y, 20, exact = FALSE)
+    expect_identical(names(f), names(e))
+    expect_identical(class(f), class(e))
+    expect_equal(f$time, e$time)
+    expect_equal(f$error, e$error)
+    expect_lt(max(abs(f$av / e$av - 1)), 1e-12)
+  }
+})
+
+test_that("the result has the documented structure", {
+  set.seed(9)
+  y <- ts(rnorm(4096), frequency = 128)
+  a <- allan(y)
+  expect_s3_class(a, c("allan", "data.frame"))
+  expect_named(a, c("tau", "m", "n", "avar", "adev", "lower", "upper", "edf",
+                    "alpha"))
+  expect_type(a$m, "integer")
+  expect_equal(a$tau, a$m / 128)
+  expect_equal(a$m, 2^(0:11))
+  expect_equal(a$n, 4097 - 2 * a$m)
+  expect_equal(a$adev, sqrt(a$avar))
+  expect_true(all(a$lower < a$adev & a$adev < a$upper))
+  expect_equal(attr(a, "freq"), 128)
+  expect_equal(attr(a, "type"), "overlapping")
+  expect_equal(attr(a, "input"), "rate")
+  expect_equal(attr(a, "N"), 4096)
+  expect_equal(attr(a, "conf"), 0.683)
+  d <- as.data.frame(a)
+  expect_identical(class(d), "data.frame")
+  expect_null(attr(d, "freq"))
+})
+
+test_that("several channels: one curve per column, in parallel, same numbers", {
+  set.seed(10)
+  m <- cbind(gx = rnorm(3000), gy = cumsum(rnorm(3000)), gz = rnorm(3000, 5))
+  for (type in c("overlapping", "standard", "total")) {
+    a <- allan(m, 100, type = type)
+    expect_equal(unique(a$channel), colnames(m))
+    for (j in colnames(m)) {
+      s <- allan(m[, j], 100, type = type)
+      rows <- a[a$channel == j, ]
+      expect_equal(rows$avar, s$avar, tolerance = 1e-14)
+      expect_equal(rows$edf, s$edf)
+    }
+  }
+  df <- as.data.frame(m)
+  expect_equal(allan(df, 100)$avar, allan(m, 100)$avar)
+  expect_equal(unique(allan(unname(m), 100)$channel), c("V1", "V2", "V3"))
+})
+
+test_that("arguments are checked with clear messages", {
+  expect_error(allan(), "`x` is missing")
+  expect_error(allan(rnorm(10)), "`freq` is missing")
+  expect_error(allan(rnorm(10), -1), "`freq` must be a single positive number")
+  expect_error(allan(c(1, NA, 3), 1), "finite numbers; found NA at position 2")
+  expect_error(allan(cbind(a = 1:5, b = c(1, 2, Inf, 4, 5)), 1),
+               "position 3 of column 2")
+  expect_error(allan(letters, 1), "must be a numeric vector")
+  expect_error(allan(rnorm(10), 1, type = "fast"), "`type` must be one of")
+  expect_error(allan(rnorm(10), 1, input = "angle"), "`input` must be one of")
+  expect_error(allan(rnorm(10), 1, conf = 1), "`conf` must be a single number")
+  expect_error(allan(1, 1), "at least 2 samples")
+  expect_error(allan(rnorm(10), 1, taus = "weekly"), "`taus` must be")
+  expect_error(allan(rnorm(10), 1, taus = -1), "`taus` must be")
+  expect_error(allan(data.frame(a = 1:3, b = letters[1:3]), 1),
+               "only numeric columns")
+  expect_warning(a <- allan(rnorm(100), 1, taus = c(1, 10, 1000)),
+                 "1 of the requested tau values")
+  expect_equal(a$m, c(1L, 10L))
+})
+
+test_that("print, summary and plot work and leave par() alone", {
+  set.seed(12)
+  a <- allan(cbind(a = rnorm(2000), b = rnorm(2000, sd = 2)), 10)
+  out <- capture.output(print(a))
+  expect_match(out[1], "<allan> overlapping variance of rate input: N = 2,000 at 10 Hz, 2 channels")
+  s <- summary(a)
+  expect_equal(s$channel, c("a", "b"))
+  expect_equal(s$adev_min, c(min(a$adev[a$channel == "a"]),
+                             min(a$adev[a$channel == "b"])))
+  expect_output(print(s), "adev_min")
+  f <- tempfile(fileext = ".pdf")
+  grDevices::pdf(f)
+  op <- graphics::par(no.readonly = TRUE)
+  expect_invisible(plot(a))
+  expect_equal(graphics::par(no.readonly = TRUE)[c("mfrow", "mar", "oma")],
+               op[c("mfrow", "mar", "oma")])
+  grDevices::dev.off()
+  unlink(f)
+})
