@@ -9,12 +9,8 @@ allan_reference_cpp <- function(v, m, type, rate) {
     .Call(`_allanvar_allan_reference_cpp`, v, m, type, rate)
 }
 
-allan_first_nonfinite_cpp <- function(x) {
-    .Call(`_allanvar_allan_first_nonfinite_cpp`, x)
-}
-
-avar_octave_exact <- function(values, freq) {
-    .Call(`_allanvar_avar_octave_exact`, values, freq)
+avar_octave_exact <- function(values, freq, threads) {
+    .Call(`_allanvar_avar_octave_exact`, values, freq, threads)
 }
 
 avari_octave_exact <- function(values, freq) {
@@ -35,6 +31,10 @@ avfit_nnls <- function(A, b) {
 
 avar_white_cov <- function(m, n, overlapping, threads) {
     .Call(`_allanvar_avar_white_cov`, m, n, overlapping, threads)
+}
+
+first_nonfinite <- function(x) {
+    .Call(`_allanvar_first_nonfinite`, x)
 }
 
 allan_edf_cpp <- function(type, m, n, L, alpha, exact) {

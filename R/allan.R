@@ -56,6 +56,25 @@
 #'   \eqn{\alpha \in \{0, -1, -2\}}, the larger of it and NIST SP 1065's
 #'   \eqn{b (L-1)/m - c} approximation.
 #'
+#' @section Methods:
+#' `print()` shows a header line and the table (`digits`, default 4);
+#' `summary()` gives, per channel, the tau range and the minimum ADEV with
+#' its interval; `plot(x, col = NULL, main = NULL, xlab, ylab, legend = TRUE,
+#' ...)` draws ADEV against tau on log-log axes with the confidence bars, one
+#' colour per channel and a legend when there are several;
+#' `as.data.frame()` drops the class and attributes.
+#'
+#' @section Cost:
+#' The phase is accumulated once per channel as a pair of double arrays
+#' (hi on a fixed grid, lo the remainder), \eqn{16 N} bytes, besides at most
+#' one copy of the input (integer or data-frame input is converted). The
+#' standard type at octave cluster sizes needs no prefix arrays at all: it
+#' builds the cluster sums pairwise in one pass over the data. Stride-1
+#' types cost \eqn{O(N)} per tau (so `taus = "all"` is \eqn{O(N^2)} for
+#' them), stride-\eqn{m} types \eqn{O(N/m)}. Channels are shared between
+#' `getOption("allanvar.threads", 2)` threads; a single channel splits its
+#' work between them.
+#'
 #' @param x Numeric vector, `ts`, matrix or data frame of samples; one curve
 #'   per column. Rate samples (angular rate, acceleration, fractional
 #'   frequency) with `input = "rate"`; angle, velocity or clock phase with
@@ -75,10 +94,10 @@
 #'   0.683 is one sigma.
 #' @return A data frame of class `c("allan", "data.frame")` with columns
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
-#'   `lower` and `upper` (confidence limits of `adev`), `edf`, `alpha` (the
-#'   noise exponent used for the EDF) and, when `x` has several columns,
-#'   `channel` (rows stacked channel by channel). Attributes: `freq`, `type`,
-#'   `input`, `N` (samples per channel), `conf`.
+#'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
+#'   has several columns, `channel` (the column name; rows stacked channel by
+#'   channel), and last `alpha` (the integer noise exponent behind the EDF).
+#'   Attributes: `freq`, `type`, `input`, `N` (samples per channel), `conf`.
 #' @seealso [avar()], [avarn()] and [avari()] for the results of
 #'   'allanvar' 1.1.
 #' @export
@@ -114,10 +133,18 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
           "\" with ", N, " samples (largest cluster size: ", maxm, ").")
   }
   nterms <- allan_nterms(type, m, L)
-  octave <- type == "standard" && rate && all(m == 2^round(log2(m)))
+  octave <- type == "standard" && rate && length(m) <= 64L &&
+    all(m == 2^round(log2(m)))
   sub <- allan_subset(m)
   res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub], allan_type_code(type),
                         rate, octave, allanvar_threads())
+  if (any(res$bad > 0)) {
+    col <- which(res$bad > 0)[1L]
+    row <- res$bad[col]
+    abort("`x` must contain only finite numbers; found ",
+          format(ch$values[[(col - 1) * N + row]]), " at position ", row,
+          if (ch$nc > 1L) paste0(" of column ", col), ".")
+  }
   norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
                  2 * m^2)
   scale <- if (rate) 1 else freq^2
@@ -126,14 +153,16 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     av <- res$sums[, j] / (norm * nterms) * scale
     e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
     ci <- allan_ci(av, e$edf, conf)
-    d <- data.frame(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
-                    adev = sqrt(av), lower = ci$lower, upper = ci$upper,
-                    edf = e$edf, alpha = e$alpha)
-    if (ch$nc > 1L) d$channel <- ch$names[j]
-    out[[j]] <- d
+    d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
+              adev = sqrt(av), lower = ci$lower, upper = ci$upper,
+              edf = e$edf)
+    if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
+    d$alpha <- e$alpha
+    out[[j]] <- structure(d, class = "data.frame",
+                          row.names = .set_row_names(length(m)))
   }
   out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)
-  rownames(out) <- NULL
+  if (ch$nc > 1L) rownames(out) <- NULL
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf)
 }
@@ -185,15 +214,9 @@ allan_channels <- function(x, min_n) {
     abort("`x` must have at least ", min_n, " samples per channel, not ", N, ".")
   }
   if (!is.double(x)) storage.mode(x) <- "double"
-  v <- x  # passed to C++ as is: attributes (ts, dim) cost no copy
-  bad <- allan_first_nonfinite_cpp(v)
-  if (bad > 0) {
-    col <- (bad - 1) %/% N + 1
-    row <- (bad - 1) %% N + 1
-    abort("`x` must contain only finite numbers; found ", format(v[[bad]]),
-          " at position ", row, if (nc > 1L) paste0(" of column ", col), ".")
-  }
-  list(values = v, N = N, nc = nc, names = nm)
+  # passed to C++ as is (attributes such as ts or dim cost no copy); the
+  # kernel checks finiteness in the pass it makes anyway
+  list(values = x, N = N, nc = nc, names = nm)
 }
 
 #' @export
@@ -256,7 +279,10 @@ plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
   d <- as.data.frame(x)
   if (is.null(d$channel)) d$channel <- "x"
   chans <- unique(d$channel)
-  if (is.null(col)) col <- grDevices::hcl.colors(max(2, length(chans)), "Dark 3")
+  if (is.null(col)) {
+    col <- c("black", "#D55E00", "#0072B2", "#009E73", "#CC79A7", "#E69F00",
+             "#56B4E9", "#999999")
+  }
   col <- rep_len(col, length(chans))
   type <- attr(x, "type")
   if (is.null(ylab)) {

@@ -43,5 +43,5 @@ avar <- function(values, freq) {
   check_present(missing(freq), "freq", "the sampling frequency in Hz")
   values <- check_values(values, min_n = 2L)
   freq <- check_freq(freq)
-  avar_octave_exact(values, freq)
+  avar_octave_exact(values, freq, allanvar_threads())
 }

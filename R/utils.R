@@ -47,15 +47,15 @@ check_values <- function(values, min_n = 2L, arg = "values") {
   if (n < min_n) {
     abort("`", arg, "` must have at least ", min_n, " samples, not ", n, ".")
   }
-  bad <- which(!is.finite(values))
-  if (length(bad)) {
-    first <- bad[1L]
+  values <- as.double(values)
+  first <- first_nonfinite(values)
+  if (first > 0) {
+    more <- sum(!is.finite(values)) - 1L
     abort("`", arg, "` must contain only finite numbers; found ",
           format(values[first]), " at position ", first,
-          if (length(bad) > 1L) paste0(" (and ", length(bad) - 1L, " more)"),
-          ".")
+          if (more > 0L) paste0(" (and ", more, " more)"), ".")
   }
-  as.double(values)
+  values
 }
 
 # `freq`: a single positive finite number (sampling frequency in Hz).

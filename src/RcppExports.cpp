@@ -42,24 +42,15 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// allan_first_nonfinite_cpp
-double allan_first_nonfinite_cpp(const Rcpp::NumericVector& x);
-RcppExport SEXP _allanvar_allan_first_nonfinite_cpp(SEXP xSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
-    rcpp_result_gen = Rcpp::wrap(allan_first_nonfinite_cpp(x));
-    return rcpp_result_gen;
-END_RCPP
-}
 // avar_octave_exact
-Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values, double freq);
-RcppExport SEXP _allanvar_avar_octave_exact(SEXP valuesSEXP, SEXP freqSEXP) {
+Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values, double freq, int threads);
+RcppExport SEXP _allanvar_avar_octave_exact(SEXP valuesSEXP, SEXP freqSEXP, SEXP threadsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type values(valuesSEXP);
     Rcpp::traits::input_parameter< double >::type freq(freqSEXP);
-    rcpp_result_gen = Rcpp::wrap(avar_octave_exact(values, freq));
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(avar_octave_exact(values, freq, threads));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -126,6 +117,16 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// first_nonfinite
+double first_nonfinite(const Rcpp::NumericVector& x);
+RcppExport SEXP _allanvar_first_nonfinite(SEXP xSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    rcpp_result_gen = Rcpp::wrap(first_nonfinite(x));
+    return rcpp_result_gen;
+END_RCPP
+}
 // allan_edf_cpp
 Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m, const Rcpp::NumericVector& n, double L, const Rcpp::IntegerVector& alpha, const Rcpp::LogicalVector& exact);
 RcppExport SEXP _allanvar_allan_edf_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP LSEXP, SEXP alphaSEXP, SEXP exactSEXP) {
@@ -145,13 +146,13 @@ END_RCPP
 static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 9},
     {"_allanvar_allan_reference_cpp", (DL_FUNC) &_allanvar_allan_reference_cpp, 4},
-    {"_allanvar_allan_first_nonfinite_cpp", (DL_FUNC) &_allanvar_allan_first_nonfinite_cpp, 1},
-    {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 2},
+    {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 3},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},
     {"_allanvar_avfit_log_nnls", (DL_FUNC) &_allanvar_avfit_log_nnls, 7},
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
+    {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {NULL, NULL, 0}
 };

@@ -42,6 +42,18 @@ struct Acc {
   double value() const { return s + c; }
 };
 
+// Runs f(i) for i in [0, n): from the main thread through parallel_for
+// (which polls for interrupts between items), serially and without any R
+// API inside a worker.
+template <class F>
+void run_items(R_xlen_t n, int threads, bool main, F f) {
+  if (main) {
+    allanvar::parallel_for(n, threads, [&](R_xlen_t i, int) { f(i); });
+  } else {
+    for (R_xlen_t i = 0; i < n; ++i) f(i);
+  }
+}
+
 // A large double buffer, uninitialised. On Linux it is 2 MiB aligned and
 // marked for transparent huge pages: a fresh 100 MB prefix array otherwise
 // costs tens of thousands of page faults, more than the sums themselves.
@@ -96,7 +108,7 @@ inline double grid_step(double bound) {
 // points), levels = 2 the prefix sums of X (n + 2 points). `bound` bounds
 // |v - c|.
 void build_prefix(const double* v, R_xlen_t n, double c, double bound,
-                  int levels, Split& out) {
+                  int levels, Split& out, int threads, bool main) {
   const R_xlen_t len = n + levels;
   out.hi.resize(len);
   out.lo.resize(len);
@@ -108,31 +120,54 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   if (levels == 2) b *= static_cast<double>(n + 1);
   const double q = grid_step(b);
   const double C = 1.5 * q * 4503599627370496.0;  // 1.5 q 2^52: ulp(C) = q
+  if (levels == 1) {
+    // X_{i+1} = X_i + (v_i - c). With two threads the second one first runs
+    // the same additions over the first part without storing them, so the
+    // result is bit-identical to the serial loop.
+    auto run = [&](R_xlen_t i0, R_xlen_t i1, double& s1, double& e1, bool store) {
+      for (R_xlen_t i = i0; i < i1; ++i) {
+        double r, re, t, te;
+        two_sum(v[i], -c, r, re);
+        two_sum(s1, r, t, te);
+        s1 = t;
+        e1 += te + re;
+        if (store) {
+          const double h = (s1 + C) - C;
+          hi[i + 1] = h;
+          lo[i + 1] = (s1 - h) + e1;
+        }
+      }
+    };
+    const R_xlen_t cut = (threads > 1 && n >= 65536)
+                             ? static_cast<R_xlen_t>(0.58 * static_cast<double>(n))
+                             : n;
+    run_items(cut < n ? 2 : 1, threads, main, [&](R_xlen_t p) {
+      double s1 = 0, e1 = 0;
+      if (p == 0) {
+        run(0, cut, s1, e1, true);
+      } else {
+        run(0, cut, s1, e1, false);
+        run(cut, n, s1, e1, true);
+      }
+    });
+    return;
+  }
+  // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c)
   double s1 = 0, e1 = 0, s2 = 0, e2 = 0;
   for (R_xlen_t i = 0; i < n; ++i) {
     double r, re, t, te;
     two_sum(v[i], -c, r, re);
-    if (levels == 1) {
-      two_sum(s1, r, t, te);
-      s1 = t;
-      e1 += te + re;
-      const double h = (s1 + C) - C;
-      hi[i + 1] = h;
-      lo[i + 1] = (s1 - h) + e1;
-    } else {
-      // P_{i+1} = P_i + X_i, then X_{i+1} = X_i + r_i.
-      two_sum(s2, s1, t, te);
-      s2 = t;
-      e2 += te + e1;
-      const double h = (s2 + C) - C;
-      hi[i + 1] = h;
-      lo[i + 1] = (s2 - h) + e2;
-      two_sum(s1, r, t, te);
-      s1 = t;
-      e1 += te + re;
-    }
+    two_sum(s2, s1, t, te);
+    s2 = t;
+    e2 += te + e1;
+    const double h = (s2 + C) - C;
+    hi[i + 1] = h;
+    lo[i + 1] = (s2 - h) + e2;
+    two_sum(s1, r, t, te);
+    s1 = t;
+    e1 += te + re;
   }
-  if (levels == 2) {
+  {
     double t, te;
     two_sum(s2, s1, t, te);
     s2 = t;
@@ -221,18 +256,7 @@ inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
   return tail;
 }
 
-// Runs f(i) for i in [0, n): in parallel from the main thread, serially (no
-// R API at all) inside a worker.
-template <class F>
-void run_items(R_xlen_t n, int threads, bool main, F f) {
-  if (main && threads > 1) {
-    allanvar::parallel_for(n, threads, [&](R_xlen_t i, int) { f(i); });
-  } else {
-    for (R_xlen_t i = 0; i < n; ++i) f(i);
-  }
-}
-
-const R_xlen_t kBlock = 2048;  // terms per cache block
+const R_xlen_t kBlock = 8192;  // terms per cache block (measured best of 512..8192)
 const R_xlen_t kChunk = 1 << 17;  // terms per parallel item
 
 // Stride-1 estimators: out[j] = sum over k < nterms[j] of f_j(k)^2. The k
@@ -309,14 +333,34 @@ double strided_sum(const double* h, const double* l, R_xlen_t m, R_xlen_t n) {
   return a.value();
 }
 
-// Stride-m estimators (standard, Hadamard): one item per tau.
+// Cuts taus into about 64 runs of similar work (work[j] terms each), so that
+// a grid of every m does not pay one thread hand-off per tau.
+std::vector<size_t> work_runs(const std::vector<R_xlen_t>& work) {
+  double total = 0;
+  for (R_xlen_t w : work) total += static_cast<double>(w) + 64;
+  std::vector<size_t> cut(1, 0);
+  double acc = 0;
+  for (size_t j = 0; j < work.size(); ++j) {
+    acc += static_cast<double>(work[j]) + 64;
+    if (acc >= total / 64 || j + 1 == work.size()) {
+      cut.push_back(j + 1);
+      acc = 0;
+    }
+  }
+  return cut;
+}
+
+// Stride-m estimators (standard, Hadamard).
 template <int D>
 void strided(const Split& X, const std::vector<R_xlen_t>& ms,
              const std::vector<R_xlen_t>& nterms, int threads, bool main,
              double* out) {
-  run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
-    out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), ms[j], nterms[j]);
-  });
+  const std::vector<size_t> cut = work_runs(nterms);
+  run_items(static_cast<R_xlen_t>(cut.size() - 1), threads, main,
+            [&](R_xlen_t r) {
+              for (size_t j = cut[r]; j < cut[r + 1]; ++j)
+                out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), ms[j], nterms[j]);
+            });
 }
 
 // Total variance (NIST SP 1065 eq. 25): second differences centred on
@@ -329,7 +373,7 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
   const double* l = X.lo.data();
   run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
     const R_xlen_t m = ms[j];
-    // weights of one term on at most 5 points; all in the exact hi grid
+    // one term has at most 5 points, total weight 8: exact on the hi grid
     Acc a;
     double s = 0;
     R_xlen_t cnt = 0;
@@ -424,16 +468,16 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
   return n2;
 }
 
-void standard_octave(const double* y, R_xlen_t N, double c, int J,
-                     std::vector<Level>& lev) {
-  const int b = 11;
+// Levels 0..jin of the samples [s0, s1) (s0 a multiple of the block), and
+// the level-b sums of its full blocks appended to th/tl.
+void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
+                 int jin, int b, std::vector<Level>& lev,
+                 std::vector<double>& th, std::vector<double>& tl) {
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
-  lev.assign(J + 1, Level());
-  std::vector<double> h(B), l(B), th, tl;
-  const int jin = std::min(J, b - 1);  // levels handled inside blocks
-  for (R_xlen_t s0 = 0; s0 < N; s0 += B) {
-    const R_xlen_t n = std::min(B, N - s0);
-    for (R_xlen_t i = 0; i < n; ++i) two_sum(y[s0 + i], -c, h[i], l[i]);
+  std::vector<double> h(B), l(B);
+  for (R_xlen_t k0 = s0; k0 < s1; k0 += B) {
+    const R_xlen_t n = std::min(B, s1 - k0);
+    for (R_xlen_t i = 0; i < n; ++i) two_sum(y[k0 + i], -c, h[i], l[i]);
     R_xlen_t cur = n;
     for (int j = 0; j <= jin; ++j)
       cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
@@ -442,10 +486,56 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
       tl.push_back(l[0]);
     }
   }
+}
+
+// Non-overlapping AV at m = 2^j, j = 0..J: the record is cut in two halves
+// at a block boundary (one per thread), whose per-level sums are then
+// joined with the one difference that straddles the cut.
+void standard_octave(const double* y, R_xlen_t N, double c, int J,
+                     std::vector<Level>& lev, int threads, bool main) {
+  const int b = 11;
+  const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
+  const int jin = std::min(J, b - 1);  // levels handled inside blocks
+  const R_xlen_t nblocks = (N + B - 1) / B;
+  const int P = (threads > 1 && nblocks >= 8) ? 2 : 1;
+  const R_xlen_t cut[3] = {0, P == 2 ? (nblocks / 2) * B : N, N};
+  std::vector<std::vector<Level> > part(P, std::vector<Level>(jin + 1));
+  std::vector<std::vector<double> > th(P), tl(P);
+  run_items(P, threads, main, [&](R_xlen_t p) {
+    octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p]);
+  });
+  lev.assign(J + 1, Level());
+  for (int j = 0; j <= jin; ++j) {
+    Level& L = lev[j];
+    L = part[0][j];
+    if (P == 2) {
+      const Level& R = part[1][j];
+      L.acc.add(R.acc.value());
+      if (L.has && R.has) {
+        const double d = (R.idh[0] - L.ph) + (R.idl[0] - L.pl);
+        L.acc.add(d * d);
+      }
+      for (size_t k = 0; k < R.idh.size() &&
+                         static_cast<R_xlen_t>(L.idh.size()) < kIdMax; ++k) {
+        L.idh.push_back(R.idh[k]);
+        L.idl.push_back(R.idl[k]);
+      }
+      if (R.has) {
+        L.ph = R.ph;
+        L.pl = R.pl;
+        L.has = true;
+      }
+    }
+  }
   if (J >= b) {
-    R_xlen_t cur = static_cast<R_xlen_t>(th.size());
+    std::vector<double> h(th[0]), l(tl[0]);
+    if (P == 2) {
+      h.insert(h.end(), th[1].begin(), th[1].end());
+      l.insert(l.end(), tl[1].begin(), tl[1].end());
+    }
+    R_xlen_t cur = static_cast<R_xlen_t>(h.size());
     for (int j = b; j <= J; ++j)
-      cur = level_step(th.data(), tl.data(), cur, lev[j], j < J);
+      cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
   }
 }
 
@@ -461,7 +551,7 @@ void detrend(std::vector<double>& v, int deg) {
     const double mid = 0.5 * (static_cast<double>(n) - 1);
     for (size_t i = 0; i < n; ++i) {
       const double t = (static_cast<double>(i) - mid) / (mid + 1);
-      b[i] = std::pow(t, p);
+      b[i] = p == 0 ? 1.0 : p == 1 ? t : t * t;
     }
     for (auto& q : basis) {
       double dot = 0;
@@ -515,7 +605,14 @@ inline double xval(const Split& X, R_xlen_t k) { return X.hi[k] + X.lo[k]; }
 struct Channel {
   std::vector<double> sums, alpha;
   std::vector<int> alpha_int;
+  R_xlen_t bad = 0;  // 1-based position of the first NA/NaN/Inf, or 0
 };
+
+R_xlen_t first_nonfinite(const double* v, R_xlen_t N) {
+  for (R_xlen_t i = 0; i < N; ++i)
+    if (!std::isfinite(v[i])) return i + 1;
+  return 0;
+}
 
 // One channel: sums of squares for every m, and the noise id per m.
 void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
@@ -527,22 +624,17 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   out.alpha.assign(ni, NA_REAL);
   out.alpha_int.assign(ni, NA_INTEGER);
   const int dmax = (type == HADAMARD || type == OHADAMARD) ? 3 : 2;
-  // centre and bound of the data
-  long double s = 0;
-  double vmin = v[0], vmax = v[0];
-  for (R_xlen_t i = 0; i < N; ++i) {
-    s += v[i];
-    vmin = std::min(vmin, v[i]);
-    vmax = std::max(vmax, v[i]);
-  }
-  const double c = rate ? static_cast<double>(s / N) : 0.5 * (vmin + vmax);
-  const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
-
   if (type == STANDARD && rate && octave) {
+    // Any constant works as the centre here (cluster sums are double-double
+    // and constants cancel); NaN or Inf shows up in the sums.
     int J = 0;
     while ((static_cast<R_xlen_t>(1) << (J + 1)) <= ms.back()) ++J;
     std::vector<Level> lev;
-    standard_octave(v, N, c, J, lev);
+    standard_octave(v, N, v[0], J, lev, threads, main);
+    if (!std::isfinite(lev[0].acc.value())) {
+      out.bad = first_nonfinite(v, N);
+      if (out.bad > 0) return;
+    }
     for (size_t j = 0; j < nt; ++j) {
       int lj = 0;
       while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
@@ -558,12 +650,26 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     return;
   }
 
+  // centre (mid-range) and bound of the data; NaN/Inf poison z
+  double vmin = v[0], vmax = v[0], z = 0;
+  for (R_xlen_t i = 0; i < N; ++i) {
+    vmin = std::min(vmin, v[i]);
+    vmax = std::max(vmax, v[i]);
+    z += v[i] * 0.0;
+  }
+  if (z != 0) {
+    out.bad = first_nonfinite(v, N);
+    return;
+  }
+  const double c = 0.5 * vmin + 0.5 * vmax;
+  const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
+
   Split X;
   const int level = type == MODIFIED ? (rate ? 2 : 1) : (rate ? 1 : 0);
   if (level == 0) {
     build_split(v, N, c, bound, X);
   } else {
-    build_prefix(v, N, c, bound, level, X);
+    build_prefix(v, N, c, bound, level, X, threads, main);
   }
   double* o = out.sums.data();
   switch (type) {
@@ -647,9 +753,12 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
       alpha_int(j, i) = ch[i].alpha_int[j];
     }
   }
+  Rcpp::NumericVector bad(nc);
+  for (R_xlen_t i = 0; i < nc; ++i) bad[i] = static_cast<double>(ch[i].bad);
   return Rcpp::List::create(Rcpp::Named("sums") = sums,
                             Rcpp::Named("alpha") = alpha,
-                            Rcpp::Named("alpha_int") = alpha_int);
+                            Rcpp::Named("alpha_int") = alpha_int,
+                            Rcpp::Named("bad") = bad);
 }
 
 // ---- test reference: direct evaluation in quadruple precision ----
@@ -735,15 +844,4 @@ Rcpp::List allan_reference_cpp(const Rcpp::NumericVector& v,
   }
   return Rcpp::List::create(Rcpp::Named("sums") = out, Rcpp::Named("n") = cnt,
                             Rcpp::Named("quad") = kRefQuad);
-}
-
-// 1-based position of the first NA/NaN/Inf in x, 0 when all are finite (one
-// pass, no allocation: cheaper than is.finite() on long records).
-// [[Rcpp::export(rng = false)]]
-double allan_first_nonfinite_cpp(const Rcpp::NumericVector& x) {
-  const R_xlen_t n = x.size();
-  const double* p = x.begin();
-  for (R_xlen_t i = 0; i < n; ++i)
-    if (!std::isfinite(p[i])) return static_cast<double>(i + 1);
-  return 0;
 }

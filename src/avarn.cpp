@@ -1,8 +1,9 @@
 // avarn(): allanvar 1.1's non-overlapping Allan variance at every cluster size.
 // Exactness forces O(N^2) work (each size re-sums every sample in long
-// double), so cluster sizes are shared between threads.
+// double), so blocks of consecutive cluster sizes are shared between threads.
 #include "exact_sums.h"
 #include "parallel.h"
+#include <algorithm>
 #include <vector>
 
 // [[Rcpp::export(rng = false)]]
@@ -15,13 +16,17 @@ Rcpp::DataFrame avarn_all_exact(const Rcpp::NumericVector& values, double freq,
   Rcpp::NumericVector time(n), av(n), error(n);
   const double* x = values.begin();
   double* avp = av.begin();
-  std::vector<std::vector<double> > means(threads, std::vector<double>(N));
-  allanvar::parallel_for(n, threads, [&](R_xlen_t i, int worker) {
-    const R_xlen_t c = i + 1;
-    const R_xlen_t M = N / c;
-    double* w = means[worker].data();
-    allanvar::cluster_means(x, c, M, w);
-    avp[i] = allanvar::cluster_mean_avar(w, M);
+  // Blocks of 16 sizes: the last clusters of neighbouring sizes overlap.
+  const R_xlen_t block = 16;
+  const R_xlen_t blocks = (n + block - 1) / block;
+  std::vector<R_xlen_t> sizes(n);
+  for (R_xlen_t i = 0; i < n; ++i) sizes[i] = i + 1;
+  std::vector<std::vector<double> > sums(threads, std::vector<double>(N));
+  allanvar::parallel_for(blocks, threads, [&](R_xlen_t b, int worker) {
+    const R_xlen_t from = b * block;
+    const R_xlen_t count = std::min(block, n - from);
+    allanvar::cluster_avars(x, N, sizes.data() + from, count, avp + from,
+                            sums[worker].data(), [] {});
   });
   for (R_xlen_t i = 0; i < n; ++i) {
     const double c = static_cast<double>(i + 1);

@@ -183,6 +183,8 @@ test_that("several channels: one curve per column, in parallel, same numbers", {
   m <- cbind(gx = rnorm(3000), gy = cumsum(rnorm(3000)), gz = rnorm(3000, 5))
   for (type in c("overlapping", "standard", "total")) {
     a <- allan(m, 100, type = type)
+    expect_named(a, c("tau", "m", "n", "avar", "adev", "lower", "upper", "edf",
+                      "channel", "alpha"))
     expect_equal(unique(a$channel), colnames(m))
     for (j in colnames(m)) {
       s <- allan(m[, j], 100, type = type)
@@ -235,4 +237,17 @@ test_that("print, summary and plot work and leave par() alone", {
                op[c("mfrow", "mar", "oma")])
   grDevices::dev.off()
   unlink(f)
+})
+
+test_that("the thread count changes nothing but the last bits", {
+  set.seed(13)
+  y <- 3 + cumsum(rnorm(2e5))
+  for (type in c("standard", "overlapping", "hadamard")) {
+    old <- options(allanvar.threads = 1)
+    a1 <- allan(y, 1, type = type)
+    options(allanvar.threads = 2)
+    a2 <- allan(y, 1, type = type)
+    options(old)
+    expect_equal(a2$avar, a1$avar, tolerance = 1e-14, info = type)
+  }
 })

@@ -1,0 +1,107 @@
+# EDF, noise identification and confidence intervals of allan().
+
+test_that("Greenhall's EDF and the exact discrete EDF for white rate noise", {
+  # NIST SP 1065 / noise-models.md: overlapping AV, m = 1, 1001 phase points:
+  # Greenhall gives 782, the exact Gaussian value is 666.
+  expect_equal(allan_edf_cpp(1L, 1, 999, 1001, 0L, FALSE), 782, tolerance = 1e-3)
+  expect_equal(allan_edf_cpp(1L, 1, 999, 1001, 0L, TRUE), 666, tolerance = 1e-3)
+  # non-overlapping white: adjacent terms correlate at -1/2, edf = 2n^2/(3n - 1)
+  n <- 99
+  expect_equal(allan_edf_cpp(0L, 7, n, 7 * (n + 1) + 1, 0L, TRUE),
+               2 * n^2 / (3 * n - 1))
+})
+
+test_that("Greenhall's EDF agrees with NIST SP 1065 Table 5 where that is accurate", {
+  N <- 1001
+  simple_wfm <- function(m) (3 * (N - 1) / (2 * m) - 2 * (N - 2) / N) * 4 * m^2 / (4 * m^2 + 5)
+  simple_rw <- function(m) (N - 2) / m * ((N - 1)^2 - 3 * m * (N - 1) + 4 * m^2) / (N - 3)^2
+  simple_ffm <- function(m) 5 * N^2 / (4 * m * (N + 3 * m))
+  for (m in c(64, 100)) {
+    expect_equal(allan_edf_cpp(1L, m, N - 2 * m, N, 0L, FALSE), simple_wfm(m), tolerance = 0.02)
+    expect_equal(allan_edf_cpp(1L, m, N - 2 * m, N, -2L, FALSE), simple_rw(m), tolerance = 0.05)
+    expect_equal(allan_edf_cpp(1L, m, N - 2 * m, N, -1L, FALSE), simple_ffm(m), tolerance = 0.04)
+  }
+  # and the exact discrete EDF tends to Greenhall's at large m
+  for (a in c(0L, -2L)) {
+    expect_equal(allan_edf_cpp(1L, 64, N - 128, N, a, TRUE),
+                 allan_edf_cpp(1L, 64, N - 128, N, a, FALSE), tolerance = 0.005)
+  }
+})
+
+test_that("the exact discrete EDF matches Monte Carlo variances", {
+  set.seed(21)
+  N <- 400
+  for (rw in c(FALSE, TRUE)) {
+    for (type in c("overlapping", "modified", "ohadamard")) {
+      m <- 4
+      av <- replicate(1500, {
+        y <- rnorm(N)
+        if (rw) y <- cumsum(y)
+        allan(y, 1, taus = I(m), type = type)$avar
+      })
+      n <- allan_nterms(type, m, N + 1)
+      edf <- allan_edf_cpp(allan_type_code(type), m, n, N + 1,
+                           if (rw) -2L else 0L, TRUE)
+      # edf = 2 E^2 / Var; the Monte Carlo estimate has ~4% standard error
+      expect_equal(2 * mean(av)^2 / var(av), edf, tolerance = 0.15,
+                   info = paste(type, rw))
+    }
+  }
+})
+
+test_that("Riley's lag-1 autocorrelation identifies power-law noise", {
+  set.seed(22)
+  w <- rnorm(1e5)
+  expect_true(all(allan(w, 1)$alpha == 0))
+  expect_true(all(allan(cumsum(w), 1)$alpha == -2))
+  expect_gte(mean(allan(diff(c(0, w)), 1)$alpha == 2), 0.8)
+  expect_true(all(allan(w, 1, input = "integrated")$alpha == 2))
+  expect_true(all(allan(cumsum(w), 1, input = "integrated")$alpha == 0))
+  for (type in allan_types) {
+    expect_true(all(allan(w, 1, type = type)$alpha == 0), info = type)
+  }
+})
+
+test_that("the chi-square interval of the deviation (NIST SP 1065 eq. 45)", {
+  set.seed(23)
+  a <- allan(rnorm(2000), 1, conf = 0.9)
+  expect_equal(a$lower, sqrt(a$edf * a$avar / qchisq(0.95, a$edf)))
+  expect_equal(a$upper, sqrt(a$edf * a$avar / qchisq(0.05, a$edf)))
+  # long curves interpolate the quantile factors
+  edf <- exp(seq(log(0.5), log(1e6), length.out = 3000))
+  ci <- allan_ci(rep(1, 3000), edf, 0.683)
+  p <- (1 - 0.683) / 2
+  expect_equal(ci$lower, sqrt(edf / qchisq(1 - p, edf)), tolerance = 1e-6)
+  expect_equal(ci$upper, sqrt(edf / qchisq(p, edf)), tolerance = 1e-6)
+})
+
+test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
+  # 1000 replicates each of white rate noise (AV = 1/m) and random-walk rate
+  # noise y = cumsum(w) (AV = (2m^2 + 1)/(6m)), N = 1024.
+  old <- options(allanvar.threads = 1)
+  on.exit(options(old))
+  set.seed(42)
+  N <- 1024
+  cover <- function(gen, truth, type) {
+    hits <- edfs <- NULL
+    for (r in 1:1000) {
+      a <- allan(gen(), 1, type = type)
+      tv <- sqrt(truth(a$m))
+      hits <- rbind(hits, a$lower <= tv & tv <= a$upper)
+      edfs <- rbind(edfs, a$edf)
+    }
+    keep <- apply(edfs, 2, stats::median) >= 5
+    colMeans(hits)[keep]
+  }
+  white <- function() rnorm(N)
+  walk <- function() cumsum(rnorm(N))
+  tw <- function(m) 1 / m
+  trw <- function(m) (2 * m^2 + 1) / (6 * m)
+  for (type in c("overlapping", "standard")) {
+    cw <- cover(white, tw, type)
+    cr <- cover(walk, trw, type)
+    expect_gte(length(cw), 7)
+    expect_true(all(cw >= 0.65 & cw <= 0.72), info = paste(type, "white:", toString(cw)))
+    expect_true(all(cr >= 0.65 & cr <= 0.72), info = paste(type, "walk:", toString(cr)))
+  }
+})

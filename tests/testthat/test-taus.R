@@ -1,0 +1,44 @@
+# Tau grids and the largest cluster size of each estimator.
+
+test_that("octave, decade and all grids", {
+  y <- rnorm(100)
+  expect_equal(allan(y, 1)$m, 2^(0:5))
+  expect_equal(allan(y, 1, taus = "decade")$m, c(1, 2, 4, 10, 20, 40))
+  expect_equal(allan(y, 1, taus = "all")$m, 1:50)
+  expect_equal(allan(y, 1, type = "total")$m, 2^(0:6))
+  expect_equal(allan(y, 1, taus = "decade", type = "total")$m,
+               c(1, 2, 4, 10, 20, 40, 100))
+})
+
+test_that("the largest cluster size of each type has one term, the next none", {
+  for (input in c("rate", "integrated")) {
+    y <- rnorm(101)
+    L <- if (input == "rate") 102 else 101
+    for (type in allan_types) {
+      a <- allan(y, 1, taus = "all", type = type, input = input)
+      mx <- max(a$m)
+      expect_equal(mx, allan_max_m(type, L), info = type)
+      expect_gte(min(a$n), 1)
+      if (type != "total") expect_lt(allan_nterms(type, mx + 1, L), 1)
+      expect_equal(a$m, seq_len(mx))
+    }
+  }
+  expect_equal(allan_max_m("overlapping", 101), 50)
+  expect_equal(allan_max_m("modified", 101), 33)
+  expect_equal(allan_max_m("hadamard", 101), 33)
+  expect_equal(allan_max_m("total", 101), 100)
+})
+
+test_that("points per decade and taus in seconds", {
+  y <- rnorm(2000)
+  a <- allan(y, 10, taus = 10)
+  expect_equal(a$m, unique(round(10^seq(0, 3, by = 0.1))))
+  a <- allan(y, 10, taus = c(0.14, 0.26, 1, 1))
+  expect_equal(a$m, c(1L, 3L, 10L))
+  expect_equal(a$tau, c(0.1, 0.3, 1))
+  expect_equal(allan(y, 10, taus = I(2.5))$m, 25L)
+  expect_error(allan(y, 10, taus = 2.5), "points per decade")
+  expect_warning(allan(y, 10, taus = c(0.01, 1)), "were dropped")
+  expect_error(suppressWarnings(allan(rnorm(4), 1, taus = I(10), type = "hadamard")),
+               "No averaging time")
+})
