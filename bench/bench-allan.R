@@ -10,7 +10,7 @@
 lib <- tempfile("allanlib")
 dir.create(lib)
 status <- system2(file.path(R.home("bin"), "R"),
-                  c("CMD", "INSTALL", "--no-test-load", paste0("--library=", lib), "."),
+                  c("CMD", "INSTALL", "--preclean", "--no-test-load", paste0("--library=", lib), "."),
                   stdout = FALSE, stderr = FALSE)
 if (status != 0) stop("R CMD INSTALL failed")
 library(allanvar, lib.loc = lib)
