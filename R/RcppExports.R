@@ -41,3 +41,7 @@ allan_edf_cpp <- function(type, m, n, L, alpha, exact) {
     .Call(`_allanvar_allan_edf_cpp`, type, m, n, L, alpha, exact)
 }
 
+edf_interpolate_cpp <- function(m, sub, es, alpha) {
+    .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
+}
+

@@ -47,21 +47,9 @@ allan_edf <- function(type, m, n, L, alpha_int, sub = seq_along(m)) {
   if (length(sub) == length(m)) {
     return(list(edf = pmax(es, 1e-3), alpha = a))
   }
-  lm <- log(m)
-  ls <- lm[sub]
-  les <- log(es)
-  lo <- findInterval(lm, ls)  # m[1] is always in sub: lo >= 1
-  hi <- lo + (lo < length(sub))
-  w <- (lm - ls[lo]) / (ls[hi] - ls[lo])
-  w[hi == lo] <- 0
-  up <- w > 0.5
-  near <- lo
-  near[up] <- hi[up]
-  alpha <- a[near]
-  edf <- exp(les[lo] + w * (les[hi] - les[lo]))
-  jump <- a[lo] != a[hi]
-  edf[jump] <- es[near[jump]]
-  list(edf = pmax(edf, 1e-3), alpha = alpha)
+  # m[1] is always in sub, so every row has an evaluated row at or below it.
+  edf_interpolate_cpp(as.double(m), as.integer(sub), as.double(es),
+                      as.integer(a))
 }
 
 # EDF at the rows where it is evaluated directly (src/edf.cpp).

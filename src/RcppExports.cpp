@@ -142,6 +142,19 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// edf_interpolate_cpp
+Rcpp::List edf_interpolate_cpp(const Rcpp::NumericVector& m, const Rcpp::IntegerVector& sub, const Rcpp::NumericVector& es, const Rcpp::IntegerVector& alpha);
+RcppExport SEXP _allanvar_edf_interpolate_cpp(SEXP mSEXP, SEXP subSEXP, SEXP esSEXP, SEXP alphaSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type sub(subSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type es(esSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type alpha(alphaSEXP);
+    rcpp_result_gen = Rcpp::wrap(edf_interpolate_cpp(m, sub, es, alpha));
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 9},
@@ -154,6 +167,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
+    {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
     {NULL, NULL, 0}
 };
 

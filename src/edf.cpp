@@ -197,3 +197,37 @@ Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m,
   }
   return out;
 }
+
+// EDF and noise exponent for every row of a long curve from the rows `sub`
+// (1-based, increasing, sub[0] = 1) where they were evaluated: log-log
+// interpolation of the EDF between the neighbouring evaluated rows, the
+// nearer row's exponent, and no interpolation across a change of exponent.
+// One pass instead of a dozen R vectors of the curve's length.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List edf_interpolate_cpp(const Rcpp::NumericVector& m,
+                               const Rcpp::IntegerVector& sub,
+                               const Rcpp::NumericVector& es,
+                               const Rcpp::IntegerVector& alpha) {
+  const R_xlen_t k = m.size(), ns = sub.size();
+  std::vector<double> ls(ns), les(ns);
+  for (R_xlen_t j = 0; j < ns; ++j) {
+    ls[j] = std::log(m[sub[j] - 1]);
+    les[j] = std::log(es[j]);
+  }
+  Rcpp::NumericVector edf(k);
+  Rcpp::IntegerVector out_alpha(k);
+  R_xlen_t lo = 0;  // largest j with ls[j] <= log(m[i])
+  for (R_xlen_t i = 0; i < k; ++i) {
+    const double lm = std::log(m[i]);
+    while (lo + 1 < ns && ls[lo + 1] <= lm) ++lo;
+    const R_xlen_t hi = lo + 1 < ns ? lo + 1 : lo;
+    const double w = hi == lo ? 0.0 : (lm - ls[lo]) / (ls[hi] - ls[lo]);
+    const R_xlen_t near = w > 0.5 ? hi : lo;
+    out_alpha[i] = alpha[near];
+    double e = alpha[lo] != alpha[hi] ? es[near]
+                                      : std::exp(les[lo] + w * (les[hi] - les[lo]));
+    edf[i] = e > 1e-3 ? e : 1e-3;
+  }
+  return Rcpp::List::create(Rcpp::Named("edf") = edf,
+                            Rcpp::Named("alpha") = out_alpha);
+}
