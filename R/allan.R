@@ -223,7 +223,8 @@ allan_channels <- function(x, min_n) {
 print.allan <- function(x, digits = 4, ...) {
   cat(allan_header(x), "\n", sep = "")
   d <- as.data.frame(x)
-  num <- vapply(d, is.double, TRUE)
+  # n is a count: rounding it to `digits` would misstate it.
+  num <- vapply(d, is.double, TRUE) & names(d) != "n"
   d[num] <- lapply(d[num], signif, digits = digits)
   print(d, row.names = FALSE, ...)
   invisible(x)
@@ -267,7 +268,8 @@ print.summary.allan <- function(x, digits = 4, ...) {
   d <- x
   attr(d, "header") <- NULL
   class(d) <- "data.frame"
-  num <- vapply(d, is.double, TRUE)
+  # n is a count: rounding it to `digits` would misstate it.
+  num <- vapply(d, is.double, TRUE) & names(d) != "n"
   d[num] <- lapply(d[num], signif, digits = digits)
   print(d, row.names = FALSE, ...)
   invisible(x)
