@@ -167,17 +167,6 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
             input = input, N = N, conf = conf)
 }
 
-# One of `choices`, with a message naming the argument.
-check_choice <- function(x, choices, arg) {
-  if (!is.character(x) || length(x) != 1L || is.na(x) || !x %in% choices) {
-    abort("`", arg, "` must be one of ",
-          paste0("\"", choices, "\"", collapse = ", "), "; not ",
-          if (is.character(x) && length(x) == 1L) format_value(x) else describe_type(x),
-          ".")
-  }
-  x
-}
-
 # The samples as one double vector (columns stacked; no copy for a double
 # vector or matrix), with the number of rows and the channel names.
 allan_channels <- function(x, min_n) {

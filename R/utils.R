@@ -100,6 +100,17 @@ check_number <- function(x, arg, lo = -Inf, hi = Inf, open = FALSE,
   if (integer) as.integer(x) else as.double(x)
 }
 
+# One of `choices`, with a message naming the argument.
+check_choice <- function(x, choices, arg) {
+  if (!is.character(x) || length(x) != 1L || is.na(x) || !x %in% choices) {
+    abort("`", arg, "` must be one of ",
+          paste0("\"", choices, "\"", collapse = ", "), "; not ",
+          if (is.character(x) && length(x) == 1L) format_value(x) else describe_type(x),
+          ".")
+  }
+  x
+}
+
 # Threads the C++ kernels may use: option `allanvar.threads` (default 2).
 allanvar_threads <- function() {
   n <- getOption("allanvar.threads", 2L)

@@ -7,6 +7,7 @@
 // then exact in double, and lo (|lo| <= q/2) carries the rest. Differences of
 // huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
 // drift or length of the record.
+#include "checks.h"
 #include "parallel.h"
 #include <algorithm>
 #include <cmath>
@@ -608,12 +609,6 @@ struct Channel {
   R_xlen_t bad = 0;  // 1-based position of the first NA/NaN/Inf, or 0
 };
 
-R_xlen_t first_nonfinite(const double* v, R_xlen_t N) {
-  for (R_xlen_t i = 0; i < N; ++i)
-    if (!std::isfinite(v[i])) return i + 1;
-  return 0;
-}
-
 // One channel: sums of squares for every m, and the noise id per m.
 void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
                  const std::vector<R_xlen_t>& nterms,
@@ -632,7 +627,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     std::vector<Level> lev;
     standard_octave(v, N, v[0], J, lev, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
-      out.bad = first_nonfinite(v, N);
+      out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
     }
     for (size_t j = 0; j < nt; ++j) {
@@ -658,7 +653,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     z += v[i] * 0.0;
   }
   if (z != 0) {
-    out.bad = first_nonfinite(v, N);
+    out.bad = allanvar::first_nonfinite(v, N);
     return;
   }
   const double c = 0.5 * vmin + 0.5 * vmax;
