@@ -400,10 +400,10 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
               file = source, name = basename(source))
   class(rec) <- "imu_record"
   if (nrow(problems)) {
-    warning(source, ": ", nrow(problems), " problem(s) in the record:\n",
-            paste0("  - ", problems$type, ": ", problems$detail, " -> ",
-                   problems$action, collapse = "\n"),
-            call. = FALSE)
+    warn(source, ": ", nrow(problems), " problem(s) in the record:\n",
+         paste0("  - ", problems$type, ": ", problems$detail, " -> ",
+                problems$action, collapse = "\n"),
+         class = "record_problems")
   }
   rec
 }

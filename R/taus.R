@@ -73,10 +73,10 @@ allan_taus <- function(taus, freq, maxm) {
   m <- round(as.double(taus) * freq)
   bad <- m < 1 | m > maxm
   if (any(bad)) {
-    warning(sum(bad), " of the requested tau values lie outside [",
-            format(1 / freq), ", ", format(maxm / freq),
-            "] s (cluster sizes 1..", maxm, ") and were dropped.",
-            call. = FALSE)
+    warn(sum(bad), " of the requested tau values lie outside [",
+         format(1 / freq), ", ", format(maxm / freq),
+         "] s (cluster sizes 1..", maxm, ") and were dropped.",
+         class = "taus_dropped")
   }
   sort(unique(m[!bad]))
 }

@@ -26,7 +26,39 @@ format_value <- function(x) {
   format(x)
 }
 
-abort <- function(...) stop(paste0(...), call. = FALSE)
+# Conditions. Every error the package raises has class
+# c("allanvar_error_<class>", "allanvar_error", "error", "condition") and, as
+# its call, the user's call (the outermost call into the package), so that
+# callers can catch errors by kind and messages say where they came from.
+# The message is the pasted `...`, unchanged.
+abort <- function(..., class = NULL, call = user_call(), data = list()) {
+  cls <- c(if (length(class)) paste0("allanvar_error_", class), "allanvar_error",
+           "error", "condition")
+  stop(structure(c(list(message = paste0(...), call = call), data), class = cls))
+}
+
+# Warnings likewise: c("allanvar_warning_<class>", "allanvar_warning",
+# "warning", "condition").
+warn <- function(..., class = NULL, call = user_call(), data = list()) {
+  cls <- c(if (length(class)) paste0("allanvar_warning_", class),
+           "allanvar_warning", "warning", "condition")
+  warning(structure(c(list(message = paste0(...), call = call), data),
+                    class = cls))
+}
+
+# The user's call: the outermost frame running a function of this package
+# (the exported function or S3 method the user called), or NULL.
+user_call <- function() {
+  ns <- topenv(environment(user_call))
+  n <- sys.nframe() - 1L
+  for (i in seq_len(max(n, 0L))) {
+    e <- environment(sys.function(i))
+    if (!is.null(e) && identical(topenv(e), ns)) {
+      return(sys.call(i))
+    }
+  }
+  NULL
+}
 
 # `values`: a numeric vector (or ts, or a one-column matrix/data frame) of
 # finite numbers with at least `min_n` samples; returned as a plain double.
@@ -35,17 +67,20 @@ check_values <- function(values, min_n = 2L, arg = "values") {
     if (NCOL(values) != 1L) {
       abort("`", arg, "` must be a single series; got ", describe_type(values),
             " with ", NCOL(values), " columns. Pass one column at a time, ",
-            "or use allan() for several channels.")
+            "or use allan() for several channels.",
+          class = "argument")
     }
     values <- if (is.data.frame(values)) values[[1L]] else values[, 1L]
   }
   if (is.null(values) || is.factor(values) || is.list(values) ||
       !(is.double(values) || is.integer(values))) {
-    abort("`", arg, "` must be a numeric vector, not ", describe_type(values), ".")
+    abort("`", arg, "` must be a numeric vector, not ", describe_type(values), ".",
+          class = "argument")
   }
   n <- length(values)
   if (n < min_n) {
-    abort("`", arg, "` must have at least ", min_n, " samples, not ", n, ".")
+    abort("`", arg, "` must have at least ", min_n, " samples, not ", n, ".",
+          class = "argument")
   }
   values <- as.double(values)
   first <- first_nonfinite(values)
@@ -53,7 +88,8 @@ check_values <- function(values, min_n = 2L, arg = "values") {
     more <- sum(!is.finite(values)) - 1L
     abort("`", arg, "` must contain only finite numbers; found ",
           format(values[first]), " at position ", first,
-          if (more > 0L) paste0(" (and ", more, " more)"), ".")
+          if (more > 0L) paste0(" (and ", more, " more)"), ".",
+          class = "argument")
   }
   values
 }
@@ -64,7 +100,8 @@ check_freq <- function(freq, arg = "freq") {
       is.factor(freq) || length(freq) != 1L || is.na(freq) ||
       !is.finite(freq) || freq <= 0) {
     abort("`", arg, "` must be a single positive number (the sampling ",
-          "frequency in Hz), not ", describe_freq(freq), ".")
+          "frequency in Hz), not ", describe_freq(freq), ".",
+          class = "argument")
   }
   as.double(freq)
 }
@@ -79,7 +116,9 @@ describe_freq <- function(freq) {
 
 # Stop with a clear message when a required argument is missing.
 check_present <- function(missing, arg, what) {
-  if (missing) abort("`", arg, "` is missing; give ", what, ".")
+  if (missing) {
+    abort("`", arg, "` is missing; give ", what, ".", class = "missing_argument")
+  }
   invisible(TRUE)
 }
 
@@ -95,7 +134,8 @@ check_number <- function(x, arg, lo = -Inf, hi = Inf, open = FALSE,
       sprintf("in [%s, %s]", lo, hi)
     abort("`", arg, "` must be a single ", if (integer) "whole " else "",
           "number ", range, ", not ",
-          if (is.numeric(x) && !is.factor(x)) format_value(x) else describe_type(x), ".")
+          if (is.numeric(x) && !is.factor(x)) format_value(x) else describe_type(x), ".",
+          class = "argument")
   }
   if (integer) as.integer(x) else as.double(x)
 }
@@ -106,7 +146,8 @@ check_choice <- function(x, choices, arg) {
     abort("`", arg, "` must be one of ",
           paste0("\"", choices, "\"", collapse = ", "), "; not ",
           if (is.character(x) && length(x) == 1L) format_value(x) else describe_type(x),
-          ".")
+          ".",
+          class = "argument")
   }
   x
 }
