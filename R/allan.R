@@ -158,8 +158,9 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   octave <- type == "standard" && rate && length(m) <= 64L &&
     all(m == 2^round(log2(m)))
   sub <- allan_subset(m)
-  res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub],
-                        allan_opts(type, rate, octave))
+  res <- allan_call_kernel(allan_sums_cpp(ch$values, N, m, nterms, m[sub],
+                                          allan_opts(type, rate, octave)),
+                           N, ch$nc)
   if (any(res$bad > 0)) {
     col <- which(res$bad > 0)[1L]
     row <- res$bad[col]
@@ -187,6 +188,19 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   if (ch$nc > 1L) rownames(out) <- NULL
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf)
+}
+
+# Evaluates a kernel call; a C++ allocation failure (in any thread) becomes
+# a classed error that says what to do.
+allan_call_kernel <- function(expr, N, nc) {
+  tryCatch(expr, error = function(e) {
+    if (!identical(conditionMessage(e), "allanvar_out_of_memory")) stop(e)
+    abort("Not enough memory for ", nc, if (nc > 1L) " channels" else
+            " channel", " of ", format(N, big.mark = ","), " samples ",
+          "(about ", format(ceiling(24 * N * min(nc, allanvar_threads()) / 2^20)),
+          " MiB of work space); analyse fewer channels at once or a ",
+          "shorter record.", class = "memory")
+  })
 }
 
 # The samples as one double vector (columns stacked; no copy for a double

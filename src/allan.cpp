@@ -106,6 +106,9 @@ struct Split {
   Buffer hi, lo;
 };
 
+// Single passes over the samples ask for interrupts every 2^20 samples.
+const R_xlen_t kPoll = (static_cast<R_xlen_t>(1) << 20) - 1;
+
 // Grid step q = 2^k with bound <= 2^50 q.
 inline double grid_step(double bound) {
   if (!(bound > 0) || !std::isfinite(bound)) return 1.0;
@@ -136,6 +139,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     // result is bit-identical to the serial loop.
     auto run = [&](R_xlen_t i0, R_xlen_t i1, double& s1, double& e1, bool store) {
       for (R_xlen_t i = i0; i < i1; ++i) {
+        if ((i & kPoll) == kPoll && allanvar::interrupted()) return;
         double r, re, t, te;
         two_sum(v[i], -c, r, re);
         two_sum(s1, r, t, te);
@@ -165,6 +169,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c)
   double s1 = 0, e1 = 0, s2 = 0, e2 = 0;
   for (R_xlen_t i = 0; i < n; ++i) {
+    if ((i & kPoll) == kPoll && allanvar::interrupted()) return;
     double r, re, t, te;
     two_sum(v[i], -c, r, re);
     two_sum(s2, s1, t, te);
@@ -288,6 +293,8 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
     for (R_xlen_t b0 = c0; b0 < c1; b0 += kBlock) {
       const R_xlen_t b1 = std::min(c1, b0 + kBlock);
       for (size_t j = 0; j < nt; ++j) {
+        // a block of every tau of a long grid is seconds of work
+        if ((j & 63) == 63 && allanvar::interrupted()) return;
         const R_xlen_t e = std::min(b1, nterms[j]);
         if (e <= b0) continue;
         p[j] += sumsq1<D>(X.hi.data(), X.lo.data(), ms[j], b0, e);
@@ -368,8 +375,10 @@ void strided(const Split& X, const std::vector<R_xlen_t>& ms,
   const std::vector<size_t> cut = work_runs(nterms);
   run_items(static_cast<R_xlen_t>(cut.size() - 1), threads, main,
             [&](R_xlen_t r) {
-              for (size_t j = cut[r]; j < cut[r + 1]; ++j)
+              for (size_t j = cut[r]; j < cut[r + 1]; ++j) {
+                if (allanvar::interrupted()) return;
                 out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), ms[j], nterms[j]);
+              }
             });
 }
 
@@ -382,6 +391,7 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
   const double* h = X.hi.data();
   const double* l = X.lo.data();
   run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
+    if (allanvar::interrupted()) return;
     const R_xlen_t m = ms[j];
     // one term has at most 5 points, total weight 8: exact on the hi grid
     Acc a;
@@ -481,6 +491,7 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   std::vector<double> h(B), l(B);
   for (R_xlen_t k0 = s0; k0 < s1; k0 += B) {
+    if (((k0 / B) & 511) == 511 && allanvar::interrupted()) return;
     const R_xlen_t n = std::min(B, s1 - k0);
     for (R_xlen_t i = 0; i < n; ++i) two_sum(y[k0 + i], -c, h[i], l[i]);
     R_xlen_t cur = n;
@@ -506,8 +517,12 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
   const int P = (threads > 1 && nblocks >= 8) ? 2 : 1;
   const R_xlen_t cut[3] = {0, P == 2 ? (nblocks / 2) * B : N, N};
   std::vector<std::vector<Level> > part(P, std::vector<Level>(jin + 1));
-  for (int p = 0; p < P; ++p)
-    for (int j = 0; j <= jin; ++j) part[p][j].keep = keep[j];
+  for (int p = 0; p < P; ++p) {
+    for (int j = 0; j <= jin; ++j) {
+      part[p][j].keep = keep[j];
+      if (keep[j]) part[p][j].z.reserve((cut[p + 1] - cut[p]) >> j);
+    }
+  }
   std::vector<std::vector<double> > th(P), tl(P);
   run_items(P, threads, main, [&](R_xlen_t p) {
     octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p]);
@@ -562,10 +577,18 @@ inline void store_id(const allanvar::NoiseId& id, Channel& out, size_t j) {
 // (level 0: the samples themselves); R(n) from the running sum of v - c.
 void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<Level>& lev,
-                     const std::vector<R_xlen_t>& mid, int dmax,
-                     Channel& out) {
+                     const std::vector<R_xlen_t>& mid, int dmax, int threads,
+                     bool main, Channel& out) {
   allanvar::RnCache rn;
-  for (size_t j = 0; j < mid.size(); ++j) {
+  for (R_xlen_t m : mid) {
+    if (allanvar::needs_b1(N + 1, m, false)) {
+      rn.build_from_rate(v, N, c);
+      break;
+    }
+  }
+  // taus are independent: shared between the threads
+  run_items(static_cast<R_xlen_t>(mid.size()), threads, main, [&](R_xlen_t j) {
+    if (allanvar::interrupted()) return;
     const R_xlen_t m = mid[j];
     int lj = 0;
     while ((static_cast<R_xlen_t>(1) << lj) < m) ++lj;
@@ -575,21 +598,11 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     if (n >= allanvar::kAcfMinPoints) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
-      id = allanvar::b1_noise_id(z, n, false, m, dmax, [&]() {
-        if (rn.empty()) {
-          rn.init(N + 1);
-          long double x = 0;
-          rn.push(0.0);
-          for (R_xlen_t i = 0; i < N; ++i) {
-            x += v[i] - c;
-            rn.push(static_cast<double>(x));
-          }
-        }
-        return rn.ratio(m);
-      });
+      id = allanvar::b1_noise_id(z, n, false, m, dmax,
+                                 [&]() { return rn.ratio(m); });
     }
     store_id(id, out, j);
-  }
+  });
 }
 
 // One channel: sums of squares for every m, and the noise id per m.
@@ -627,7 +640,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
       out.sums[j] = lev[lj].acc.value();
     }
-    octave_noise_id(v, N, v[0], lev, mid, dmax, out);
+    octave_noise_id(v, N, v[0], lev, mid, dmax, threads, main, out);
     return;
   }
 
@@ -671,7 +684,15 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   };
   const R_xlen_t Lp = rate ? N + 1 : N;
   allanvar::RnCache rn;
-  for (size_t j = 0; j < ni; ++j) {
+  for (R_xlen_t m : mid) {
+    if (allanvar::needs_b1(Lp, m, !rate)) {
+      rn.build(phase, Lp);
+      break;
+    }
+  }
+  // taus are independent: shared between the threads
+  run_items(static_cast<R_xlen_t>(ni), threads, main, [&](R_xlen_t j) {
+    if (allanvar::interrupted()) return;
     const R_xlen_t m = mid[j];
     allanvar::NoiseId id;
     if (m == 1 && N >= allanvar::kAcfMinPoints) {
@@ -680,7 +701,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn);
     }
     store_id(id, out, j);
-  }
+  });
 }
 
 }  // namespace
@@ -695,6 +716,7 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
                           const Rcpp::NumericVector& mid,
                           const Rcpp::List& options) {
   const AllanOptions opts = allanvar::allan_options(options);
+  const allanvar::InterruptScope scope;
   const int threads = opts.threads;
   const R_xlen_t N = static_cast<R_xlen_t>(nrow);
   const R_xlen_t nc = x.size() / N;
@@ -706,15 +728,22 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
     nts[j] = static_cast<R_xlen_t>(nterms[j]);
   }
   for (size_t j = 0; j < ni; ++j) mids[j] = static_cast<R_xlen_t>(mid[j]);
-  std::vector<Channel> ch(nc);
+  std::vector<Channel> ch;
   const double* p = x.begin();
-  if (nc == 1) {
-    one_channel(p, N, ms, nts, mids, opts, threads, true, ch[0]);
-  } else {
-    allanvar::parallel_for(nc, threads, [&](R_xlen_t i, int) {
-      one_channel(p + i * N, N, ms, nts, mids, opts, 1, false, ch[i]);
-    });
+  try {
+    ch.resize(nc);
+    if (nc == 1) {
+      one_channel(p, N, ms, nts, mids, opts, threads, true, ch[0]);
+    } else {
+      allanvar::parallel_for(nc, threads, [&](R_xlen_t i, int) {
+        one_channel(p + i * N, N, ms, nts, mids, opts, 1, false, ch[i]);
+      });
+    }
+  } catch (const std::bad_alloc&) {
+    // R/allan.R turns this into a classed error
+    Rcpp::stop("allanvar_out_of_memory");
   }
+  scope.finish();
   Rcpp::NumericMatrix sums(nt, nc), alpha(ni, nc);
   Rcpp::IntegerMatrix alpha_int(ni, nc), id_method(ni, nc);
   for (R_xlen_t i = 0; i < nc; ++i) {

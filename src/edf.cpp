@@ -49,6 +49,24 @@ double sz(double t, double F, int alpha, int d) {
 double basic_sum(double J, double M, double S, double F, int alpha, int d) {
   const double z0 = sz(0, F, alpha, d), zJ = sz(J / S, F, alpha, d);
   double s = z0 * z0 + (1 - J / M) * zJ * zJ;
+  if (alpha == 2 && std::isfinite(F)) {
+    // White PM: sx(t) vanishes for |t| >= 1/F, so sz(j/S) is zero unless j
+    // lies within S/F of a multiple of S: O(d) terms instead of O(J) (J
+    // reaches N at long tau).
+    const double rad = S / F;
+    const double Jm = std::floor(J);
+    double next = 1;  // the first j not summed yet
+    for (double k = 0; k * S - rad < Jm; k += 1) {
+      const double lo = std::max(next, std::floor(k * S - rad));
+      const double hi = std::min(Jm - 1, std::ceil(k * S + rad));
+      for (double j = lo; j <= hi; j += 1) {
+        const double z = sz(j / S, F, alpha, d);
+        s += 2 * (1 - j / M) * z * z;
+      }
+      next = std::max(next, hi + 1);
+    }
+    return s;
+  }
   for (int j = 1; j < static_cast<int>(J); ++j) {
     const double z = sz(j / S, F, alpha, d);
     s += 2 * (1 - j / M) * z * z;

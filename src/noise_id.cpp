@@ -7,71 +7,15 @@
 
 namespace allanvar {
 
-namespace {
-
-// r1 and the step of Riley & Greenhall: delta = r1 / (1 + r1).
-double lag1_delta(const double* e, R_xlen_t n) {
-  long double mu = 0;
-  for (R_xlen_t i = 0; i < n; ++i) mu += e[i];
-  mu /= n;
-  long double a = 0, b = 0;
-  for (R_xlen_t i = 0; i < n; ++i) {
-    const long double d = e[i] - mu;
-    b += d * d;
-    if (i + 1 < n) a += d * (e[i + 1] - mu);
-  }
-  const double r1 = b > 0 ? static_cast<double>(a / b) : 0.0;
-  return r1 / (1.0 + r1);
-}
-
-}  // namespace
 
 // Least-squares polynomial (degree 1 for frequency, 2 for phase) removed
 // with the orthogonal polynomials of the equally spaced points
 // p1 = i - c, p2 = p1^2 - (n^2 - 1)/12; then the lag-1 ACF, differencing
-// while delta >= 0.25 and d < dmax (Riley & Greenhall 2004, eq. 2-4).
+// while delta >= 0.25 and d < dmax (Riley & Greenhall 2004, eq. 2-4). The
+// first step reads z twice and stores nothing (most records stop there);
+// differencing works on a copy of the residuals.
 NoiseId acf_noise_id(const double* z, R_xlen_t n, bool phase, int dmax) {
-  NoiseId out;
-  out.points = n;
-  if (n < 4) return out;
-  const int deg = phase ? 2 : 1;
-  const long double nn = static_cast<long double>(n);
-  const long double c = (nn - 1) / 2;
-  const long double q = (nn * nn - 1) / 12;
-  const double z0 = z[0];
-  long double s0 = 0, s1 = 0, s2 = 0;
-  for (R_xlen_t i = 0; i < n; ++i) {
-    const long double v = z[i] - z0;
-    const long double p1 = i - c;
-    s0 += v;
-    s1 += v * p1;
-    if (deg == 2) s2 += v * (p1 * p1 - q);
-  }
-  const long double a0 = s0 / nn;
-  const long double a1 = s1 / (nn * (nn * nn - 1) / 12);
-  const long double a2 =
-      deg == 2 ? s2 / (nn * (nn * nn - 1) * (nn * nn - 4) / 180) : 0;
-  std::vector<double> e(n);
-  for (R_xlen_t i = 0; i < n; ++i) {
-    const long double p1 = i - c;
-    e[i] = static_cast<double>((z[i] - z0) - a0 - a1 * p1 -
-                               a2 * (p1 * p1 - q));
-  }
-  int d = 0;
-  R_xlen_t len = n;
-  for (;;) {
-    const double rho = lag1_delta(e.data(), len);
-    if (rho < 0.25 || d >= dmax || len < 4) {
-      const double add = phase ? 2.0 : 0.0;
-      out.alpha = -2.0 * (rho + d) + add;
-      out.alpha_int = static_cast<int>(-std::nearbyint(2 * rho) - 2.0 * d + add);
-      out.method = NOISE_ID_ACF;
-      return out;
-    }
-    for (R_xlen_t i = 0; i + 1 < len; ++i) e[i] = e[i + 1] - e[i];
-    --len;
-    ++d;
-  }
+  return acf_noise_id_at([z](R_xlen_t i) { return z[i]; }, n, phase, dmax);
 }
 
 // Standard (N-sample) variance over the two-sample (Allan) variance of the
@@ -147,23 +91,58 @@ int rn_alpha(double rn, double m) {
   return alpha;
 }
 
+// From rate samples: X(k) = sum_{i<k} (v_i - c), L = N + 1. Per block of s
+// samples, X grows by sum w_t and P by s X + sum (s - 1 - t) w_t: two
+// independent sums instead of a running chain.
+void RnCache::build_from_rate(const double* v, R_xlen_t N, double c) {
+  init(N + 1);
+  double X = 0, P = 0;
+  R_xlen_t k = 0;
+  const double s = static_cast<double>(s_);
+  for (; k + s_ <= N + 1; k += s_) {
+    X_.push_back(X);
+    P_.push_back(P);
+    // block [k, k + s): x(k + t) = X + sum_{u < t} w_u, w_u = v[k + u] - c
+    const R_xlen_t len = std::min<R_xlen_t>(s_, N - k);
+    double sw0 = 0, sw1 = 0, sm0 = 0, sm1 = 0;
+    R_xlen_t t = 0;
+    for (; t + 2 <= len; t += 2) {
+      const double w0 = v[k + t] - c, w1 = v[k + t + 1] - c;
+      sw0 += w0;
+      sw1 += w1;
+      sm0 += (s - 1 - static_cast<double>(t)) * w0;
+      sm1 += (s - 2 - static_cast<double>(t)) * w1;
+    }
+    for (; t < len; ++t) {
+      const double w0 = v[k + t] - c;
+      sw0 += w0;
+      sm0 += (s - 1 - static_cast<double>(t)) * w0;
+    }
+    P += s * X + sm0 + sm1;
+    X += sw0 + sw1;
+  }
+  if (k == N + 1) P_.push_back(P);
+  k_ = L_;
+}
+
 double RnCache::ratio(R_xlen_t m) const {
   if (L_ - 1 < 4 * m) return NAN;
   const R_xlen_t ms = std::max<R_xlen_t>(1, (m + s_ / 2) / s_);
   const R_xlen_t nx = static_cast<R_xlen_t>(X_.size());
   const R_xlen_t np = static_cast<R_xlen_t>(P_.size());
-  long double sd = 0, st = 0;
+  double sd = 0, st = 0;
   R_xlen_t cnt = 0;
+  const double w = static_cast<double>(ms * s_);
   for (R_xlen_t j = 0; j + 2 * ms < nx && j + 3 * ms < np; ++j) {
-    const long double d = X_[j + 2 * ms] - 2 * X_[j + ms] + X_[j];
-    const long double t = (P_[j + 3 * ms] - 3 * P_[j + 2 * ms] +
-                           3 * P_[j + ms] - P_[j]) / (ms * s_);
+    const double d = X_[j + 2 * ms] - 2 * X_[j + ms] + X_[j];
+    const double t = (P_[j + 3 * ms] - 3 * P_[j + 2 * ms] +
+                      3 * P_[j + ms] - P_[j]) / w;
     sd += d * d;
     st += t * t;
     ++cnt;
   }
   if (cnt == 0 || !(sd > 0)) return NAN;
-  return static_cast<double>(st / sd);
+  return st / sd;
 }
 
 }  // namespace allanvar

@@ -49,6 +49,169 @@ const R_xlen_t kAcfMinPoints = 64;
 // frequency. dmax: most differences taken (2 for Allan, 3 for Hadamard).
 NoiseId acf_noise_id(const double* z, R_xlen_t n, bool phase, int dmax);
 
+namespace noise_id_detail {
+
+// delta = r1 / (1 + r1) of Riley & Greenhall from r1 = num / den.
+inline double delta_of(double num, double den) {
+  const double r1 = den > 0 ? num / den : 0.0;
+  return r1 / (1.0 + r1);
+}
+
+// delta of e[0..n) (two passes: mean, then lag-0 and lag-1 sums).
+inline double lag1_delta(const double* e, R_xlen_t n) {
+  double mu = 0;
+  for (R_xlen_t i = 0; i < n; ++i) mu += e[i];
+  mu /= static_cast<double>(n);
+  double a = 0, b = 0, prev = e[0] - mu;
+  b = prev * prev;
+  for (R_xlen_t i = 1; i < n; ++i) {
+    const double d = e[i] - mu;
+    b += d * d;
+    a += prev * d;
+    prev = d;
+  }
+  return delta_of(a, b);
+}
+
+}  // namespace noise_id_detail
+
+// Least-squares polynomial (degree 1 for frequency, 2 for phase) removed
+// with the orthogonal polynomials of the equally spaced points
+// p1 = i - c, p2 = p1^2 - (n^2 - 1)/12; then the lag-1 ACF, differencing
+// while delta >= 0.25 and d < dmax (Riley & Greenhall 2004, eq. 2-4). The
+// first step reads z(i) twice and stores nothing (most records stop
+// there); differencing works on a copy of the residuals.
+namespace noise_id_detail {
+
+// Sums of v = z - z0 against 1, p1, p2 (two interleaved chains each).
+template <bool QUAD, class Z>
+inline void fit_sums(const Z& z, R_xlen_t n, double c, double q, double* s) {
+  const double z0 = z(0);
+  double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
+  double p = -c;
+  R_xlen_t i = 0;
+  for (; i + 2 <= n; i += 2, p += 2) {
+    const double v = z(i) - z0, w = z(i + 1) - z0;
+    a0 += v;
+    b0 += w;
+    a1 += v * p;
+    b1 += w * (p + 1);
+    if (QUAD) {
+      a2 += v * (p * p - q);
+      b2 += w * ((p + 1) * (p + 1) - q);
+    }
+  }
+  for (; i < n; ++i, p += 1) {
+    const double v = z(i) - z0;
+    a0 += v;
+    a1 += v * p;
+    if (QUAD) a2 += v * (p * p - q);
+  }
+  s[0] = a0 + b0;
+  s[1] = a1 + b1;
+  s[2] = a2 + b2;
+}
+
+// Lag-0 and lag-1 sums of the residuals e_i = z_i - z0 - fit(p_i).
+template <bool QUAD, class Z>
+inline void resid_sums(const Z& z, R_xlen_t n, double c, double q,
+                const double* a, double* out) {
+  const double z0 = z(0);
+  auto e_at = [&](R_xlen_t i, double p) {
+    return (z(i) - z0) - a[0] - a[1] * p - (QUAD ? a[2] * (p * p - q) : 0.0);
+  };
+  double S1 = 0, S2 = 0, Sc = 0, T1 = 0, T2 = 0, Tc = 0;
+  double prev = e_at(0, -c);
+  const double e0 = prev;
+  S1 = prev;
+  S2 = prev * prev;
+  double p = 1 - c;
+  R_xlen_t i = 1;
+  for (; i + 2 <= n; i += 2, p += 2) {
+    const double e = e_at(i, p), f = e_at(i + 1, p + 1);
+    S1 += e;
+    T1 += f;
+    S2 += e * e;
+    T2 += f * f;
+    Sc += prev * e;
+    Tc += e * f;
+    prev = f;
+  }
+  for (; i < n; ++i, p += 1) {
+    const double e = e_at(i, p);
+    S1 += e;
+    S2 += e * e;
+    Sc += prev * e;
+    prev = e;
+  }
+  out[0] = S1 + T1;
+  out[1] = S2 + T2;
+  out[2] = Sc + Tc;
+  out[3] = e0;
+  out[4] = prev;
+}
+
+}  // namespace noise_id_detail
+
+template <class Z>
+NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
+  using namespace noise_id_detail;
+  NoiseId out;
+  out.points = n;
+  if (n < 4) return out;
+  const bool quad = phase;
+  const double nn = static_cast<double>(n);
+  const double c = (nn - 1) / 2;
+  const double q = (nn * nn - 1) / 12;
+  const double z0 = z(0);
+  double s[3];
+  if (quad) {
+    fit_sums<true>(z, n, c, q, s);
+  } else {
+    fit_sums<false>(z, n, c, q, s);
+  }
+  double a[3];
+  a[0] = s[0] / nn;
+  a[1] = s[1] / (nn * (nn * nn - 1) / 12);
+  a[2] = quad ? s[2] / (nn * (nn * nn - 1) * (nn * nn - 4) / 180) : 0;
+  double r[5];
+  if (quad) {
+    resid_sums<true>(z, n, c, q, a, r);
+  } else {
+    resid_sums<false>(z, n, c, q, a, r);
+  }
+  const double S1 = r[0], S2 = r[1], Sc = r[2], e0 = r[3], elast = r[4];
+  const double mu = S1 / nn;
+  const double num = Sc - mu * (2 * S1 - e0 - elast) + (nn - 1) * mu * mu;
+  const double den = S2 - nn * mu * mu;
+  double rho = delta_of(num, den);
+  int d = 0;
+  std::vector<double> e;
+  R_xlen_t len = n;
+  for (;;) {
+    if (rho < 0.25 || d >= dmax || len < 4) {
+      const double add = phase ? 2.0 : 0.0;
+      out.alpha = -2.0 * (rho + d) + add;
+      out.alpha_int = static_cast<int>(-std::nearbyint(2 * rho) - 2.0 * d + add);
+      out.method = NOISE_ID_ACF;
+      return out;
+    }
+    if (e.empty()) {
+      e.resize(n);
+      for (R_xlen_t i = 0; i < n; ++i) {
+        const double p = static_cast<double>(i) - c;
+        e[i] = (z(i) - z0) - a[0] - a[1] * p - a[2] * (p * p - q);
+      }
+    }
+    for (R_xlen_t i = 0; i + 1 < len; ++i) e[i] = e[i + 1] - e[i];
+    --len;
+    ++d;
+    rho = lag1_delta(e.data(), len);
+  }
+}
+
+
+
 // B1 ratio of the averaged frequencies ybar[0..n); rn() gives MVAR/AVAR at
 // m, called only when B1 points to white or flicker PM (NaN: unavailable).
 double b1_ratio(const double* ybar, R_xlen_t n);
@@ -66,7 +229,8 @@ class RnCache {
     L_ = L;
     s_ = L > 4096 ? L / 4096 : 1;
     k_ = 0;
-    sum_ = 0;
+    gap_ = 0;
+    sum_ = comp_ = 0;
     X_.clear();
     P_.clear();
     X_.reserve(L / s_ + 2);
@@ -75,21 +239,48 @@ class RnCache {
   bool empty() const { return X_.empty(); }
   // The phase at k = 0, 1, ..., L-1, in order.
   void push(double xk) {
-    if (k_ % s_ == 0) {
+    if (--gap_ <= 0) {
       X_.push_back(xk);
-      P_.push_back(sum_);
+      P_.push_back(sum_ + comp_);
+      gap_ = s_;
     }
-    sum_ += xk;
-    if (++k_ == L_ && L_ % s_ == 0) P_.push_back(sum_);
+    // compensated running sum (Kahan-Babuska)
+    const double t = sum_ + xk;
+    comp_ += std::fabs(sum_) >= std::fabs(xk) ? (sum_ - t) + xk : (xk - t) + sum_;
+    sum_ = t;
+    if (++k_ == L_ && L_ % s_ == 0) P_.push_back(sum_ + comp_);
   }
+  // The same from the phase x(k), k < L, in blocks of s points.
+  template <class X>
+  void build(const X& x, R_xlen_t L) {
+    init(L);
+    double P = 0;
+    R_xlen_t k = 0;
+    for (; k + s_ <= L; k += s_) {
+      X_.push_back(x(k));
+      P_.push_back(P);
+      double a = 0, b = 0;
+      R_xlen_t t = 0;
+      for (; t + 2 <= s_; t += 2) {
+        a += x(k + t);
+        b += x(k + t + 1);
+      }
+      if (t < s_) a += x(k + t);
+      P += a + b;
+    }
+    if (k == L) P_.push_back(P);
+    k_ = L_;
+  }
+  // The same from rate samples v[0..N) about c (phase L = N + 1 points).
+  void build_from_rate(const double* v, R_xlen_t N, double c);
   // MVAR/AVAR at (about) m; NaN when the record holds less than 4 m phase
   // points (the MVAR terms would all overlap: one effective sample).
   double ratio(R_xlen_t m) const;
 
  private:
-  R_xlen_t L_ = 0, s_ = 1, k_ = 0;
-  long double sum_ = 0;
-  std::vector<long double> X_, P_;
+  R_xlen_t L_ = 0, s_ = 1, k_ = 0, gap_ = 0;
+  double sum_ = 0, comp_ = 0;
+  std::vector<double> X_, P_;
 };
 
 // The decimated series for the ACF has this many points at m.
@@ -139,16 +330,20 @@ template <class X>
 NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
                        bool phase, RnCache& rn) {
   const R_xlen_t n = acf_points(L, m, phase);
+  if (n >= kAcfMinPoints) {
+    if (phase) {
+      return acf_noise_id_at([&](R_xlen_t i) { return x(i * m); }, n, true,
+                             dmax);
+    }
+    return acf_noise_id_at(
+        [&](R_xlen_t i) { return x((i + 1) * m) - x(i * m); }, n, false, dmax);
+  }
   std::vector<double> z(n > 0 ? n : 0);
   for (R_xlen_t i = 0; i < n; ++i) {
     z[i] = phase ? x(i * m) : x((i + 1) * m) - x(i * m);
   }
-  if (n >= kAcfMinPoints) return acf_noise_id(z.data(), n, phase, dmax);
   return b1_noise_id(z.data(), n, phase, m, dmax, [&]() {
-    if (rn.empty()) {
-      rn.init(L);
-      for (R_xlen_t k = 0; k < L; ++k) rn.push(x(k));
-    }
+    if (rn.empty()) rn.build(x, L);  // build it beforehand to share it
     return rn.ratio(m);
   });
 }
