@@ -251,3 +251,102 @@ test_that("the thread count changes nothing but the last bits", {
     expect_equal(a2$avar, a1$avar, tolerance = 1e-14, info = type)
   }
 })
+
+# ---- interrupts and memory errors, in child R processes ----
+
+# Child processes and memory limits: run by tools/test.sh (CI), not under
+# R CMD check.
+skip_in_check <- function() {
+  if (nzchar(Sys.getenv("_R_CHECK_PACKAGE_NAME_"))) skip("under R CMD check")
+}
+
+# The library holding the installed allanvar (the one these tests run
+# against), or a skip when the package is only loaded from source.
+installed_lib <- function() {
+  path <- tryCatch(find.package("allanvar"), error = function(e) "")
+  if (!nzchar(path) || !dir.exists(file.path(path, "Meta"))) {
+    skip("allanvar is not installed (loaded from source)")
+  }
+  dirname(path)
+}
+
+# Starts `run` in a child R process after `setup`, sends SIGINT `wait`
+# seconds after the child reports that setup is done, and returns the
+# seconds from the signal to the child catching the interrupt.
+interrupt_delay <- function(setup, run, wait = 2) {
+  skip_if_not_installed("callr")
+  lib <- installed_lib()
+  ready <- tempfile()
+  done <- tempfile()
+  on.exit(unlink(c(ready, done)), add = TRUE)
+  p <- callr::r_bg(function(setup, run, ready, done, lib) {
+    library(allanvar, lib.loc = lib)
+    options(allanvar.threads = 2L)
+    set.seed(1)
+    env <- new.env()
+    eval(parse(text = setup), env)
+    writeLines("ready", ready)
+    t <- tryCatch({
+      eval(parse(text = run), env)
+      NA_real_
+    }, interrupt = function(e) as.numeric(Sys.time()))
+    writeLines(format(t, digits = 16), done)
+  }, args = list(setup = setup, run = run, ready = ready, done = done,
+                 lib = lib))
+  on.exit(p$kill(), add = TRUE)
+  deadline <- Sys.time() + 120
+  while (!file.exists(ready) && p$is_alive() && Sys.time() < deadline) {
+    Sys.sleep(0.05)
+  }
+  expect_true(file.exists(ready))
+  Sys.sleep(wait)
+  sent <- as.numeric(Sys.time())
+  p$interrupt()
+  p$wait(60000)
+  expect_true(file.exists(done))
+  as.numeric(readLines(done)) - sent
+}
+
+test_that("Ctrl-C stops a long allan() within a second", {
+  skip_in_check()
+  # before: 460 s for the first, 11.6 s for two channels (issue 12)
+  d <- interrupt_delay("x <- rnorm(1e7)",
+                       "allan(x, 100, taus = 'all', type = 'overlapping')")
+  expect_false(is.na(d))  # interrupted, not finished
+  expect_lt(d, 1)
+  d <- interrupt_delay("x <- matrix(rnorm(6e5), ncol = 2)",
+                       "allan(x, 100, taus = 'all', type = 'overlapping')")
+  expect_false(is.na(d))
+  expect_lt(d, 1)
+  d <- interrupt_delay("x <- matrix(rnorm(6e5), ncol = 2)",
+                       "allan(x, 100, taus = 'all', type = 'total')")
+  expect_false(is.na(d))
+  expect_lt(d, 1)
+})
+
+test_that("running out of memory in a worker thread is an R error, and R goes on", {
+  skip_in_check()
+  skip_on_os(c("windows", "mac"))
+  lib <- installed_lib()
+  script <- tempfile(fileext = ".R")
+  on.exit(unlink(script), add = TRUE)
+  writeLines(c(
+    sprintf("library(allanvar, lib.loc = '%s')", lib),
+    "options(allanvar.threads = 2L)",
+    "x <- tryCatch(matrix(rnorm(2e7), ncol = 2), error = function(e) NULL)",
+    "if (is.null(x)) { cat('no-data\\n'); quit(status = 0) }",
+    "r <- tryCatch(allan(x, 1, type = 'modified'), error = function(e) e)",
+    "cat(class(r)[1], '\\n')",
+    "cat('alive', sum(1:10), '\\n')"), script)
+  rscript <- file.path(R.home("bin"), "Rscript")
+  # 700 MB of address space: room for R and the data, not for the work
+  # space of two channels at once
+  out <- suppressWarnings(system2("bash", c("-c", shQuote(sprintf(
+    "ulimit -v 700000; '%s' --vanilla '%s' 2>&1", rscript, script))),
+    stdout = TRUE))
+  if (any(grepl("no-data", out))) skip("the memory limit left no room for the data")
+  if (any(grepl("^allan ", out))) skip("the limit left enough memory to finish")
+  expect_true(any(grepl("allanvar_error_memory", out)), info = paste(out, collapse = "\n"))
+  expect_true(any(grepl("alive 55", out)), info = paste(out, collapse = "\n"))
+  expect_null(attr(out, "status"))  # exit status 0: R was not aborted
+})
