@@ -170,10 +170,36 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   }
   norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
                  2 * m^2)
-  scale <- if (rate) 1 else freq^2
+  # Sums that overflowed (or underflowed) in a channel of huge (tiny) but
+  # finite numbers: that channel again on x 2^-e (exact), scaled back.
+  sc <- rep(0, ch$nc)
+  for (j in seq_len(ch$nc)) {
+    sj <- res$sums[, j]
+    if (all(is.finite(sj)) && !any(sj < 2^-900)) next
+    xj <- if (ch$nc == 1L) ch$values else ch$values[(j - 1) * N + seq_len(N)]
+    e <- range_exponent(xj)
+    # zero sums of a constant channel are right as they are
+    if (e == 0 || (all(sj == 0) && diff(range(xj)) == 0)) next
+    rj <- allan_call_kernel(allan_sums_cpp(times_pow2(as.double(xj), -e), N,
+                                           m, nterms, m[sub],
+                                           allan_opts(type, rate, octave)),
+                            N, 1L)
+    res$sums[, j] <- rj$sums[, 1L]
+    res$alpha_int[, j] <- rj$alpha_int[, 1L]
+    sc[j] <- e
+  }
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {
-    av <- res$sums[, j] / (norm * nterms) * scale
+    av <- res$sums[, j] / (norm * nterms)
+    if (!rate && sc[j] == 0) {
+      av <- times_freq2(av, freq)
+    } else if (sc[j] != 0) {
+      # one product of powers of two: 2^2e and freq^2 = a^2 2^2b
+      b <- if (rate) 0 else floor(log2(freq))
+      a <- if (rate) 1 else freq / 2^b
+      av <- times_pow2(av * a * a, 2 * sc[j] + 2 * b)
+    }
+    check_representable(av, nonzero = res$sums[, j] > 0)
     e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
     ci <- allan_ci(av, e$edf, conf)
     d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
@@ -188,6 +214,60 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   if (ch$nc > 1L) rownames(out) <- NULL
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf)
+}
+
+# ---- range: series near 1e300 or 1e-300, sampling rates near 1e300 ----
+# A power of two scales exactly, so a kernel run on x * 2^-e gives the
+# variance of x times 2^-2e with every bit kept; results are scaled back
+# with times_pow2() and must be representable doubles.
+
+# v * 2^e without an intermediate overflow (2^e alone may not exist).
+times_pow2 <- function(v, e) {
+  while (any(e > 1000)) {
+    k <- e > 1000
+    v[k] <- v[k] * 2^1000
+    e[k] <- e[k] - 1000
+  }
+  while (any(e < -1000)) {
+    k <- e < -1000
+    v[k] <- v[k] * 2^-1000
+    e[k] <- e[k] + 1000
+  }
+  v * 2^e
+}
+
+# v * f^2 for a sampling rate f that may be near the double range.
+times_freq2 <- function(v, f) {
+  if (is.finite(f^2) && f^2 > 0) return(v * f^2)
+  b <- floor(log2(f))
+  a <- f / 2^b
+  times_pow2(v * a * a, 2 * b)
+}
+
+# The exponent e with max |x| = m 2^e, m in [0.5, 1), of the finite values.
+range_exponent <- function(x) {
+  mx <- max(abs(x[is.finite(x)]), 0)
+  if (mx == 0) return(0)
+  floor(log2(mx)) + 1
+}
+
+# Stops when variances cannot be represented (ADEV beyond 1.3e154, or a
+# non-zero variance below the smallest double); `nonzero`: where the
+# variance is known to be positive.
+check_representable <- function(av, nonzero = FALSE, what = "`x`") {
+  if (any(!is.finite(av))) {
+    abort("The variance of ", what, " exceeds the largest double (",
+          format(.Machine$double.xmax, digits = 3), "); divide the data by ",
+          "a power of ten (e.g. x / 1e150) and scale the result back.",
+          class = "overflow")
+  }
+  if (any(nonzero & av < .Machine$double.xmin)) {
+    abort("The variance of ", what, " is below the smallest double (",
+          format(.Machine$double.xmin, digits = 3), "); multiply the data ",
+          "by a power of ten (e.g. x * 1e150) and scale the result back.",
+          class = "underflow")
+  }
+  av
 }
 
 # Evaluates a kernel call; a C++ allocation failure (in any thread) becomes

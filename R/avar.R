@@ -43,5 +43,23 @@ avar <- function(values, freq) {
   check_present(missing(freq), "freq", "the sampling frequency in Hz")
   values <- check_values(values, min_n = 2L)
   freq <- check_freq(freq)
-  avar_octave_exact(values, freq, allanvar_threads())
+  compat_range(avar_octave_exact(values, freq, allanvar_threads()), values,
+               freq, function(v, f) avar_octave_exact(v, f, allanvar_threads()))
+}
+
+# allanvar 1.1's arithmetic as it is, unless it overflows (values near
+# 1e300, or integrated input at a huge rate): then the same arithmetic on
+# values * 2^-e at 1 Hz (exact: a power of two), scaled back by
+# 2^2e freq^2 (freq^2 only for integrated input, where tau enters the
+# variance). Inputs that 1.1 handles finitely keep its bits; a variance
+# beyond the double range is a classed error.
+compat_range <- function(res, values, freq, kernel, integrated = FALSE) {
+  if (all(is.finite(res$av))) return(res)
+  e <- range_exponent(values)
+  r <- kernel(times_pow2(values, -e), 1)
+  b <- if (integrated) floor(log2(freq)) else 0
+  a <- if (integrated) freq / 2^b else 1
+  res$av <- check_representable(times_pow2(r$av * a * a, 2 * e + 2 * b),
+                                 what = "`values`")
+  res
 }

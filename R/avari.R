@@ -26,5 +26,6 @@ avari <- function(values, freq) {
   check_present(missing(freq), "freq", "the sampling frequency in Hz")
   values <- check_values(values, min_n = 4L)
   freq <- check_freq(freq)
-  avari_octave_exact(values, freq)
+  compat_range(avari_octave_exact(values, freq), values, freq,
+               avari_octave_exact, integrated = TRUE)
 }

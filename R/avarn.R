@@ -32,10 +32,12 @@ avarn <- function(values, freq, exact = TRUE) {
   if (!is.logical(exact) || length(exact) != 1L || is.na(exact)) {
     abort("`exact` must be TRUE or FALSE, not ", describe_type(exact), ".")
   }
-  if (exact) {
-    return(avarn_all_exact(values, freq, allanvar_threads()))
+  kernel <- if (exact) {
+    function(v, f) avarn_all_exact(v, f, allanvar_threads())
+  } else {
+    avarn_fast
   }
-  avarn_fast(values, freq)
+  compat_range(kernel(values, freq), values, freq, kernel)
 }
 
 # The O(N log N) path for avarn(exact = FALSE): allan()'s non-overlapping

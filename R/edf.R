@@ -82,5 +82,6 @@ allan_ci <- function(avar, edf, conf) {
     hi <- exp(stats::splinefun(lg, log(g / stats::qchisq(p, g)),
                                method = "fmm")(le))
   }
-  list(lower = sqrt(avar * lo), upper = sqrt(avar * hi))
+  # sqrt of each factor: avar * hi may overflow where the limit does not
+  list(lower = sqrt(avar) * sqrt(lo), upper = sqrt(avar) * sqrt(hi))
 }

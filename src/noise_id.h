@@ -189,6 +189,7 @@ NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
   std::vector<double> e;
   R_xlen_t len = n;
   for (;;) {
+    if (!std::isfinite(rho)) return out;  // sums beyond the double range
     if (rho < 0.25 || d >= dmax || len < 4) {
       const double add = phase ? 2.0 : 0.0;
       out.alpha = -2.0 * (rho + d) + add;

@@ -350,3 +350,28 @@ test_that("running out of memory in a worker thread is an R error, and R goes on
   expect_true(any(grepl("alive 55", out)), info = paste(out, collapse = "\n"))
   expect_null(attr(out, "status"))  # exit status 0: R was not aborted
 })
+
+test_that("huge and tiny series: exact results by power-of-two scaling, or a classed error", {
+  set.seed(14)
+  z <- rnorm(5000)
+  for (type in allan_types) {
+    ref <- allan(z, 1, type = type)
+    # 2^510: the squared differences overflow unless the kernel scales
+    big <- allan(z * 2^510, 1, type = type)
+    expect_equal(big$avar, ref$avar * 2^1020, tolerance = 1e-13, info = type)
+    expect_true(all(is.finite(big$upper)), info = type)
+    expect_equal(big$edf, ref$edf, info = type)
+  }
+  # integrated input at 1e300 Hz: phase 1e-290 s, AV about 1e20
+  w <- cumsum(z)
+  a <- allan(w * 1e-290, 1e300, input = "integrated")
+  b <- allan(w, 1e10, input = "integrated")
+  expect_equal(a$avar, b$avar, tolerance = 1e-13)
+  # variances beyond the double range are refused, not returned as Inf or 0
+  expect_error(allan(z * 1e200, 1), class = "allanvar_error_overflow")
+  expect_error(allan(z * 1e-300, 1), class = "allanvar_error_underflow")
+  expect_error(allan(w, 1e300, input = "integrated"),
+               class = "allanvar_error_overflow")
+  # a constant series near the top of the range has variance 0
+  expect_equal(allan(rep(1e300, 100), 1)$avar, rep(0, 6))
+})

@@ -109,3 +109,18 @@ test_that("avar() rejects bad freq with a message naming `freq`", {
 test_that("avar() does not print", {
   expect_silent(avar(rnorm(100), 1))
 })
+
+test_that("avar/avari/avarn: values near 1e300 scale exactly, 1.1's bits otherwise", {
+  set.seed(15)
+  z <- rnorm(4096)
+  a <- avar(z * 2^510, 1)
+  expect_true(all(is.finite(a$av)))
+  expect_equal(a$av, avar(z, 1)$av * 2^1020, tolerance = 1e-14)
+  expect_equal(a$time, avar(z, 1)$time)
+  a <- avari(cumsum(z) * 2^-500, 2^500)
+  expect_equal(a$av, avari(cumsum(z), 1)$av, tolerance = 1e-14)
+  a <- avarn(z[1:300] * 2^510, 1)
+  expect_equal(a$av, avarn(z[1:300], 1)$av * 2^1020, tolerance = 1e-14)
+  expect_error(avar(z * 1e300, 1), class = "allanvar_error_overflow")
+  expect_error(avari(cumsum(z), 1e300), class = "allanvar_error_overflow")
+})
