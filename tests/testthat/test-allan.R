@@ -327,6 +327,7 @@ test_that("Ctrl-C stops a long allan() within a second", {
 test_that("running out of memory in a worker thread is an R error, and R goes on", {
   skip_in_check()
   skip_on_os(c("windows", "mac"))
+  if (nzchar(Sys.getenv("ALLANVAR_SANITIZE"))) skip("ASan: no ulimit -v")
   lib <- installed_lib()
   script <- tempfile(fileext = ".R")
   on.exit(unlink(script), add = TRUE)
