@@ -9,6 +9,10 @@ allan_reference_cpp <- function(v, m, type, rate) {
     .Call(`_allanvar_allan_reference_cpp`, v, m, type, rate)
 }
 
+allan_gap_sums_cpp <- function(x, m, options) {
+    .Call(`_allanvar_allan_gap_sums_cpp`, x, m, options)
+}
+
 avar_octave_exact <- function(values, freq, threads) {
     .Call(`_allanvar_avar_octave_exact`, values, freq, threads)
 }

@@ -77,6 +77,22 @@
 #' every \eqn{m \le 64} and 40 taus per decade above; the other rows take
 #' the type of the nearest such tau and a log-log interpolation of its EDF.
 #'
+#' @section Gaps:
+#' With `gaps = "skip"`, a term is kept only when every value it is made of
+#' is present: for rate input the samples it spans (\eqn{[k, k+2m)} for the
+#' Allan types, \eqn{[k, k+3m)} for Hadamard, \eqn{[k, k+3m-1)} for the
+#' modified type: the frequency-to-phase conversion never integrates across
+#' a gap); for integrated input the phase points it uses (\eqn{x_k, x_{k+m},
+#' x_{k+2m}}, and \eqn{x_{k+3m}} for Hadamard; all of \eqn{x_k \dots
+#' x_{k+3m-1}} for the modified type). The variance is the mean square of
+#' the kept terms, `n` counts them, and the attribute `missing` gives the
+#' number of missing values per channel (print shows the total). Cluster
+#' sizes with no complete term are left out with a warning. The noise type
+#' is identified on the longest run without a gap (`NA` where that run is
+#' too short), and the EDF uses the kept terms and the present points. The
+#' total type is not defined with gaps (its reflection would carry a gap to
+#' the far end) and is refused.
+#'
 #' @section Methods:
 #' `print()` shows a header line and the table (`digits`, default 4);
 #' `summary()` gives, per channel, the tau range and the minimum ADEV with
@@ -113,6 +129,10 @@
 #' @param input `"rate"` (default) or `"integrated"`.
 #' @param conf Confidence level of the interval, in (0, 1); the default
 #'   0.683 is one sigma.
+#' @param gaps What NA/NaN in `x` mean: `"error"` (the default, as before)
+#'   or `"skip"`: they are missing samples (or phase points), and every term
+#'   that touches one is left out, as Stable32 and allantools' `gradev` do
+#'   (see the section Gaps). `Inf` is always an error.
 #' @return A data frame of class `c("allan", "data.frame")` with columns
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
 #'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
@@ -131,7 +151,7 @@
 #' plot(av)
 #' allan(cbind(x = y, z = 2 * y), type = "modified", taus = "decade")
 allan <- function(x, freq, taus = "octave", type = "overlapping",
-                  input = "rate", conf = 0.683) {
+                  input = "rate", conf = 0.683, gaps = "error") {
   check_present(missing(x), "x", "the samples")
   if (missing(freq)) {
     if (!stats::is.ts(x)) {
@@ -144,6 +164,7 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   type <- check_choice(type, allan_types, "type")
   input <- check_choice(input, c("rate", "integrated"), "input")
   conf <- check_number(conf, "conf", 0, 1, open = TRUE)
+  gaps <- check_choice(gaps, c("error", "skip"), "gaps")
   ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)
   N <- ch$N
   rate <- input == "rate"
@@ -155,6 +176,9 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
           "\" with ", N, " samples (largest cluster size: ", maxm, ").")
   }
   nterms <- allan_nterms(type, m, L)
+  if (gaps == "skip" && anyNA(ch$values)) {
+    return(allan_gaps(ch, freq, m, type, input, conf))
+  }
   octave <- type == "standard" && rate && length(m) <= 64L &&
     all(m == 2^round(log2(m)))
   sub <- allan_subset(m)
@@ -164,9 +188,12 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   if (any(res$bad > 0)) {
     col <- which(res$bad > 0)[1L]
     row <- res$bad[col]
-    abort("`x` must contain only finite numbers; found ",
-          format(ch$values[[(col - 1) * N + row]]), " at position ", row,
-          if (ch$nc > 1L) paste0(" of column ", col), ".")
+    bad <- ch$values[[(col - 1) * N + row]]
+    abort("`x` must contain only finite numbers; found ", format(bad),
+          " at position ", row, if (ch$nc > 1L) paste0(" of column ", col),
+          if (is.na(bad)) paste0(" (gaps = \"skip\" skips the terms that ",
+                                 "touch missing values)"), ".",
+          class = "values")
   }
   norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
                  2 * m^2)
@@ -214,6 +241,86 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   if (ch$nc > 1L) rownames(out) <- NULL
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf)
+}
+
+# ---- gaps: allan(gaps = "skip") ----
+# NA/NaN are missing samples (rate) or phase points (integrated). A term is
+# kept only when every value it is made of is present (src/allan.cpp,
+# allan_gap_sums_cpp); `n` counts the kept terms. The noise type comes from
+# the longest run without a gap; the EDF from the kept terms and the
+# present points. Inf stays an error; the total type is not defined.
+allan_gaps <- function(ch, freq, m, type, input, conf) {
+  N <- ch$N
+  rate <- input == "rate"
+  L <- if (rate) N + 1 else N
+  if (type == "total") {
+    abort("`gaps = \"skip\"` is not defined for type \"total\" (its ",
+          "reflected extension would carry a gap to the far end); use ",
+          "\"overlapping\" or fill the gaps.", class = "gaps")
+  }
+  inf <- which(is.infinite(ch$values))
+  if (length(inf)) {
+    col <- (inf[1] - 1L) %/% N + 1L
+    abort("`x` must contain only finite numbers or NA; found ",
+          format(ch$values[[inf[1]]]), " at position ", (inf[1] - 1L) %% N + 1L,
+          if (ch$nc > 1L) paste0(" of column ", col), ".", class = "values")
+  }
+  norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
+                 2 * m^2)
+  opts <- allan_opts(type, rate, FALSE)
+  out <- vector("list", ch$nc)
+  missing <- integer(ch$nc)
+  dropped <- NULL
+  for (j in seq_len(ch$nc)) {
+    xj <- as.double(if (ch$nc == 1L) ch$values else
+      ch$values[(j - 1) * N + seq_len(N)])
+    miss <- is.na(xj)
+    missing[j] <- sum(miss)
+    g <- allan_call_kernel(allan_gap_sums_cpp(xj, m, opts), N, 1L)
+    keep <- g$n > 0
+    if (!all(keep)) dropped <- c(dropped, m[!keep])
+    mj <- m[keep]
+    nj <- g$n[keep]
+    av <- g$sums[keep] / (norm[keep] * nj)
+    if (!rate) av <- times_freq2(av, freq)
+    check_representable(av, nonzero = g$sums[keep] > 0)
+    # noise type from the longest run without a gap
+    r <- rle(!miss)
+    end <- cumsum(r$lengths)
+    best <- which.max(ifelse(r$values, r$lengths, -1L))
+    run <- seq.int(end[best] - r$lengths[best] + 1L, end[best])
+    alpha <- rep(NA_integer_, length(mj))
+    if (r$values[best] && length(run) >= (if (rate) 2L else 3L)) {
+      Lr <- if (rate) length(run) + 1 else length(run)
+      ok <- mj <= allan_max_m(type, Lr)
+      if (any(ok)) {
+        rr <- allan_call_kernel(allan_sums_cpp(
+          xj[run], length(run), mj[ok], allan_nterms(type, mj[ok], Lr),
+          mj[ok], opts), length(run), 1L)
+        alpha[ok] <- rr$alpha_int[, 1L]
+      }
+    }
+    e <- allan_edf(type, mj, nj, L - missing[j], alpha)
+    ci <- allan_ci(av, e$edf, conf)
+    d <- list(tau = mj / freq, m = as.integer(mj), n = nj, avar = av,
+              adev = sqrt(av), lower = ci$lower, upper = ci$upper,
+              edf = e$edf)
+    if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(mj))
+    d$alpha <- e$alpha
+    out[[j]] <- structure(d, class = "data.frame",
+                          row.names = .set_row_names(length(mj)))
+  }
+  if (length(dropped)) {
+    warn("No complete term at cluster size(s) ",
+         paste(sort(unique(dropped)), collapse = ", "),
+         " (every term touches a gap); those rows are left out.",
+         class = "gaps")
+  }
+  out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)
+  if (ch$nc > 1L) rownames(out) <- NULL
+  names(missing) <- ch$names
+  structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
+            input = input, N = N, conf = conf, missing = missing)
 }
 
 # ---- range: series near 1e300 or 1e-300, sampling rates near 1e300 ----
@@ -338,9 +445,12 @@ print.allan <- function(x, digits = 4, ...) {
 allan_header <- function(x) {
   a <- attributes(x)
   nch <- if ("channel" %in% names(x)) length(unique(x$channel)) else 1L
-  sprintf("<allan> %s variance of %s input: N = %s at %s Hz%s; %s%% intervals",
+  sprintf("<allan> %s variance of %s input: N = %s at %s Hz%s%s; %s%% intervals",
           a$type, a$input, format(a$N, big.mark = ","), format(a$freq),
           if (nch > 1L) sprintf(", %d channels", nch) else "",
+          if (!is.null(a$missing)) sprintf(" (%s missing)",
+                                           format(sum(a$missing), big.mark = ","))
+          else "",
           format(100 * a$conf))
 }
 

@@ -39,6 +39,18 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// allan_gap_sums_cpp
+Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x, const Rcpp::NumericVector& m, const Rcpp::List& options);
+RcppExport SEXP _allanvar_allan_gap_sums_cpp(SEXP xSEXP, SEXP mSEXP, SEXP optionsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type options(optionsSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_gap_sums_cpp(x, m, options));
+    return rcpp_result_gen;
+END_RCPP
+}
 // avar_octave_exact
 Rcpp::DataFrame avar_octave_exact(const Rcpp::NumericVector& values, double freq, int threads);
 RcppExport SEXP _allanvar_avar_octave_exact(SEXP valuesSEXP, SEXP freqSEXP, SEXP threadsSEXP) {
@@ -165,6 +177,7 @@ END_RCPP
 static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 6},
     {"_allanvar_allan_reference_cpp", (DL_FUNC) &_allanvar_allan_reference_cpp, 4},
+    {"_allanvar_allan_gap_sums_cpp", (DL_FUNC) &_allanvar_allan_gap_sums_cpp, 3},
     {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 3},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
     {"_allanvar_avarn_all_exact", (DL_FUNC) &_allanvar_avarn_all_exact, 3},

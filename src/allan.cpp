@@ -849,3 +849,100 @@ Rcpp::List allan_reference_cpp(const Rcpp::NumericVector& v,
   return Rcpp::List::create(Rcpp::Named("sums") = out, Rcpp::Named("n") = cnt,
                             Rcpp::Named("quad") = kRefQuad);
 }
+
+// ---- data with gaps (allan(gaps = "skip")) ----
+//
+// A term is kept only when every sample (rate input) or phase point
+// (integrated input) it is made of is present; the variance is the mean
+// square of the kept terms, and their count is returned. Rate input: the
+// term at k uses the samples [k, k + 2m) (Allan), [k, k + 3m) (Hadamard) or
+// [k, k + 3m - 1) (modified); integrated input: the points k, k + m,
+// k + 2m (and k + 3m for Hadamard), or all of [k, k + 3m) (modified).
+// Missing values enter the prefix sums as 0: a kept term never spans one.
+// The total variance is not defined here (its reflected extension would
+// carry a gap to the far end) and is refused by R/allan.R.
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
+                              const Rcpp::NumericVector& m,
+                              const Rcpp::List& options) {
+  const AllanOptions opts = allanvar::allan_options(options);
+  if (opts.type == TOTAL) Rcpp::stop("internal: no gap kernel for total");
+  const allanvar::InterruptScope scope;
+  const R_xlen_t N = x.size();
+  const bool rate = opts.rate;
+  const int type = opts.type;
+  // missing flags' prefix count over the input values
+  std::vector<R_xlen_t> G(N + 1, 0);
+  std::vector<double> v(N);
+  double vmin = R_PosInf, vmax = R_NegInf;
+  for (R_xlen_t i = 0; i < N; ++i) {
+    const bool miss = std::isnan(x[i]);
+    G[i + 1] = G[i] + (miss ? 1 : 0);
+    v[i] = miss ? 0.0 : x[i];
+    if (!miss) {
+      vmin = std::min(vmin, x[i]);
+      vmax = std::max(vmax, x[i]);
+    }
+  }
+  const R_xlen_t nm = m.size();
+  Rcpp::NumericVector sums(nm), counts(nm);
+  if (!(vmax >= vmin)) return Rcpp::List::create(Rcpp::Named("sums") = sums,
+                                                 Rcpp::Named("n") = counts);
+  const double c = 0.5 * vmin + 0.5 * vmax;
+  // missing values sit at the centre: 0 after centring
+  for (R_xlen_t i = 0; i < N; ++i) if (std::isnan(x[i])) v[i] = c;
+  const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
+  Split X;
+  const int level = type == MODIFIED ? (rate ? 2 : 1) : (rate ? 1 : 0);
+  try {
+    if (level == 0) {
+      build_split(v.data(), N, c, bound, X);
+    } else {
+      build_prefix(v.data(), N, c, bound, level, X, 1, true);
+    }
+  } catch (const std::bad_alloc&) {
+    Rcpp::stop("allanvar_out_of_memory");
+  }
+  const double* h = X.hi.data();
+  const double* l = X.lo.data();
+  const bool stride1 = allanvar::estimator_info(type).overlapping;
+  const int d = type == STANDARD || type == OVERLAPPING ? 2 : 3;
+  const R_xlen_t L = rate ? N + 1 : N;
+  auto missing = [&](R_xlen_t a, R_xlen_t b) { return G[b] - G[a] > 0; };
+  for (R_xlen_t j = 0; j < nm; ++j) {
+    if (allanvar::interrupted()) break;
+    const R_xlen_t mm = static_cast<R_xlen_t>(m[j]);
+    const R_xlen_t span = type == MODIFIED ? 3 * mm : d * mm;  // phase points - 1
+    const R_xlen_t step = stride1 ? 1 : mm;
+    Acc acc;
+    double s = 0;
+    R_xlen_t cnt = 0, blk = 0;
+    for (R_xlen_t k = 0; k + span <= L - (type == MODIFIED ? 0 : 1); k += step) {
+      bool skip;
+      if (rate) {
+        skip = missing(k, k + span - (type == MODIFIED ? 1 : 0));
+      } else if (type == MODIFIED) {
+        skip = missing(k, k + span);
+      } else {
+        skip = false;
+        for (int t = 0; t <= d; ++t) skip = skip || missing(k + t * mm, k + t * mm + 1);
+      }
+      if (skip) continue;
+      const double dv = d == 2 ? diff_at<2>(h, l, mm, k) : diff_at<3>(h, l, mm, k);
+      s += dv * dv;
+      ++cnt;
+      if (++blk == kBlock) {
+        acc.add(s);
+        s = 0;
+        blk = 0;
+      }
+    }
+    acc.add(s);
+    sums[j] = acc.value();
+    counts[j] = static_cast<double>(cnt);
+  }
+  scope.finish();
+  return Rcpp::List::create(Rcpp::Named("sums") = sums,
+                            Rcpp::Named("n") = counts);
+}

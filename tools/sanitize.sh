@@ -27,10 +27,13 @@ CXX14FLAGS = $flags
 CXX17FLAGS = $flags
 LDFLAGS = -fsanitize=address,undefined
 MK
-mkdir -p "$work/lib"
+mkdir -p "$work/lib" "$work/src"
+# build from a copy: instrumented objects must not land in the source tree
+git ls-files -z | xargs -0 -I{} cp --parents {} "$work/src/" 2>/dev/null || cp -r . "$work/src/"
+rm -f "$work"/src/src/*.o "$work"/src/src/*.so
 echo "sanitize: building with $flags"
 R_MAKEVARS_USER="$work/Makevars" R CMD INSTALL --preclean --no-test-load \
-  --library="$work/lib" . >"$work/install.log" 2>&1 || { cat "$work/install.log"; exit 1; }
+  --library="$work/lib" "$work/src" >"$work/install.log" 2>&1 || { cat "$work/install.log"; exit 1; }
 asan=$(gcc -print-file-name=libasan.so)
 ubsan=$(gcc -print-file-name=libubsan.so)
 log="$work/tests.log"

@@ -376,3 +376,105 @@ test_that("huge and tiny series: exact results by power-of-two scaling, or a cla
   # a constant series near the top of the range has variance 0
   expect_equal(allan(rep(1e300, 100), 1)$avar, rep(0, 6))
 })
+
+# ---- gaps ----
+
+# The gap rule written out term by term (allantools' gradev for the
+# overlapping phase case): a term is kept when every value it uses is there.
+gap_reference <- function(v, m, type, rate) {
+  x <- if (rate) c(0, cumsum(ifelse(is.na(v), 0, v))) else v
+  L <- length(x)
+  d <- if (type %in% c("standard", "overlapping")) 2 else 3
+  w <- if (d == 2) c(1, -2, 1) else c(-1, 3, -3, 1)
+  step <- if (type %in% c("standard", "hadamard")) m else 1
+  span <- if (type == "modified") 3 * m else d * m
+  s <- 0
+  n <- 0
+  k <- 0
+  last <- if (type == "modified") L - span else L - 1 - span  # last k
+  while (k <= last) {
+    if (rate) {
+      # samples k .. k + span - 1 (modified: X_k .. X_{k+3m-1}, so one fewer)
+      used <- v[(k + 1):(k + span - (type == "modified"))]
+    } else if (type == "modified") {
+      used <- v[(k + 1):(k + span)]             # points k .. k + 3m - 1
+    } else {
+      used <- v[k + 1 + (0:d) * m]
+    }
+    if (!anyNA(used)) {
+      t <- if (type == "modified") {
+        sum(vapply(0:(m - 1), function(j) sum(c(1, -2, 1) * x[k + j + 1 + (0:2) * m]), 0))
+      } else {
+        sum(w * x[k + 1 + (0:d) * m])
+      }
+      s <- s + t^2
+      n <- n + 1
+    }
+    k <- k + step
+  }
+  norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
+                 2 * m^2)
+  c(avar = s / (norm * n), n = n)
+}
+
+test_that("gaps = \"skip\": every term that touches a missing value is left out", {
+  set.seed(16)
+  v <- cumsum(rnorm(60))
+  v[c(7, 20:22, 41)] <- NA
+  v[33] <- NaN
+  for (rate in c(TRUE, FALSE)) {
+    for (type in c("overlapping", "standard", "modified", "hadamard", "ohadamard")) {
+      a <- suppressWarnings(allan(v, 1, taus = "all", type = type,
+                                  input = if (rate) "rate" else "integrated",
+                                  gaps = "skip"))
+      for (i in seq_len(nrow(a))) {
+        ref <- gap_reference(v, a$m[i], type, rate)
+        expect_equal(a$n[i], ref[["n"]], info = paste(type, rate, a$m[i]))
+        expect_equal(a$avar[i], ref[["avar"]], tolerance = 1e-12,
+                     info = paste(type, rate, a$m[i]))
+      }
+      expect_equal(attr(a, "missing"), c(x = 6L))
+    }
+  }
+  # without gaps, "skip" changes nothing
+  w <- rnorm(500)
+  expect_equal(allan(w, 1, gaps = "skip"), allan(w, 1))
+  # the default still refuses NA, and says what to do; Inf is never a gap
+  expect_error(allan(v, 1), class = "allanvar_error_values")
+  expect_error(allan(v, 1), "gaps = \"skip\"")
+  expect_error(allan(c(1, Inf, NA, 4, 5), 1, gaps = "skip"),
+               "found Inf at position 2", class = "allanvar_error_values")
+  expect_error(allan(v, 1, type = "total", gaps = "skip"),
+               class = "allanvar_error_gaps")
+  expect_output(print(suppressWarnings(allan(v, 1, gaps = "skip"))), "6 missing")
+  # a cluster size whose every term spans a gap is left out, with a warning
+  expect_warning(allan(c(1, 2, NA, 4, 5, 6, 7), 1, taus = "all", gaps = "skip"),
+                 class = "allanvar_warning_gaps")
+})
+
+test_that("gaps against allantools' gradev reference data (optional)", {
+  root <- Sys.getenv("ALLANVAR_PEER_DATA")
+  skip_if_not(nzchar(root) && dir.exists(file.path(root, "tests", "gradev")),
+              "ALLANVAR_PEER_DATA (an allantools checkout) is not set")
+  d <- file.path(root, "tests", "gradev")
+  y <- scan(file.path(d, "y.dat"), quiet = TRUE)
+  yg <- scan(file.path(d, "y_gap.dat"), quiet = TRUE)
+  expect_gt(sum(is.na(yg)), 0)
+  m <- c(1, 2, 3, 5, 10, 20, 50, 100, 200)
+  a <- suppressWarnings(allan(yg, 1, taus = m, input = "integrated",
+                              gaps = "skip"))
+  for (mm in m) {
+    ref <- gap_reference(yg, mm, "overlapping", FALSE)
+    if (ref[["n"]] == 0) {
+      expect_false(mm %in% a$m)
+      next
+    }
+    i <- match(mm, a$m)
+    expect_equal(a$avar[i], ref[["avar"]], tolerance = 1e-12)
+    expect_equal(a$n[i], ref[["n"]])
+  }
+  expect_gte(nrow(a), 5)
+  # allantools' own check: the gap curve stays within e of the full one
+  b <- allan(y, 1, taus = a$tau, input = "integrated")
+  expect_true(all(abs(log(a$adev / b$adev)) < 1))
+})
