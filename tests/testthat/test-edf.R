@@ -120,3 +120,37 @@ test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
     expect_true(all(cr >= 0.65 & cr <= 0.72), info = paste(type, "walk:", toString(cr)))
   }
 })
+
+test_that("68% coverage 0.60-0.76 for white/flicker/RW FM and white/flicker PM", {
+  # Own generators: Kasdin & Walter's fractional integration (flicker: the
+  # filter h_k = h_{k-1} (k - 1 + a/2) / k applied by FFT), cumsum for
+  # random walk, first differences of white or flicker phase for PM. The
+  # truth is the ensemble mean of the AV over the replicates. Rows read by
+  # the lag-1 autocorrelation (N/m >= 64) with median EDF >= 5.
+  old <- options(allanvar.threads = 1)
+  on.exit(options(old))
+  set.seed(8)
+  N <- 1024
+  flicker <- function(n) {
+    h <- numeric(n)
+    h[1] <- 1
+    for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
+    Re(stats::fft(stats::fft(c(h, rep(0, n))) * stats::fft(c(rnorm(n), rep(0, n))),
+                  inverse = TRUE))[1:n] / (2 * n)
+  }
+  gens <- list(wfm = function() rnorm(N), ffm = function() flicker(N),
+               rwfm = function() cumsum(rnorm(N)),
+               wpm = function() diff(rnorm(N + 1)),
+               fpm = function() diff(flicker(N + 1)))
+  for (g in names(gens)) {
+    res <- lapply(1:300, function(i) allan(gens[[g]](), 1))
+    av <- sapply(res, function(a) a$avar)
+    truth <- sqrt(rowMeans(av))
+    hits <- sapply(res, function(a) a$lower <= truth & truth <= a$upper)
+    keep <- apply(sapply(res, function(a) a$edf), 1, stats::median) >= 5 &
+      N / res[[1]]$m >= 64
+    cov <- rowMeans(hits)[keep]
+    expect_gte(length(cov), 5)
+    expect_true(all(cov >= 0.60 & cov <= 0.76), info = paste(g, toString(cov)))
+  }
+})
