@@ -273,7 +273,7 @@ installed_lib <- function() {
 # Starts `run` in a child R process after `setup`, sends SIGINT `wait`
 # seconds after the child reports that setup is done, and returns the
 # seconds from the signal to the child catching the interrupt.
-interrupt_delay <- function(setup, run, wait = 2) {
+interrupt_delay <- function(setup, run, wait = 4) {
   skip_if_not_installed("callr")
   lib <- installed_lib()
   ready <- tempfile()
