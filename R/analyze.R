@@ -36,7 +36,8 @@
 #'   character vector of file paths (read with [read_imu()] and `read_args`).
 #' @param taus,type Passed to [allan()]: the tau grid (the same for every
 #'   channel of a record) and the estimator.
-#' @param terms Terms to fit, passed to [avfit()].
+#' @param terms Terms to fit, passed to [avfit()]; `NULL` (default) for the
+#'   datasheet model N, B, K.
 #' @param refine Run [avrefine()] on each fit to identify effects the model
 #'   misses (logical).
 #' @param segment Which gap-free segment to use: `"longest"` (default),
@@ -73,7 +74,7 @@
 #' a
 #' }
 analyze_imu <- function(x, taus = "octave", type = "overlapping",
-                        terms = c("N", "B", "K"), refine = TRUE,
+                        terms = NULL, refine = TRUE,
                         segment = "longest", channels = NULL,
                         progress = interactive() &&
                           isTRUE(getOption("allanvar.progress", TRUE)),

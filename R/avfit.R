@@ -72,7 +72,9 @@
 #'
 #' @param av The Allan variance curve (see Input).
 #' @param terms Character vector of terms to fit (see [av_terms()]); `gm` and
-#'   `sinusoid` may be repeated, e.g. `c("N", "gm", "gm")`.
+#'   `sinusoid` may be repeated, e.g. `c("N", "gm", "gm")`. `NULL` (the
+#'   default) fits the datasheet model: the terms a datasheet reads, N, B
+#'   and K.
 #' @inheritParams as_av_curve
 #' @param start Optional named starting values, e.g. `c(gm1.tc = 30)`
 #'   (nonlinear parameters start there instead of the grid search).
@@ -121,7 +123,7 @@
 #' tab <- data.frame(tau = av$time, avar = av$av)
 #' coef(avfit(tab, c("N", "B", "K"), n = 1e5, freq = 100,
 #'            type = "non-overlapping"))
-avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
+avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
                   type = NULL, channel = NULL, start = NULL, fixed = NULL,
                   tau_range = NULL, bias_correct = TRUE, correlation = FALSE,
                   control = avfit_control(), ...) {
@@ -130,7 +132,7 @@ avfit <- function(av, terms = c("N", "B", "K"), n = NULL, freq = NULL,
   check_flag(bias_correct, "bias_correct")
   check_flag(correlation, "correlation")
   check_present(missing(av), "av", "an Allan variance curve")
-  terms <- check_terms(terms)
+  terms <- check_terms(terms %||% datasheet_terms())
   control <- check_control(control)
   curve <- as_av_curve(av, n = n, freq = freq, type = type, channel = channel)
   lay <- coef_layout(terms)

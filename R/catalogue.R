@@ -257,6 +257,9 @@ reading_entry <- function(role) {
   NULL
 }
 
+# The datasheet model: the kinds that provide a reading (N, B, K).
+datasheet_terms <- function() reading_entries()$kind
+
 reading_symbol <- function(role) {
   e <- reading_entry(role)
   if (is.null(e)) NA_character_ else e$reading$symbol

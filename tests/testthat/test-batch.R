@@ -125,7 +125,7 @@ test_that("white-like Gauss-Markov terms are folded into N, once", {
   expect_equal(rd3$tau[rd3$term == "B"], 0.32)
   expect_equal(rd3$value[rd3$term == "B"], curve$adev[6] / sqrt(2 * log(2) / pi))
   expect_match(rd$method[rd$term == "K"], "upper bound")
-  g <- allanvar:::gm_terms(cf, drop_white = TRUE)
+  g <- allanvar:::unfolded_coef(cf, kinds = "gm")
   expect_identical(names(g), c("gm1.sigma", "gm1.tc"))
   expect_equal(unname(g), c(1e-3, 20))
 })
