@@ -124,6 +124,10 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
                refine_args = refine_args)
   # One future per axis: axes differ in cost (the refinement), so this
   # balances the workers, and progress arrives as each axis finishes.
+  # future.seed = TRUE can leave the caller's RNG kind at L'Ecuyer-CMRG
+  # (when no seed existed yet): the caller's RNG state is restored.
+  restore <- save_rng()
+  on.exit(restore(), add = TRUE)
   results <- future.apply::future_lapply(jobs, analyze_channel, opts = opts,
                                          future.seed = TRUE,
                                          future.scheduling = Inf)
