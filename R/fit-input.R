@@ -144,7 +144,7 @@ as_av_curve <- function(av, n = NULL, freq = NULL, type = NULL, channel = NULL) 
   m <- if (is.null(freq)) rep(NA_real_, length(tau)) else tau * freq
   if (is.null(edf) && !is.null(n)) ok <- ok & m <= n / 2
   data <- data.frame(tau = tau[ok], m = m[ok], avar = avv[ok],
-                     edf = if (is.null(edf)) NA_real_ else edf[ok])
+                     edf = if (is.null(edf)) rep(NA_real_, sum(ok)) else edf[ok])
   data <- data[order(data$tau), , drop = FALSE]
   rownames(data) <- NULL
   if (nrow(data) < 1L) {
