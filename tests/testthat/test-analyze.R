@@ -80,3 +80,17 @@ test_that("effects the closed loop adds reach the datasheet", {
   expect_equal(fp$value[fp$term == "gm1" & fp$parameter == "q_d"],
                sig^2 * (1 - exp(-0.02 / tc)))
 })
+
+test_that("analyze_imu() errors are classed and worded", {
+  r <- two_records()[[1]]
+  expect_snapshot(error = TRUE, {
+    analyze_imu()
+    analyze_imu(1)
+    analyze_imu(character())
+    analyze_imu(r, refine = NA)
+    analyze_imu(r, progress = "yes")
+    analyze_imu(r, channels = "gyro_q")
+    analyze_imu(r, refine_args = 1)
+  })
+  expect_error(analyze_imu(1), class = "allanvar_error_argument")
+})

@@ -360,3 +360,27 @@ test_that("several nonlinear terms: the search finds the global optimum", {
                fixed = c(gm1.sigma = 0))
   expect_true(is.na(fit$se["gm1.tc"]))
 })
+
+test_that("avfit() and its methods raise classed errors with stable wording", {
+  tab <- data.frame(tau = m_oct / f, avar = av_model(m_oct / f, c(N = 1), f))
+  fit <- avfit(tab, "N", n = n, freq = f)
+  expect_snapshot(error = TRUE, {
+    avfit()
+    avfit(tab, "Z", n = n, freq = f)
+    avfit(tab, c("N", "N"), n = n, freq = f)
+    avfit(tab, "N", n = n, freq = f, start = c(X = 1))
+    avfit(tab, "N", n = n, freq = f, tau_range = 1)
+    avfit(tab[1:2, ], c("N", "B", "K"), n = n, freq = f)
+    avfit(tab, "N", n = n, freq = f, bias_correct = NA)
+    avfit(tab, "N", n = n, freq = f, taus = 3)
+    avfit(fit, "N", freq = 10)
+    residuals(fit, type = "raw")
+    predict(fit, -1)
+    confint(fit, "B")
+  })
+  expect_error(avfit(tab, "Z", n = n, freq = f), class = "allanvar_error_argument")
+  expect_error(avfit(1:3), class = "allanvar_error_curve")
+  expect_error(avfit(tab[1:2, ], c("N", "B", "K"), n = n, freq = f),
+               class = "allanvar_error_curve")
+  expect_error(av_model(1, c(X = 1)), class = "allanvar_error_argument")
+})

@@ -69,3 +69,13 @@ test_that("avdiagnose validates its arguments and prints", {
   expect_equal(d$freq, 50)
   expect_output(print(d), "Quantized: step 0.1")
 })
+
+test_that("avdiagnose() errors are classed and worded", {
+  expect_snapshot(error = TRUE, {
+    avdiagnose()
+    avdiagnose(rnorm(1000), -1)
+    avdiagnose(letters, 1)
+    avdiagnose(rep(1, 10), 1)
+    avdiagnose(rnorm(1000), 1, alpha = 2)
+  })
+})

@@ -120,3 +120,15 @@ test_that("catalogue listing and argument checks", {
   expect_error(check_terms(c("N", "N")), "only gm and sinusoid")
   expect_error(check_terms("Z"), "unknown term")
 })
+
+test_that("av_model() errors are classed and worded", {
+  expect_snapshot(error = TRUE, {
+    av_model(c(N = 1))
+    av_model(-1, c(N = 1))
+    av_model(1, c(X = 1))
+    av_model(1, c(gm1.sigma = 1))
+    av_model(1, c(N = -1))
+    av_model(1, c(gm1.sigma = 1, gm1.tc = 0))
+    av_model(1, 1)
+  })
+})
