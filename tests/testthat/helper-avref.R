@@ -1,5 +1,5 @@
 # Shared by test-signatures.R and test-trace.R. References: the continuous IEEE 952 AV
-# forms (noise-models.md section 1), written out here independently of the
+# forms (vignette("noise-terms")), written out here independently of the
 # package's catalogue, and series with known construction.
 
 av_ref <- function(tau, Q = 0, N = 0, B = 0, K = 0, R = 0, gm = NULL, sn = NULL) {

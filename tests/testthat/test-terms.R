@@ -1,5 +1,6 @@
 # General discrete formula for a stationary rate with autocovariance gamma(h)
-# (noise-models.md section 1), an independent reference for the closed forms.
+# (Zhang 2008; vignette("noise-terms")), an independent reference for the
+# closed forms.
 av_from_acf <- function(m, gamma) {
   i <- seq_len(m - 1)
   (m * (gamma(0) - gamma(m)) +
@@ -16,7 +17,7 @@ test_that("flicker table matches direct numerical integration", {
     ref <- 2 / pi * I
     expect_equal(av_model(m, c(B = 1), freq = 1), ref, tolerance = 1e-8)
   }
-  # published ratios to the plateau (noise-models.md)
+  # published ratios to the plateau (vignette("noise-terms"))
   r <- av_model(c(1, 2, 4, 8, 16), c(B = 1), freq = 1) / pl
   expect_equal(r, c(1.443, 1.154, 1.050, 1.015, 1.0046), tolerance = 1e-3)
   expect_equal(av_model(1, c(B = 1), freq = 1) / pl, 1 / log(2), tolerance = 1e-9)
