@@ -133,3 +133,34 @@ test_that("av_model() errors are classed and worded", {
     av_model(1, 1)
   })
 })
+
+test_that("the catalogue's autocovariances and PSDs give its AV forms", {
+  # autocovariance route (discrete forms) for every entry that defines one
+  pars <- list(Q = NULL, N = NULL, gm = c(tc = 0.4), sinusoid = c(f0 = 3.3))
+  for (k in names(pars)) {
+    e <- allanvar:::effect_entry(k)
+    expect_false(is.null(e$acf))
+    for (m in c(1, 2, 7, 40)) {
+      expect_equal(e$basis(m / 100, 0.01, pars[[k]]),
+                   av_from_acf(m, function(h) e$acf(h, 0.01, pars[[k]])),
+                   tolerance = 1e-9, label = paste(k, m))
+    }
+  }
+  # PSD route (continuous forms): AV = 4 int S(f) sin^4(pi f tau)/(pi f tau)^2 df,
+  # in x = pi f tau, period by period, plus the tail (mean of sin^4 is 3/8)
+  av_psd <- function(tau, S) {
+    g <- function(x) S(x / (pi * tau)) * sin(x)^4 / x^2
+    body <- sum(vapply(0:299, function(k)
+      integrate(g, k * pi, (k + 1) * pi, rel.tol = 1e-10)$value, 0))
+    4 / (pi * tau) * (body + S(300 / tau) * 3 / 8 / (300 * pi))
+  }
+  pars <- list(N = NULL, B = NULL, K = NULL, gm = c(tc = 0.4))
+  for (k in names(pars)) {
+    e <- allanvar:::effect_entry(k)
+    for (tau in c(0.05, 1, 20)) {
+      expect_equal(av_psd(tau, function(f) e$psd(f, pars[[k]])),
+                   e$basis(tau, NULL, pars[[k]]), tolerance = 2e-3,
+                   label = paste(k, tau))
+    }
+  }
+})
