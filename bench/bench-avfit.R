@@ -11,7 +11,7 @@
 lib <- Sys.getenv("ALLANVAR_LIB")
 if (nzchar(lib)) library(allanvar, lib.loc = lib) else library(allanvar)
 cat("allanvar", format(utils::packageVersion("allanvar")), "from",
-    dirname(dirname(system.file(package = "allanvar"))), "\n")
+    dirname(system.file(package = "allanvar")), "\n")
 avar_white_cov <- allanvar:::avar_white_cov
 options(allanvar.threads = 2L)
 reps <- 3L
