@@ -109,11 +109,12 @@ avsim <- function(n, freq, ..., seed = NULL) {
     p <- e$params
     amp <- p$name[p$role == "amp"]
     nl <- p$name[p$role == "nonlinear"]
+    if (!nrow(v)) next
+    labels <- term_labels(rep(k, nrow(v)))
     for (i in seq_len(nrow(v))) {
       row <- unlist(v[i, p$name, drop = FALSE])
       y <- y + e$sim(n, tau0, row[amp], if (length(nl)) row[nl] else NULL)
-      label <- if (e$repeatable) paste0(k, i) else k
-      coef[paste0(label, ".", p$name)] <- unname(row)
+      coef[coef_names(e, labels[i])] <- unname(row)
     }
   }
   out <- stats::ts(y, start = 0, frequency = freq)
