@@ -110,7 +110,7 @@ avsim <- function(n, freq, ..., seed = NULL) {
     amp <- p$name[p$role == "amp"]
     nl <- p$name[p$role == "nonlinear"]
     if (!nrow(v)) next
-    labels <- term_labels(rep(k, nrow(v)))
+    labels <- instance_labels(e, nrow(v))
     for (i in seq_len(nrow(v))) {
       row <- unlist(v[i, p$name, drop = FALSE])
       y <- y + e$sim(n, tau0, row[amp], if (length(nl)) row[nl] else NULL)

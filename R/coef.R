@@ -48,11 +48,16 @@ term_labels <- function(terms) {
   sp <- split_term(terms)
   lab <- sp$kind
   for (k in unique(sp$kind)) {
-    if (!effect_entry(k)$repeatable) next
     i <- which(sp$kind == k)
-    lab[i] <- paste0(k, seq_along(i))
+    lab[i] <- instance_labels(effect_entry(k), length(i))
   }
   ifelse(nzchar(sp$variant), paste0(lab, "_", sp$variant), lab)
+}
+
+# Labels of `count` instances of entry `e` (any component): the kind, or the
+# kind numbered for a repeatable entry.
+instance_labels <- function(e, count) {
+  if (e$repeatable) paste0(e$name, seq_len(count)) else rep(e$name, count)
 }
 
 # Kind and variant of labels: "gm2" -> ("gm", ""), "fwn1_ma" -> ("fwn", "ma").
