@@ -127,6 +127,25 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// dynamic_sums_cpp
+Rcpp::NumericMatrix dynamic_sums_cpp(Rcpp::NumericVector x, SEXP y, bool rate, Rcpp::NumericVector m, Rcpp::NumericVector nterms, int kind, double step, double nwin, int threads);
+RcppExport SEXP _allanvar_dynamic_sums_cpp(SEXP xSEXP, SEXP ySEXP, SEXP rateSEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP kindSEXP, SEXP stepSEXP, SEXP nwinSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::RNGScope rcpp_rngScope_gen;
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type x(xSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type y(ySEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type m(mSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type nterms(ntermsSEXP);
+    Rcpp::traits::input_parameter< int >::type kind(kindSEXP);
+    Rcpp::traits::input_parameter< double >::type step(stepSEXP);
+    Rcpp::traits::input_parameter< double >::type nwin(nwinSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(dynamic_sums_cpp(x, y, rate, m, nterms, kind, step, nwin, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
 // allan_edf_cpp
 Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m, const Rcpp::NumericVector& n, double L, const Rcpp::IntegerVector& alpha, const Rcpp::LogicalVector& exact);
 RcppExport SEXP _allanvar_allan_edf_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP LSEXP, SEXP alphaSEXP, SEXP exactSEXP) {
@@ -166,6 +185,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
+    {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 9},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
     {NULL, NULL, 0}
