@@ -88,9 +88,14 @@ gh_edf1 <- function(alpha, d, m, L, overlapping, modified) {
     }
     return(basic(Jmax, Jmax, Jmax / r, Inf))
   }
-  if (J <= Jmax) return(basic(J, M, S, m))
   a <- gh_table2[[key]][[d - 1]]
-  if (alpha == 2) return(M / (a[1] - a[2] / r))
+  if (alpha == 2) {
+    # white phase noise: closed form unless the record holds at most d
+    # strides (then the exact sum, whose support is finite)
+    if (ceiling(r) > d) return(M / (a[1] - a[2] / r))
+    return(basic(J, M, S, m))
+  }
+  if (J <= Jmax) return(basic(J, M, S, m))
   b <- gh_table3[[d - 1]]
   if (r > d + 1) return((b[1] + b[2] * log(m))^2 * r / (a[1] - a[2] / r))
   Jmax * (b[1] + b[2] * log(m))^2 /

@@ -188,18 +188,18 @@ dyn_samples <- function(value, arg, freq, lo, N, default) {
   check_number(value, arg, 0, Inf, open = TRUE)
   k <- round(value * freq)
   if (k < lo || k > N) {
-    abort("`", arg, "` must span between ", lo, " and ", N,
-          " samples (", format(lo / freq), " to ", format(N / freq),
-          " s at ", format(freq), " Hz); ", format(value), " s is ", k,
-          " samples.", class = "argument")
+    abort("`", arg, "` must be between ", lo, " and ", N, " samples long (",
+          format(lo / freq), " to ", format(N / freq), " s at ", format(freq),
+          " Hz), not ", format(value), " s (", k, if (k == 1) " sample)."
+          else " samples).", class = "argument")
   }
   as.double(k)
 }
 
 # The cluster sizes asked for by `taus`, within [1, maxm].
 dyn_taus <- function(taus, freq, maxm) {
-  if (is.character(taus)) {
-    taus <- check_choice(taus, c("octave", "decade", "all"), "taus")
+  if (is.character(taus) && length(taus) == 1L && !is.na(taus) &&
+      taus %in% c("octave", "decade", "all")) {
     m <- switch(taus,
       octave = 2^(0:floor(log2(maxm) + 1e-9)),
       decade = sort(as.vector(outer(c(1, 2, 4),
@@ -211,7 +211,9 @@ dyn_taus <- function(taus, freq, maxm) {
       anyNA(taus) || any(!is.finite(taus)) || any(taus <= 0)) {
     abort("`taus` must be \"octave\", \"decade\", \"all\", a number of ",
           "points per decade, or a numeric vector of positive tau in ",
-          "seconds; not ", describe_type(taus), ".", class = "argument")
+          "seconds; not ", if (is.character(taus) && length(taus) == 1L)
+            format_value(taus) else describe_type(taus), ".",
+          class = "argument")
   }
   if (length(taus) == 1L && !inherits(taus, "AsIs")) {
     k <- check_number(taus, "taus", 1, 1000, integer = TRUE)
@@ -285,8 +287,8 @@ print.allan_dynamic <- function(x, digits = 3, ...) {
   rows <- unique(round(seq(1, nw, length.out = min(nw, 5L))))
   tab <- t(x$adev[rows, , drop = FALSE])
   tab <- signif(tab, digits)
-  dimnames(tab) <- list(paste0("tau=", format(signif(x$tau, 4))),
-                        paste0("t=", format(signif(x$time[rows], 4))))
+  dimnames(tab) <- list(paste0("tau=", signif(x$tau, 4)),
+                        paste0("t=", signif(x$time[rows], 4)))
   cat("adev at ", length(rows), " of ", nw, " window centres (s):\n", sep = "")
   print(tab, ...)
   invisible(x)
@@ -413,34 +415,46 @@ dyn_plot_surface <- function(x, col, contour, main, xlab, ylab, dev_name,
                   ...)
   graphics::axis(1)
   yt <- seq(floor(min(ly)), ceiling(max(ly)))
-  graphics::axis(2, at = yt, labels = format(10^yt, scientific = TRUE,
-                                             trim = TRUE), las = 1)
+  graphics::axis(2, at = yt, labels = formatC(10^yt, format = "g"), las = 1)
   graphics::box()
   if (contour && nrow(zz) > 1L && ncol(zz) > 1L) {
-    graphics::contour(tx, ly, zz, add = TRUE, col = "grey30",
-                      labcex = 0.6, nlevels = 6)
+    v <- dyn_key_values(zr)
+    graphics::contour(tx, ly, zz, add = TRUE, col = "grey20", labcex = 0.6,
+                      levels = log10(v), labels = formatC(v, format = "g"))
   }
   dyn_colour_key(zr, col, dev_name)
 }
 
-# A vertical colour key in the right margin, labelled in decades.
+# A vertical colour key in the right margin, ticks at 1-2-5 values (or
+# decades when the range is wide).
 dyn_colour_key <- function(zr, col, dev_name) {
   usr <- graphics::par("usr")
-  cx <- graphics::grconvertX(c(1.03, 1.08), "npc", "user")
+  cx <- graphics::grconvertX(c(1.03, 1.07), "npc", "user")
   br <- seq(usr[3], usr[4], length.out = length(col) + 1L)
   op <- graphics::par(xpd = NA)
   on.exit(graphics::par(op))
   graphics::rect(cx[1], br[-length(br)], cx[2], br[-1L], col = col,
                  border = NA)
   graphics::rect(cx[1], usr[3], cx[2], usr[4], border = "black")
-  ticks <- pretty(zr)
-  ticks <- ticks[ticks >= zr[1] & ticks <= zr[2]]
-  ty <- usr[3] + (ticks - zr[1]) / diff(zr) * (usr[4] - usr[3])
+  v <- dyn_key_values(zr)
+  ty <- usr[3] + (log10(v) - zr[1]) / diff(zr) * (usr[4] - usr[3])
   graphics::segments(cx[2], ty, cx[2] + 0.3 * diff(cx), ty)
-  graphics::text(cx[2] + 0.45 * diff(cx), ty,
-                 format(signif(10^ticks, 2), scientific = TRUE, trim = TRUE),
+  graphics::text(cx[2] + 0.45 * diff(cx), ty, formatC(v, format = "g"),
                  adj = 0, cex = 0.7)
-  graphics::mtext(dev_name, side = 4, line = 5, cex = 0.8)
+  graphics::mtext(dev_name, side = 4, line = 5.2, cex = 0.8)
+}
+
+# Round deviations within the log10 range zr: 1-2-5 values, or decades.
+dyn_key_values <- function(zr) {
+  k <- seq(floor(zr[1]), ceiling(zr[2]))
+  inside <- function(v) v[log10(v) >= zr[1] - 1e-9 & log10(v) <= zr[2] + 1e-9]
+  v <- inside(as.vector(outer(c(1, 2, 5), 10^k)))
+  if (length(v) > 8L || length(v) < 2L) {
+    dec <- inside(10^k)
+    if (length(dec) >= 2L) v <- dec
+  }
+  if (length(v) < 2L) v <- signif(10^zr, 2)
+  v
 }
 
 dyn_plot_lines <- function(x, what, at, col, main, xlab, ylab, dev_name,
@@ -492,8 +506,8 @@ dyn_plot_lines <- function(x, what, at, col, main, xlab, ylab, dev_name,
                        code = 3, length = 0.02, col = col[i])
     }
   }
-  lab <- if (windows) paste0("t = ", format(signif(x$time[pick], 4)), " s")
-         else paste0("tau = ", format(signif(x$tau[pick], 4)), " s")
+  lab <- if (windows) paste0("t = ", signif(x$time[pick], 4), " s")
+         else paste0("tau = ", signif(x$tau[pick], 4), " s")
   graphics::legend("topright", legend = lab, col = col, lty = 1, pch = 20,
-                   bty = "n", cex = 0.8)
+                   bg = "white", box.col = NA, inset = 0.01, cex = 0.8)
 }
