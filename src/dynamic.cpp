@@ -296,19 +296,29 @@ Rcpp::NumericMatrix dynamic_sums_cpp(Rcpp::NumericVector x, SEXP y, bool rate,
     const R_xlen_t mm = static_cast<R_xlen_t>(m[t]);
     const R_xlen_t st = strided ? mm : 1;
     const R_xlen_t nt = static_cast<R_xlen_t>(nterms[t]);
-    std::vector<std::pair<R_xlen_t, R_xlen_t>> rw(nw);
-    for (R_xlen_t w = 0; w < nw; ++w) rw[w] = {(w * stp) % st, w};
-    std::sort(rw.begin(), rw.end());
+    // windows grouped by the residue of their start (counting sort: no
+    // O(nw log nw) pass per tau, and one group when stride divides step)
+    std::vector<R_xlen_t> order(nw);
+    std::vector<R_xlen_t> res(nw);
+    for (R_xlen_t w = 0; w < nw; ++w) res[w] = (w * stp) % st;
+    if (st == 1 || stp % st == 0) {
+      for (R_xlen_t w = 0; w < nw; ++w) order[w] = w;
+    } else {
+      std::vector<R_xlen_t> count(st + 1, 0);
+      for (R_xlen_t w = 0; w < nw; ++w) ++count[res[w] + 1];
+      for (R_xlen_t r = 0; r < st; ++r) count[r + 1] += count[r];
+      for (R_xlen_t w = 0; w < nw; ++w) order[count[res[w]]++] = w;
+    }
     for (R_xlen_t i = 0; i < nw;) {
       Group g;
       g.tau = t;
-      g.r = rw[i].first;
+      g.r = res[order[i]];
       g.st = st;
       g.m = mm;
       g.nt = nt;
-      for (; i < nw && rw[i].first == g.r; ++i) {
-        g.win.push_back(rw[i].second);
-        g.ja.push_back((rw[i].second * stp - g.r) / st);
+      for (; i < nw && res[order[i]] == g.r; ++i) {
+        g.win.push_back(order[i]);
+        g.ja.push_back((order[i] * stp - g.r) / st);
       }
       g.j_first = g.ja.front();
       g.j_last = g.ja.back() + nt;
