@@ -156,6 +156,24 @@ test_that("groslambert() is the mean product of the differences, every type", {
   }
 })
 
+test_that("a closed loop makes the hat and Groslambert covariance equal", {
+  # x_AB + x_BC + x_CA = 0 exactly (small integers): sigma^2_BC expands to
+  # sigma^2_AB + sigma^2_CA + 2 cov(AB, CA), so the two estimators coincide
+  p <- c(3, -1, 4, 1, -5, 9, 2, -6, 5, 3, -5, 8, 9, -7, 9, 3, 2, -3, 8, 4)
+  q <- c(2, 7, -1, 8, 2, -8, 1, 8, 2, -8, 4, 5, -9, 0, 4, 5, 2, -3, 5, 3)
+  y <- cbind("A-B" = p, "B-C" = q, "C-A" = -(p + q))
+  for (type in c("overlapping", "standard", "modified", "hadamard",
+                 "ohadamard")) {
+    for (input in c("rate", "integrated")) {
+      h <- three_cornered_hat(y, freq = 1, type = type, input = input,
+                              taus = "all")
+      g <- groslambert(y, freq = 1, type = type, input = input, taus = "all")
+      expect_equal(h$avar, g$avar, tolerance = 1e-12)
+      expect_equal(h$status, g$status)
+    }
+  }
+})
+
 test_that("the hat is the combination of the pairwise variances, any order", {
   set.seed(21)
   ab <- rnorm(64)
