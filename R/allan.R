@@ -136,8 +136,8 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   octave <- type == "standard" && rate && length(m) <= 64L &&
     all(m == 2^round(log2(m)))
   sub <- allan_subset(m)
-  res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub], allan_type_code(type),
-                        rate, octave, allanvar_threads())
+  res <- allan_sums_cpp(ch$values, N, m, nterms, m[sub],
+                        allan_opts(type, rate, octave))
   if (any(res$bad > 0)) {
     col <- which(res$bad > 0)[1L]
     row <- res$bad[col]

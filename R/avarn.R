@@ -45,8 +45,7 @@ avarn_fast <- function(values, freq) {
   cs <- seq_len(ceiling((N - 1) / 2))
   nterms <- allan_nterms("standard", cs, N + 1)
   res <- allan_sums_cpp(values, N, cs, nterms, numeric(0),
-                        allan_type_code("standard"), TRUE, FALSE,
-                        allanvar_threads())
+                        allan_opts("standard", rate = TRUE))
   data.frame(time = cs * (1 / freq), av = res$sums[, 1] / (2 * cs^2 * nterms),
              error = 1 / sqrt(2 * ((N / cs) - 1)))
 }

@@ -8,19 +8,6 @@
 #  * Greenhall & Riley (2004) general algorithm otherwise;
 #  * NIST SP 1065 Table 11 for the total variance at m >= 8.
 
-# The "d" (order of the difference) and whether each type is overlapped or
-# modified, as Greenhall's algorithm needs them.
-edf_setup <- function(type) {
-  switch(type,
-    standard = list(d = 2, overlapping = FALSE, modified = FALSE),
-    overlapping = list(d = 2, overlapping = TRUE, modified = FALSE),
-    modified = list(d = 2, overlapping = TRUE, modified = TRUE),
-    hadamard = list(d = 3, overlapping = FALSE, modified = FALSE),
-    ohadamard = list(d = 3, overlapping = TRUE, modified = FALSE),
-    total = list(d = 2, overlapping = TRUE, modified = FALSE)
-  )
-}
-
 # Where the noise id and the EDF are evaluated directly: every row of a
 # short curve; for long ones ("all"), every m <= 64 plus 40 points per
 # decade. The rest take the noise type of the nearest such m (in log tau)
@@ -37,7 +24,8 @@ allan_subset <- function(m) {
 # rows `sub` (NA where the data were too few: filled from the nearest
 # shorter tau, else the nearest longer one).
 allan_edf <- function(type, m, n, L, alpha_int, sub = seq_along(m)) {
-  d <- edf_setup(type)$d
+  tab <- allan_type_table()
+  d <- tab$d[match(type, tab$name)]
   a <- alpha_int
   if (all(is.na(a))) a[] <- 0L
   for (i in seq_along(a)) if (is.na(a[i]) && i > 1) a[i] <- a[i - 1]
@@ -65,7 +53,8 @@ allan_edf_direct <- function(type, m, n, L, alpha) {
   oav <- rep(NA_real_, length(m))
   ok <- no >= 1
   if (any(ok)) {
-    oav[ok] <- allan_edf_cpp(1L, m[ok], no[ok], L, alpha[ok], exact[ok])
+    oav[ok] <- allan_edf_cpp(allan_type_code("overlapping"), m[ok], no[ok], L,
+                             alpha[ok], exact[ok])
   }
   b <- c(1.50, 1.17, 0.93)[match(alpha, c(0L, -1L, -2L))]
   cc <- c(0, 0.22, 0.36)[match(alpha, c(0L, -1L, -2L))]

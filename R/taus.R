@@ -1,13 +1,32 @@
 # Cluster-size grids for allan(). A curve is computed at cluster sizes m
 # (tau = m / freq); every estimator has a largest m with at least one term.
 
+# The types allan() offers, in the order its documentation lists them
+# (overlapping, the default, first).
 allan_types <- c("overlapping", "standard", "modified", "hadamard",
                  "ohadamard", "total")
 
-# The C++ kernels' code for each type (enum Type in src/allan.cpp).
+# The estimator table defined once in src/types.h (name, code, d,
+# overlapping, modified), read from C++ on first use.
+allan_type_table <- local({
+  table <- NULL
+  function() {
+    if (is.null(table)) table <<- allan_type_table_cpp()
+    table
+  }
+})
+
+# The C++ kernels' code for each type.
 allan_type_code <- function(type) {
-  match(type, c("standard", "overlapping", "modified", "hadamard",
-                "ohadamard", "total")) - 1L
+  tab <- allan_type_table()
+  tab$code[match(type, tab$name)]
+}
+
+# The options the sums kernel reads (src/opts-allan.h), built once per call.
+allan_opts <- function(type, rate, octave = FALSE,
+                       threads = allanvar_threads()) {
+  list(type = allan_type_code(type), rate = isTRUE(rate),
+       octave = isTRUE(octave), threads = as.integer(threads))
 }
 
 # Largest cluster size with at least one term, for L phase points (L = N + 1

@@ -12,8 +12,8 @@ Rcpp::Rostream<false>& Rcpp::Rcerr = Rcpp::Rcpp_cerr_get();
 #endif
 
 // allan_sums_cpp
-Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow, const Rcpp::NumericVector& m, const Rcpp::NumericVector& nterms, const Rcpp::NumericVector& mid, int type, bool rate, bool octave, int threads);
-RcppExport SEXP _allanvar_allan_sums_cpp(SEXP xSEXP, SEXP nrowSEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP midSEXP, SEXP typeSEXP, SEXP rateSEXP, SEXP octaveSEXP, SEXP threadsSEXP) {
+Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow, const Rcpp::NumericVector& m, const Rcpp::NumericVector& nterms, const Rcpp::NumericVector& mid, const Rcpp::List& options);
+RcppExport SEXP _allanvar_allan_sums_cpp(SEXP xSEXP, SEXP nrowSEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP midSEXP, SEXP optionsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
@@ -21,11 +21,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type nterms(ntermsSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type mid(midSEXP);
-    Rcpp::traits::input_parameter< int >::type type(typeSEXP);
-    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
-    Rcpp::traits::input_parameter< bool >::type octave(octaveSEXP);
-    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(allan_sums_cpp(x, nrow, m, nterms, mid, type, rate, octave, threads));
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type options(optionsSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_sums_cpp(x, nrow, m, nterms, mid, options));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -174,9 +171,18 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// allan_type_table_cpp
+Rcpp::DataFrame allan_type_table_cpp();
+RcppExport SEXP _allanvar_allan_type_table_cpp() {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    rcpp_result_gen = Rcpp::wrap(allan_type_table_cpp());
+    return rcpp_result_gen;
+END_RCPP
+}
 
 static const R_CallMethodDef CallEntries[] = {
-    {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 9},
+    {"_allanvar_allan_sums_cpp", (DL_FUNC) &_allanvar_allan_sums_cpp, 6},
     {"_allanvar_allan_reference_cpp", (DL_FUNC) &_allanvar_allan_reference_cpp, 4},
     {"_allanvar_avar_octave_exact", (DL_FUNC) &_allanvar_avar_octave_exact, 3},
     {"_allanvar_avari_octave_exact", (DL_FUNC) &_allanvar_avari_octave_exact, 2},
@@ -188,6 +194,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 9},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
+    {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 0},
     {NULL, NULL, 0}
 };
 

@@ -8,7 +8,9 @@
 // huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
 // drift or length of the record.
 #include "checks.h"
+#include "opts-allan.h"
 #include "parallel.h"
+#include "types.h"
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -21,7 +23,13 @@
 
 namespace {
 
-enum Type { STANDARD = 0, OVERLAPPING, MODIFIED, HADAMARD, OHADAMARD, TOTAL };
+using allanvar::AllanOptions;
+using allanvar::STANDARD;
+using allanvar::OVERLAPPING;
+using allanvar::MODIFIED;
+using allanvar::HADAMARD;
+using allanvar::OHADAMARD;
+using allanvar::TOTAL;
 
 // a + b = s + e exactly (Knuth's TwoSum).
 inline void two_sum(double a, double b, double& s, double& e) {
@@ -612,13 +620,15 @@ struct Channel {
 // One channel: sums of squares for every m, and the noise id per m.
 void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
                  const std::vector<R_xlen_t>& nterms,
-                 const std::vector<R_xlen_t>& mid, int type, bool rate,
-                 bool octave, int threads, bool main, Channel& out) {
+                 const std::vector<R_xlen_t>& mid, const AllanOptions& opts,
+                 int threads, bool main, Channel& out) {
+  const int type = opts.type;
+  const bool rate = opts.rate, octave = opts.octave;
   const size_t nt = ms.size(), ni = mid.size();
   out.sums.assign(nt, 0.0);
   out.alpha.assign(ni, NA_REAL);
   out.alpha_int.assign(ni, NA_INTEGER);
-  const int dmax = (type == HADAMARD || type == OHADAMARD) ? 3 : 2;
+  const int dmax = allanvar::estimator_info(type).d;
   if (type == STANDARD && rate && octave) {
     // Any constant works as the centre here (cluster sums are double-double
     // and constants cancel); NaN or Inf shows up in the sums.
@@ -713,13 +723,15 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
 
 // Sums of squared differences (the estimator numerators) for every channel
 // (column of x, nrow samples each) and cluster size m, and the noise id at
-// the cluster sizes `mid`.
+// the cluster sizes `mid`; `opts` from allan_opts() (R/allan.R).
 // [[Rcpp::export(rng = false)]]
 Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
                           const Rcpp::NumericVector& m,
                           const Rcpp::NumericVector& nterms,
-                          const Rcpp::NumericVector& mid, int type,
-                          bool rate, bool octave, int threads) {
+                          const Rcpp::NumericVector& mid,
+                          const Rcpp::List& options) {
+  const AllanOptions opts = allanvar::allan_options(options);
+  const int threads = opts.threads;
   const R_xlen_t N = static_cast<R_xlen_t>(nrow);
   const R_xlen_t nc = x.size() / N;
   const size_t nt = m.size();
@@ -733,10 +745,10 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
   std::vector<Channel> ch(nc);
   const double* p = x.begin();
   if (nc == 1) {
-    one_channel(p, N, ms, nts, mids, type, rate, octave, threads, true, ch[0]);
+    one_channel(p, N, ms, nts, mids, opts, threads, true, ch[0]);
   } else {
     allanvar::parallel_for(nc, threads, [&](R_xlen_t i, int) {
-      one_channel(p + i * N, N, ms, nts, mids, type, rate, octave, 1, false, ch[i]);
+      one_channel(p + i * N, N, ms, nts, mids, opts, 1, false, ch[i]);
     });
   }
   Rcpp::NumericMatrix sums(nt, nc), alpha(ni, nc);
@@ -772,6 +784,8 @@ const bool kRefQuad = false;
 Rcpp::List allan_reference_cpp(const Rcpp::NumericVector& v,
                                const Rcpp::NumericVector& m, int type,
                                bool rate) {
+  if (!allanvar::valid_estimator(type))
+    Rcpp::stop("internal: unknown estimator code %d", type);
   const R_xlen_t N = v.size();
   ref_real mean = 0;
   for (R_xlen_t i = 0; i < N; ++i) mean += static_cast<ref_real>(v[i]);

@@ -6,6 +6,7 @@
 //    rate noise, where the continuous-time model of Greenhall overstates the
 //    EDF at small m.
 #include <Rcpp.h>
+#include "types.h"
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -125,18 +126,19 @@ double greenhall(int alpha, int d, double m, double N, bool overlapping,
 }
 
 // Weights of one term on the innovations of discrete white (rw = false) or
-// random-walk (rw = true) rate noise: types 0/1/5 second differences of
-// cluster sums, 3/4 third differences, 2 the modified (sum of m shifted
-// second differences).
+// random-walk (rw = true) rate noise: second differences of cluster sums
+// (d = 2), third differences (d = 3), or for the modified type the sum of m
+// shifted second differences.
 std::vector<double> weights(int type, long m, bool rw) {
+  const allanvar::EstimatorInfo& info = allanvar::estimator_info(type);
   std::vector<double> g;
-  if (type == 3 || type == 4) {
+  if (info.d == 3) {
     g.assign(3 * m, 1.0);
     for (long i = m; i < 2 * m; ++i) g[i] = -2.0;
   } else {
     std::vector<double> p(2 * m, 1.0);
     for (long i = 0; i < m; ++i) p[i] = -1.0;
-    if (type == 2) {
+    if (info.modified) {
       g.assign(3 * m - 1, 0.0);
       for (long i = 0; i < 2 * m; ++i)
         for (long j = 0; j < m; ++j) g[i + j] += p[i];
@@ -161,7 +163,7 @@ std::vector<double> weights(int type, long m, bool rw) {
 double discrete(int type, long m, double n, bool rw) {
   const std::vector<double> g = weights(type, m, rw);
   const long G = static_cast<long>(g.size());
-  const long s = (type == 0 || type == 3) ? m : 1;
+  const long s = allanvar::estimator_info(type).overlapping ? 1 : m;
   double c0 = 0;
   for (long t = 0; t < G; ++t) c0 += g[t] * g[t];
   double den = n * c0 * c0;
@@ -175,24 +177,27 @@ double discrete(int type, long m, double n, bool rw) {
 
 }  // namespace
 
-// EDF per row: type code (0 standard, 1 overlapping, 2 modified, 3 hadamard,
-// 4 ohadamard), cluster size m, number of terms n, phase points L, noise
-// exponent alpha; exact discrete moments when `exact` (white or random-walk
-// rate noise at small m), Greenhall otherwise.
+// EDF per row: estimator code (src/types.h), cluster size m, number of
+// terms n, phase points L, noise exponent alpha; exact discrete moments when
+// `exact` (white or random-walk rate noise at small m), Greenhall otherwise.
+// The total type is not handled here (R/edf.R combines the overlapping EDF
+// with NIST SP 1065's table for it).
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m,
                                   const Rcpp::NumericVector& n, double L,
                                   const Rcpp::IntegerVector& alpha,
                                   const Rcpp::LogicalVector& exact) {
+  if (!allanvar::valid_estimator(type) || type == allanvar::TOTAL)
+    Rcpp::stop("internal: no EDF kernel for estimator code %d", type);
+  const allanvar::EstimatorInfo& info = allanvar::estimator_info(type);
   const R_xlen_t k = m.size();
   Rcpp::NumericVector out(k);
-  const int d = (type == 3 || type == 4) ? 3 : 2;
-  const bool ov = type == 1 || type == 2 || type == 4;
   for (R_xlen_t i = 0; i < k; ++i) {
     if (exact[i]) {
       out[i] = discrete(type, static_cast<long>(m[i]), n[i], alpha[i] == -2);
     } else {
-      out[i] = greenhall(alpha[i], d, m[i], L, ov, type == 2);
+      out[i] = greenhall(alpha[i], info.d, m[i], L, info.overlapping,
+                         info.modified);
     }
   }
   return out;

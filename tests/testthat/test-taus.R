@@ -42,3 +42,28 @@ test_that("points per decade and taus in seconds", {
   expect_error(suppressWarnings(allan(rnorm(4), 1, taus = I(10), type = "hadamard")),
                "No averaging time")
 })
+
+test_that("the estimator table is defined once (src/types.h) and mirrored in R", {
+  tab <- allan_type_table()
+  expect_setequal(tab$name, allan_types)
+  expect_equal(tab$code, seq_along(tab$name) - 1L)
+  # what Greenhall's EDF needs, per type
+  expect_equal(tab$d[match(c("standard", "hadamard", "ohadamard"), tab$name)],
+               c(2L, 3L, 3L))
+  expect_equal(tab$overlapping[match(c("standard", "overlapping", "modified"),
+                                     tab$name)], c(FALSE, TRUE, TRUE))
+  expect_equal(tab$modified, tab$name == "modified")
+})
+
+test_that("the sums kernel validates its options struct once", {
+  ok <- allan_opts("overlapping", rate = TRUE)
+  expect_type(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, ok), "list")
+  bad <- ok
+  bad$type <- 99L
+  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "unknown estimator")
+  bad <- ok
+  bad$rate <- NA
+  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "TRUE or FALSE")
+  bad <- allan_opts("overlapping", rate = TRUE, octave = TRUE)
+  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "octave")
+})

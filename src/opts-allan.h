@@ -1,0 +1,50 @@
+// Options of the allan() sums kernel, turned once from the R list built by
+// allan_opts() (R/allan.R) into a typed struct the kernel reads. Checks here
+// guard the kernel against a malformed internal call; users' arguments were
+// already checked by allan().
+#ifndef ALLANVAR_OPTS_ALLAN_H
+#define ALLANVAR_OPTS_ALLAN_H
+
+#include <Rcpp.h>
+#include "types.h"
+
+namespace allanvar {
+
+struct AllanOptions {
+  int type;      // an Estimator
+  bool rate;     // rate samples (else integrated: phase, angle, velocity)
+  bool octave;   // standard type at m = 2^j: the pairwise one-pass kernel
+  int threads;   // threads the kernel may use (>= 1)
+};
+
+inline bool opt_flag(const Rcpp::List& o, const char* name) {
+  SEXP v = o[name];
+  if (TYPEOF(v) != LGLSXP || Rf_length(v) != 1 || LOGICAL(v)[0] == NA_LOGICAL)
+    Rcpp::stop("internal: allan option `%s` must be TRUE or FALSE", name);
+  return LOGICAL(v)[0] != 0;
+}
+
+inline int opt_int(const Rcpp::List& o, const char* name) {
+  SEXP v = o[name];
+  if (TYPEOF(v) != INTSXP || Rf_length(v) != 1 || INTEGER(v)[0] == NA_INTEGER)
+    Rcpp::stop("internal: allan option `%s` must be a single integer", name);
+  return INTEGER(v)[0];
+}
+
+inline AllanOptions allan_options(const Rcpp::List& o) {
+  AllanOptions opts;
+  opts.type = opt_int(o, "type");
+  if (!valid_estimator(opts.type))
+    Rcpp::stop("internal: unknown estimator code %d", opts.type);
+  opts.rate = opt_flag(o, "rate");
+  opts.octave = opt_flag(o, "octave");
+  opts.threads = opt_int(o, "threads");
+  if (opts.threads < 1) opts.threads = 1;
+  if (opts.octave && (opts.type != STANDARD || !opts.rate))
+    Rcpp::stop("internal: the octave kernel is for standard rate input only");
+  return opts;
+}
+
+}  // namespace allanvar
+
+#endif

@@ -1,0 +1,23 @@
+// The estimator table of src/types.h, for R (R/taus.R reads it once).
+#include <Rcpp.h>
+#include "types.h"
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::DataFrame allan_type_table_cpp() {
+  const int n = allanvar::N_ESTIMATORS;
+  Rcpp::CharacterVector name(n);
+  Rcpp::IntegerVector code(n), d(n);
+  Rcpp::LogicalVector overlapping(n), modified(n);
+  for (int i = 0; i < n; ++i) {
+    const allanvar::EstimatorInfo& e = allanvar::estimator_info(i);
+    name[i] = e.name;
+    code[i] = i;
+    d[i] = e.d;
+    overlapping[i] = e.overlapping;
+    modified[i] = e.modified;
+  }
+  return Rcpp::DataFrame::create(
+      Rcpp::Named("name") = name, Rcpp::Named("code") = code,
+      Rcpp::Named("d") = d, Rcpp::Named("overlapping") = overlapping,
+      Rcpp::Named("modified") = modified, Rcpp::Named("stringsAsFactors") = false);
+}
