@@ -37,8 +37,8 @@ first_nonfinite <- function(x) {
     .Call(`_allanvar_first_nonfinite`, x)
 }
 
-dynamic_sums_cpp <- function(x, y, rate, m, nterms, kind, step, nwin, threads) {
-    .Call(`_allanvar_dynamic_sums_cpp`, x, y, rate, m, nterms, kind, step, nwin, threads)
+dynamic_sums_cpp <- function(x, y, m, nterms, options) {
+    .Call(`_allanvar_dynamic_sums_cpp`, x, y, m, nterms, options)
 }
 
 allan_edf_cpp <- function(type, m, n, L, alpha, exact) {

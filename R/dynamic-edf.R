@@ -105,9 +105,11 @@ gh_edf1 <- function(alpha, d, m, L, overlapping, modified) {
 # EDF for every cluster size in m (rows) and noise exponent in `alphas`
 # (columns) of estimator `type` on L phase points.
 greenhall_edf <- function(type, m, L, alphas) {
-  d <- if (type %in% c("hadamard", "ohadamard")) 3 else 2
-  ov <- type %in% c("overlapping", "modified", "ohadamard")
-  mod <- type == "modified"
+  tab <- allan_type_table()
+  e <- tab[match(type, tab$name), ]
+  d <- e$d
+  ov <- e$overlapping
+  mod <- e$modified
   out <- matrix(NA_real_, length(m), length(alphas),
                 dimnames = list(NULL, alphas))
   for (j in seq_along(alphas)) {

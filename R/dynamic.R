@@ -130,8 +130,7 @@ dynamic_allan <- function(x, freq, window = NULL, step = NULL, taus = "octave",
                           "ohadamard")) -4 else -2, 2, integer = TRUE)
   }
   nt <- dyn_nterms(type, m, Lw)
-  sums <- dynamic_sums_cpp(x, NULL, rate, m, nt, dyn_type_code(type), S,
-                           nwin, allanvar_threads())
+  sums <- dynamic_sums_cpp(x, NULL, m, nt, dyn_opts(type, rate, S, nwin))
   avar <- sweep(sums, 2L, dyn_norm(type, m) * nt, "/") *
     (if (rate) 1 else freq^2)
   avar[avar < 0] <- 0  # a sum of squares; guards the last bit only
@@ -148,12 +147,14 @@ dynamic_allan <- function(x, freq, window = NULL, step = NULL, taus = "octave",
     class = "allan_dynamic")
 }
 
+# The types with a windowed kernel: every type of allan() but "total".
 dyn_types <- c("overlapping", "standard", "modified", "hadamard", "ohadamard")
 
-# The kernel's code for each type (enum Kind in src/dynamic.cpp).
-dyn_type_code <- function(type) {
-  match(type, c("standard", "overlapping", "modified", "hadamard",
-                "ohadamard")) - 1L
+# The options the windowed-sums kernel reads (src/opts-dynamic.h); type codes
+# from the estimator table of src/types.h.
+dyn_opts <- function(type, rate, step, nwin, threads = allanvar_threads()) {
+  list(type = allan_type_code(type), rate = isTRUE(rate), step = step,
+       nwin = nwin, threads = as.integer(threads))
 }
 
 # Largest cluster size with a term in L phase points, and the number of

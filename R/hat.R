@@ -189,9 +189,8 @@ groslambert <- function(x, freq, pairs = NULL, taus = "octave",
   norm <- dyn_norm(type, m) * nt / (if (rate) 1 else attr(av, "freq")^2)
   out <- lapply(cmp$sources, function(src) {
     r <- hat_roles(cmp, src)
-    sums <- dynamic_sums_cpp(cmp$values[, r$i], cmp$values[, r$j], rate, m,
-                             nt, dyn_type_code(type), 1, 1,
-                             allanvar_threads())
+    sums <- dynamic_sums_cpp(cmp$values[, r$i], cmp$values[, r$j], m, nt,
+                             dyn_opts(type, rate, step = 1, nwin = 1))
     g <- r$sign * as.vector(sums) / norm
     pos <- pmax(g, 0)
     v <- (S[, r$i] * S[, r$j] + pos^2) / sqrt(nu[, r$i] * nu[, r$j])

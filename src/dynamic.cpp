@@ -16,7 +16,9 @@
 // (|lo| <= q/2) carries the remainder. The running sums are kept as a pair
 // (sum, compensation), so a quiet window after a loud stretch keeps its
 // digits.
+#include "opts-dynamic.h"
 #include "parallel.h"
+#include "types.h"
 #include <Rcpp.h>
 #include <algorithm>
 #include <cmath>
@@ -28,8 +30,6 @@
 #endif
 
 namespace {
-
-enum Kind { STANDARD = 0, OVERLAPPING, MODIFIED, HADAMARD, OHADAMARD };
 
 // a + b = s + e exactly (Knuth's TwoSum).
 inline void two_sum(double a, double b, double& s, double& e) {
@@ -227,10 +227,10 @@ void add_terms(const Source& src, R_xlen_t k0, R_xlen_t count, R_xlen_t st,
   }
 }
 
-void add_range(int kind, bool cross, const Source& src, R_xlen_t k0,
+// Order-3 differences: the Hadamard types, and the modified type on Q.
+void add_range(bool third, bool cross, const Source& src, R_xlen_t k0,
                R_xlen_t count, R_xlen_t st, R_xlen_t m, Pair& acc) {
   if (count <= 0) return;
-  const bool third = kind != STANDARD && kind != OVERLAPPING;
   if (third) {
     if (cross) add_terms<3, true>(src, k0, count, st, m, acc);
     else add_terms<3, false>(src, k0, count, st, m, acc);
@@ -262,15 +262,21 @@ const R_xlen_t kChunk = R_xlen_t(1) << 18;
 // For each window w (start sample w * step, terms `nterms[t]` per window for
 // cluster size m[t]) and each m, the sum of the squared differences of `x`,
 // or, with `y`, of the products of the differences of x and y. Returns an
-// nwin x length(m) matrix. Input is checked in R (finite, long enough).
-// [[Rcpp::export]]
-Rcpp::NumericMatrix dynamic_sums_cpp(Rcpp::NumericVector x, SEXP y, bool rate,
-                                     Rcpp::NumericVector m,
-                                     Rcpp::NumericVector nterms, int kind,
-                                     double step, double nwin, int threads) {
+// nwin x length(m) matrix. Input is checked in R (finite, long enough);
+// `options` from dyn_opts() (R/dynamic.R).
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericMatrix dynamic_sums_cpp(const Rcpp::NumericVector& x, SEXP y,
+                                     const Rcpp::NumericVector& m,
+                                     const Rcpp::NumericVector& nterms,
+                                     const Rcpp::List& options) {
+  const allanvar::DynamicOptions opts = allanvar::dynamic_options(options);
+  const allanvar::EstimatorInfo& info = allanvar::estimator_info(opts.type);
   const R_xlen_t n = x.size();
   const bool cross = !Rf_isNull(y);
-  const bool second = kind == MODIFIED;
+  const bool rate = opts.rate;
+  const bool second = info.modified;
+  // the modified variance is an order-3 difference of Q (see diff())
+  const bool third = info.d == 3 || info.modified;
   Grid X1, Q1, X2, Q2;
   build_phase(x.begin(), n, rate, second, X1, Q1);
   Source src{nullptr, nullptr, nullptr, nullptr};
@@ -279,15 +285,16 @@ Rcpp::NumericMatrix dynamic_sums_cpp(Rcpp::NumericVector x, SEXP y, bool rate,
   src.l1 = g1.lo.data();
   if (cross) {
     Rcpp::NumericVector yy(y);
+    if (yy.size() != n) Rcpp::stop("internal: x and y differ in length");
     build_phase(yy.begin(), n, rate, second, X2, Q2);
     const Grid& g2 = second ? Q2 : X2;
     src.h2 = g2.hi.data();
     src.l2 = g2.lo.data();
   }
   const R_xlen_t ntau = m.size();
-  const R_xlen_t nw = static_cast<R_xlen_t>(nwin);
-  const R_xlen_t stp = static_cast<R_xlen_t>(step);
-  const bool strided = kind == STANDARD || kind == HADAMARD;
+  const R_xlen_t nw = opts.nwin;
+  const R_xlen_t stp = opts.step;
+  const bool strided = !info.overlapping;
 
   // Streams and their chunks.
   std::vector<Group> groups;
@@ -342,7 +349,8 @@ Rcpp::NumericMatrix dynamic_sums_cpp(Rcpp::NumericVector x, SEXP y, bool rate,
   std::vector<R_xlen_t> chunk_a(nw * ntau), chunk_b(nw * ntau);
 
   allanvar::parallel_for(
-      static_cast<R_xlen_t>(items.size()), threads, [&](R_xlen_t it, int) {
+      static_cast<R_xlen_t>(items.size()), opts.threads,
+      [&](R_xlen_t it, int) {
         const Item& item = items[it];
         const Group& g = groups[item.group];
         const R_xlen_t G = static_cast<R_xlen_t>(g.win.size());
@@ -366,7 +374,7 @@ Rcpp::NumericMatrix dynamic_sums_cpp(Rcpp::NumericVector x, SEXP y, bool rate,
           if (ia == ib && next == na) {
             j = next;
           } else {
-            add_range(kind, cross, src, g.r + j * g.st, next - j, g.st, g.m,
+            add_range(third, cross, src, g.r + j * g.st, next - j, g.st, g.m,
                       acc);
             j = next;
           }
@@ -385,8 +393,8 @@ Rcpp::NumericMatrix dynamic_sums_cpp(Rcpp::NumericVector x, SEXP y, bool rate,
         }
         // the rest of the chunk, unless no window is open
         if (ia != ib) {
-          add_range(kind, cross, src, g.r + j * g.st, item.j1 - j, g.st, g.m,
-                    acc);
+          add_range(third, cross, src, g.r + j * g.st, item.j1 - j, g.st,
+                    g.m, acc);
         }
         total[it] = acc;
       });
