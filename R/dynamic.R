@@ -126,8 +126,8 @@ dynamic_allan <- function(x, freq, window = NULL, step = NULL, taus = "octave",
   maxm <- dyn_max_m(type, Lw)
   m <- dyn_taus(taus, freq, maxm)
   if (!is.null(alpha)) {
-    alpha <- check_number(alpha, "alpha", if (type %in% c("hadamard",
-                          "ohadamard")) -4 else -2, 2, integer = TRUE)
+    alpha <- check_number(alpha, "alpha", min(dyn_alphas(type)), 2,
+                          integer = TRUE)
   }
   nt <- dyn_nterms(type, m, Lw)
   sums <- dynamic_sums_cpp(x, NULL, m, nt, dyn_opts(type, rate, S, nwin))
@@ -155,6 +155,13 @@ dyn_types <- c("overlapping", "standard", "modified", "hadamard", "ohadamard")
 dyn_opts <- function(type, rate, step, nwin, threads = allanvar_threads()) {
   list(type = allan_type_code(type), rate = isTRUE(rate), step = step,
        nwin = nwin, threads = as.integer(threads))
+}
+
+# The noise exponents an estimator of difference order d resolves
+# (alpha + 2 d > 1).
+dyn_alphas <- function(type) {
+  tab <- allan_type_table()
+  if (tab$d[match(type, tab$name)] == 3L) -4:2 else -2:2
 }
 
 # Largest cluster size with a term in L phase points, and the number of
@@ -242,7 +249,7 @@ dyn_taus <- function(taus, freq, maxm) {
 # window's slope at long tau, from a few degrees of freedom, misreads it
 # too often to choose an EDF).
 dyn_edf <- function(type, m, L, avar, alpha, conf) {
-  alphas <- if (type %in% c("hadamard", "ohadamard")) -4:2 else -2:2
+  alphas <- dyn_alphas(type)
   tab <- greenhall_edf(type, m, L, alphas)
   tab[!is.finite(tab) | tab <= 0] <- NA
   nt <- length(m)
