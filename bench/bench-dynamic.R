@@ -97,4 +97,5 @@ cat(sprintf("load average at the end: %s\n",
             tryCatch(paste(scan("/proc/loadavg", what = "", n = 3,
                                 quiet = TRUE), collapse = " "),
                      error = function(e) "n/a")))
+options(width = 150)
 print(out, row.names = FALSE)
