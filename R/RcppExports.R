@@ -37,6 +37,10 @@ first_nonfinite <- function(x) {
     .Call(`_allanvar_first_nonfinite`, x)
 }
 
+dynamic_sums_cpp <- function(x, y, m, nterms, options) {
+    .Call(`_allanvar_dynamic_sums_cpp`, x, y, m, nterms, options)
+}
+
 allan_edf_cpp <- function(type, m, n, L, alpha, exact) {
     .Call(`_allanvar_allan_edf_cpp`, type, m, n, L, alpha, exact)
 }

@@ -124,6 +124,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// dynamic_sums_cpp
+Rcpp::NumericMatrix dynamic_sums_cpp(const Rcpp::NumericVector& x, SEXP y, const Rcpp::NumericVector& m, const Rcpp::NumericVector& nterms, const Rcpp::List& options);
+RcppExport SEXP _allanvar_dynamic_sums_cpp(SEXP xSEXP, SEXP ySEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP optionsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type nterms(ntermsSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type options(optionsSEXP);
+    rcpp_result_gen = Rcpp::wrap(dynamic_sums_cpp(x, y, m, nterms, options));
+    return rcpp_result_gen;
+END_RCPP
+}
 // allan_edf_cpp
 Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m, const Rcpp::NumericVector& n, double L, const Rcpp::IntegerVector& alpha, const Rcpp::LogicalVector& exact);
 RcppExport SEXP _allanvar_allan_edf_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP LSEXP, SEXP alphaSEXP, SEXP exactSEXP) {
@@ -172,6 +186,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
+    {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
     {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 0},
