@@ -49,7 +49,7 @@ mcap_tables <- function(buf, recs) {
   })
   counts <- numeric()
   for (k in which(recs$op == 0x0BL)) {
-    at <- recs$off[k] + 1 + 46  # after the fixed fields of Statistics
+    at <- recs$off[k] + 1 + 42  # after the 42 bytes of fixed fields of Statistics
     len <- raw_u32(buf, at)
     for (e in seq_len(len %/% 10)) {
       p <- at + 4 + 10 * (e - 1)

@@ -25,9 +25,9 @@ imu_topics <- function(file) {
   check_file(file)
   fmt <- detect_format(file)
   switch(fmt,
-    rosbag = bag_scan(file)$topics,
-    mcap = mcap_scan(file)$topics,
-    db3 = db3_topics(file),
+    rosbag = ros_call(bag_scan(file)$topics, file),
+    mcap = ros_call(mcap_scan(file)$topics, file),
+    db3 = ros_call(db3_topics(file), file),
     abort("\"", basename(file), "\" is not a ROS bag (format 2.0), a rosbag2 ",
           "db3 or an MCAP file.", class = "file_format"))
 }
@@ -73,11 +73,21 @@ select_topic <- function(topics, topic, file) {
 }
 
 read_ros_imu <- function(file, fmt, topic, columns, units, progress) {
-  got <- switch(fmt,
+  got <- ros_call(switch(fmt,
     rosbag = bag_read_imu(file, topic, progress),
     mcap = mcap_read_imu(file, topic, progress),
-    db3 = db3_read_imu(file, topic, progress))
+    db3 = db3_read_imu(file, topic, progress)), file)
   ros_source(got, columns, units)
+}
+
+# Malformed files: the decoders' messages (which say what and where) as
+# classed errors naming the file.
+ros_call <- function(expr, file) {
+  tryCatch(expr, error = function(e) {
+    if (inherits(e, "allanvar_error")) stop(e)
+    abort("\"", basename(file), "\" is malformed: ", conditionMessage(e),
+          class = "file_format")
+  })
 }
 
 # The decoded table (columns sec, nsec, wx, wy, wz, ax, ay, az, recv_sec,
