@@ -7,7 +7,6 @@ read_csv_imu <- function(file, time, time_unit, columns, units, sep, dec,
   first <- readLines(file, n = 1L, warn = FALSE)
   if (!length(first)) abort("`file` \"", file, "\" is empty.", class = "file")
   problems <- empty_problems()
-  first <- sub("^\ufeff", "", first)
   fields <- split_fields(first, sep)
   if (!all(validUTF8(fields))) {
     # A byte that is not UTF-8: kept visible as <xx> so that names still work.
@@ -280,10 +279,21 @@ abort_column_text <- function(file, name, value, line, j, n_bad, n, sep) {
         encodeString(value, quote = "\""), ").", hint, class = "file_values")
 }
 
+# Fields of the header line, split byte-wise so that a byte that is not
+# UTF-8 stays in its own field (the caller reports it).
 split_fields <- function(line, sep) {
-  f <- if (identical(sep, "")) strsplit(trimws(line), "[[:space:]]+")[[1L]]
-  else trimws(strsplit(line, sep, fixed = TRUE)[[1L]])
-  gsub("^[\"']|[\"']$", "", f)
+  line <- sub("^\xef\xbb\xbf", "", line, useBytes = TRUE)   # UTF-8 BOM
+  f <- if (identical(sep, "")) {
+    strsplit(line, "[ \t]+", useBytes = TRUE)[[1L]]
+  } else {
+    strsplit(line, sep, fixed = TRUE, useBytes = TRUE)[[1L]]
+  }
+  f <- f[nzchar(f) | !identical(sep, "")]
+  f <- gsub("^[ \t\r]+|[ \t\r]+$", "", f, useBytes = TRUE)
+  f <- gsub("^[\"']|[\"']$", "", f, useBytes = TRUE)
+  ok <- validUTF8(f)
+  Encoding(f[ok]) <- "UTF-8"
+  f
 }
 
 clean_names <- function(x) {
