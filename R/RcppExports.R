@@ -73,6 +73,14 @@ int64_to_double <- function(x) {
     .Call(`_allanvar_int64_to_double`, x)
 }
 
+col_first_nonfinite <- function(x) {
+    .Call(`_allanvar_col_first_nonfinite`, x)
+}
+
+col_block_avar <- function(x, j, m) {
+    .Call(`_allanvar_col_block_avar`, x, j, m)
+}
+
 decode_imu_blobs <- function(blobs, encoding, recv_ns) {
     .Call(`_allanvar_decode_imu_blobs`, blobs, encoding, recv_ns)
 }

@@ -134,7 +134,9 @@ read_csv_imu <- function(file, time, time_unit, columns, units, sep, dec,
   if (!is.null(time_col)) {
     tv <- num[[as.character(time_col)]]
     is64 <- inherits(tv, "integer64")
-    approx <- if (is64) int64_to_double(tv) else as.double(tv)
+    # The unit is guessed from the first stamps (and the last, for size).
+    probe <- c(utils::head(tv, 100001L), utils::tail(tv, 1L))
+    approx <- if (is64) int64_to_double(probe) else as.double(probe)
     integral <- is64 || is.integer(tv) ||
       isTRUE(all(approx == round(approx), na.rm = TRUE))
     declared <- time_unit
@@ -152,14 +154,14 @@ read_csv_imu <- function(file, time, time_unit, columns, units, sep, dec,
     }
     ok <- which(!is.na(approx))
     per_s <- c(s = 1, ms = 1e3, us = 1e6, ns = 1e9)[[time_unit]]
-    t_sec <- if (!length(ok)) approx else if (is64) {
-      int64_rel_seconds(tv, ok[1L], per_s)
+    t_sec <- if (!length(ok)) rep(NA_real_, length(tv)) else if (is64) {
+      int64_rel_seconds(tv, i0 <- probe_index(ok[1L], length(tv)), per_s)
     } else {
-      (approx - approx[ok[1L]]) / per_s
+      (as.double(tv) - as.double(tv[i0 <- probe_index(ok[1L], length(tv))])) / per_s
     }
     time_label <- list(what = sprintf("column %d %s", time_col, raw_names[time_col]),
                        unit = time_unit, declared = declared != "auto",
-                       line = lines[ok[1L]])
+                       line = lines[if (length(ok)) i0 else 1L])
   }
   list(x = x, time = t_sec, units = units, sensors = ch_sensor,
        units_assumed = assumed, problems = problems, lines = lines,
@@ -167,6 +169,9 @@ read_csv_imu <- function(file, time, time_unit, columns, units, sep, dec,
 }
 
 csv_na_strings <- c("NA", "NaN", "nan", "")
+
+# Position in the full column of element i of c(head(v, 100001), tail(v, 1)).
+probe_index <- function(i, n) if (i <= min(100001L, n)) i else n
 
 # The selected columns of the file as a list, with the line number of each
 # row. Fast path: fread. When fread stops early, or the file's rows do not

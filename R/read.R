@@ -418,8 +418,8 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
   miss <- logical(nrow(x))
   inf <- logical(nrow(x))
   first_miss <- first_inf <- NULL
-  for (j in seq_len(ncol(x))) {
-    if (first_nonfinite(x[, j]) == 0) next
+  nonfinite <- col_first_nonfinite(x)
+  for (j in which(nonfinite > 0)) {
     v <- x[, j]
     m <- is.na(v)
     f <- is.infinite(v)

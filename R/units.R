@@ -293,8 +293,7 @@ check_gyro_noise <- function(x, sensors, units, freq, checks, source,
   if (k < 10L) return(checks)
   msgs <- character()
   for (j in gy) {
-    mm <- .colMeans(x[seq_len(k * m), j], m, k)
-    av <- 0.5 * mean(diff(mm)^2)
+    av <- col_block_avar(x, j, m)
     N <- sqrt(av * m / freq) * to_dph
     if (!is.finite(N) || N == 0) next
     checks$evidence[j] <- sprintf("N ~ %.3g deg/sqrt(h) from ADEV at %.3g s", N, m / freq)

@@ -239,6 +239,28 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// col_first_nonfinite
+Rcpp::NumericVector col_first_nonfinite(const Rcpp::NumericMatrix& x);
+RcppExport SEXP _allanvar_col_first_nonfinite(SEXP xSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type x(xSEXP);
+    rcpp_result_gen = Rcpp::wrap(col_first_nonfinite(x));
+    return rcpp_result_gen;
+END_RCPP
+}
+// col_block_avar
+double col_block_avar(const Rcpp::NumericMatrix& x, int j, double m);
+RcppExport SEXP _allanvar_col_block_avar(SEXP xSEXP, SEXP jSEXP, SEXP mSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< int >::type j(jSEXP);
+    Rcpp::traits::input_parameter< double >::type m(mSEXP);
+    rcpp_result_gen = Rcpp::wrap(col_block_avar(x, j, m));
+    return rcpp_result_gen;
+END_RCPP
+}
 // decode_imu_blobs
 Rcpp::NumericMatrix decode_imu_blobs(const Rcpp::List& blobs, int encoding, const Rcpp::NumericVector& recv_ns);
 RcppExport SEXP _allanvar_decode_imu_blobs(SEXP blobsSEXP, SEXP encodingSEXP, SEXP recv_nsSEXP) {
@@ -330,6 +352,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
     {"_allanvar_int64_rel_seconds", (DL_FUNC) &_allanvar_int64_rel_seconds, 3},
     {"_allanvar_int64_to_double", (DL_FUNC) &_allanvar_int64_to_double, 1},
+    {"_allanvar_col_first_nonfinite", (DL_FUNC) &_allanvar_col_first_nonfinite, 1},
+    {"_allanvar_col_block_avar", (DL_FUNC) &_allanvar_col_block_avar, 3},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},

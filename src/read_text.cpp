@@ -2,6 +2,7 @@
 // with the wrong number of fields, and exact integer timestamps.
 #include <Rcpp.h>
 #include <cstdint>
+#include <cmath>
 #include <cstring>
 
 // Lines of a delimited text whose number of fields differs from `expected`
@@ -75,4 +76,44 @@ Rcpp::NumericVector int64_to_double(const Rcpp::NumericVector& x) {
     out[i] = (v == INT64_MIN) ? NA_REAL : static_cast<double>(v);
   }
   return out;
+}
+
+// 1-based row of the first NA, NaN or infinite value of each column of a
+// matrix (0 when a column is all finite), without copying the columns.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector col_first_nonfinite(const Rcpp::NumericMatrix& x) {
+  const R_xlen_t n = x.nrow();
+  const int p = x.ncol();
+  Rcpp::NumericVector out(p);
+  for (int j = 0; j < p; ++j) {
+    const double* v = &x[static_cast<R_xlen_t>(j) * n];
+    out[j] = 0;
+    for (R_xlen_t i = 0; i < n; ++i) {
+      if (!std::isfinite(v[i])) {
+        out[j] = static_cast<double>(i + 1);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+// Column j (1-based) of x: the mean of each of the k = n %/% m clusters of
+// m samples, then the non-overlapping Allan variance of those means
+// (IEEE Std 952, eq. C.2), for the unit plausibility checks (R/units.R).
+// [[Rcpp::export(rng = false)]]
+double col_block_avar(const Rcpp::NumericMatrix& x, int j, double m) {
+  const R_xlen_t n = x.nrow();
+  const R_xlen_t mm = static_cast<R_xlen_t>(m);
+  const R_xlen_t k = n / mm;
+  const double* v = &x[static_cast<R_xlen_t>(j - 1) * n];
+  double prev = 0, s = 0;
+  for (R_xlen_t c = 0; c < k; ++c) {
+    double a = 0;
+    for (R_xlen_t i = c * mm; i < (c + 1) * mm; ++i) a += v[i];
+    a /= m;
+    if (c > 0) s += (a - prev) * (a - prev);
+    prev = a;
+  }
+  return k > 1 ? 0.5 * s / static_cast<double>(k - 1) : NA_REAL;
 }
