@@ -98,6 +98,7 @@ bag_read_imu <- function(file, topic, progress) {
   s <- bag_scan(file)
   topic <- select_topic(s$topics, topic, file)
   ids <- as.integer(s$conns$conn[s$conns$topic == topic])
+  if (!is.null(progress)) progress("decoding chunks")
   parts <- vector("list", nrow(s$chunks))
   bad <- 0
   for (k in seq_len(nrow(s$chunks))) {

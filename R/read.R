@@ -159,7 +159,7 @@ read_imu <- function(file, time = NULL,
     abort("`topic` must be a single topic name, not ", describe_type(topic),
           ".", class = "argument")
   }
-  p <- read_progress(3L)
+  p <- read_progress(4L)
   fmt <- detect_format(file)
   src <- if (fmt == "text") {
     read_csv_imu(file, time, time_unit, columns, units, sep, dec, sensors,

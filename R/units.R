@@ -258,7 +258,11 @@ check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
           evidence[acc] <- paste0(evidence[acc], ": looks like ", hit)
         }
       } else if (length(hit)) {
-        src[acc] <- if (assumed) "gravity" else src[acc]
+        if (assumed) {
+          src[acc] <- "gravity"
+          said <- sprintf("accelerometers in %s, as gravity confirms (|mean a| = %.5g)",
+                          hit, r)
+        }
         evidence[acc] <- paste0(evidence[acc], " (gravity)")
       }
     }
@@ -267,7 +271,7 @@ check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
     message(basename(source), ": no units given; assuming rad/s for ",
             "gyroscopes", if (is.null(said)) " and m/s^2 for accelerometers",
             " (set `units`)", if (!is.null(said)) paste0("; ", said), ".")
-  } else if (!is.null(said)) {
+  } else if (!is.null(said) && any(src == "gravity" & units != "m/s^2")) {
     message(basename(source), ": ", said, ".")
   }
   list(units = units,
@@ -281,6 +285,9 @@ check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
 # span about 1e-4 deg/sqrt(h) (navigation grade) to a few deg/sqrt(h)
 # (consumer MEMS); outside 1e-5..60 the unit is almost surely wrong.
 gyro_noise_range <- c(1e-5, 60)
+# A static gyro reads its bias plus Earth's rate (7.3e-5 rad/s): MEMS biases
+# reach a few deg/s, never 1 rad/s (57 deg/s).
+gyro_mean_limit <- 1
 
 check_gyro_noise <- function(x, sensors, units, freq, checks, source,
                              assumed = FALSE) {
@@ -296,16 +303,22 @@ check_gyro_noise <- function(x, sensors, units, freq, checks, source,
     av <- col_block_avar(x, j, m)
     N <- sqrt(av * m / freq) * to_dph
     if (!is.finite(N) || N == 0) next
-    checks$evidence[j] <- sprintf("N ~ %.3g deg/sqrt(h) from ADEV at %.3g s", N, m / freq)
-    if (N > gyro_noise_range[2L] || N < gyro_noise_range[1L]) {
+    mean_rate <- abs(mean(x[, j]))
+    checks$evidence[j] <- sprintf("N ~ %.3g deg/sqrt(h) from ADEV at %.3g s; |mean| %.3g rad/s",
+                                  N, m / freq, mean_rate)
+    if (N > gyro_noise_range[2L] || N < gyro_noise_range[1L] ||
+        mean_rate > gyro_mean_limit) {
       cur <- lookup_unit(units[[j]], sensor = "gyro", kind = "rate")$to_si
       cand <- c("deg/s", "rad/s", "deg/h", "mrad/s")
       f <- vapply(cand, function(u) lookup_unit(u, sensor = "gyro", kind = "rate")$to_si, 0)
       alt <- N * f / cur
       ok <- cand[alt >= 1e-4 & alt <= 30 & cand != units[[j]]]
       checks$evidence[j] <- paste0(checks$evidence[j], ": implausible")
-      msgs <- c(msgs, sprintf("%s: white noise N ~ %.3g deg/sqrt(h) if the samples are %s%s",
-                              colnames(x)[j], N, units[[j]],
+      msgs <- c(msgs, sprintf("%s: white noise N ~ %.3g deg/sqrt(h)%s if the samples are %s%s",
+                              colnames(x)[j], N,
+                              if (mean_rate > gyro_mean_limit)
+                                sprintf(" and a mean rate of %.3g rad/s", mean_rate) else "",
+                              units[[j]],
                               if (length(ok)) sprintf("; as %s it would be %.3g", ok[1L],
                                                       alt[match(ok[1L], cand)]) else ""))
       attr(msgs, "alt") <- c(attr(msgs, "alt"), if (length(ok)) ok[1L])
@@ -315,7 +328,8 @@ check_gyro_noise <- function(x, sensors, units, freq, checks, source,
     alt <- attr(msgs, "alt")
     warn(source, ": the gyroscope units look wrong (real gyros span ",
          gyro_noise_range[1L], " to ", gyro_noise_range[2L],
-         " deg/sqrt(h) of white noise):\n", paste0("  - ", msgs, collapse = "\n"),
+         " deg/sqrt(h) of white noise, and a static one reads less than ",
+         gyro_mean_limit, " rad/s):\n", paste0("  - ", msgs, collapse = "\n"),
          if (length(alt)) paste0("\nGive units = c(gyro = \"", alt[1L], "\") ",
                                  "(CLI: --gyro-units ", alt[1L], ") if they are ",
                                  alt[1L], "."),

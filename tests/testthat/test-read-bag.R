@@ -69,3 +69,19 @@ test_that("the LZ4 frame decoder inverts the reference lz4 tool", {
   }
   expect_error(allanvar:::lz4_decompress_cpp(as.raw(1:10), 0), "lz4")
 })
+
+test_that("long reads report progress through progressr, and only when asked", {
+  f <- ros_fixture("imu_lz4.bag")
+  steps <- character()
+  record <- function(p) steps <<- c(steps, p$message)
+  withr_opt <- options(progressr.enable = TRUE)
+  on.exit(options(withr_opt))
+  withCallingHandlers(
+    progressr::with_progress(read_imu(f, topic = "/imu0"),
+                             handlers = progressr::handler_void()),
+    progression = record)
+  expect_true(all(c("scanning the bag", "decoding chunks",
+                    "checking stamps and units") %in% steps))
+  # no handler: nothing printed
+  expect_silent(read_imu(f, topic = "/imu0"))
+})
