@@ -45,7 +45,7 @@ u32 <- function(x) {
 }
 u64 <- function(x) {
   x <- as.numeric(x)
-  c(u32(x %% 2^32), u32(x %/% 2^32))
+  as.vector(rbind(matrix(u32(x %% 2^32), 4L), matrix(u32(x %/% 2^32), 4L)))
 }
 f64 <- function(x) writeBin(as.double(x), raw(), size = 8L, endian = "little")
 str32 <- function(s) c(u32(nchar(s, "bytes")), charToRaw(s))
@@ -142,13 +142,20 @@ write_ros1_bag <- function(file, topics, compression = "none", per_chunk = 2000L
     index <- list()
     for (k in unique(rows$k)) parts[[length(parts) + 1L]] <- conn_rec(topics[[k]])
     off <- sum(lengths(parts))
-    # message data records: header (op, conn, time) + data
-    recs <- lapply(seq_len(nrow(rows)), function(r) {
-      tp <- topics[[rows$k[r]]]
-      h <- bag_header_fields(op = u8(2), conn = u32(tp$conn),
-                             time = c(u32(rows$sec[r]), u32(rows$nsec[r])))
-      bag_record(h, tp$msgs[, rows$i[r]])
-    })
+    # message data records: header (op, conn, time) + data, built for all
+    # messages of a topic at once (fixed-size headers)
+    recs <- vector("list", nrow(rows))
+    for (k in unique(rows$k)) {
+      tp <- topics[[k]]
+      sel <- which(rows$k == k)
+      nm <- length(sel)
+      h <- rbind(matrix(c(u32(4), charToRaw("op="), u8(2), u32(9), charToRaw("conn="),
+                          u32(tp$conn), u32(13), charToRaw("time=")), 30L, nm),
+                 matrix(u32(as.vector(rbind(rows$sec[sel], rows$nsec[sel]))), 8L, nm))
+      body <- tp$msgs[, rows$i[sel], drop = FALSE]
+      m <- rbind(matrix(u32(38), 4L, nm), h, matrix(u32(nrow(body)), 4L, nm), body)
+      for (j in seq_len(nm)) recs[[sel[j]]] <- m[, j]
+    }
     lens <- lengths(recs)
     offs <- off + c(0, cumsum(lens))[seq_along(lens)]
     raw <- c(unlist(parts), unlist(recs))
@@ -213,11 +220,18 @@ write_mcap <- function(file, topics, compression = "", encoding = "cdr",
   for (cidx in unique(chunk_of)) {
     sel <- which(chunk_of == cidx)
     rows <- ord[sel, ]
-    recs <- lapply(seq_len(nrow(rows)), function(r) {
-      tp <- topics[[rows$k[r]]]
-      t <- ns[sel[r]]
-      mcap_rec(5, c(u16(tp$id), u32(rows$i[r] - 1), u64(t), u64(t), tp$msgs[, rows$i[r]]))
-    })
+    recs <- vector("list", nrow(rows))
+    for (k in unique(rows$k)) {
+      tp <- topics[[k]]
+      w <- which(rows$k == k)
+      nm <- length(w)
+      body <- tp$msgs[, rows$i[w], drop = FALSE]
+      t <- ns[sel[w]]
+      m <- rbind(matrix(c(u8(5), u64(22 + nrow(body)), u16(tp$id)), 11L, nm),
+                 matrix(u32(rows$i[w] - 1), 4L, nm),
+                 matrix(u64(t), 8L, nm), matrix(u64(t), 8L, nm), body)
+      for (j in seq_len(nm)) recs[[w[j]]] <- m[, j]
+    }
     pre <- if (first) c(unlist(lapply(topics, schema)), unlist(lapply(topics, channel)))
     first <- FALSE
     raw <- c(pre, unlist(recs))
@@ -243,6 +257,7 @@ write_mcap <- function(file, topics, compression = "", encoding = "cdr",
 # ---- rosbag2 SQLite --------------------------------------------------------
 
 write_db3 <- function(file, topics) {
+  unlink(file)
   con <- DBI::dbConnect(RSQLite::SQLite(), file)
   on.exit(DBI::dbDisconnect(con))
   DBI::dbExecute(con, "CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL)")
