@@ -7,6 +7,8 @@
 #include "bytes.h"
 
 #include <Rcpp.h>
+#include <algorithm>
+#include <cstring>
 #include <string>
 
 namespace allanvar {
@@ -15,8 +17,16 @@ namespace {
 
 const std::uint32_t kFrameMagic = 0x184D2204u;
 
-void block_decode(const unsigned char* p, std::size_t n,
-                  std::vector<unsigned char>& out) {
+// Output buffer written through a raw pointer; grows geometrically.
+struct sink {
+  std::vector<unsigned char>& v;
+  std::size_t pos;
+  void need(std::size_t extra) {
+    if (v.size() - pos < extra) v.resize(std::max(v.size() * 2, pos + extra));
+  }
+};
+
+void block_decode(const unsigned char* p, std::size_t n, sink& out) {
   std::size_t i = 0;
   while (i < n) {
     const unsigned token = p[i++];
@@ -30,13 +40,15 @@ void block_decode(const unsigned char* p, std::size_t n,
       } while (b == 255);
     }
     if (lit > n - i) throw format_error("lz4: literals run past the block");
-    out.insert(out.end(), p + i, p + i + lit);
+    out.need(lit);
+    std::memcpy(out.v.data() + out.pos, p + i, lit);
+    out.pos += lit;
     i += lit;
     if (i == n) break;  // the last sequence has literals only
     if (n - i < 2) throw format_error("lz4: truncated match offset");
     const std::size_t offset = rd_u16(p + i);
     i += 2;
-    if (offset == 0 || offset > out.size()) {
+    if (offset == 0 || offset > out.pos) {
       throw format_error("lz4: match offset outside the decoded data");
     }
     std::size_t len = (token & 15u) + 4;
@@ -48,18 +60,33 @@ void block_decode(const unsigned char* p, std::size_t n,
         len += b;
       } while (b == 255);
     }
-    // Byte by byte: a match may overlap the bytes it produces.
-    std::size_t from = out.size() - offset;
-    out.reserve(out.size() + len);
-    for (std::size_t k = 0; k < len; ++k) out.push_back(out[from + k]);
+    out.need(len);
+    unsigned char* d = out.v.data() + out.pos;
+    const unsigned char* s = d - offset;
+    if (offset >= len) {
+      std::memcpy(d, s, len);
+    } else {
+      // Overlapping match: the bytes repeat with period `offset`; copy
+      // from a whole number of periods back, the span doubling each time.
+      std::size_t done = 0;
+      while (done < len) {
+        const std::size_t back = (done / offset + 1) * offset;
+        const std::size_t c = std::min(len - done, back);
+        std::memcpy(d + done, d + done - back, c);
+        done += c;
+      }
+      (void)s;
+    }
+    out.pos += len;
   }
 }
 
 }  // namespace
 
 void lz4_frame_decode(const unsigned char* src, std::size_t n,
-                      std::vector<unsigned char>& out, std::size_t expected) {
-  if (expected) out.reserve(out.size() + expected);
+                      std::vector<unsigned char>& dst, std::size_t expected) {
+  sink out{dst, dst.size()};
+  dst.resize(dst.size() + (expected ? expected : 4 * n + 64));
   std::size_t i = 0;
   while (i < n) {
     if (n - i < 4) throw format_error("lz4: truncated frame");
@@ -92,7 +119,9 @@ void lz4_frame_decode(const unsigned char* src, std::size_t n,
       const std::size_t size = word & 0x7FFFFFFFu;
       if (size > n - i) throw format_error("lz4: block runs past the data");
       if (word & 0x80000000u) {
-        out.insert(out.end(), src + i, src + i + size);
+        out.need(size);
+        std::memcpy(dst.data() + out.pos, src + i, size);
+        out.pos += size;
       } else {
         block_decode(src + i, size, out);
       }
@@ -104,6 +133,7 @@ void lz4_frame_decode(const unsigned char* src, std::size_t n,
       i += 4;
     }
   }
+  dst.resize(out.pos);
 }
 
 }  // namespace allanvar
