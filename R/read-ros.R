@@ -19,7 +19,7 @@ ros_channels <- c("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
 #' @export
 #' @examples
 #' f <- system.file("extdata", "imu_small.mcap", package = "allanvar")
-#' if (nzchar(f)) imu_topics(f)
+#' imu_topics(f)
 imu_topics <- function(file) {
   check_present(missing(file), "file", "the path of a ROS bag, db3 or MCAP file")
   check_file(file)
@@ -85,6 +85,10 @@ read_ros_imu <- function(file, fmt, topic, columns, units, progress) {
 ros_call <- function(expr, file) {
   tryCatch(expr, error = function(e) {
     if (inherits(e, "allanvar_error")) stop(e)
+    if (grepl("no zstd support", conditionMessage(e), fixed = TRUE)) {
+      abort("\"", basename(file), "\" has zstd-compressed chunks, but ",
+            sub("^zstd: ", "", conditionMessage(e)), ".", class = "dependency")
+    }
     abort("\"", basename(file), "\" is malformed: ", conditionMessage(e),
           class = "file_format")
   })

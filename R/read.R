@@ -80,9 +80,10 @@
 #'   or `FALSE` when there is none (then `freq` is required).
 #' @param time_unit Unit of the timestamps (text files). `"auto"` uses the
 #'   header (e.g. `[ns]`), then ns for the Kalibr layout (unless the stamps
-#'   clearly are not), then the magnitude of the stamps (absolute epochs:
-#'   > 1e17 ns, > 1e14 us, > 1e11 ms) or of the median step (< 0.5 s,
-#'   < 500 ms, < 5e5 us, else ns); the choice is reported in `time_unit`.
+#'   clearly are not), then the magnitude of the stamps (absolute epochs
+#'   above 1e17 are ns, above 1e14 us, above 1e11 ms) or of the median step
+#'   (below 0.5: s, below 500: ms, below 5e5: us, else ns); the choice is
+#'   reported in `time_unit`.
 #' @param columns Data columns: `NULL` for every recognized gyro/accel
 #'   column, or a character (names) or integer (indices) vector, optionally
 #'   named with the channel names to use (e.g.
@@ -130,6 +131,11 @@
 #' r <- read_imu(f)
 #' r
 #' unlink(f)
+#'
+#' # A ROS2 recording in MCAP (300 sensor_msgs/Imu messages at 200 Hz)
+#' bag <- system.file("extdata", "imu_small.mcap", package = "allanvar")
+#' imu_topics(bag)
+#' read_imu(bag, topic = "/imu0")
 read_imu <- function(file, time = NULL,
                      time_unit = c("auto", "s", "ns", "us", "ms"),
                      columns = NULL, units = NULL, sep = ",",

@@ -5,7 +5,7 @@ test_that("MCAP with uncompressed, lz4 and zstd chunks gives the CSV's record", 
   for (cmp in c("none", "lz4", "zstd", "ros1")) {
     if (cmp == "zstd" && !allanvar:::zstd_available_cpp()) {
       expect_error(read_imu(ros_fixture("imu_zstd.mcap"), topic = "/imu0"),
-                   "libzstd", class = "allanvar_error_file_format")
+                   "libzstd", class = "allanvar_error_dependency")
       next
     }
     r <- read_imu(ros_fixture(paste0("imu_", cmp, ".mcap")), topic = "/imu0")
