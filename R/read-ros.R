@@ -86,7 +86,7 @@ ros_call <- function(expr, file) {
   tryCatch(expr, error = function(e) {
     if (inherits(e, "allanvar_error")) stop(e)
     if (grepl("no zstd support", conditionMessage(e), fixed = TRUE)) {
-      abort("\"", basename(file), "\" has zstd-compressed chunks, but ",
+      abort("\"", basename(file), "\" has zstd-compressed chunks, but there is ",
             sub("^zstd: ", "", conditionMessage(e)), ".", class = "dependency")
     }
     abort("\"", basename(file), "\" is malformed: ", conditionMessage(e),

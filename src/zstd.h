@@ -1,4 +1,4 @@
-// zstd decompression through the system libzstd, when configure found it.
+// zstd decompression through the system libzstd, loaded at run time.
 #ifndef ALLANVAR_ZSTD_H
 #define ALLANVAR_ZSTD_H
 

@@ -39,3 +39,22 @@ test_that("zstd decoding matches the reference zstd tool", {
   expect_identical(allanvar:::zstd_decompress_cpp(readBin(o, "raw", file.size(o)),
                                                   length(x)), x)
 })
+
+test_that("without libzstd only zstd chunks are refused, saying what to install", {
+  skip_if_not_installed("callr")
+  skip_if_not(installed_allanvar(), "needs the installed package")
+  f <- normalizePath(ros_fixture("imu_zstd.mcap"))
+  g <- normalizePath(ros_fixture("imu_lz4.mcap"))
+  res <- callr::r(function(f, g) {
+    e <- tryCatch(allanvar::read_imu(f, topic = "/imu0"), error = function(e) e)
+    list(avail = allanvar:::zstd_available_cpp(), class = class(e),
+         msg = conditionMessage(e),
+         lz4 = nrow(allanvar::read_imu(g, topic = "/imu0")$data))
+  }, args = list(f = f, g = g), env = c(callr::rcmd_safe_env(),
+                                         ALLANVAR_DISABLE_ZSTD = "1"),
+  libpath = .libPaths())
+  expect_false(res$avail)
+  expect_true("allanvar_error_dependency" %in% res$class)
+  expect_match(res$msg, "libzstd")
+  expect_equal(res$lz4, 300L)
+})
