@@ -71,23 +71,33 @@ as_av_curve <- function(av, n = NULL, freq = NULL, type = NULL, channel = NULL) 
   if (!is.null(n)) n <- check_number(n, "n", lo = 2, integer = FALSE)
   edf <- NULL
   L <- NULL
-  if (inherits(av, "allan")) {
-    if ("channel" %in% names(av)) {
-      chans <- unique(av$channel)
-      if (is.null(channel)) {
-        if (length(chans) > 1L) {
-          abort("`av` holds ", length(chans), " channels (",
-                paste(chans, collapse = ", "), "); choose one with `channel`.",
-                class = "argument")
-        }
-        channel <- chans[1]
-      }
-      if (!channel %in% chans) {
-        abort("`channel` must be one of ", paste(chans, collapse = ", "), ".",
+  # A curve of several channels (allan() of a matrix, another tool's curve):
+  # one channel is fitted, never a mixture of them.
+  if (is.data.frame(av) && "channel" %in% names(av)) {
+    chans <- unique(as.character(av$channel))
+    if (is.null(channel)) {
+      if (length(chans) > 1L) {
+        abort("`av` holds ", length(chans), " channels (",
+              paste(chans, collapse = ", "), "); choose one with `channel`.",
               class = "argument")
       }
-      av <- av[av$channel == channel, , drop = FALSE]
+      channel <- chans[1]
     }
+    if (!is.character(channel) || length(channel) != 1L || !channel %in% chans) {
+      abort("`channel` must be one of ", paste(chans, collapse = ", "), ".",
+            class = "argument")
+    }
+    keep <- as.character(av$channel) == channel
+    av <- av[keep, , drop = FALSE]
+    if (anyDuplicated(av$tau[is.finite(av$tau)])) {
+      abort("`av` repeats averaging times within channel \"", channel,
+            "\": give one curve per channel.", class = "curve")
+    }
+  }
+  if (inherits(av, "tool_curve") && is.null(freq) && !is.null(attr(av, "freq"))) {
+    freq <- check_freq(attr(av, "freq"))
+  }
+  if (inherits(av, "allan")) {
     if (is.null(freq)) freq <- attr(av, "freq")
     if (is.null(n)) n <- attr(av, "N")
     if (is.null(type) && !is.null(attr(av, "type"))) type <- attr(av, "type")

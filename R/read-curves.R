@@ -39,10 +39,11 @@
 #'   older versions and the worst axis now; Kalibr's wiki says to inflate the
 #'   values for real use; neither is recorded in the file.
 #'
-#' A curve is a data frame of class `"av_curve"` with one row per channel and
-#' averaging time; give one channel's rows to [avfit()] with the number of
-#' samples and the rate (`n`, `freq`), which these files do not hold, e.g.
-#' `avfit(cv[cv$channel == "gyro_x", ], n = 1e6, freq = 200)`.
+#' A curve is a data frame of class `"tool_curve"` with one row per channel
+#' and averaging time; give it to [avfit()] or [as_av_curve()] with the
+#' channel, the number of samples and the rate (`channel`, `n`, `freq`),
+#' which these files do not hold, e.g.
+#' `avfit(cv, channel = "gyro_x", n = 1e6, freq = 200)`.
 #'
 #' @param file Path of the file.
 #' @param dir Directory holding imu_utils' `data_<name>_*.txt` files.
@@ -59,7 +60,7 @@
 #' @param scaled Whether `gyr_n`/`acc_n` are `sqrt(freq)` times N (`TRUE`,
 #'   imu_utils since May 2018) or N (`FALSE`); `NULL` decides from `curve`,
 #'   else assumes `TRUE`. The choice is in `attr(, "scaled")`.
-#' @return `read_avr_curve()`, `read_imu_utils_curve()`: an `"av_curve"` data
+#' @return `read_avr_curve()`, `read_imu_utils_curve()`: a `"tool_curve"` data
 #'   frame with columns `channel` (`gyro_x`, ..., `accel_z`), `sensor`,
 #'   `tau` (s), `adev` and `avar` (SI: rad/s, m/s^2) and `unit`, and
 #'   attributes `source` (the tool), `freq` (Hz or `NULL`), `file` and
@@ -104,7 +105,7 @@ read_avr_curve <- function(file) {
   long <- curve_long(tab[[1L]], as.matrix(tab[, 2:7]),
                      c("accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"),
                      to_si = c(1, 1, 1, deg, deg, deg))
-  new_av_curve(long, source = "allan_variance_ros", freq = NULL, file = file,
+  new_tool_curve(long, source = "allan_variance_ros", freq = NULL, file = file,
                conventions = c(
                  "Allan deviations (not variances), overlapping bins of 0.1 s to 1000 s",
                  "gyroscope columns in deg/s (rad/s * 180/pi), converted here with pi/180",
@@ -160,7 +161,7 @@ read_imu_utils_curve <- function(dir, name, fitted = FALSE) {
                           c("accel_x", "accel_y", "accel_z"), rep(1, 3))
   }
   tau1 <- if (!is.null(gyr)) gyr[[1L]][1L] else acc[[1L]][1L]
-  new_av_curve(do.call(rbind, parts), source = "imu_utils", freq = 1 / tau1,
+  new_tool_curve(do.call(rbind, parts), source = "imu_utils", freq = 1 / tau1,
                file = file.path(dir, sprintf("data_%s_*.txt", kind)),
                conventions = c(
                  "Allan deviations; gyroscope in deg/h with imu_utils' factor 57.3 * 3600 (converted back with it)",
@@ -174,7 +175,7 @@ read_imu_utils_curve <- function(dir, name, fitted = FALSE) {
 read_imu_utils_yaml <- function(file, freq = NULL, curve = NULL, scaled = NULL) {
   check_present(missing(file), "file", "the path of an imu_utils *_imu_param.yaml")
   y <- read_yaml_file(file)
-  if (!is.null(curve) && !inherits(curve, "av_curve")) {
+  if (!is.null(curve) && !inherits(curve, "tool_curve")) {
     abort("`curve` must be a read_imu_utils_curve() result, not ",
           describe_type(curve), ".", class = "argument")
   }
@@ -282,21 +283,21 @@ curve_long <- function(tau, dev, channels, to_si) {
              stringsAsFactors = FALSE)
 }
 
-new_av_curve <- function(d, source, freq, file, conventions) {
+new_tool_curve <- function(d, source, freq, file, conventions) {
   rownames(d) <- NULL
   d <- d[is.finite(d$tau) & d$tau > 0 & is.finite(d$adev), , drop = FALSE]
   attr(d, "source") <- source
   attr(d, "freq") <- freq
   attr(d, "file") <- file
   attr(d, "conventions") <- conventions
-  class(d) <- c("av_curve", "data.frame")
+  class(d) <- c("tool_curve", "data.frame")
   d
 }
 
 #' @export
-print.av_curve <- function(x, ...) {
+print.tool_curve <- function(x, ...) {
   ch <- unique(x$channel)
-  cat(sprintf("<av_curve> from %s: %d channel(s) (%s), %d averaging times from %.3g s to %.3g s\n",
+  cat(sprintf("<tool_curve> from %s: %d channel(s) (%s), %d averaging times from %.3g s to %.3g s\n",
               attr(x, "source"), length(ch), paste(ch, collapse = ", "),
               length(unique(x$tau)), min(x$tau), max(x$tau)))
   if (!is.null(attr(x, "freq"))) cat(sprintf("  sampling rate %.6g Hz\n", attr(x, "freq")))

@@ -44,7 +44,7 @@ test_that("imu_utils' fitted curve reads back to its yaml within 1%", {
   on.exit(unlink(d, recursive = TRUE))
   write_imu_utils(d)
   cv <- read_imu_utils_curve(d, "BMI160", fitted = TRUE)
-  expect_s3_class(cv, "av_curve")
+  expect_s3_class(cv, "tool_curve")
   expect_equal(attr(cv, "freq"), 1 / 0.005091714049)
   # deg/h back to rad/s with imu_utils' own 57.3
   expect_equal(cv$adev[cv$channel == "gyro_x"][1], 281.4451122 / (57.3 * 3600))
@@ -146,4 +146,22 @@ test_that("the published imu_utils files read back within 1% (optional)", {
     expect_equal(exp(ours), y$N[y$sensor == "gyro" & y$axis == "x"], tolerance = 0.3,
                  label = paste(name, "measured ADEV(1 s) vs gyr_n / sqrt(f)"))
   }
+})
+
+test_that("another tool's curve is fitted one channel at a time", {
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  tau <- 10^seq(-1, 2, by = 0.25)
+  N <- c(0.002, 0.003, 0.004, 0.01, 0.02, 0.03)  # accel m/s^2, gyro deg/s
+  write.table(cbind(tau, outer(1 / sqrt(tau), N)), f, row.names = FALSE,
+              col.names = FALSE)
+  cv <- read_avr_curve(f)
+  expect_error(avfit(cv, "N", n = 1e6, freq = 100), "choose one with `channel`",
+               class = "allanvar_error_argument")
+  fit <- avfit(cv, "N", channel = "gyro_y", n = 1e6, freq = 100)
+  # deg/s in the file, rad/s after reading: N = 0.02 deg/s*sqrt(s)
+  expect_equal(unname(coef(fit)["N"]), 0.02 * pi / 180, tolerance = 0.02)
+  expect_error(avfit(rbind(cv[cv$channel == "gyro_x", ], cv[cv$channel == "gyro_x", ]),
+                     "N", n = 1e6, freq = 100), "repeats averaging times",
+               class = "allanvar_error_curve")
 })
