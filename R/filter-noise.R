@@ -327,11 +327,12 @@ sim_circulant <- function(n, g) {
 
 # ---- raw-data evidence -------------------------------------------------------------
 
-# Sample autocorrelation at lags 0..max_lag by FFT (O(n log n)).
+# Sample autocorrelation at lags 0..max_lag by FFT (O(n log n)); zero
+# padding by max_lag is enough to keep the circular wrap off those lags.
 acf_lags <- function(x, max_lag) {
   n <- length(x)
   x <- x - mean(x)
-  nfft <- stats::nextn(2L * n)
+  nfft <- stats::nextn(n + max_lag + 1L)
   f <- stats::fft(c(x, numeric(nfft - n)))
   a <- Re(stats::fft(Mod(f)^2, inverse = TRUE))[seq_len(max_lag + 1L)] / nfft
   a / a[1L]
@@ -368,8 +369,12 @@ filter_start <- function(r1, family, freq) {
       list(fc = stats::uniroot(f, c(lo, hi), tol = 1e-8 * freq)$root)
     },
     bartlett = {
+      # two cascaded L-tap averages: triangular taps L - |k|, k = -(L-1)..L-1
       Ls <- 1:512
-      r <- vapply(Ls, function(L) filter_rho1(list(family = "bartlett", L = L, n = 2L), tau0), 0)
+      r <- vapply(Ls, function(L) {
+        h <- L - abs(seq.int(-(L - 1L), L - 1L))
+        sum(h[-1L] * h[-length(h)]) / sum(h^2)
+      }, 0)
       list(L = Ls[which.min(abs(r - r1))], n = 2L)
     },
     NULL)
@@ -413,7 +418,7 @@ filter_evidence <- function(x, freq, max_lag = 16L, base_lags = 24:48,
   # Roll-off of the periodogram: mean PSD in the top 5% of the band over the
   # mean PSD in [fs/25, fs/15] (white-dominated for sensors whose slow
   # processes sit below 1 Hz).
-  w <- welch_psd_lin(x, freq, seg = min(4096L, 2^floor(log2(n / 8))))
+  w <- welch_psd_lin(x, freq, seg = min(512L, 2^floor(log2(n / 8))))
   top <- w$f > 0.95 * freq / 2
   mid <- w$f > freq / 25 & w$f < freq / 15
   ratio <- mean(w$psd[top]) / mean(w$psd[mid])
@@ -444,7 +449,7 @@ welch_psd_lin <- function(x, freq, seg) {
     st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
     idx <- outer(seq_len(seg) - 1L, st, `+`)
     X <- matrix(x[idx], nrow = seg)
-    X <- sweep(X, 2L, colMeans(X)) * win
+    X <- (X - rep(colMeans(X), each = seg)) * win
     acc <- acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
   }
   k <- length(starts)
