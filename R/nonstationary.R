@@ -37,45 +37,63 @@ robust_d_scale <- function(d) sqrt(stats::median(d^2) / stats::qchisq(0.5, 1))
 #' Bias steps in a rate series (internal)
 #'
 #' Multi-scale search on block means (about `target_blocks` blocks): at
-#' each window of 2^j blocks the Allan differences at every split point are
-#' standardised by their robust scale; the largest |z| over scales and
-#' splits is a step when it exceeds the Bonferroni threshold
-#' \eqn{\Phi^{-1}(1 - \alpha / (2M))}, M the number of effectively
-#' independent windows (sum over scales of blocks / window). Its time is
-#' refined to the sample by the split maximising the difference of means
-#' over the window, its size is the difference of the means over the window
-#' on each side at the scale where the Allan variance is least (the most
-#' precise window the noise allows, kept within the neighbouring steps). The
-#' step is then removed and the search repeated (binary segmentation).
+#' each window of 2^j blocks (up to 1/64 of the record, so that the robust
+#' scale rests on at least 64 independent windows) the Allan differences at
+#' every split point are standardised by their robust scale; the largest
+#' |z| over scales and splits is a candidate when it exceeds the Bonferroni
+#' threshold \eqn{\Phi^{-1}(1 - \alpha / (2M))}, M the number of
+#' effectively independent windows (sum over scales of blocks / window).
+#' A step is sharp: the difference over a quarter of the detecting window
+#' keeps at least half of it (a ramp or a slow wander shrinks in proportion
+#' to the window and is not a step; its location is set aside and the
+#' search goes on). The time is refined to the sample by the split
+#' maximising the difference of means over the window, the size is the
+#' difference of the means over the window on each side at the scale where
+#' the Allan variance is least (the most precise window the noise allows,
+#' kept within the neighbouring steps). The step is then removed and the
+#' search repeated (binary segmentation).
+#'
+#' Two steps of opposite sign and similar size (ratio 1/3 to 3) less than
+#' `pulse_gap` seconds apart are a transient (a pulse or a shock that
+#' decays), not two bias steps: they are returned in attribute `pulses`
+#' (start, end, size) and left out of the steps.
 #' @return data.frame `index` (first sample after the step), `time` (s from
 #'   the first sample), `size` (rate unit), `se` (its standard error from
 #'   the Allan variance at the window used), `z` (detection statistic),
-#'   `window` (s).
+#'   `window` (s); attributes `pulses` (data.frame `start`, `end` (s),
+#'   `size`) and `rejected` (number of candidates that were not sharp).
 #' @noRd
 detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
-                         target_blocks = 20000L, min_window = 4L) {
+                         target_blocks = 20000L, min_window = 4L,
+                         pulse_gap = 120) {
   n <- length(x)
   tau0 <- 1 / freq
   b <- max(1L, n %/% target_blocks)
   y <- block_avg(x, b)
   nb <- length(y)
-  ws <- as.integer(2^(log2(min_window):floor(log2(nb / 8))))
-  ws <- ws[ws >= min_window]
   empty <- data.frame(index = integer(), time = numeric(), size = numeric(),
                       se = numeric(), z = numeric(), window = numeric())
+  attr(empty, "pulses") <- data.frame(start = numeric(), end = numeric(),
+                                      size = numeric())
+  attr(empty, "rejected") <- 0L
+  if (nb < 4L * 64L) return(empty)
+  ws <- as.integer(2^(ceiling(log2(min_window)):floor(log2(nb / 64))))
   if (!length(ws)) return(empty)
   M <- sum(nb / ws)
   zc <- stats::qnorm(1 - alpha / (2 * M))
   # Null scale at each window, from the series as given (robust to steps).
   scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w)), 0)
-  # Each step found is removed by its local size (the difference of the
-  # means over the least-noisy window on each side), not by segment means:
-  # under red noise a segment's mean is far from the level next to the step.
   v <- scale^2 / 2
   wbest <- ws[which.min(v)] * b
   idx <- integer(0)
   zs <- numeric(0)
   sizes <- numeric(0)
+  wins <- integer(0)
+  excluded <- logical(nb)
+  rejected <- 0L
+  # Each step found is removed by its local size (the difference of the
+  # means over the least-noisy window on each side), not by segment means:
+  # under red noise a segment's mean is far from the level next to the step.
   local_size <- function(xs, at, others) {
     bounds <- sort(c(1L, others, n + 1L))
     left <- max(bounds[bounds <= at - 1L])
@@ -83,33 +101,56 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     W <- max(1L, min(wbest, at - left, right - at))
     c(size = mean(xs[at:(at + W - 1L)]) - mean(xs[(at - W):(at - 1L)]), W = W)
   }
-  for (k in seq_len(max_steps)) {
+  for (k in seq_len(max_steps + 20L)) {
+    if (length(idx) >= max_steps) break
     xs <- remove_steps(x, data.frame(index = idx, size = sizes))
     r <- block_avg(xs, b)
     best <- list(z = 0)
     for (j in seq_along(ws)) {
       d <- allan_differences(r, ws[j])
       z <- d / scale[j]
+      z[excluded[ws[j]:(nb - ws[j])]] <- 0
       i <- which.max(abs(z))
-      if (abs(z[i]) > abs(best$z)) best <- list(z = z[i], i = i + ws[j] - 1L, j = j)
+      if (abs(z[i]) > abs(best$z)) best <- list(z = z[i], d = d[i], i = i + ws[j] - 1L, j = j)
     }
     if (abs(best$z) < zc) break
+    w <- ws[best$j]
+    # sharp or gradual: the difference over a quarter of the window
+    wq <- max(1L, w %/% 4L)
+    iq <- best$i
+    dq <- if (iq >= wq && iq + wq <= nb)
+      (sum(r[(iq + 1L):(iq + wq)]) - sum(r[(iq - wq + 1L):iq])) / wq else best$d
+    if (!(sign(dq) == sign(best$d) && abs(dq) >= 0.5 * abs(best$d))) {
+      rejected <- rejected + 1L
+      excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
+      next
+    }
     # refine to the sample: split maximising |difference of window means|
-    W <- ws[best$j] * b
+    W <- w * b
     lo <- max(W + 1L, (best$i - 1L) * b + 1L)
     hi <- min(n - W + 1L, (best$i + 1L) * b + 1L)
-    if (hi < lo) break
+    if (hi < lo) {
+      excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
+      next
+    }
     cs <- c(0, cumsum(xs))
     cand <- lo:hi
     dd <- (cs[cand + W] - 2 * cs[cand] + cs[cand - W]) / W
     at <- cand[which.max(abs(dd))]      # first sample after the step
-    if (any(abs(idx - at) < b)) break   # the same step again: nothing new
+    if (any(abs(idx - at) < b)) {       # the same step again: set aside
+      excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
+      next
+    }
     sz <- local_size(xs, at, idx)
     idx <- c(idx, at)
     zs <- c(zs, best$z)
     sizes <- c(sizes, sz[["size"]])
+    wins <- c(wins, W)
   }
-  if (!length(idx)) return(empty)
+  if (!length(idx)) {
+    attr(empty, "rejected") <- rejected
+    return(empty)
+  }
   o <- order(idx)
   idx <- idx[o]
   zs <- zs[o]
@@ -124,7 +165,30 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     data.frame(index = idx[k], time = (idx[k] - 1) * tau0, size = sz[["size"]],
                se = se, z = zs[k], window = W * tau0)
   })
-  do.call(rbind, rows)
+  out <- do.call(rbind, rows)
+  # opposite-sign pairs close together are transients
+  pulse <- rep(FALSE, nrow(out))
+  prow <- list()
+  k <- 1L
+  while (k < nrow(out)) {
+    a <- out[k, ]
+    c2 <- out[k + 1L, ]
+    ratio <- abs(c2$size / a$size)
+    if (sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
+        ratio > 1 / 3 && ratio < 3) {
+      pulse[c(k, k + 1L)] <- TRUE
+      prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,
+                                              size = a$size)
+      k <- k + 2L
+    } else {
+      k <- k + 1L
+    }
+  }
+  steps <- out[!pulse, , drop = FALSE]
+  rownames(steps) <- NULL
+  attr(steps, "pulses") <- if (length(prow)) do.call(rbind, prow) else attr(empty, "pulses")
+  attr(steps, "rejected") <- rejected
+  steps
 }
 
 # The series with the steps removed: each step's size subtracted from every

@@ -111,3 +111,25 @@ test_that("spikes inflate the short-tau Allan deviation; the correction removes 
   ref <- allan(x, 100, taus = ba$tau)$adev
   expect_equal(ba$adev_corrected, ref, tolerance = 1e-3)
 })
+
+test_that("a ramp is not a step, and a short pulse is a transient, not two steps", {
+  n <- 2e5
+  freq <- 100
+  x <- gen_base(n, seed = 12)
+  # a ramp of 0.3 over 300 s in the middle: significant at the longest
+  # windows, but a slow change, not a step
+  r <- x + 0.3 * pmin(pmax((seq_len(n) - 90000) / 30000, 0), 1)
+  st <- detect_steps(r, freq)
+  expect_equal(nrow(st), 0L)
+  expect_gte(attr(st, "rejected"), 1L)
+  # a pulse of 0.05 lasting 30 s
+  p <- x
+  p[80001:83000] <- p[80001:83000] + 0.05
+  st <- detect_steps(p, freq)
+  expect_equal(nrow(st), 0L)
+  pu <- attr(st, "pulses")
+  expect_equal(nrow(pu), 1L)
+  expect_equal(pu$start, 800, tolerance = 0.01)
+  expect_equal(pu$end, 830, tolerance = 0.01)
+  expect_equal(pu$size, 0.05, tolerance = 0.2)
+})
