@@ -43,10 +43,10 @@ robust_d_scale <- function(d) sqrt(stats::median(d^2) / stats::qchisq(0.5, 1))
 #' |z| over scales and splits is a candidate when it exceeds the Bonferroni
 #' threshold \eqn{\Phi^{-1}(1 - \alpha / (2M))}, M the number of
 #' effectively independent windows (sum over scales of blocks / window).
-#' A step is sharp: the difference over a quarter of the detecting window
-#' keeps at least half of it (a ramp or a slow wander shrinks in proportion
-#' to the window and is not a step; its location is set aside and the
-#' search goes on). The time is refined to the sample by the split
+#' A step is sharp: the differences over a half and a quarter of the
+#' detecting window keep its size (mean ratio at least 0.65; a ramp or a
+#' slow wander shrinks in proportion to the window, ratios 1/2 and 1/4, and
+#' is not a step; its location is set aside and the search goes on). The time is refined to the sample by the split
 #' maximising the difference of means over the window, the size is the
 #' difference of the means over the window on each side at the scale where
 #' the Allan variance is least (the most precise window the noise allows,
@@ -115,14 +115,19 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     }
     if (abs(best$z) < zc) break
     w <- ws[best$j]
-    # sharp or gradual: the difference over a quarter of the window
-    wq <- max(1L, w %/% 4L)
+    # sharp or gradual: the differences over a half and a quarter of the
+    # window keep the size of a step (ratios 1, 1) but shrink for a ramp
+    # (1/2, 1/4); a step needs their mean ratio >= 0.65
     iq <- best$i
-    dq <- if (iq >= wq && iq + wq <= nb)
-      (sum(r[(iq + 1L):(iq + wq)]) - sum(r[(iq - wq + 1L):iq])) / wq else best$d
-    if (!(sign(dq) == sign(best$d) && abs(dq) >= 0.5 * abs(best$d))) {
+    ratios <- vapply(c(2L, 4L), function(q) {
+      wq <- max(1L, w %/% q)
+      if (iq < wq || iq + wq > nb) return(1)
+      (sum(r[(iq + 1L):(iq + wq)]) - sum(r[(iq - wq + 1L):iq])) / wq / best$d
+    }, 0)
+    if (isTRUE(getOption("dbg"))) message(sprintf("cand i=%d w=%d z=%.1f ratios %.2f %.2f", best$i, w, best$z, ratios[1], ratios[2]))
+    if (mean(ratios) < 0.65) {
       rejected <- rejected + 1L
-      excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
+      excluded[max(1L, best$i - 4L * w):min(nb, best$i + 4L * w)] <- TRUE
       next
     }
     # refine to the sample: split maximising |difference of window means|

@@ -116,9 +116,9 @@ test_that("a ramp is not a step, and a short pulse is a transient, not two steps
   n <- 2e5
   freq <- 100
   x <- gen_base(n, seed = 12)
-  # a ramp of 0.3 over 300 s in the middle: significant at the longest
-  # windows, but a slow change, not a step
-  r <- x + 0.3 * pmin(pmax((seq_len(n) - 90000) / 30000, 0), 1)
+  # a ramp of 1 over 300 s in the middle: far above the noise at the
+  # longest windows (z ~ 20), but a slow change, not a step
+  r <- x + 1 * pmin(pmax((seq_len(n) - 90000) / 30000, 0), 1)
   st <- detect_steps(r, freq)
   expect_equal(nrow(st), 0L)
   expect_gte(attr(st, "rejected"), 1L)
