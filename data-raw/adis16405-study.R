@@ -81,7 +81,7 @@ for (k in 1:3) {
       av_pred_meas_m4 = round(pred[3L] / meas[3L], 3),
       lines = sum(ln$kind == "line"), bands = nrow(bd),
       band = if (nrow(bd)) sprintf("%.1f Hz w %.1f share %.2f", bd$f_center[1], bd$width[1], bd$share[1]) else "",
-      spikes = nrow(sp), steps = nrow(st),
+      spikes = nrow(sp), steps = nrow(st), pulses = nrow(pu),
       warmup = if (wu$present) sprintf("A=%.3g tc=%.0fs z=%.0f", wu$amplitude, wu$tc, wu$z) else "",
       seconds = round(el, 1), stringsAsFactors = FALSE)
     if (nrow(ln)) line_rows[[length(line_rows) + 1L]] <- cbind(unit = k, axis = axis, ln)
@@ -89,6 +89,11 @@ for (k in 1:3) {
       say("unit%d %s steps: %s", k, axis,
           paste(sprintf("t=%.0fs size=%.3g (z=%.1f, se %.2g)", st$time, st$size, st$z, st$se),
                 collapse = "; "))
+    }
+    pu <- attr(st, "pulses")
+    if (nrow(pu)) {
+      say("unit%d %s transients (opposite steps < 120 s apart): %s", k, axis,
+          paste(sprintf("%.0f-%.0fs size %.3g", pu$start, pu$end, pu$size), collapse = "; "))
     }
     if (nrow(sp)) {
       say("unit%d %s spikes: %d, largest |size| %.3g at t=%.1fs", k, axis, nrow(sp),
