@@ -199,3 +199,14 @@ visible_lines <- function(lines, tau_min, tau_max, freq) {
   attr(lines, "band") <- b
   lines
 }
+
+# Lines that sit inside a broad band (find_bands()) are bins of that band,
+# not sinusoids: drop them.
+lines_outside_bands <- function(lines, bands) {
+  if (!nrow(lines) || !nrow(bands)) return(lines)
+  inside <- vapply(lines$f0, function(f) any(f >= bands$f_from & f <= bands$f_to), NA)
+  out <- lines[!inside, , drop = FALSE]
+  attr(out, "resolution") <- attr(lines, "resolution")
+  attr(out, "nyquist") <- attr(lines, "nyquist")
+  out
+}

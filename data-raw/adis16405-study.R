@@ -52,11 +52,12 @@ for (k in 1:3) {
     fe <- filter_evidence(x, freq)
     bw_ma <- if (!is.null(fe$start$ma)) filter_bandwidth(filter_spec("ma", L = fe$start$ma$L), 1 / freq) else NULL
     bw_lp1 <- if (!is.null(fe$start$lp1)) filter_bandwidth(filter_spec("lp1", fc = fe$start$lp1$fc, freq = freq), 1 / freq) else NULL
-    ln <- harmonic_sets(find_lines(x, freq))
-    ln <- visible_lines(ln, 1 / freq, max(av$tau), freq)
     bd <- find_bands(x, freq)
+    ln <- harmonic_sets(lines_outside_bands(find_lines(x, freq), bd))
+    ln <- visible_lines(ln, 1 / freq, max(av$tau), freq)
     sp <- detect_spikes(x, freq)
     st <- detect_steps(remove_spikes(x, sp), freq)
+    pu <- attr(st, "pulses")
     wu <- detect_warmup(remove_spikes(x, sp), freq)
     # Does filtered white noise explain the short tau? Predicted AV at
     # m = 1, 2, 4 from N (slope -1/2) and the ma filter read from the ACF,
@@ -90,7 +91,6 @@ for (k in 1:3) {
           paste(sprintf("t=%.0fs size=%.3g (z=%.1f, se %.2g)", st$time, st$size, st$z, st$se),
                 collapse = "; "))
     }
-    pu <- attr(st, "pulses")
     if (nrow(pu)) {
       say("unit%d %s transients (opposite steps < 120 s apart): %s", k, axis,
           paste(sprintf("%.0f-%.0fs size %.3g", pu$start, pu$end, pu$size), collapse = "; "))

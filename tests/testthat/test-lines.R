@@ -44,6 +44,11 @@ test_that("a resonance (a broad band) is not read as a line", {
   b <- find_bands(x, freq)
   expect_equal(nrow(b), 1L)
   expect_equal(b$f_center, 20, tolerance = 0.05)
+  # a real line beside the band survives; bins of the band do not
+  y <- x + 0.1 * sin(2 * pi * 7.3 * seq_len(n) / freq)
+  l <- lines_outside_bands(find_lines(y, freq), find_bands(y, freq))
+  expect_false(is.na(match_line(7.3, l)))
+  expect_false(any(l$f0 > b$f_from & l$f0 < b$f_to))
 })
 
 test_that("white plus random walk shows no line in 10 seeds (at most one false alarm)", {
