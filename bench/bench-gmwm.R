@@ -30,7 +30,12 @@ cat(sprintf("simts %s\n", utils::packageVersion("simts")))
 
 freq <- 100
 tau0 <- 1 / freq
-truth <- c(N = 0.01, K = 1e-3, sigma = 0.02, tc = 2)
+# Two composites: K clearly above the GM at long tau ("strong K"), and K
+# level with the GM's tail at the longest tau of a 1e5 record ("weak K").
+scenarios <- list(
+  "strong K" = c(N = 0.01, K = 1e-3, sigma = 0.02, tc = 2),
+  "weak K" = c(N = 0.01, K = 2e-4, sigma = 0.02, tc = 2))
+truth <- scenarios[[1L]]
 
 # Our own generator: white (sd N / sqrt(tau0)), random walk (increments
 # K sqrt(tau0)), AR(1) started from its stationary law.
@@ -71,6 +76,8 @@ rel_rmse <- function(est) {
 }
 
 rows <- list()
+for (sc in names(scenarios)) {
+truth <- scenarios[[sc]]
 for (k in 1:2) {
   n <- c(1e5, 1e6)[k]
   ea <- eg <- matrix(NA_real_, seeds[k], 4L, dimnames = list(NULL, names(truth)))
@@ -83,13 +90,17 @@ for (k in 1:2) {
   }
   ok <- stats::complete.cases(eg)
   rows[[length(rows) + 1L]] <- data.frame(
-    n = n, method = c("allanvar", "gmwm"), seeds = c(seeds[k], sum(ok)),
+    scenario = sc, n = n, method = c("allanvar", "gmwm"), seeds = c(seeds[k], sum(ok)),
     rbind(rel_rmse(ea), rel_rmse(eg[ok, , drop = FALSE])),
     median_s = c(median(ta), median(tg)), check.names = FALSE)
 }
+}
 out <- do.call(rbind, rows)
-cat(sprintf("Truth: N = %g, K = %g, GM sigma = %g, tc = %g s; %g Hz\n",
-            truth[["N"]], truth[["K"]], truth[["sigma"]], truth[["tc"]], freq))
+for (sc in names(scenarios)) {
+  tr <- scenarios[[sc]]
+  cat(sprintf("%s: N = %g, K = %g, GM sigma = %g, tc = %g s; %g Hz\n", sc,
+              tr[["N"]], tr[["K"]], tr[["sigma"]], tr[["tc"]], freq))
+}
 cat("Relative RMSE of each parameter, percent (lower is better):\n")
 num <- c("N", "K", "sigma", "tc")
 out[num] <- lapply(out[num], function(v) signif(v, 3))
