@@ -459,3 +459,65 @@ welch_psd_lin <- function(x, freq, seg) {
   list(f = (seq_len(half) - 1) * freq / seg, psd = p, nu = nu, seg = seg,
        df = freq / seg, k = k)
 }
+
+# ---- reading the filter from a curve or checking it against the data ----------
+
+# Start value of a family's parameter from a curve alone: the ratio
+# q = AV(tau0) tau0 / N^2 of the first point to the white line through the
+# longer taus (1 for white noise, less for a filter). For ma, L = (1/q + 2)/3
+# when L <= 2 (AV(1) = N^2 / (tau0 (3L - 2))); otherwise, and for the other
+# families, by inverting filter_av(1) numerically. NULL when q is not in
+# (0, 1).
+filter_start_from_curve <- function(q, family, freq) {
+  tau0 <- 1 / freq
+  if (!is.finite(q) || q <= 0 || q >= 1) return(NULL)
+  av1 <- function(p) {
+    sp <- switch(family,
+      ma = list(family = "ma", L = p),
+      bartlett = list(family = "bartlett", L = max(1L, round(p)), n = 2L),
+      lp1 = list(family = "lp1", fc = p, freq = freq),
+      lp2 = list(family = "lp2", fc = p, freq = freq))
+    filter_av(1, sp, tau0) * tau0 - q
+  }
+  switch(family,
+    ma = {
+      if (q >= 0.25) return(list(L = (1 / q + 2) / 3))
+      list(L = stats::uniroot(av1, c(2, 1e4), tol = 1e-9)$root)
+    },
+    bartlett = {
+      Ls <- 1:256
+      v <- vapply(Ls, av1, 0)
+      list(L = Ls[which.min(abs(v))], n = 2L)
+    },
+    lp1 = , lp2 = {
+      lo <- freq * 1e-4
+      hi <- freq * if (family == "lp1") 0.5 else 0.4999
+      if (av1(lo) * av1(hi) > 0) return(NULL)
+      list(fc = stats::uniroot(av1, c(lo, hi), tol = 1e-9 * freq)$root)
+    },
+    NULL)
+}
+
+# What the raw data say about a fitted filter: the lag-1 autocorrelation the
+# filter predicts for the whole series, N^2 g(1) / var(x), against the raw
+# one's filter part (filter_evidence(): the excess over the slow-process
+# level). Supported when the raw excess is significant (z > 5) and within a
+# factor 1.5 of the prediction; contradicted when the raw data show no
+# short-lag correlation (z < 2) or disagree by more than a factor 3;
+# otherwise undecided.
+filter_raw_support <- function(spec, N, fe, var_x, freq) {
+  tau0 <- 1 / freq
+  pred <- N^2 * filter_acf(spec, tau0, 1) / var_x
+  obs <- fe$r1
+  z <- fe$z1
+  ratio <- obs / pred
+  support <- if (is.finite(z) && z > 5 && is.finite(ratio) && ratio > 1 / 1.5 &&
+                 ratio < 1.5) TRUE
+    else if (!is.finite(z) || z < 2 || !is.finite(ratio) || ratio < 1 / 3 ||
+             ratio > 3) FALSE
+    else NA
+  list(text = sprintf(paste("raw lag-1 autocorrelation beyond the slow processes",
+                            "%.3f (z = %.0f) against %.3f predicted by the filter"),
+                      obs, z, pred),
+       support = support)
+}

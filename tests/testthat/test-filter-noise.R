@@ -156,3 +156,31 @@ test_that("bad filter specifications are refused with classed errors", {
   expect_error(filter_spec("fir", h = c(1, -1)), class = "allanvar_error_argument")
   expect_snapshot(filter_spec("lp2", fc = 60, freq = 100), error = TRUE)
 })
+
+test_that("a curve alone gives the filter's start value from its first point", {
+  tau0 <- 0.01
+  for (sp in list(filter_spec("ma", L = 1.2), filter_spec("ma", L = 4),
+                  filter_spec("lp1", fc = 12, freq = 100),
+                  filter_spec("lp2", fc = 20, freq = 100))) {
+    q <- filter_av(1, sp, tau0) * tau0
+    st <- filter_start_from_curve(q, sp$family, 100)
+    par <- if (sp$family == "ma") "L" else "fc"
+    expect_equal(st[[par]], sp[[par]], tolerance = 1e-6)
+  }
+  expect_equal(filter_start_from_curve(q = 1 / (3 * 1.2 - 2), "ma", 100)$L, 1.2)
+  expect_null(filter_start_from_curve(1.1, "ma", 100))
+})
+
+test_that("the raw data support a fitted filter, and contradict one on white noise", {
+  set.seed(8)
+  n <- 1e5
+  w <- rnorm(n + 3, sd = 0.1)
+  x <- as.numeric(stats::filter(w, rep(0.25, 4), sides = 1))[-(1:3)]
+  fe <- filter_evidence(x, 100)
+  N <- 0.1 * sqrt(0.01)                 # white level of the input
+  ok <- filter_raw_support(filter_spec("ma", L = 4), N, fe, var(x), 100)
+  expect_true(ok$support)
+  wrong <- filter_raw_support(filter_spec("ma", L = 4), N,
+                              filter_evidence(rnorm(n, sd = 0.05), 100), 0.05^2, 100)
+  expect_false(wrong$support)
+})
