@@ -146,3 +146,24 @@ fit_lorentz <- function(f, ex, bg, tau0, fc, power, sdf) {
 resonance_start <- function(band) {
   list(sigma = sqrt(band$power), fr = band$f_center, tc = band$tc)
 }
+
+# What the raw data say about a fitted resonance: a band of find_bands()
+# whose centre lies within half its width (or 2 resolution bins) of f_r is
+# support; its power within a factor 3 of sigma^2 as well; no band at all
+# near f_r contradicts it.
+resonance_raw_support <- function(sigma, fr, tc, bands) {
+  if (!nrow(bands)) {
+    return(list(text = sprintf("no spectral band near %s Hz", format(signif(fr, 3))),
+                support = FALSE))
+  }
+  res <- attr(bands, "resolution")
+  if (is.null(res)) res <- 0
+  d <- abs(bands$f_center - fr)
+  j <- which.min(d)
+  near <- d[j] <= max(0.5 * bands$width[j], 2 * res)
+  pr <- bands$power[j] / sigma^2
+  txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x the fitted)",
+                 format(signif(bands$f_center[j], 4)), format(signif(bands$width[j], 2)),
+                 100 * bands$share[j], pr)
+  list(text = txt, support = near && pr > 1 / 3 && pr < 3)
+}

@@ -62,3 +62,16 @@ test_that("band start values recover the resonance from an independent generator
   expect_equal(s$sigma, 0.8, tolerance = 0.3)
   expect_equal(s$tc, 0.08, tolerance = 0.5)
 })
+
+test_that("the raw data support a resonance where a band is, and contradict one elsewhere", {
+  set.seed(33)
+  n <- 2e5
+  r <- exp(-0.01 / 0.08)
+  w0 <- 2 * pi * 20 / 100
+  z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
+  x <- rnorm(n) + 0.8 * z / stats::sd(z)
+  b <- find_bands(x, 100)
+  expect_true(resonance_raw_support(0.8, 20, 0.08, b)$support)
+  expect_false(resonance_raw_support(0.8, 7, 0.08, b)$support)
+  expect_false(resonance_raw_support(0.8, 20, 0.08, find_bands(rnorm(n), 100))$support)
+})
