@@ -74,8 +74,15 @@ rel_rmse <- function(est) {
   rel <- sweep(est, 2L, truth[colnames(est)], "/") - 1
   100 * sqrt(colMeans(rel^2))
 }
+# median absolute relative error: the typical error, which a few wild
+# estimates do not dominate
+rel_mdae <- function(est) {
+  rel <- sweep(est, 2L, truth[colnames(est)], "/") - 1
+  100 * apply(abs(rel), 2L, stats::median)
+}
 
 rows <- list()
+mdae <- list()
 for (sc in names(scenarios)) {
 truth <- scenarios[[sc]]
 for (k in 1:2) {
@@ -93,6 +100,9 @@ for (k in 1:2) {
     scenario = sc, n = n, method = c("allanvar", "gmwm"), seeds = c(seeds[k], sum(ok)),
     rbind(rel_rmse(ea), rel_rmse(eg[ok, , drop = FALSE])),
     median_s = c(median(ta), median(tg)), check.names = FALSE)
+  mdae[[length(mdae) + 1L]] <- data.frame(
+    scenario = sc, n = n, method = c("allanvar", "gmwm"),
+    rbind(rel_mdae(ea), rel_mdae(eg[ok, , drop = FALSE])), check.names = FALSE)
 }
 }
 out <- do.call(rbind, rows)
@@ -106,3 +116,7 @@ num <- c("N", "K", "sigma", "tc")
 out[num] <- lapply(out[num], function(v) signif(v, 3))
 out$median_s <- signif(out$median_s, 3)
 print(out, row.names = FALSE)
+md <- do.call(rbind, mdae)
+md[num] <- lapply(md[num], function(v) signif(v, 3))
+cat("\nMedian absolute relative error, percent:\n")
+print(md, row.names = FALSE)
