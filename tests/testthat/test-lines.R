@@ -82,3 +82,25 @@ test_that("the sparse running median is exact at its anchors", {
   expect_equal(sm[anchors], ex[anchors])
   expect_true(all(sm[anchors + 5] <= pmax(ex[anchors], ex[anchors + 10]) + 1e-12))
 })
+
+test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinusoid", {
+  set.seed(41)
+  n <- 2e5
+  freq <- 100
+  t <- seq_len(n) / freq
+  phi <- exp(-1 / (freq * 5))
+  gm <- as.numeric(stats::filter(rnorm(n, sd = 0.02 * sqrt(1 - phi^2)), phi,
+                                 method = "recursive"))
+  x <- rnorm(n, sd = 0.1) + gm + 0.03 * sin(2 * pi * 0.2 * t + 0.4)
+  # the line hides the exponential ACF ...
+  expect_true(is.na(acf_exponential(x, freq, 5)$tc))
+  l <- find_lines(x, freq)
+  expect_false(is.na(match_line(0.2, l)))
+  y <- remove_lines(x, freq, l$f0[l$kind == "line"])
+  # ... which shows once the line is taken out
+  a <- acf_exponential(y, freq, 5)
+  expect_equal(a$tc, 5, tolerance = 0.3)
+  expect_gt(a$z, 5)
+  # and the line is gone from the periodogram
+  expect_true(is.na(match_line(0.2, find_lines(y, freq))))
+})
