@@ -127,6 +127,17 @@ test_that("start values read from the raw ACF recover each family within 10%", {
   ev <- filter_evidence(z, 100)
   expect_equal(ev$start$ma$L, 1.2, tolerance = 0.1)
   expect_equal(ev$length, 1L)
+  # Bartlett: two cascaded 5-tap averages (triangular taps over 9 samples)
+  tri <- c(1:5, 4:1) / 25
+  b <- as.numeric(stats::filter(w, tri, sides = 1))[-(1:8)]
+  expect_equal(filter_evidence(b, 100)$start$bartlett$L, 5)
+  # second-order Butterworth at 15 Hz (bilinear, written out here)
+  K <- tan(pi * 15 / 100)
+  den <- 1 + sqrt(2) * K + K^2
+  v <- as.numeric(stats::filter(w, c(1, 2, 1) * K^2 / den, sides = 1))[-(1:2)]
+  y2 <- as.numeric(stats::filter(v, c(-2 * (K^2 - 1) / den, -(1 - sqrt(2) * K + K^2) / den),
+                                 method = "recursive"))[-(1:50)]
+  expect_equal(filter_evidence(y2, 100)$start$lp2$fc, 15, tolerance = 0.1)
 })
 
 test_that("slow processes raise the ACF but are not read as a filter", {
