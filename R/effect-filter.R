@@ -23,8 +23,8 @@ filter_variant <- function(variant) {
     NULL)
   if (is.null(nlp)) return(NULL)
   list(
-    params = rbind(effect_param("N", "amp", "u*sqrt(s)",
-                                "rate unit x sqrt(second) (white level at DC)"),
+    params = rbind(effect_param("Nf", "amp", "u*sqrt(s)",
+                                "rate unit x sqrt(second) (white level at DC, as N)"),
                    nlp),
     nl_range = function(tau, freq) {
       if (variant == "ma") list(L = c(1.001, 64))
@@ -61,7 +61,7 @@ effect_filter <- function() {
       evidence = function(par, raw, x, freq) {
         if (is.null(x)) return(list(text = "", support = NA))
         sp <- filter_spec_of(variant, par, 1 / freq)
-        filter_raw_support(sp, par[["N"]], filter_evidence(x, freq),
+        filter_raw_support(sp, par[["Nf"]], filter_evidence(x, freq),
                            stats::var(x), freq)
       }
     ))
@@ -89,7 +89,7 @@ effect_filter <- function() {
     evidence = entry("ma")$evidence,
     # the filter keeps the DC level: N is the white reading
     fold = list(into = "white", when = function(par) TRUE,
-                amount = function(par) par[["N"]]^2,
+                amount = function(par) par[["Nf"]]^2,
                 note = "white level of the filtered term"),
     describe = function(values) "filter (the sensor's averaging)"
   )
@@ -105,7 +105,7 @@ effect_resonance <- function() {
                    profile = "oscillatory", print_unit = TRUE),
       effect_param("tc", "nonlinear", "s", "second (damping time; FWHM 1/(pi tc))",
                    profile = "smooth", print_unit = TRUE)),
-    repeatable = TRUE, slope = NA_real_, psd_alpha = NA_real_,
+    repeatable = FALSE, slope = NA_real_, psd_alpha = NA_real_,
     formula = "Re of the AR(1) form with the complex pole exp(-tau0/tc + 2 pi i fr tau0)",
     signature = paste("a bump at tau ~ 0.37/fr with nulls like a sinusoid's but",
                       "damped; a broad periodogram band at fr of width 1/(pi tc)"),

@@ -12,7 +12,7 @@ test_that("a 400 Hz curve with a 4-tap average: filter term gives N and L, N+B+K
   a <- allan(x, freq)
   f <- avfit(a, terms = c("filter", "K"))
   cf <- coef(f)
-  expect_equal(cf[["filter.N"]], 0.01, tolerance = 0.1)
+  expect_equal(cf[["filter.Nf"]], 0.01, tolerance = 0.1)
   expect_equal(cf[["filter.L"]], 4, tolerance = 0.1)
   expect_equal(cf[["K"]], 1e-4, tolerance = 0.5)
   expect_lt(f$chi2, 2)
@@ -41,7 +41,7 @@ test_that("each low-pass variant fits its own curve (parameters within 10%)", {
   f2 <- avfit(allan(y2, freq), terms = "filter:lp2")
   cf <- coef(f2)
   expect_equal(unname(cf[grepl("fc$", names(cf))]), fc, tolerance = 0.1)
-  expect_equal(unname(cf[grepl("N$", names(cf))]), 0.01, tolerance = 0.1)
+  expect_equal(unname(cf[grepl("Nf$", names(cf))]), 0.01, tolerance = 0.1)
 })
 
 test_that("a resonance term fits a narrow-band process", {
@@ -53,10 +53,10 @@ test_that("a resonance term fits a narrow-band process", {
   z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
   x <- rnorm(n, sd = 0.5) + 0.5 * z / stats::sd(z)
   f <- avfit(allan(x, freq), terms = c("N", "resonance"),
-             start = c(resonance1.fr = 19, resonance1.tc = 0.05))
+             start = c(resonance.fr = 19, resonance.tc = 0.05))
   cf <- coef(f)
-  expect_equal(cf[["resonance1.fr"]], 20, tolerance = 0.1)
-  expect_equal(cf[["resonance1.sigma"]], 0.5, tolerance = 0.3)
+  expect_equal(cf[["resonance.fr"]], 20, tolerance = 0.1)
+  expect_equal(cf[["resonance.sigma"]], 0.5, tolerance = 0.3)
   # the generator is a white-driven AR(2), whose autocovariance has a small
   # sine part the entry's cos form lacks: a slightly larger chi2
   expect_lt(f$chi2, 5)
