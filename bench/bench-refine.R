@@ -55,6 +55,8 @@ for (n in ns) {
     sec <- time_med(function() f(x), r)
     rows[[length(rows) + 1L]] <- data.frame(case = nm, n = n, seconds = signif(sec, 3),
                                             ratio_to_sum = signif(sec / base, 3))
+    # progress, so that a long run that is stopped still leaves its rows
+    message(sprintf("%s, n = %g: %.3g s", nm, n, sec))
   }
   cat(sprintf("done n = %g\n", n))
 }
