@@ -201,7 +201,7 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
   comp <- model_components(data$tau, tau0, lay, pr$plan)
   fitted <- rowSums(comp)
   z <- (pr$y - log(fitted)) / pr$s
-  objective <- sum((pr$W %*% (pr$y - log(fitted)))^2)
+  objective <- sum(wmul(pr$W, pr$y - log(fitted))^2)
   nfree <- sum(!lay$fixed)
   dfres <- nrow(data) - nfree
   chi2 <- if (dfres > 0) objective / dfres else NA_real_
@@ -214,7 +214,7 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
     coefficients = stats::setNames(lay$value, lay$name),
     se = stats::setNames(sqrt(pmax(diag(vc), 0)), lay$name), vcov = vc,
     chi2 = chi2, rms = 100 * sqrt(mean((sqrt(data$avar / fitted) - 1)^2)),
-    objective = objective, logdet = -2 * sum(log(diag(pr$W))),
+    objective = objective, logdet = w_logdet(pr$W),
     df.residual = dfres, nobs = nrow(data), npar = nfree, terms = terms,
     layout = lay, data = data, components = comp, freq = curve$freq,
     n = curve$n, type = curve$type, edf_source = curve$edf_source,

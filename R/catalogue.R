@@ -69,7 +69,7 @@ catalogue <- function() {
 builtin_effects <- function() {
   list(effect_quantization(), effect_white(), effect_flicker(),
        effect_random_walk(), effect_ramp(), effect_gauss_markov(),
-       effect_sinusoid())
+       effect_sinusoid(), effect_filter(), effect_resonance())
 }
 
 #' Register an effect in the catalogue (internal)

@@ -116,7 +116,7 @@ solve_amps <- function(pr, nlv, control, off = NULL) {
   for (i in which(amp$fixed)) offset <- offset + amp$value[i]^2 * Bm[, amp$name[i]]
   cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
   if (!length(free)) {
-    obj <- if (all(offset > 0)) sum((pr$W %*% (pr$y - log(offset)))^2) else Inf
+    obj <- if (all(offset > 0)) sum(wmul(pr$W, pr$y - log(offset))^2) else Inf
     return(list(c = cc, objective = obj, iterations = 0L, converged = TRUE,
                 layout = lay))
   }

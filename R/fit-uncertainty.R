@@ -64,7 +64,7 @@ pinv_raw <- function(A) {
 # not identified (NA).
 fit_vcov <- function(lay, tau, tau0, W, chi2, plan = model_plan(lay)) {
   jj <- jacobian_lnav(lay, tau, tau0, plan)
-  Js <- -W %*% jj$J
+  Js <- -wmul(W, jj$J)
   V <- pinv(crossprod(Js)) * max(1, if (is.na(chi2)) 1 else chi2)
   vc <- matrix(0, nrow(lay), nrow(lay), dimnames = list(lay$name, lay$name))
   fn <- lay$name[jj$free]

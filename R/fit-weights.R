@@ -66,8 +66,11 @@ white_corr <- function(m, n, type) {
 }
 
 # Whitening matrix W with ||W r||^2 = r' Sigma^-1 r, Sigma = diag(s) R diag(s).
+# Independent points: W is diagonal and is kept as its diagonal, a
+# one-column matrix (a dense J x J diagonal is 800 MB at J = 10,000); apply
+# it with wmul(), which src/avfit.cpp mirrors.
 whitening <- function(s, corr) {
-  if (is.null(corr)) return(diag(1 / s, length(s)))
+  if (is.null(corr)) return(matrix(1 / s, ncol = 1L))
   Sig <- corr * outer(s, s)
   U <- chol_or_null(Sig)
   # nearly coincident taus can make Sigma numerically singular: add a ridge
@@ -78,6 +81,18 @@ whitening <- function(s, corr) {
   }
   if (is.null(U)) return(diag(1 / s, length(s)))
   t(backsolve(U, diag(length(s))))
+}
+
+# W %*% v for a whitening matrix or a diagonal one kept as a column.
+wmul <- function(W, v) {
+  v <- as.matrix(v)
+  if (ncol(W) == 1L && nrow(W) == nrow(v) && nrow(v) > 1L) W[, 1L] * v else W %*% v
+}
+
+# log-determinant term of the whitening: -2 sum log diag(W).
+w_logdet <- function(W) {
+  d <- if (ncol(W) == 1L && nrow(W) > 1L) W[, 1L] else diag(W)
+  -2 * sum(log(d))
 }
 
 # Cholesky factor, or NULL when the matrix is not numerically positive

@@ -29,3 +29,22 @@ test_that("the mixture EDF combines the terms' EDFs by their AV shares", {
   # only deterministic terms: white-noise EDF
   expect_equal(edf_model(m, n, "overlapping", cbind(1 / m), NA), w)
 })
+
+test_that("independent points keep W as its diagonal, and the fit is the same", {
+  W <- whitening(c(0.5, 0.25, 0.1), NULL)
+  expect_equal(dim(W), c(3L, 1L))
+  v <- c(1, 2, 3)
+  expect_equal(as.numeric(wmul(W, v)), as.numeric(diag(1 / c(0.5, 0.25, 0.1)) %*% v))
+  A <- matrix(1:6, 3)
+  expect_equal(wmul(W, A), diag(1 / c(0.5, 0.25, 0.1)) %*% A)
+  expect_equal(w_logdet(W), -2 * sum(log(1 / c(0.5, 0.25, 0.1))))
+  # the C++ solve with the diagonal as a column equals the dense one
+  set.seed(3)
+  B <- cbind(1 / (1:40), (1:40) / 3)
+  y <- log(B %*% c(2, 0.5)) + rnorm(40, sd = 0.05)
+  s <- runif(40, 0.05, 0.2)
+  a <- avfit_log_nnls(B, numeric(40), as.numeric(y), matrix(1 / s, ncol = 1), numeric(2), 100L, 1e-12)
+  b <- avfit_log_nnls(B, numeric(40), as.numeric(y), diag(1 / s), numeric(2), 100L, 1e-12)
+  expect_equal(a$c, b$c, tolerance = 1e-10)
+  expect_equal(a$objective, b$objective, tolerance = 1e-10)
+})
