@@ -41,6 +41,10 @@ first_nonfinite <- function(x) {
     .Call(`_allanvar_first_nonfinite`, x)
 }
 
+dynamic_sums_cpp <- function(x, y, m, nterms, options) {
+    .Call(`_allanvar_dynamic_sums_cpp`, x, y, m, nterms, options)
+}
+
 allan_edf_cpp <- function(type, m, n, L, alpha, exact) {
     .Call(`_allanvar_allan_edf_cpp`, type, m, n, L, alpha, exact)
 }
@@ -49,7 +53,67 @@ edf_interpolate_cpp <- function(m, sub, es, alpha) {
     .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
 }
 
+lz4_decompress_cpp <- function(x, expected) {
+    .Call(`_allanvar_lz4_decompress_cpp`, x, expected)
+}
+
+mcap_records <- function(buf, start, end) {
+    .Call(`_allanvar_mcap_records`, buf, start, end)
+}
+
+mcap_chunk_raw <- function(buf, off, len) {
+    .Call(`_allanvar_mcap_chunk_raw`, buf, off, len)
+}
+
+mcap_imu <- function(buf, op, off, len, ids, enc) {
+    .Call(`_allanvar_mcap_imu`, buf, op, off, len, ids, enc)
+}
+
+csv_field_faults <- function(bytes, sep, expected) {
+    .Call(`_allanvar_csv_field_faults`, bytes, sep, expected)
+}
+
+int64_rel_seconds <- function(x, origin, per_second) {
+    .Call(`_allanvar_int64_rel_seconds`, x, origin, per_second)
+}
+
+int64_to_double <- function(x) {
+    .Call(`_allanvar_int64_to_double`, x)
+}
+
+col_first_nonfinite <- function(x) {
+    .Call(`_allanvar_col_first_nonfinite`, x)
+}
+
+col_block_avar <- function(x, j, m) {
+    .Call(`_allanvar_col_block_avar`, x, j, m)
+}
+
+decode_imu_blobs <- function(blobs, encoding, recv_ns) {
+    .Call(`_allanvar_decode_imu_blobs`, blobs, encoding, recv_ns)
+}
+
+stamp_rel_seconds <- function(sec, nsec, origin) {
+    .Call(`_allanvar_stamp_rel_seconds`, sec, nsec, origin)
+}
+
+rosbag_records <- function(buf, start, end) {
+    .Call(`_allanvar_rosbag_records`, buf, start, end)
+}
+
+rosbag_chunk_imu <- function(buf, off, len, compression, size, conns) {
+    .Call(`_allanvar_rosbag_chunk_imu`, buf, off, len, compression, size, conns)
+}
+
 allan_type_table_cpp <- function() {
     .Call(`_allanvar_allan_type_table_cpp`)
+}
+
+zstd_available_cpp <- function() {
+    .Call(`_allanvar_zstd_available_cpp`)
+}
+
+zstd_decompress_cpp <- function(x, expected) {
+    .Call(`_allanvar_zstd_decompress_cpp`, x, expected)
 }
 

@@ -25,7 +25,9 @@
 #'     time.}
 #'   \item{`fits`}{one row per axis: `chi2_before`, `rms_before` (datasheet
 #'     model), `chi2_after`, `rms_after` (refined), `n_steps`, `effects`
-#'     added, `unconfirmed` (steps the raw data contradict), `final_terms`.}
+#'     added, `unconfirmed` (steps the raw data contradict), `final_terms`,
+#'     `converged` (both fits converged), `failed_refits` (refits of the loop
+#'     that failed, see `avrefine()`).}
 #'   \item{`coef`}{coefficients (`value`, `se`) of the datasheet (`stage =
 #'     "datasheet"`) and refined models.}
 #'   \item{`steps`}{the refinement steps of every axis, with the columns of

@@ -1,3 +1,8 @@
+# The closed loop: screen candidate effects, refit the winner, record the
+# step. The residual signatures (signatures.R), the tracing to candidates
+# (trace.R) and the raw-data evidence (evidence.R) come from their own
+# files; every fact about an effect comes from the catalogue.
+
 #' Close the loop: find what a noise model misses and add it
 #'
 #' Starting from a fitted noise model (typically the datasheet model
@@ -23,10 +28,16 @@
 #' For speed, candidates are first screened with the nonlinear parameters
 #' already in the model (`tc`, `f0`) held at their current values, and the
 #' winner is refitted with all of them free; only when screening finds
-#' nothing are the candidates tried again with everything free. A sinusoid
-#' whose frequency the raw periodogram resolves is also tried with `f0`
-#' held at the periodogram value (one parameter fewer), and such a
-#' frequency stays held in later steps.
+#' nothing are the candidates tried again with everything free. Every refit
+#' starts from the current model's nonlinear estimates and uses its
+#' settings (`bias_correct`, `correlation`, `control`, and its EDF), given
+#' to [avfit()] explicitly; arguments in `...` override them.
+#'
+#' A refit that fails (an error, or no degrees of freedom left) does not
+#' stop the loop: it is recorded as a condition of class
+#' `allanvar_error_refit` (the original condition in its `parent`) in
+#' `$refine$failures`, with the step and the candidate; warnings raised by
+#' refits are recorded there too.
 #'
 #' Every candidate kind in `candidates` that is not already in the model
 #' (gm and sinusoid may repeat) is refitted at each step; the residual
@@ -43,8 +54,8 @@
 #' @param fit An [avfit()] result.
 #' @param data Optional raw rate series (numeric vector or `ts`) at the
 #'   fit's sampling frequency, used to confirm effects from the data itself.
-#' @param candidates Effects that may be added: any of `"Q"`, `"N"`, `"B"`,
-#'   `"K"`, `"R"`, `"gm"`, `"sinusoid"`.
+#' @param candidates Effects that may be added: terms of the catalogue
+#'   ([av_terms()]); default all of them.
 #' @param max_steps Maximum number of effects to add.
 #' @param criterion `"BIC"` (default) or `"AIC"`.
 #' @param min_gain Minimum decrease of the criterion for an effect to be
@@ -65,7 +76,9 @@
 #'   `rms_before`, `rms_after` (RMS relative ADEV error, percent),
 #'   `crit_before`, `crit_after` (the criterion). `refine` holds the
 #'   arguments, the raw-data diagnostics ([avdiagnose()]) and the
-#'   signatures left when the loop stopped. The object keeps class `avfit`
+#'   signatures left when the loop stopped and `failures` (a data frame
+#'   `step`, `effect`, `stage`, `message`, with the conditions in the list
+#'   column `condition`). The object keeps class `avfit`
 #'   (with `avrefine` in front, whose print method lists the steps), so
 #'   every avfit method applies.
 #' @seealso [avfit()], [avdiagnose()], [avsim()]
@@ -76,27 +89,28 @@
 #' fit <- avfit(allan(x, 100, taus = 5), terms = "N")
 #' ref <- avrefine(fit, candidates = c("gm", "K"), max_steps = 1)
 #' ref$steps[, c("effect", "params", "chi2_before", "chi2_after")]
-avrefine <- function(fit, data = NULL,
-                     candidates = c("Q", "N", "B", "K", "R", "gm", "sinusoid"),
+avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
                      max_steps = 5, criterion = "BIC", min_gain = 10,
                      level = 3.5, ...) {
   check_present(missing(fit), "fit", "an avfit() result")
   if (!inherits(fit, "avfit")) {
-    abort("`fit` must be an avfit() result, not ", describe_type(fit), ".")
+    abort("`fit` must be an avfit() result, not ", describe_type(fit), ".",
+          class = "argument")
   }
-  kinds <- c("Q", "N", "B", "K", "R", "gm", "sinusoid")
+  kinds <- effect_kinds()
   if (!is.character(candidates) || !length(candidates) || anyNA(candidates) ||
       !all(candidates %in% kinds)) {
     abort("`candidates` must name effects among ", paste(kinds, collapse = ", "),
           ", not ", if (is.character(candidates))
             paste(encodeString(setdiff(candidates, kinds), quote = '"'), collapse = ", ")
-          else describe_type(candidates), ".")
+          else describe_type(candidates), ".", class = "argument")
   }
   candidates <- unique(candidates)
   max_steps <- check_number(max_steps, "max_steps", 0, 50, integer = TRUE)
   if (!is.character(criterion) || length(criterion) != 1L ||
       !criterion %in% c("BIC", "AIC")) {
-    abort("`criterion` must be \"BIC\" or \"AIC\", not ", format_value(criterion), ".")
+    abort("`criterion` must be \"BIC\" or \"AIC\", not ", format_value(criterion), ".",
+          class = "argument")
   }
   min_gain <- check_number(min_gain, "min_gain", 0)
   level <- check_number(level, "level", 0, open = TRUE)
@@ -106,20 +120,28 @@ avrefine <- function(fit, data = NULL,
     if (stats::is.ts(data) && !is.null(freq) &&
         abs(stats::frequency(data) - freq) > 1e-6 * freq) {
       abort("`data` is a ts at ", stats::frequency(data), " Hz but the fit is at ",
-            freq, " Hz; give the raw series the curve was computed from.")
+            freq, " Hz; give the raw series the curve was computed from.",
+            class = "argument")
     }
     if (is.null(freq)) {
-      abort("`data` needs the fit's sampling frequency, but `fit$freq` is NULL.")
+      abort("`data` needs the fit's sampling frequency, but `fit$freq` is NULL.",
+            class = "argument")
     }
     data <- check_values(data, min_n = 256L, arg = "data")
     raw <- avdiagnose(data, freq)
   }
+  # The settings every refit uses, explicitly: the fit's own, overridden by
+  # the arguments in `...`.
+  settings <- utils::modifyList(
+    list(bias_correct = !isFALSE(fit$bias_correct),
+         correlation = isTRUE(fit$correlation),
+         control = fit$control %||% avfit_control()),
+    list(...))
   crit <- function(f) if (criterion == "BIC") stats::BIC(f) else stats::AIC(f)
+  failures <- new_failures()
 
   steps <- list()
   current <- fit
-  # Sinusoid frequencies taken from the raw periodogram stay held.
-  known <- numeric(0)
   sig <- NULL
   for (step in seq_len(max_steps)) {
     tau <- current$data$tau
@@ -138,13 +160,13 @@ avrefine <- function(fit, data = NULL,
     # screened fit is put on the all-free scale by charging the held ones.
     nl_now <- stats::coef(current)[current$layout$role == "nonlinear"]
     pen <- if (criterion == "BIC") log(current$nobs) else 2
-    crit_s <- function(f) crit(f) + pen * (length(hold_now) - length(known))
+    crit_s <- function(f) crit(f) + pen * length(hold_now)
     best <- NULL
     # When screening finds nothing, the candidates are tried once more with
     # all nonlinear parameters free (slower, but catches effects that only
     # pay once the others may move). Traced candidates first; the others
     # only when none of those pays.
-    holds <- if (length(nl_now) > length(known)) list(nl_now, known) else list(known)
+    holds <- if (length(nl_now)) list(nl_now, numeric(0)) else list(numeric(0))
     passes <- list()
     for (h in holds) {
       passes[[length(passes) + 1L]] <- list(hold = h, tier = which(trials$traced))
@@ -152,18 +174,15 @@ avrefine <- function(fit, data = NULL,
     }
     for (pass in passes) {
       hold_now <- pass$hold
-      tier <- pass$tier
-      for (i in tier) {
+      for (i in pass$tier) {
         tr <- trials[i, ]
-        init <- tr$init[[1L]]
-        new <- refit_with(current, c(current$terms, tr$effect), tr$effect, init, ...,
-                          hold = hold_now,
-                          good_enough = function(f) crit_s(f) < c0 - min_gain)
-        if (tr$effect == "sinusoid" && isTRUE(tr$from_raw)) {
-          alt <- refit_fixed_f0(current, c(current$terms, tr$effect), init$f0, ...,
-                                hold = hold_now)
-          if (!is.null(alt) && (is.null(new) || crit_s(alt) < crit_s(new))) new <- alt
-        }
+        new <- refit_with(current, c(current$terms, tr$effect), tr$effect,
+                          tr$init[[1L]], settings, hold = hold_now,
+                          good_enough = function(f) crit_s(f) < c0 - min_gain,
+                          record = function(cnd, stage) {
+                            failures <<- add_failure(failures, cnd, step,
+                                                     tr$effect, stage)
+                          })
         if (is.null(new)) next
         c1 <- crit_s(new)
         pays <- is.finite(c1) && c1 < c0 - min_gain &&
@@ -173,7 +192,7 @@ avrefine <- function(fit, data = NULL,
         # An added term that explains (almost) nothing anywhere is a refit
         # artefact, not an effect.
         if (max_share(new, lab) < 0.02) next
-        par <- effect_params(new, lab)
+        par <- instance_params(stats::coef(new), new$layout, lab)
         ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
         # Raw-data support or contradiction weighs min_gain criterion units;
         # an effect the raw data contradict must pay twice the margin.
@@ -188,59 +207,46 @@ avrefine <- function(fit, data = NULL,
     if (is.null(best)) break
     # Refit the winner with the held nonlinear parameters free again (the new
     # one starts where screening put it).
-    if (length(hold_now) > length(known)) {
+    if (length(hold_now)) {
       lay <- best$fit$layout
-      start <- stats::coef(best$fit)[lay$role == "nonlinear"]
-      f0_held <- lay$name[lay$fixed & lay$param == "f0" & lay$label == best$label]
-      hold <- c(known, stats::coef(best$fit)[f0_held])
-      start <- start[!names(start) %in% names(hold)]
-      args <- c(list(av = current, terms = best$fit$terms, start = start), list(...))
-      if (length(hold)) args$fixed <- c(args$fixed, hold)
-      full <- tryCatch(suppressWarnings(do.call(avfit, args)), error = function(e) NULL)
-      if (!is.null(full) && is.finite(full$chi2) && crit(full) <= best$crit + 1e-6) {
+      args <- refit_args(current, best$fit$terms, settings,
+                         start = stats::coef(best$fit)[lay$role == "nonlinear"])
+      full <- try_refit(args, function(cnd, stage) {
+        failures <<- add_failure(failures, cnd, step, best$trial$effect, stage)
+      }, "refit of the winner")
+      if (!is.null(full) && crit(full) <= best$crit + 1e-6) {
         best$fit <- full
         best$crit <- crit(full)
-        best$params <- effect_params(full, best$label)
+        best$params <- instance_params(stats::coef(full), full$layout, best$label)
       }
     }
     tr <- best$trial
-    lay <- best$fit$layout
-    f0_held <- lay$name[lay$fixed & lay$param == "f0" & lay$label == best$label]
-    if (length(f0_held)) known <- c(known, stats::coef(best$fit)[f0_held])
     # Describe the effect where the fitted term actually sits, which may
     # differ from where the trial started.
-    loc <- locate_signature(sig, best$fit, best$label, tr)
-    tr$tau_from <- loc$tau_from
-    tr$tau_to <- loc$tau_to
+    loc <- locate_signature(sig, best$fit, best$label)
     evidence <- loc$text
     if (nzchar(best$ev$text)) {
       evidence <- paste0(evidence, "; raw data: ", best$ev$text,
                          if (isFALSE(best$ev$support)) " (NOT supported by the raw data)")
     }
-    steps[[length(steps) + 1L]] <- data.frame(
+    steps[[length(steps) + 1L]] <- new_steps(
       effect = tr$effect, label = best$label,
-      tau_from = tr$tau_from, tau_to = tr$tau_to,
-      params = paste0(format_params(best$params, tr$effect),
-                      if (length(f0_held)) " (f0 from the periodogram)"),
+      tau_from = loc$tau_from, tau_to = loc$tau_to,
+      params = format_params(best$params, tr$effect),
       evidence = evidence, confirmed = best$ev$support,
       chi2_before = current$chi2, chi2_after = best$fit$chi2,
       rms_before = current$rms, rms_after = best$fit$rms,
-      crit_before = c0, crit_after = best$crit,
-      stringsAsFactors = FALSE)
+      crit_before = c0, crit_after = best$crit)
     current <- best$fit
   }
-  old <- fit$steps
-  new_steps <- if (length(steps)) do.call(rbind, steps) else empty_steps()
-  if (is.data.frame(old) && nrow(old)) {
-    new_steps <- merge_steps(old, new_steps)
-  }
-  rownames(new_steps) <- NULL
-  current$steps <- new_steps
+  all_steps <- Reduce(bind_steps, steps, fit$steps)
+  current$steps <- all_steps
   current$refine <- list(candidates = candidates, criterion = criterion,
                          min_gain = min_gain, level = level, diagnostics = raw,
-                         remaining = sig, start_terms = fit$terms)
+                         remaining = sig, start_terms = fit$terms,
+                         failures = failures)
   class(current) <- unique(c("avrefine", class(current)))
-  current
+  validate_avfit(current)
 }
 
 #' @export
@@ -251,99 +257,146 @@ print.avrefine <- function(x, ...) {
   invisible(x)
 }
 
-empty_steps <- function() {
-  data.frame(effect = character(), label = character(), tau_from = numeric(),
-             tau_to = numeric(), params = character(), evidence = character(),
-             confirmed = logical(), chi2_before = numeric(), chi2_after = numeric(),
-             rms_before = numeric(), rms_after = numeric(), crit_before = numeric(),
-             crit_after = numeric(), stringsAsFactors = FALSE)
+# ---- refits -----------------------------------------------------------------
+
+# The arguments of a refit of `fit` with `terms`: the settings, start values
+# (given ones first, then the fit's nonlinear estimates) and held values.
+refit_args <- function(fit, terms, settings, start = NULL, hold = NULL) {
+  args <- c(list(av = fit, terms = terms), settings)
+  names_new <- coef_layout(terms)$name
+  st <- c(settings$start, start)
+  prev <- stats::coef(fit)[fit$layout$role == "nonlinear"]
+  prev <- prev[names(prev) %in% names_new & !names(prev) %in% names(st)]
+  st <- c(st, prev)
+  args$start <- if (length(st)) st else NULL
+  if (length(hold)) args$fixed <- c(settings$fixed, hold)
+  args
 }
 
-merge_steps <- function(old, new) {
-  cols <- union(names(old), names(new))
-  fill <- function(d) {
-    for (cl in setdiff(cols, names(d))) d[[cl]] <- rep(NA, nrow(d))
-    d[cols]
+# Run one refit; a failure is recorded through `record(condition, stage)`
+# and gives NULL, as does a fit with no degrees of freedom left. Warnings
+# are recorded and muffled.
+try_refit <- function(args, record, stage) {
+  res <- withCallingHandlers(
+    tryCatch(do.call(avfit, args), error = function(e) {
+      record(e, stage)
+      NULL
+    }),
+    warning = function(w) {
+      record(w, stage)
+      invokeRestart("muffleWarning")
+    })
+  if (!is.null(res) && !is.finite(res$chi2)) {
+    record(simpleCondition("no degrees of freedom left for chi2"), stage)
+    return(NULL)
   }
-  rbind(fill(old), fill(new))
-}
-
-# One trial per candidate kind: the best-scoring traced start, or a generic
-# start when no signature points at that kind (the refit then decides).
-candidate_trials <- function(traced, present, candidates, sig) {
-  kinds <- candidates[!(candidates %in% c("Q", "N", "B", "K", "R") &
-                          candidates %in% present)]
-  rows <- list()
-  strongest <- sig[which.max(abs(sig$strength)), ]
-  for (k in kinds) {
-    t <- traced[traced$effect == k, , drop = FALSE]
-    if (nrow(t)) {
-      # gm and sinusoid: try up to two distinct starts (signature and raw data).
-      take <- if (k %in% c("gm", "sinusoid")) seq_len(min(2L, nrow(t))) else 1L
-      t$traced <- rep(TRUE, nrow(t))
-      rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
-    } else {
-      rows[[length(rows) + 1L]] <- data.frame(
-        effect = k, tau_from = strongest$tau_from, tau_to = strongest$tau_to,
-        signature = paste0(strongest$description, " (no signature specific to ", k, ")"),
-        score = 0, from_raw = FALSE, traced = FALSE, stringsAsFactors = FALSE)
-      rows[[length(rows)]]$init <- list(list())
-    }
-  }
-  if (!length(rows)) return(data.frame())
-  do.call(rbind, rows)
+  res
 }
 
 # Refit the curve with one more term. avfit() profiles the nonlinear
-# parameters on its own grid; when the tracing gives a starting Tc or f0 the
-# refit is also tried from there, and the better of the two is kept. NULL
-# when both fail.
-refit_with <- function(fit, terms, effect, init, ..., hold = NULL,
-                       good_enough = NULL) {
-  one <- function(start) {
-    args <- c(list(av = fit, terms = terms), list(...))
-    if (length(start)) args$start <- c(args$start, start)
-    if (length(hold)) args$fixed <- c(args$fixed, hold)
-    res <- tryCatch(suppressWarnings(do.call(avfit, args)),
-                    error = function(e) NULL)
-    if (is.null(res) || !is.finite(res$chi2)) NULL else res
+# parameters on its own grid; when the tracing gives a start value for the
+# new term's nonlinear parameters the refit is also tried from there, and
+# the better of the two is kept. NULL when both fail.
+refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
+                       good_enough = NULL, record) {
+  one <- function(start, stage) {
+    try_refit(refit_args(fit, terms, settings, start = start, hold = hold),
+              record, stage)
   }
-  best <- one(NULL)
+  best <- one(NULL, "screen")
   if (!is.null(best) && !is.null(good_enough) && good_enough(best)) return(best)
   lab <- new_label(fit$terms, effect)
-  nl <- c(gm = "tc", sinusoid = "f0")[effect]
-  if (!is.na(nl) && is.finite(init[[nl]] %||% NA_real_) && init[[nl]] > 0) {
-    st <- stats::setNames(init[[nl]], paste0(lab, ".", nl))
-    alt <- one(st)
+  sp <- split_term(effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  nl <- e$params$name[e$params$role == "nonlinear"]
+  ok <- vapply(nl, function(p) {
+    v <- init[[p]]
+    is.numeric(v) && length(v) == 1L && is.finite(v) && v > 0
+  }, logical(1))
+  if (any(ok)) {
+    st <- unlist(init[nl[ok]])
+    names(st) <- coef_names(e, lab)[match(nl[ok], e$params$name)]
+    alt <- one(st, "screen from the traced start")
     if (!is.null(alt) && (is.null(best) || alt$objective < best$objective)) best <- alt
   }
   best
 }
 
-# A sinusoid whose line the raw periodogram resolves: its f0 is known far
-# better from the data than from the curve, so also try it held fixed there.
-refit_fixed_f0 <- function(fit, terms, f0, ..., hold = NULL) {
-  lab <- new_label(fit$terms, "sinusoid")
-  args <- c(list(av = fit, terms = terms), list(...))
-  args$fixed <- c(args$fixed, hold, stats::setNames(f0, paste0(lab, ".f0")))
-  res <- tryCatch(suppressWarnings(do.call(avfit, args)), error = function(e) NULL)
-  if (is.null(res) || !is.finite(res$chi2)) NULL else res
+# ---- failures ---------------------------------------------------------------
+
+new_failures <- function() {
+  out <- data.frame(step = integer(), effect = character(), stage = character(),
+                    message = character(), stringsAsFactors = FALSE)
+  out$condition <- list()
+  out
+}
+
+# Record a refit's condition as an allanvar_error_refit (or, for a warning,
+# allanvar_warning_refit) condition whose parent is the original.
+add_failure <- function(failures, cnd, step, effect, stage) {
+  is_warning <- inherits(cnd, "warning")
+  msg <- sprintf("refit with %s (%s) %s: %s", effect, stage,
+                 if (is_warning) "warned" else "failed", conditionMessage(cnd))
+  cls <- if (is_warning) {
+    c("allanvar_warning_refit", "allanvar_warning", "warning", "condition")
+  } else {
+    c("allanvar_error_refit", "allanvar_error", "error", "condition")
+  }
+  rec <- structure(list(message = msg, call = NULL, parent = cnd, step = step,
+                        effect = effect, stage = stage), class = cls)
+  row <- data.frame(step = as.integer(step), effect = effect, stage = stage,
+                    message = msg, stringsAsFactors = FALSE)
+  row$condition <- list(rec)
+  rbind(failures, row)
+}
+
+# ---- trials and steps ---------------------------------------------------------
+
+# One trial per candidate kind: the best-scoring traced start (two for kinds
+# with nonlinear parameters), or a generic start when no signature points
+# at that kind (the refit then decides).
+candidate_trials <- function(traced, present, candidates, sig) {
+  pk <- split_term(present)$kind
+  kinds <- candidates[vapply(candidates, function(k) {
+    effect_entry(k)$repeatable || !k %in% pk
+  }, logical(1))]
+  rows <- list()
+  strongest <- sig[which.max(abs(sig$strength)), ]
+  for (k in kinds) {
+    t <- traced[traced$effect == k, , drop = FALSE]
+    if (nrow(t)) {
+      nonlinear <- any(effect_entry(k)$params$role == "nonlinear")
+      take <- if (nonlinear) seq_len(min(2L, nrow(t))) else 1L
+      t$traced <- rep(TRUE, nrow(t))
+      rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
+    } else {
+      r <- data.frame(
+        effect = k, tau_from = strongest$tau_from, tau_to = strongest$tau_to,
+        signature = paste0(strongest$description, " (no signature specific to ", k, ")"),
+        score = 0, traced = FALSE, stringsAsFactors = FALSE)
+      r$init <- list(list())
+      rows[[length(rows) + 1L]] <- r[, c("effect", "tau_from", "tau_to", "signature",
+                                         "score", "init", "traced")]
+    }
+  }
+  if (!length(rows)) return(data.frame())
+  do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
+                                                "signature", "score", "init",
+                                                "traced")]))
 }
 
 # The residual signature that matches an accepted term: the one whose tau
 # range holds (or lies nearest, within a factor 3) the term's characteristic
-# tau (GM ADEV peak 1.893 Tc, sinusoid first peak 0.371 / f0, otherwise the
-# tau where the term's share of the model is largest). Without one, the tau
-# range is where the term carries over a quarter of the model AV.
-locate_signature <- function(sig, fit, label, trial) {
+# tau (the catalogue's peak_tau, otherwise the tau where the term's share of
+# the model is largest). Without one, the tau range is where the term
+# carries over a quarter of the model AV.
+locate_signature <- function(sig, fit, label) {
   tau <- fit$data$tau
-  comp <- tryCatch(av_model(tau, stats::coef(fit), freq = fit$freq, by_term = TRUE),
-                   error = function(e) NULL)
-  share <- if (!is.null(comp) && label %in% colnames(comp))
-    comp[, label] / rowSums(comp) else rep(NA_real_, length(tau))
-  cf <- stats::coef(fit)
-  tchar <- if (startsWith(label, "gm")) gm_peak_ratio * cf[[paste0(label, ".tc")]]
-    else if (startsWith(label, "sinusoid")) sin_peak_ratio / cf[[paste0(label, ".f0")]]
+  comp <- fit$components
+  share <- comp[, label] / rowSums(comp)
+  e <- effect_entry(parse_labels(label)$kind, parse_labels(label)$variant)
+  par <- instance_params(stats::coef(fit), fit$layout, label)
+  tchar <- if (!is.null(e$peak_tau)) e$peak_tau(par)
     else if (all(is.na(share))) NA_real_ else tau[which.max(share)]
   big <- which(share > 0.25)
   range <- if (length(big)) range(tau[big]) else range(tau)
@@ -354,17 +407,8 @@ locate_signature <- function(sig, fit, label, trial) {
     dist <- dist - 0.01 * (s$sign > 0)       # prefer a positive run on ties
     j <- which.min(dist)
     if (dist[j] < log(3)) {
-      txt <- s$description[j]
-      if (isTRUE(trial$from_raw) && grepl("periodogram", trial$signature) &&
-          startsWith(label, "sinusoid")) {
-        f0 <- cf[[paste0(label, ".f0")]]
-        lf <- trial$init[[1L]]$f0
-        if (abs(f0 - lf) < 0.25 * lf) {
-          txt <- paste0(txt, sprintf("; proposed by a periodogram line at %s Hz",
-                                     format_num(lf)))
-        }
-      }
-      return(list(tau_from = s$tau_from[j], tau_to = s$tau_to[j], text = txt))
+      return(list(tau_from = s$tau_from[j], tau_to = s$tau_to[j],
+                  text = s$description[j]))
     }
   }
   list(tau_from = range[1L], tau_to = range[2L],
@@ -374,57 +418,7 @@ locate_signature <- function(sig, fit, label, trial) {
 
 # Largest share of the model AV carried by one term instance over the taus.
 max_share <- function(fit, label) {
-  comp <- tryCatch(av_model(fit$data$tau, stats::coef(fit), freq = fit$freq,
-                            by_term = TRUE), error = function(e) NULL)
-  if (is.null(comp) || !label %in% colnames(comp)) return(1)
+  comp <- fit$components
+  if (!label %in% colnames(comp)) return(1)
   max(comp[, label] / rowSums(comp))
-}
-
-# Label the new instance gets: "gm" -> "gm2" if one gm is already there.
-new_label <- function(terms, effect) {
-  if (effect %in% c("gm", "sinusoid")) paste0(effect, sum(terms == effect) + 1L)
-  else effect
-}
-
-# Fitted parameters of one term instance as a named numeric vector
-# (names without the label prefix: sigma, tc, amp, f0, or the kind).
-effect_params <- function(fit, label) {
-  cf <- stats::coef(fit)
-  if (label %in% names(cf)) return(stats::setNames(cf[[label]], label))
-  hit <- startsWith(names(cf), paste0(label, "."))
-  stats::setNames(unname(cf[hit]), sub("^[^.]*\\.", "", names(cf)[hit]))
-}
-
-format_params <- function(par, effect) {
-  units <- c(tc = " s", f0 = " Hz")
-  nm <- names(par)
-  txt <- vapply(seq_along(par), function(i) {
-    u <- if (nm[i] %in% names(units)) units[[nm[i]]] else ""
-    sprintf("%s=%s%s", nm[i], format(signif(par[[i]], 3)), u)
-  }, character(1))
-  paste(txt, collapse = ", ")
-}
-
-# Steps as text for print/summary of a refined fit.
-format_steps <- function(steps) {
-  if (is.null(steps) || !nrow(steps)) return(character(0))
-  vapply(seq_len(nrow(steps)), function(i) {
-    s <- steps[i, ]
-    sprintf("%d. + %s (%s), tau %s-%s s: chi2/dof %.2f -> %.2f, RMS %.1f%% -> %.1f%%\n     evidence: %s",
-            i, s$effect, s$params, format_num(s$tau_from), format_num(s$tau_to),
-            s$chi2_before, s$chi2_after, s$rms_before, s$rms_after, s$evidence)
-  }, character(1))
-}
-
-# Print the steps of a refined fit (after the avfit print).
-print_steps <- function(x, ...) {
-  txt <- format_steps(x$steps)
-  if (length(txt)) {
-    cat("Refinement steps (avrefine):\n")
-    cat(txt, sep = "\n")
-  } else if (!is.null(x$refine)) {
-    cat("Refinement: nothing added (no effect paid by ", x$refine$criterion, ").\n",
-        sep = "")
-  }
-  invisible(x)
 }

@@ -6,7 +6,12 @@
 #' ([av_model()] with the same `freq`), so that a simulation and its
 #' theory can be compared directly.
 #'
-#' Recipes (\eqn{\tau_0 = 1/f}, \eqn{w} standard normal):
+#' Each effect of the catalogue ([av_terms()]) is given by name in `...`:
+#' a single-parameter term by its coefficient (`N = 0.01`), a term with
+#' several parameters by a list or data frame of them, one row per instance
+#' for the repeatable ones (`gm = data.frame(sigma = , tc = )`). Each
+#' entry's simulator is used, in the catalogue's order. The built-in
+#' recipes (\eqn{\tau_0 = 1/f}, \eqn{w} standard normal):
 #' * `Q`: \eqn{y_k = (e_{k+1} - e_k)/\tau_0}, \eqn{e} i.i.d. uniform with
 #'   variance \eqn{Q^2} (angle quantum \eqn{\sqrt{12}Q}).
 #' * `N`: \eqn{y_k = (N/\sqrt{\tau_0}) w_k}.
@@ -24,15 +29,15 @@
 #'
 #' @param n Number of samples (a whole number >= 2).
 #' @param freq Sampling frequency in Hz.
-#' @param Q,N,B,K,R Non-negative coefficients in IEEE 952 units ("u" the rate
-#'   unit): quantization `Q` \[u s\], white noise `N` \[u sqrt(s)\], bias
-#'   instability (flicker) `B` \[u\], rate random walk `K` \[u/sqrt(s)\],
-#'   rate ramp `R` \[u/s\].
-#' @param gm Gauss-Markov terms: `NULL`, a list `list(sigma = , tc = )` or a
-#'   data frame with columns `sigma` \[u\] and `tc` \[s\], one row per term.
-#' @param sinusoid Sinusoidal terms: `NULL`, a list `list(amp = , f0 = )` or
-#'   a data frame with columns `amp` \[u\] and `f0` \[Hz\] (below `freq / 2`),
-#'   one row per term.
+#' @param ... The effects, named by their term: non-negative coefficients
+#'   in IEEE 952 units ("u" the rate unit) for quantization `Q` \[u s\],
+#'   white noise `N` \[u sqrt(s)\], bias instability (flicker) `B` \[u\],
+#'   rate random walk `K` \[u/sqrt(s)\], rate ramp `R` \[u/s\]; Gauss-Markov
+#'   terms `gm` as a list `list(sigma = , tc = )` or a data frame with
+#'   columns `sigma` \[u\] and `tc` \[s\], one row per term; sinusoidal
+#'   terms `sinusoid` as a list `list(amp = , f0 = )` or a data frame with
+#'   columns `amp` \[u\] and `f0` \[Hz\] (below `freq / 2`). Any other effect
+#'   registered in the catalogue likewise, by its parameters.
 #' @param seed Optional integer seed. When given, the result is reproducible
 #'   and the caller's random-number state is left as it was.
 #' @return A `ts` of `n` samples with frequency `freq`, and attribute
@@ -46,20 +51,40 @@
 #' attr(x, "coef")
 #' av <- avar(x, 100)
 #' cbind(av$time, sqrt(av$av), sqrt(av_model(av$time, attr(x, "coef"), 100)))
-avsim <- function(n, freq, Q = 0, N = 0, B = 0, K = 0, R = 0, gm = NULL,
-                  sinusoid = NULL, seed = NULL) {
+avsim <- function(n, freq, ..., seed = NULL) {
   check_present(missing(n), "n", "the number of samples")
   check_present(missing(freq), "freq", "the sampling frequency in Hz")
   n <- check_number(n, "n", lo = 2, hi = 2^31 - 1, integer = TRUE)
   freq <- check_freq(freq)
-  amps <- c(Q = check_number(Q, "Q", lo = 0), N = check_number(N, "N", lo = 0),
-            B = check_number(B, "B", lo = 0), K = check_number(K, "K", lo = 0),
-            R = check_number(R, "R", lo = 0))
-  gm <- check_term_table(gm, "gm", c("sigma", "tc"))
-  sinusoid <- check_term_table(sinusoid, "sinusoid", c("amp", "f0"))
-  if (nrow(sinusoid) && any(sinusoid$f0 >= freq / 2)) {
-    abort("`sinusoid` frequencies `f0` must be below the Nyquist frequency ",
-          "freq / 2 = ", format(freq / 2), " Hz.")
+  effects <- list(...)
+  nm <- names(effects)
+  if (length(effects) && (is.null(nm) || any(!nzchar(nm)))) {
+    abort("The effects in `...` must be named by their term, e.g. ",
+          "avsim(n, freq, N = 0.01); see av_terms().", class = "argument")
+  }
+  kinds <- effect_kinds(c("av", "series"))
+  unknown <- setdiff(nm, kinds)
+  if (length(unknown)) {
+    abort("`", unknown[1], "` is not an effect of the catalogue; known ",
+          "effects are ", paste(kinds, collapse = ", "), ".", class = "argument")
+  }
+  if (anyDuplicated(nm)) {
+    abort("`", nm[duplicated(nm)][1], "` is given twice.", class = "argument")
+  }
+  # Check everything before drawing anything.
+  specs <- list()
+  for (k in intersect(kinds, nm)) {
+    e <- effect_entry(k)
+    if (isTRUE(e$bare)) {
+      specs[[k]] <- check_number(effects[[k]], k, lo = 0)
+    } else {
+      tab <- check_term_table(effects[[k]], k, e$params)
+      if (!e$repeatable && nrow(tab) > 1L) {
+        abort("`", k, "` may appear once; give one row.", class = "argument")
+      }
+      if (!is.null(e$sim_check)) e$sim_check(tab, freq, k)
+      specs[[k]] <- tab
+    }
   }
   if (!is.null(seed)) {
     seed <- check_number(seed, "seed", integer = TRUE,
@@ -69,31 +94,39 @@ avsim <- function(n, freq, Q = 0, N = 0, B = 0, K = 0, R = 0, gm = NULL,
     set.seed(seed)
   }
   tau0 <- 1 / freq
-  cat <- term_catalogue()
   y <- numeric(n)
   coef <- numeric(0)
-  for (k in names(amps)) {
-    if (amps[[k]] > 0) y <- y + cat[[k]]$sim(n, tau0, amps[[k]], NULL)
-    coef[k] <- amps[[k]]
-  }
-  coef <- coef[coef > 0]
-  for (i in seq_len(nrow(gm))) {
-    y <- y + cat$gm$sim(n, tau0, gm$sigma[i], c(tc = gm$tc[i]))
-    coef[paste0("gm", i, c(".sigma", ".tc"))] <- c(gm$sigma[i], gm$tc[i])
-  }
-  for (i in seq_len(nrow(sinusoid))) {
-    y <- y + cat$sinusoid$sim(n, tau0, sinusoid$amp[i], c(f0 = sinusoid$f0[i]))
-    coef[paste0("sinusoid", i, c(".amp", ".f0"))] <-
-      c(sinusoid$amp[i], sinusoid$f0[i])
+  for (k in names(specs)) {
+    e <- effect_entry(k)
+    v <- specs[[k]]
+    if (isTRUE(e$bare)) {
+      if (v > 0) {
+        y <- y + e$sim(n, tau0, stats::setNames(v, k), NULL)
+        coef[k] <- v
+      }
+      next
+    }
+    p <- e$params
+    amp <- p$name[p$role == "amp"]
+    nl <- p$name[p$role == "nonlinear"]
+    if (!nrow(v)) next
+    labels <- instance_labels(e, nrow(v))
+    for (i in seq_len(nrow(v))) {
+      row <- unlist(v[i, p$name, drop = FALSE])
+      y <- y + e$sim(n, tau0, row[amp], if (length(nl)) row[nl] else NULL)
+      coef[coef_names(e, labels[i])] <- unname(row)
+    }
   }
   out <- stats::ts(y, start = 0, frequency = freq)
   attr(out, "coef") <- coef
   out
 }
 
-# gm / sinusoid arguments: NULL, a list or a data frame with the given
-# columns -> a data frame (zero rows for NULL).
-check_term_table <- function(x, arg, cols) {
+# The argument of an effect with several parameters: NULL, a list or a data
+# frame with the parameters as columns -> a data frame (zero rows for NULL).
+# Amplitudes must be non-negative, nonlinear parameters positive.
+check_term_table <- function(x, arg, params) {
+  cols <- params$name
   empty <- as.data.frame(stats::setNames(rep(list(numeric(0)), length(cols)), cols))
   if (is.null(x)) return(empty)
   if (is.list(x) && !is.data.frame(x)) {
@@ -101,25 +134,29 @@ check_term_table <- function(x, arg, cols) {
       abort("`", arg, "` must be a list or data frame with elements ",
             paste(cols, collapse = " and "), "; got ",
             if (length(names(x))) paste(names(x), collapse = ", ") else "no names",
-            ".")
+            ".", class = "argument")
     }
-    x <- tryCatch(as.data.frame(x[cols]), error = function(e) {
+    lens <- lengths(x[cols])
+    if (length(unique(lens)) != 1L) {
       abort("`", arg, "`: elements ", paste(cols, collapse = " and "),
-            " must have the same length.")
-    })
+            " must have the same length.", class = "argument")
+    }
+    x <- as.data.frame(x[cols])
   }
   if (!is.data.frame(x) || !all(cols %in% names(x))) {
     abort("`", arg, "` must be NULL, a list or a data frame with columns ",
-          paste(cols, collapse = " and "), ", not ", describe_type(x), ".")
+          paste(cols, collapse = " and "), ", not ", describe_type(x), ".",
+          class = "argument")
   }
   x <- x[cols]
-  for (cl in cols) {
-    v <- x[[cl]]
+  for (j in seq_along(cols)) {
+    v <- x[[cols[j]]]
+    amp <- params$role[j] == "amp"
     if (!is.numeric(v) || anyNA(v) || any(!is.finite(v)) ||
-        any(v < 0) || (cl != cols[1] && any(v <= 0))) {
-      abort("`", arg, "$", cl, "` must be ",
-            if (cl == cols[1]) "non-negative" else "positive",
-            " finite numbers.")
+        any(v < 0) || (!amp && any(v <= 0))) {
+      abort("`", arg, "$", cols[j], "` must be ",
+            if (amp) "non-negative" else "positive",
+            " finite numbers.", class = "argument")
     }
   }
   rownames(x) <- NULL

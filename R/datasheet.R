@@ -49,19 +49,19 @@ datasheet.imu_analysis_list <- function(x, average = FALSE, ...) {
 #' @export
 datasheet.imu_analysis <- function(x, average = FALSE, ...) {
   if (!is.logical(average) || length(average) != 1L || is.na(average)) {
-    abort("`average` must be TRUE or FALSE, not ", format_value(average), ".")
+    abort("`average` must be TRUE or FALSE, not ", format_value(average), ".",
+          class = "argument")
   }
   long <- list()
   for (ch in x$channels) {
     rd <- ch$readings
     eff <- added_effects(ch$fit)
-    for (term in c("N", "B", "K")) {
-      r <- rd[rd$term == term, ]
-      kind <- if (term == "B") "rate" else term
-      si <- si_unit(ch$sensor, kind)
-      us <- c(si, datasheet_units(ch$sensor)[[term]])
+    for (j in seq_len(nrow(rd))) {
+      r <- rd[j, ]
+      si <- r$unit
+      us <- c(si, datasheet_units(ch$sensor)[[r$term]])
       long[[length(long) + 1L]] <- data.frame(
-        record = x$name, sensor = ch$sensor, axis = ch$channel, term = term,
+        record = x$name, sensor = ch$sensor, axis = ch$channel, term = r$term,
         value = vapply(us, function(u) convert_units(r$value, si, u), 0),
         unit = us, tau = r$tau, method = r$method, effects = eff,
         stringsAsFactors = FALSE)
@@ -89,8 +89,11 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
   out
 }
 
-# One row per axis; one column per (term, unit), plus tau_B, method, effects.
+# One row per axis; one column per (term, unit), plus the tau of the reading
+# read at the flat minimum (tau_B), method, effects.
 wide_table <- function(l) {
+  tau_term <- reading_symbol("flicker")
+  tau_col <- sprintf("tau_%s [s]", tau_term)
   axes <- unique(l$axis)
   key <- unique(l[c("term", "unit")])
   cols <- list(record = vapply(axes, function(a) l$record[l$axis == a][1L], ""),
@@ -101,9 +104,9 @@ wide_table <- function(l) {
       v <- l$value[l$axis == a & l$term == key$term[i] & l$unit == key$unit[i]]
       if (length(v)) v[1L] else NA_real_
     }, 0)
-    if (key$term[i] == "B" && !"tau_B [s]" %in% names(cols)) {
-      cols[["tau_B [s]"]] <- vapply(axes, function(a)
-        l$tau[l$axis == a & l$term == "B"][1L], 0)
+    if (key$term[i] %in% tau_term && !tau_col %in% names(cols)) {
+      cols[[tau_col]] <- vapply(axes, function(a)
+        l$tau[l$axis == a & l$term == tau_term][1L], 0)
     }
   }
   cols$method <- vapply(axes, function(a) {
@@ -118,24 +121,24 @@ wide_table <- function(l) {
   df
 }
 
+# The effects the closed loop added, as the catalogue describes them (with
+# the fitted values of every instance of that kind).
 added_effects <- function(fit) {
   st <- fit$steps
   if (is.null(st) || !nrow(st)) return("none")
   eff <- as.character(st$effect)
   cf <- fit$coefficients
-  lab <- vapply(seq_along(eff), function(i) {
-    e <- eff[i]
-    if (e == "gm") {
-      tc <- cf[grepl("^gm[0-9]+\\.tc$", names(cf))]
-      if (length(tc)) return(sprintf("gm (Tc = %s s)",
-                                     paste(signif(tc, 3), collapse = ", ")))
-    }
-    if (e == "sinusoid") {
-      f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
-      if (length(f0)) return(sprintf("sinusoid (f0 = %s Hz)",
-                                     paste(signif(f0, 3), collapse = ", ")))
-    }
-    e
+  lay <- if (length(cf)) check_coef(cf) else NULL
+  lab <- vapply(eff, function(term) {
+    sp <- split_term(term)
+    e <- effect_entry(sp$kind, sp$variant)
+    rows <- if (is.null(lay)) NULL else lay[lay$kind == sp$kind, , drop = FALSE]
+    if (is.null(rows) || !nrow(rows)) return(term)
+    values <- do.call(rbind, lapply(unique(rows$label), function(l) {
+      r <- rows[rows$label == l, , drop = FALSE]
+      as.data.frame(as.list(stats::setNames(r$value, r$param)))
+    }))
+    e$describe(values)
   }, "")
   paste(unique(lab), collapse = ", ")
 }
@@ -167,7 +170,7 @@ print.imu_datasheet <- function(x, digits = 3, ...) {
 #' @param x An `imu_datasheet` ([datasheet()]), or an `imu_analysis` /
 #'   `imu_analysis_list` whose datasheet is written.
 #' @param file Path of the CSV file.
-#' @param format `"long"` (one row per axis, term and unit: `record`,
+#' @param format `"long"` (default; one row per axis, term and unit: `record`,
 #'   `sensor`, `axis`, `term`, `value`, `unit`, `tau`, `method`, `effects`)
 #'   or `"wide"` (the printed tables, one block per sensor, stacked).
 #' @return `file`, invisibly.
@@ -181,12 +184,12 @@ print.imu_datasheet <- function(x, digits = 3, ...) {
 #' write_datasheet(a, f)
 #' read.csv(f)
 #' }
-write_datasheet <- function(x, file, format = c("long", "wide")) {
-  format <- match.arg(format)
+write_datasheet <- function(x, file, format = "long") {
+  format <- check_choice(format, c("long", "wide"), "format")
   if (inherits(x, c("imu_analysis", "imu_analysis_list"))) x <- datasheet(x)
   if (!inherits(x, "imu_datasheet")) {
     abort("`x` must be an imu_datasheet or imu_analysis, not ",
-          describe_type(x), ".")
+          describe_type(x), ".", class = "argument")
   }
   if (format == "long") {
     utils::write.csv(x$long, file, row.names = FALSE)

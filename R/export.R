@@ -35,13 +35,13 @@
 #'                        accelerometer_random_walk = 3e-3,
 #'                        update_rate = 200), f)
 #' cat(readLines(f), sep = "\n")
-write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
+write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
                               rostopic = "/imu0", inflate = 1) {
   check_present(missing(x), "x", "an imu_analysis or the four noise values")
-  axis <- match.arg(axis)
+  axis <- check_choice(axis, c("max", "mean"), "axis")
   inflate <- check_number(inflate, "inflate", lo = 1)
   if (!is.character(rostopic) || length(rostopic) != 1L) {
-    abort("`rostopic` must be a single string.")
+    abort("`rostopic` must be a single string.", class = "argument")
   }
   keys <- c("accelerometer_noise_density", "accelerometer_random_walk",
             "gyroscope_noise_density", "gyroscope_random_walk")
@@ -51,12 +51,15 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
     vals <- numeric()
     for (k in keys) {
       sensor <- if (startsWith(k, "gyro")) "gyro" else "accel"
-      term <- if (endsWith(k, "noise_density")) "N" else "K"
+      # Kalibr's noise density is the white-noise reading, its random walk
+      # the rate-random-walk reading.
+      role <- if (endsWith(k, "noise_density")) "white" else "random_walk"
       rows <- lapply(Filter(function(cc) cc$sensor == sensor, x$channels),
                      function(cc) {
-                       r <- cc$readings[cc$readings$term == term, ]
+                       r <- reading_of(cc$readings, role)
                        data.frame(axis = cc$channel, value = r$value,
-                                  method = r$method, stringsAsFactors = FALSE)
+                                  is_bound = isTRUE(r$is_bound),
+                                  stringsAsFactors = FALSE)
                      })
       if (!length(rows)) {
         vals[k] <- NA_real_
@@ -68,11 +71,11 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
         i <- which.max(rows$value)
         vals[k] <- rows$value[i]
         notes[k] <- sprintf("worst axis (%s)", rows$axis[i])
-        bound <- grepl("upper bound", rows$method[i])
+        bound <- rows$is_bound[i]
       } else {
         vals[k] <- mean(rows$value)
         notes[k] <- "mean of the axes"
-        bound <- any(grepl("upper bound", rows$method))
+        bound <- any(rows$is_bound)
       }
       if (bound) notes[k] <- paste0(notes[k], "; UPPER BOUND, +1/2 region not reached")
       header <- c(header, sprintf("#   %-28s %s", k, paste(sprintf(
@@ -89,13 +92,13 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
     x <- as.list(x)
     miss <- setdiff(c(keys, "update_rate"), names(x))
     if (length(miss)) {
-      abort("`x` lacks ", paste(miss, collapse = ", "), ".")
+      abort("`x` lacks ", paste(miss, collapse = ", "), ".", class = "argument")
     }
     vals <- vapply(keys, function(k) check_number(x[[k]], k, lo = 0), 0)
     rate <- check_freq(x[["update_rate"]], "update_rate")
   } else {
     abort("`x` must be an imu_analysis or a named list of the noise values, not ",
-          describe_type(x), ".")
+          describe_type(x), ".", class = "argument")
   }
   vals <- vals * inflate
   units <- c(accelerometer_noise_density = "m/s^2/sqrt(Hz)",
@@ -161,30 +164,36 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = c("max", "mean"),
 #'   `gm1.tc`, ..., in the rate unit, e.g. SI).
 #' @param dt The filter step in seconds; default `1 / freq` of the analysis
 #'   (required for a plain vector without `freq`).
-#' @param bias_instability `"gm"` or `"omit"`, see above.
+#' @param bias_instability `"gm"` (default) or `"omit"`, see above.
 #' @param tau_B For a vector or `avfit`: the tau (s) of the flat minimum,
 #'   used by `bias_instability = "gm"`.
 #' @return A data frame with one row per parameter: `channel`, `sensor`,
 #'   `term`, `parameter`, `value`, `unit`, `continuous` (the coefficient it
-#'   comes from), `continuous_unit`, `dt` and `convention`.
+#'   comes from), `continuous_unit`, `dt` and `convention`; rows in the
+#'   catalogue's order of the terms (N, B, K, then the Gauss-Markov terms).
 #' @export
 #' @examples
 #' filter_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
-filter_params <- function(x, dt = NULL, bias_instability = c("gm", "omit"),
+filter_params <- function(x, dt = NULL, bias_instability = "gm",
                           tau_B = NULL) {
   check_present(missing(x), "x", "an imu_analysis, an avfit or coefficients")
-  bias_instability <- match.arg(bias_instability)
+  bias_instability <- check_choice(bias_instability, c("gm", "omit"),
+                                   "bias_instability")
   if (inherits(x, "imu_analysis")) {
     if (is.null(dt)) dt <- 1 / x$freq
     dt <- check_number(dt, "dt", lo = 0, open = TRUE)
     rows <- lapply(x$channels, function(ch) {
       rd <- ch$readings
-      cf <- ch$coef
-      cf <- gm_terms(cf, drop_white = grepl("white-like GM", rd$method[rd$term == "N"]))
-      cf[c("N", "B", "K")] <- rd$value[match(c("N", "B", "K"), rd$term)]
-      tb <- rd$tau[rd$term == "B"]
-      discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability, tb,
-                    k_bound = grepl("upper bound", rd$method[rd$term == "K"]))
+      # the readings replace the fitted values; terms folded into a reading
+      # are not repeated
+      folded <- unlist(strsplit(rd$folded[nzchar(rd$folded)], ",", fixed = TRUE))
+      cf <- unfolded_coef(ch$coef, folded = folded)
+      cf <- cf[!names(cf) %in% rd$term]
+      cf <- c(stats::setNames(rd$value, rd$term), cf)
+      flat <- reading_of(rd, "flicker")
+      discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability,
+                    if (nrow(flat)) flat$tau else NA_real_,
+                    bounds = rd$term[rd$is_bound])
     })
     out <- do.call(rbind, rows)
   } else {
@@ -198,9 +207,12 @@ filter_params <- function(x, dt = NULL, bias_instability = c("gm", "omit"),
     }
     if (!is.numeric(x) || is.null(names(x))) {
       abort("`x` must be an imu_analysis, an avfit or a named numeric vector ",
-            "of coefficients, not ", describe_type(x), ".")
+            "of coefficients, not ", describe_type(x), ".", class = "argument")
     }
-    if (is.null(dt)) abort("`dt` is missing; give the filter step in seconds.")
+    if (is.null(dt)) {
+      abort("`dt` is missing; give the filter step in seconds.",
+            class = "missing_argument")
+    }
     dt <- check_number(dt, "dt", lo = 0, open = TRUE)
     out <- discrete_rows(x, dt, "x", sensor, bias_instability,
                          if (is.null(tau_B)) NA_real_ else tau_B)
@@ -209,65 +221,27 @@ filter_params <- function(x, dt = NULL, bias_instability = c("gm", "omit"),
   out
 }
 
-# The GM coefficients, renumbered; without those already folded into N.
-gm_terms <- function(cf, drop_white = FALSE) {
-  out <- numeric()
-  j <- 1L
-  k <- 1L
-  while (paste0("gm", j, ".sigma") %in% names(cf)) {
-    sig <- cf[[paste0("gm", j, ".sigma")]]
-    tc <- cf[[paste0("gm", j, ".tc")]]
-    if (!(drop_white && tc < 0.1)) {
-      out[paste0("gm", k, c(".sigma", ".tc"))] <- c(sig, tc)
-      k <- k + 1L
-    }
-    j <- j + 1L
+# The discrete-time rows of every instance in `cf` whose catalogue entry has
+# a discrete-time model, in catalogue order. `bounds`: terms that are upper
+# bounds.
+discrete_rows <- function(cf, dt, channel, sensor, bi, tau_b, bounds = character()) {
+  unit <- function(kind) {
+    if (is.na(sensor)) c(rate = "u", N = "u*sqrt(s)", K = "u/sqrt(s)")[[kind]]
+    else si_unit(sensor, kind)
   }
-  out
-}
-
-discrete_rows <- function(cf, dt, channel, sensor, bi, tau_b, k_bound = FALSE) {
-  u <- if (is.na(sensor)) "u" else si_unit(sensor, "rate")
-  un <- if (is.na(sensor)) "u*sqrt(s)" else si_unit(sensor, "N")
-  uk <- if (is.na(sensor)) "u/sqrt(s)" else si_unit(sensor, "K")
+  cf <- cf[is.finite(cf)]
+  lay <- if (length(cf)) check_coef(cf) else NULL
   rows <- list()
-  add <- function(term, parameter, value, unit, cont, cont_unit, conv) {
-    rows[[length(rows) + 1L]] <<- data.frame(
-      channel = channel, sensor = sensor, term = term, parameter = parameter,
-      value = value, unit = unit, continuous = cont,
-      continuous_unit = cont_unit, dt = dt, convention = conv,
-      stringsAsFactors = FALSE)
+  for (l in unique(lay$label)) {
+    r <- lay[lay$label == l, , drop = FALSE]
+    e <- effect_entry(r$kind[1L], r$variant[1L])
+    if (is.null(e$discrete)) next
+    par <- stats::setNames(r$value, r$param)
+    rows[[length(rows) + 1L]] <- e$discrete(par, dt, unit, list(
+      label = l, bias_instability = bi, tau_B = tau_b,
+      bound = any(r$name %in% bounds)))
   }
-  get <- function(nm) if (nm %in% names(cf)) unname(cf[[nm]]) else NA_real_
-  n <- get("N")
-  if (is.finite(n)) {
-    add("N", "sigma_d", n / sqrt(dt), u, n, un,
-        "white noise per sample: y[k] = sigma_d * w[k], sigma_d = N / sqrt(dt)")
-  }
-  k <- get("K")
-  if (is.finite(k)) {
-    add("K", "sigma_bd", k * sqrt(dt), u, k, uk, paste0(
-      "bias random walk: b[k] = b[k-1] + sigma_bd * w[k], sigma_bd = K * sqrt(dt)",
-      if (k_bound) " (K is an upper bound: +1/2 region not reached)" else ""))
-  }
-  gm_gm <- function(term, sigma, tc, how) {
-    phi <- exp(-dt / tc)
-    add(term, "phi", phi, "1", tc, "s",
-        paste0(how, "Gauss-Markov: x[k] = phi * x[k-1] + w[k], phi = exp(-dt / Tc)"))
-    add(term, "q_d", sigma^2 * (1 - phi^2), paste0("(", u, ")^2"), sigma, u,
-        paste0(how, "driving-noise variance Var(w[k]) = q_d = sigma^2 * (1 - phi^2)"))
-  }
-  b <- get("B")
-  if (bi == "gm" && is.finite(b) && b > 0 && is.finite(tau_b)) {
-    gm_gm("B", 0.664 * b / 0.6174, tau_b / 1.893,
-          "bias instability approximated (Tc = tau_B / 1.893, sigma = 0.664 B / 0.6174) by ")
-  }
-  j <- 1L
-  while (is.finite(get(paste0("gm", j, ".sigma")))) {
-    gm_gm(paste0("gm", j), get(paste0("gm", j, ".sigma")),
-          get(paste0("gm", j, ".tc")), "")
-    j <- j + 1L
-  }
+  rows <- Filter(Negate(is.null), rows)
   if (!length(rows)) {
     return(data.frame(channel = character(), sensor = character(),
                       term = character(), parameter = character(),
@@ -275,5 +249,9 @@ discrete_rows <- function(cf, dt, channel, sensor, bi, tau_b, k_bound = FALSE) {
                       continuous = numeric(), continuous_unit = character(),
                       dt = numeric(), convention = character()))
   }
-  do.call(rbind, rows)
+  out <- do.call(rbind, rows)
+  cbind(data.frame(channel = channel, sensor = sensor, stringsAsFactors = FALSE),
+        out[c("term", "parameter", "value", "unit", "continuous",
+              "continuous_unit")],
+        dt = dt, convention = out$convention, stringsAsFactors = FALSE)
 }

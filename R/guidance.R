@@ -60,7 +60,8 @@ imu_guidance <- function(x) {
   if (is.list(x) && !is.null(x$curve) && !is.null(x$readings)) {
     return(channel_guidance(x))
   }
-  abort("`x` must be an imu_analysis, not ", describe_type(x), ".")
+  abort("`x` must be an imu_analysis, not ", describe_type(x), ".",
+        class = "argument")
 }
 
 channel_guidance <- function(ch) {
@@ -85,36 +86,37 @@ channel_guidance <- function(ch) {
       if (is.null(edf)) NA else min(edf[few], na.rm = TRUE)))
   }
   rd <- ch$readings
-  val <- function(t) rd$value[rd$term == t]
-  N <- val("N")
-  B <- val("B")
-  K <- val("K")
-  n2 <- if (is.finite(N)) N^2 else 0
-  b2 <- if (is.finite(B)) B^2 else 0
+  white <- reading_of(rd, "white")
+  flat <- reading_of(rd, "flicker")
+  walk <- reading_of(rd, "random_walk")
+  N <- white$value
+  B <- flat$value
+  K <- walk$value
+  n2 <- if (isTRUE(is.finite(N))) N^2 else 0
+  b2 <- if (isTRUE(is.finite(B))) B^2 else 0
   need <- function(tau) T * 3 * tau / tau_rel
-  kmeth <- rd$method[rd$term == "K"]
-  if (grepl("upper bound", kmeth)) {
+  if (isTRUE(walk$is_bound)) {
     tx <- tau_cross(n2, b2, K)
     msg <- c(msg, sprintf(
       "the +1/2 (rate random walk) region is never reached up to tau = %s: K <= %.3g %s only; resolving a K that large needs a record of at least %s (this one is %s), a smaller K a longer one.",
-      hours(tau_rel), K, rd$unit[rd$term == "K"], hours(need(tx)), hours(T)))
-  } else if (is.finite(K) && K > 0) {
+      hours(tau_rel), K, walk$unit, hours(need(tx)), hours(T)))
+  } else if (isTRUE(is.finite(K) && K > 0)) {
     tx <- tau_cross(n2, b2, K)
     if (tau_rel < 3 * tx) {
       msg <- c(msg, sprintf(
         "K = %.3g %s is read beyond the reliable range: the +1/2 line meets the rest at tau = %s, so tau up to %s (a record of %s) is needed; this record is %s.",
-        K, rd$unit[rd$term == "K"], hours(tx), hours(3 * tx), hours(need(tx)),
+        K, walk$unit, hours(tx), hours(3 * tx), hours(need(tx)),
         hours(T)))
     }
   }
-  tau_b <- rd$tau[rd$term == "B"]
-  if (is.finite(tau_b) && tau_b > tau_rel / 3) {
+  tau_b <- flat$tau
+  if (isTRUE(is.finite(tau_b) && tau_b > tau_rel / 3)) {
     msg <- c(msg, sprintf(
       "the Allan deviation minimum (tau = %s) is not inside the reliable range (up to %s / 3): B = %.3g %s may be an overestimate of the flat region; a record of at least %s is needed (this one is %s).",
-      hours(tau_b), hours(tau_rel), B, rd$unit[rd$term == "B"],
+      hours(tau_b), hours(tau_rel), B, flat$unit,
       hours(need(tau_b)), hours(T)))
   }
-  if (!is.finite(N)) {
+  if (!isTRUE(is.finite(N))) {
     msg <- c(msg, "no -1/2 (white noise) region found: N not read; a higher sampling rate shows more of the short-tau region.")
   }
   fit <- ch$fit

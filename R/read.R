@@ -1,13 +1,25 @@
-#' Read an IMU recording from a delimited file
+#' Read an IMU recording: delimited text, ROS1 bag, ROS2 db3 or MCAP
 #'
-#' Reads a text file with a timestamp column and gyroscope and/or
-#' accelerometer columns, converts the samples to SI units (rad/s, m/s^2),
-#' takes the sampling rate from the timestamps and checks them. The
-#' Kalibr/EuRoC layout is recognized without arguments:
-#' `timestamp,omega_x,omega_y,omega_z,alpha_x,alpha_y,alpha_z` (timestamps in
-#' ns, rad/s, m/s^2), and EuRoC's
-#' `#timestamp [ns],w_RS_S_x [rad s^-1],...,a_RS_S_z [m s^-2]`.
-#' Other layouts are described with `time`, `columns`, `units` and `sensors`.
+#' Reads a recording of gyroscope and/or accelerometer samples, converts them
+#' to SI units (rad/s, m/s^2), takes the sampling rate from the timestamps
+#' and checks them. The format is recognized from the file's first bytes:
+#'
+#' * **Delimited text** (read with [data.table::fread()]; integer stamps are
+#'   kept exact through bit64). The Kalibr/EuRoC layout is recognized without
+#'   arguments: `timestamp,omega_x,omega_y,omega_z,alpha_x,alpha_y,alpha_z`
+#'   (timestamps in ns, rad/s, m/s^2), and EuRoC's
+#'   `#timestamp [ns],w_RS_S_x [rad s^-1],...,a_RS_S_z [m s^-2]`. Other
+#'   layouts are described with `time`, `columns`, `units` and `sensors`.
+#' * **ROS bags**, without ROS: `sensor_msgs/Imu` messages of one topic from a
+#'   ROS1 `.bag` (format 2.0; chunks uncompressed, bz2 or lz4), a ROS2
+#'   `.db3` (rosbag2 SQLite storage, CDR messages) or an `.mcap` file (chunks
+#'   uncompressed, lz4 or zstd; CDR or ROS1 messages). The messages' header
+#'   stamps are the timestamps (the receive times when every header stamp is
+#'   zero, reported). `topic` names the topic; without it the only IMU topic
+#'   is used, and with several the call stops and lists them (see
+#'   [imu_topics()]). ROS holds angular velocity in rad/s and linear
+#'   acceleration in m/s^2 (REP 103); `units` overrides that for drivers that
+#'   publish other units.
 #'
 #' @section Timestamp checks (never silent):
 #' Each problem found is listed in the result's `problems` table and in one
@@ -24,29 +36,63 @@
 #'   is always computed (`sampling$jitter_rms`, seconds); above 1% of the
 #'   step it is listed as a problem. Samples are used as they are (the Allan
 #'   variance assumes a regular grid).
-#' * rows with missing or non-numeric values are dropped.
+#' * a sampling rate that no IMU has (above 100 kHz or below 0.001 Hz) for
+#'   the time unit in use stops the reading, naming the time column and the
+#'   unit that would give a plausible rate.
 #'
 #' The sampling rate is `1 / median(step)` unless `freq` is given.
-#' Nanosecond stamps near 1.6e18 are held as doubles (resolution 256 ns);
-#' they are made relative to the first stamp before use.
+#' Integer stamps (ns, us, ms) are read as 64-bit integers and made relative
+#' to the first stamp exactly: `t = (stamp - first) / 1e9` for ns.
 #'
-#' @param file Path of the delimited text file.
-#' @param time Timestamp column: `NULL` to detect it (a column named
-#'   `timestamp`, `time`, `t`, `stamp`, ...), a column name or index, or
-#'   `FALSE` when there is none (then `freq` is required).
-#' @param time_unit Unit of the timestamps. `"auto"` uses the header (e.g.
-#'   `[ns]`), then ns for the Kalibr layout, then the magnitude of the stamps
-#'   (absolute epochs: > 1e17 ns, > 1e14 us, > 1e11 ms) or of the median
-#'   step (< 0.5 s, < 500 ms, < 5e5 us, else ns); the choice is reported in
-#'   `time_unit`.
+#' @section File faults (never silent):
+#' Every fault of a text file is reported with its line (the file's own line
+#' number, the header being line 1) and column, in `problems`, and handled
+#' by one rule:
+#' * a **cell that is not a number** (`abc`): its row is dropped; when more
+#'   than half of a column is not numbers the reading stops, saying what to
+#'   do (decimal commas are recognized: use `dec = ","`);
+#' * a **line with the wrong number of fields**, or a blank line: dropped;
+#'   when more than half of the lines are wrong the reading stops (decimal
+#'   commas in a comma-separated file are recognized and explained);
+#' * **missing** (`NA`, `NaN`, empty) or **infinite** (`Inf`) values: the
+#'   row is dropped;
+#' * **stamps in a unit other than the layout's** (a Kalibr header holding
+#'   seconds): read in the unit they show, reported as `time unit`;
+#' * a **byte that is not UTF-8** in the header: shown as `<xx>` in the
+#'   column name, reported as `encoding`;
+#' * a directory, a missing or an empty file: an error.
+#'
+#' @section Units (checked, never only assumed):
+#' With no `units` and none in the header or layout, gyroscopes are taken
+#' as rad/s and accelerometers as m/s^2, unless three accelerometer axes
+#' show gravity: the norm of their means near 1 (g), 9.81 (m/s^2) or 1000
+#' (mg), within 10%, then that unit is used. Given units are checked the
+#' same way (a warning of class `allanvar_warning_accel_units` when gravity
+#' says otherwise). Each gyroscope's white-noise level is estimated from the
+#' Allan deviation at 1 s; outside 1e-5 to 60 deg/sqrt(h), which real gyros
+#' span, a warning of class `allanvar_warning_gyro_units` says which unit
+#' the samples seem to be in (deg/s samples read as rad/s make N 57 times
+#' too large). The findings are in the record's `unit_checks`.
+#'
+#' @param file Path of the recording.
+#' @param time Timestamp column (text files): `NULL` to detect it (a column
+#'   named `timestamp`, `time`, `t`, `stamp`, ...), a column name or index,
+#'   or `FALSE` when there is none (then `freq` is required).
+#' @param time_unit Unit of the timestamps (text files). `"auto"` uses the
+#'   header (e.g. `[ns]`), then ns for the Kalibr layout (unless the stamps
+#'   clearly are not), then the magnitude of the stamps (absolute epochs
+#'   above 1e17 are ns, above 1e14 us, above 1e11 ms) or of the median step
+#'   (below 0.5: s, below 500: ms, below 5e5: us, else ns); the choice is
+#'   reported in `time_unit`.
 #' @param columns Data columns: `NULL` for every recognized gyro/accel
 #'   column, or a character (names) or integer (indices) vector, optionally
 #'   named with the channel names to use (e.g.
-#'   `c(gyro_x = "gx", gyro_y = "gy")`).
+#'   `c(gyro_x = "gx", gyro_y = "gy")`). For bags: a subset of `gyro_x`,
+#'   ..., `accel_z`.
 #' @param units Units of the input: `NULL` (from the header's brackets,
-#'   else SI, with a message), a vector named by sensor (`c(gyro = "deg/s", accel = "g")`) or
-#'   by channel, or a single unit for every channel of its sensor. See
-#'   [av_units()].
+#'   else checked against gravity as described above), a vector named by
+#'   sensor (`c(gyro = "deg/s", accel = "g")`) or by channel, or a single
+#'   unit for every channel of its sensor. See [av_units()].
 #' @param sep Field separator (`""` for white space).
 #' @param gap What to do with gaps: `"segments"`, `"error"` or `"ignore"`.
 #' @param freq Optional sampling frequency in Hz; required when there is no
@@ -54,6 +100,9 @@
 #'   (with a warning when they differ by more than 1%).
 #' @param sensors Optional sensor type per channel (`"gyro"` or `"accel"`),
 #'   named by channel, for columns whose names do not say it.
+#' @param topic For bags: the topic of the `sensor_msgs/Imu` messages.
+#' @param dec Decimal mark of a text file: `"."` (default) or `","` (then
+#'   `sep` must be another character, e.g. `";"`).
 #' @param ... Unused; an error if given, to catch misspelled arguments.
 #' @return An object of class `"imu_record"`: a list with `data` (numeric
 #'   matrix, one column per channel, SI units), `time` (seconds since the
@@ -61,8 +110,12 @@
 #'   units) per channel, `si_units`, `time_unit`, `segments` (data frame
 #'   `start`, `end`, `n`, `t_start`, `duration`), `problems` (data frame
 #'   `type`, `count`, `detail`, `action`), `sampling` (list: `dt_median`,
-#'   `jitter_rms`, `jitter_rel`, `gaps`) and `file`.
-#' @seealso [imu_record()] for data already in memory, [analyze_imu()].
+#'   `jitter_rms`, `jitter_rel`, `gaps`), `unit_checks` (data frame
+#'   `channel`, `sensor`, `unit`, `source`, `evidence`), `layout`
+#'   (`"kalibr"`, `"euroc"`, `"custom"`, `"rosbag"`, `"db3"`, `"mcap"`),
+#'   `topic` (bags) and `file`.
+#' @seealso [imu_record()] for data already in memory, [imu_topics()],
+#'   [analyze_imu()].
 #' @export
 #' @examples
 #' f <- tempfile(fileext = ".csv")
@@ -78,161 +131,174 @@
 #' r <- read_imu(f)
 #' r
 #' unlink(f)
+#'
+#' # A ROS2 recording in MCAP (300 sensor_msgs/Imu messages at 200 Hz)
+#' bag <- system.file("extdata", "imu_small.mcap", package = "allanvar")
+#' imu_topics(bag)
+#' read_imu(bag, topic = "/imu0")
 read_imu <- function(file, time = NULL,
                      time_unit = c("auto", "s", "ns", "us", "ms"),
                      columns = NULL, units = NULL, sep = ",",
                      gap = c("segments", "error", "ignore"),
-                     freq = NULL, sensors = NULL, ...) {
-  check_present(missing(file), "file", "the path of a delimited text file")
+                     freq = NULL, sensors = NULL, topic = NULL, dec = ".",
+                     ...) {
+  check_present(missing(file), "file", "the path of a recording")
   if (...length()) {
     abort("unknown argument(s) to read_imu(): ",
-          paste(names(list(...)), collapse = ", "), ".")
+          paste(names(list(...)), collapse = ", "), ".", class = "argument")
   }
-  if (!is.character(file) || length(file) != 1L || is.na(file)) {
-    abort("`file` must be a single file path, not ", describe_type(file), ".")
+  check_file(file)
+  time_unit <- choice_arg(time_unit, c("auto", "s", "ns", "us", "ms"), "time_unit")
+  gap <- choice_arg(gap, c("segments", "error", "ignore"), "gap")
+  if (!is.character(sep) || length(sep) != 1L || is.na(sep) || nchar(sep) > 1L) {
+    abort("`sep` must be a single character (\"\" for white space), not ",
+          format_value(sep), ".", class = "argument")
   }
-  if (!file.exists(file)) abort("`file` \"", file, "\" does not exist.")
-  time_unit <- match.arg(time_unit)
-  gap <- match.arg(gap)
-  if (!is.character(sep) || length(sep) != 1L) {
-    abort("`sep` must be a single character string, not ", describe_type(sep), ".")
+  dec <- check_choice(dec, c(".", ","), "dec")
+  if (identical(dec, sep)) {
+    abort("`dec` and `sep` must differ; both are \"", sep, "\".",
+          class = "argument")
   }
   if (!is.null(freq)) freq <- check_freq(freq)
-
-  # Header: the first line, when its first field is not a number.
-  first <- readLines(file, n = 1L, warn = FALSE)
-  if (!length(first)) abort("`file` \"", file, "\" is empty.")
-  fields <- split_fields(first, sep)
-  has_header <- is.na(suppressWarnings(as.numeric(fields[1L])))
-  raw_names <- if (has_header) fields else paste0("V", seq_along(fields))
-  clean <- clean_names(raw_names)
-  hdr_units <- bracket_units(raw_names)
-
-  # Time column.
-  time_col <- NULL
-  if (is.null(time)) {
-    hit <- which(clean %in% c("timestamp", "time", "t", "stamp", "time_s",
-                              "time_ns", "timestamp_ns", "sec", "seconds",
-                              "field.header.stamp", "%time"))
-    if (length(hit)) time_col <- hit[1L]
-  } else if (!isFALSE(time)) {
-    time_col <- pick_columns(time, raw_names, clean, "time")
-    if (length(time_col) != 1L) abort("`time` must name a single column.")
+  if (!is.null(topic) && (!is.character(topic) || length(topic) != 1L ||
+                          is.na(topic))) {
+    abort("`topic` must be a single topic name, not ", describe_type(topic),
+          ".", class = "argument")
   }
-  if (is.null(time_col) && is.null(freq)) {
-    abort("no timestamp column found in \"", basename(file), "\" (columns: ",
-          paste(raw_names, collapse = ", "), "); name it with `time = ` ",
-          "or give the sampling rate with `freq = `.")
-  }
-
-  # Data columns and their channel names and sensors.
-  layout <- "custom"
-  if (is.null(columns)) {
-    known <- known_channel(clean)
-    data_cols <- which(!is.na(known$name))
-    data_cols <- setdiff(data_cols, time_col)
-    if (!length(data_cols)) {
-      abort("no gyroscope or accelerometer columns recognized in \"",
-            basename(file), "\" (columns: ", paste(raw_names, collapse = ", "),
-            "); choose them with `columns = ` (and `sensors = `).")
-    }
-    ch_names <- known$name[data_cols]
-    ch_sensor <- known$sensor[data_cols]
-    if (any(known$layout[data_cols] %in% c("kalibr", "euroc"))) {
-      layout <- known$layout[data_cols][1L]
-    }
+  p <- read_progress(4L)
+  fmt <- detect_format(file)
+  src <- if (fmt == "text") {
+    read_csv_imu(file, time, time_unit, columns, units, sep, dec, sensors,
+                 freq, p)
   } else {
-    data_cols <- pick_columns(columns, raw_names, clean, "columns")
-    ch_names <- if (!is.null(names(columns)) && all(nzchar(names(columns))))
-      names(columns) else raw_names[data_cols]
-    known <- known_channel(clean_names(ch_names))
-    ch_sensor <- known$sensor
-    ch_names <- ifelse(is.na(known$name), ch_names, known$name)
+    read_ros_imu(file, fmt, topic, columns, units, p)
   }
-  if (!is.null(sensors)) {
-    if (!is.character(sensors) || !all(sensors %in% c("gyro", "accel"))) {
-      abort("`sensors` must be \"gyro\" or \"accel\" per channel.")
-    }
-    if (is.null(names(sensors))) {
-      if (length(sensors) != length(ch_names)) {
-        abort("`sensors` must have one entry per channel (", length(ch_names),
-              ") or be named by channel.")
-      }
-      ch_sensor <- unname(sensors)
-    } else {
-      idx <- match(names(sensors), ch_names)
-      by_col <- match(names(sensors), raw_names[data_cols])
-      idx[is.na(idx)] <- by_col[is.na(idx)]
-      if (anyNA(idx)) {
-        abort("`sensors` names ", paste(names(sensors)[is.na(idx)], collapse = ", "),
-              " are not among the channels (", paste(ch_names, collapse = ", "), ").")
-      }
-      ch_sensor[idx] <- unname(sensors)
-    }
-  }
-  if (anyNA(ch_sensor)) {
-    abort("the sensor type of column(s) ",
-          paste(ch_names[is.na(ch_sensor)], collapse = ", "),
-          " is unknown; say it with `sensors = c(", ch_names[is.na(ch_sensor)][1L],
-          " = \"gyro\")` (or \"accel\").")
-  }
-  if (anyDuplicated(ch_names)) {
-    abort("channel names must be unique; got ", paste(ch_names, collapse = ", "), ".")
-  }
-  if (is.null(units)) {
-    hu <- hdr_units[data_cols]
-    if (layout %in% c("kalibr", "euroc") || all(!is.na(hu))) {
-      units <- ifelse(is.na(hu), ifelse(ch_sensor == "gyro", "rad/s", "m/s^2"), hu)
-      names(units) <- ch_names
-    } else {
-      message("read_imu(): no units given for ", basename(file), "; assuming ",
-              "rad/s for gyroscopes and m/s^2 for accelerometers (set `units`).")
-    }
-  }
-
-  # The time column is read as text: nanosecond epochs (~1.6e18) do not fit
-  # a double exactly, so they are split into whole and fractional seconds.
-  what <- rep(list(0), length(fields))
-  if (!is.null(time_col)) what[[time_col]] <- ""
-  keep <- seq_along(fields) %in% c(time_col, data_cols)
-  what[!keep] <- list(NULL)
-  cols <- scan(file, what = what, sep = sep,
-               skip = as.integer(has_header), quiet = TRUE,
-               na.strings = c("NA", "NaN", "nan", ""), fill = TRUE,
-               strip.white = TRUE, comment.char = "", flush = TRUE)
-  x <- do.call(cbind, cols[data_cols])
-  colnames(x) <- ch_names
-  t_sec <- NULL
-  if (!is.null(time_col)) {
-    t_txt <- cols[[time_col]]
-    t_num <- suppressWarnings(as.numeric(t_txt))
-    if (time_unit == "auto") {
-      time_unit <- guess_time_unit(t_num, hdr_units[time_col], layout)
-    }
-    t_sec <- stamps_to_seconds(t_txt, t_num, time_unit)
-  }
-  rec <- new_imu_record(x, time = t_sec, time_unit = "s", freq = freq,
-                        units = units, sensors = ch_sensor, gap = gap,
-                        source = file)
-  rec$time_unit <- time_unit
-  rec$layout <- layout
+  p("checking stamps and units")
+  rec <- new_imu_record(src$x, time = src$time, time_unit = "s", freq = freq,
+                        units = src$units, sensors = src$sensors, gap = gap,
+                        source = file, problems = src$problems,
+                        rows = src$lines, row_word = src$row_word %||% "line",
+                        time_label = src$time_label,
+                        units_assumed = src$units_assumed,
+                        units_source = if (is.null(units)) "file" else "given")
+  p("done")
+  rec$time_unit <- src$time_unit
+  rec$layout <- src$layout
+  if (!is.null(src$topic)) rec$topic <- src$topic
   rec
+}
+
+# A file path that exists and is a regular, non-empty file.
+check_file <- function(file, arg = "file") {
+  if (!is.character(file) || length(file) != 1L || is.na(file) || !nzchar(file)) {
+    abort("`", arg, "` must be a single file path, not ",
+          if (is.character(file) && length(file) == 1L) format_value(file)
+          else describe_type(file), ".", class = "argument")
+  }
+  if (dir.exists(file)) {
+    abort("`", arg, "` \"", file, "\" is a directory, not a file; give the ",
+          "path of the recording inside it.", class = "file")
+  }
+  if (!file.exists(file)) {
+    abort("`", arg, "` \"", file, "\" does not exist.", class = "file")
+  }
+  if (isTRUE(file.size(file) == 0)) {
+    abort("`", arg, "` \"", file, "\" is empty.", class = "file")
+  }
+  invisible(file)
+}
+
+# The format from the first bytes: ROS1 bag, MCAP, SQLite (rosbag2) or text.
+detect_format <- function(file) {
+  head <- readBin(file, "raw", 16L)
+  starts <- function(magic) {
+    length(head) >= length(magic) && identical(head[seq_along(magic)], magic)
+  }
+  if (starts(charToRaw("#ROSBAG V2.0"))) return("rosbag")
+  if (starts(as.raw(c(0x89, charToRaw("MCAP"))))) return("mcap")
+  if (starts(charToRaw("SQLite format 3"))) return("db3")
+  if (starts(charToRaw("#ROSBAG"))) {
+    abort("\"", basename(file), "\" is a ROS bag of a format older than 2.0; ",
+          "only format 2.0 (ROS Groovy and later) is read. Run `rosbag fix` ",
+          "on it, or export the topic to CSV.", class = "file_format")
+  }
+  "text"
+}
+
+# An argument whose default is the vector of its choices (first = default).
+choice_arg <- function(x, choices, arg) {
+  if (identical(x, choices)) return(choices[1L])
+  check_choice(x, choices, arg)
+}
+
+`%||%` <- function(a, b) if (is.null(a)) b else a
+
+# progressr's progressor for long reads: silent unless handlers are set
+# (progressr::handlers()), as everywhere in the package.
+read_progress <- function(steps) {
+  if (requireNamespace("progressr", quietly = TRUE)) {
+    pr <- progressr::progressor(steps = steps, envir = parent.frame())
+    function(msg = NULL) pr(msg)
+  } else {
+    function(msg = NULL) invisible(NULL)
+  }
+}
+
+# Sensor per channel from `sensors` (unnamed: one per channel; named: by
+# channel or column name).
+apply_sensors <- function(sensors, ch_names, ch_sensor, col_names = ch_names) {
+  if (is.null(sensors)) {
+    if (anyNA(ch_sensor)) {
+      abort("the sensor type of column(s) ",
+            paste(ch_names[is.na(ch_sensor)], collapse = ", "),
+            " is unknown; say it with `sensors = c(", ch_names[is.na(ch_sensor)][1L],
+            " = \"gyro\")` (or \"accel\").", class = "sensors")
+    }
+    return(ch_sensor)
+  }
+  if (!is.character(sensors) || anyNA(sensors) ||
+      !all(sensors %in% c("gyro", "accel"))) {
+    abort("`sensors` must be \"gyro\" or \"accel\" per channel, not ",
+          format_value(sensors), ".", class = "argument")
+  }
+  if (is.null(names(sensors))) {
+    if (length(sensors) != length(ch_names)) {
+      abort("`sensors` must have one entry per channel (", length(ch_names),
+            ") or be named by channel.", class = "argument")
+    }
+    ch_sensor <- unname(sensors)
+  } else {
+    idx <- match(names(sensors), ch_names)
+    by_col <- match(names(sensors), col_names)
+    idx[is.na(idx)] <- by_col[is.na(idx)]
+    if (anyNA(idx)) {
+      abort("`sensors` names ", paste(names(sensors)[is.na(idx)], collapse = ", "),
+            " are not among the channels (", paste(ch_names, collapse = ", "), ").",
+            class = "argument")
+    }
+    ch_sensor[idx] <- unname(sensors)
+  }
+  apply_sensors(NULL, ch_names, ch_sensor)
 }
 
 #' Build an IMU record from data in memory
 #'
 #' The in-memory counterpart of [read_imu()]: takes a matrix or data frame
 #' of samples (and optionally timestamps), converts to SI and runs the same
-#' timestamp checks.
+#' timestamp and unit checks.
 #'
 #' @param x Numeric matrix or data frame, one column per channel, with
 #'   column names. Names such as `gyro_x`, `omega_x`, `accel_x`, `alpha_x`
-#'   give the sensor type; otherwise use `sensors`.
+#'   give the sensor type; otherwise use `sensors`. Dates, factors, text and
+#'   arrays of more than two dimensions are refused.
 #' @param freq Sampling frequency in Hz (required without `time`; taken from
 #'   `attr(x, "freq")` when present).
-#' @param units Input units, as in [read_imu()]. `NULL` means SI.
+#' @param units Input units, as in [read_imu()]. `NULL` means SI, unless
+#'   three accelerometer axes show gravity in another unit (see
+#'   [read_imu()], section Units).
 #' @param sensors Sensor per channel, as in [read_imu()].
-#' @param time Optional timestamps (one per row).
+#' @param time Optional timestamps (one per row): numbers, or
+#'   `bit64::integer64` for exact integer stamps.
 #' @param time_unit Unit of `time`: `"s"`, `"ms"`, `"us"` or `"ns"`.
 #' @param gap As in [read_imu()].
 #' @param name A name for the record (used in tables and plots).
@@ -246,66 +312,160 @@ imu_record <- function(x, freq = NULL, units = NULL, sensors = NULL,
                        time = NULL, time_unit = "s",
                        gap = c("segments", "error", "ignore"), name = NULL) {
   check_present(missing(x), "x", "a matrix or data frame of samples")
-  gap <- match.arg(gap)
+  gap <- choice_arg(gap, c("segments", "error", "ignore"), "gap")
   if (is.null(freq)) freq <- attr(x, "freq")
   if (!is.null(freq)) freq <- check_freq(freq)
+  if (inherits(x, c("Date", "POSIXt", "difftime", "factor")) ||
+      (is.data.frame(x) && any(vapply(x, function(v)
+        inherits(v, c("Date", "POSIXt", "difftime", "factor")) || !is.numeric(v),
+        logical(1))))) {
+    abort("`x` must hold numeric samples, not dates, times, factors or text ",
+          "(got ", if (is.data.frame(x)) "a data frame with such columns"
+          else paste0("a ", class(x)[1L], " vector"), ").", class = "argument")
+  }
+  if (length(dim(x)) > 2L) {
+    abort("`x` must be a matrix or data frame (one column per channel), not ",
+          "an array of ", length(dim(x)), " dimensions.", class = "argument")
+  }
   if (is.data.frame(x)) x <- as.matrix(x)
   if (is.null(dim(x))) x <- matrix(x, ncol = 1L, dimnames = list(NULL, "x"))
-  if (!is.numeric(x)) abort("`x` must be numeric, not ", describe_type(x), ".")
+  if (!is.numeric(x) || is.list(x)) {
+    abort("`x` must be numeric, not ", describe_type(x), ".", class = "argument")
+  }
   if (is.null(colnames(x))) {
-    abort("`x` must have column names (e.g. gyro_x, accel_x).")
+    abort("`x` must have column names (e.g. gyro_x, accel_x).", class = "argument")
   }
   known <- known_channel(clean_names(colnames(x)))
   ch_sensor <- known$sensor
   if (!is.null(sensors)) {
+    if (!is.character(sensors) || anyNA(sensors) ||
+        !all(sensors %in% c("gyro", "accel"))) {
+      abort("`sensors` must be \"gyro\" or \"accel\" per column, not ",
+            format_value(sensors), ".", class = "argument")
+    }
     if (is.null(names(sensors))) ch_sensor <- rep_len(sensors, ncol(x))
     else ch_sensor[match(names(sensors), colnames(x))] <- unname(sensors)
   }
   if (anyNA(ch_sensor) || !all(ch_sensor %in% c("gyro", "accel"))) {
     abort("the sensor type of column(s) ",
           paste(colnames(x)[is.na(ch_sensor)], collapse = ", "),
-          " is unknown; give `sensors` (\"gyro\" or \"accel\" per column).")
+          " is unknown; give `sensors` (\"gyro\" or \"accel\" per column).",
+          class = "sensors")
   }
-  time_unit <- match.arg(time_unit, c("s", "ms", "us", "ns"))
+  time_unit <- check_choice(time_unit, c("s", "ms", "us", "ns"), "time_unit")
   if (is.null(time) && is.null(freq)) {
-    abort("give `freq` (the sampling frequency in Hz) or `time` (timestamps).")
+    abort("give `freq` (the sampling frequency in Hz) or `time` (timestamps).",
+          class = "no_time")
+  }
+  label <- NULL
+  if (!is.null(time)) {
+    if (inherits(time, "integer64")) {
+      ok <- which(!is.na(int64_to_double(time)))
+      per_s <- c(s = 1, ms = 1e3, us = 1e6, ns = 1e9)[[time_unit]]
+      time <- if (length(ok)) int64_rel_seconds(time, ok[1L], per_s) else
+        rep(NA_real_, length(time))
+      label <- list(what = "`time`", unit = time_unit, declared = TRUE, line = 1L)
+      time_unit <- "s"
+    } else if (!is.numeric(time) || is.factor(time) || !is.null(dim(time))) {
+      abort("`time` must be a numeric vector of stamps (or bit64::integer64), ",
+            "not ", describe_type(time), ".", class = "argument")
+    } else {
+      label <- list(what = "`time`", unit = time_unit, declared = TRUE, line = 1L)
+    }
   }
   storage.mode(x) <- "double"
   rec <- new_imu_record(x, time = time, time_unit = time_unit, freq = freq,
                         units = units, sensors = ch_sensor, gap = gap,
-                        source = if (is.null(name)) "in memory" else name)
+                        source = if (is.null(name)) "in memory" else name,
+                        row_word = "row", time_label = label,
+                        units_assumed = is.null(units), quiet_units = TRUE,
+                        units_source = if (is.null(units)) "default" else "given")
   rec$layout <- "memory"
   if (!is.null(name)) rec$name <- name
   rec
 }
 
-# Shared by read_imu() and imu_record(): checks the stamps, converts units.
+empty_problems <- function() {
+  data.frame(type = character(), count = integer(), detail = character(),
+             action = character(), stringsAsFactors = FALSE)
+}
+
+add_problem <- function(problems, type, count, detail, action) {
+  problems[nrow(problems) + 1L, ] <- list(type, as.integer(count), detail, action)
+  problems
+}
+
+# Shared by read_imu() and imu_record(): drops and reports bad rows, checks
+# the stamps and the units, converts to SI. `rows`: the file line (or
+# message) number of each row, for the reports; `time_label`: where the
+# stamps came from and their unit, for the rate check.
 new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
-                           source) {
+                           source, problems = NULL, rows = NULL,
+                           row_word = "row", time_label = NULL,
+                           units_assumed = FALSE, quiet_units = FALSE,
+                           units_source = "given") {
   ch <- colnames(x)
   names(sensors) <- ch
   in_units <- resolve_units(units, ch, sensors)
-  problems <- data.frame(type = character(), count = integer(),
-                         detail = character(), action = character(),
-                         stringsAsFactors = FALSE)
+  if (is.null(problems)) problems <- empty_problems()
   add <- function(type, count, detail, action) {
-    problems[nrow(problems) + 1L, ] <<- list(type, as.integer(count), detail, action)
+    problems <<- add_problem(problems, type, count, detail, action)
   }
   scale <- c(s = 1, ms = 1e-3, us = 1e-6, ns = 1e-9)[[time_unit]]
+  where <- function(i) {
+    sprintf("%s %d", row_word, if (is.null(rows)) i else rows[i])
+  }
 
   if (!is.null(time) && length(time) != nrow(x)) {
     abort("`time` must have one stamp per row (", nrow(x), "), not ",
-          length(time), ".")
+          length(time), ".", class = "argument")
   }
-  bad <- !stats::complete.cases(x)
-  if (!is.null(time)) bad <- bad | !is.finite(time)
+  # Missing and infinite values, by column, first one named.
+  miss <- logical(nrow(x))
+  inf <- logical(nrow(x))
+  first_miss <- first_inf <- NULL
+  nonfinite <- col_first_nonfinite(x)
+  for (j in which(nonfinite > 0)) {
+    v <- x[, j]
+    m <- is.na(v)
+    f <- is.infinite(v)
+    if (any(m) && (is.null(first_miss) || which(m)[1L] < first_miss$i)) {
+      first_miss <- list(i = which(m)[1L], col = ch[j])
+    }
+    if (any(f) && (is.null(first_inf) || which(f)[1L] < first_inf$i)) {
+      first_inf <- list(i = which(f)[1L], col = ch[j], value = v[which(f)[1L]])
+    }
+    miss <- miss | m
+    inf <- inf | f
+  }
+  if (!is.null(time)) {
+    tm <- !is.finite(time)
+    if (any(tm) && (is.null(first_miss) || which(tm)[1L] < first_miss$i)) {
+      first_miss <- list(i = which(tm)[1L], col = "time")
+    }
+    miss <- miss | tm
+  }
+  inf <- inf & !miss
+  if (any(miss)) {
+    add("missing", sum(miss), sprintf(
+      "%d row(s) with missing values (first at %s, column %s)",
+      sum(miss), where(first_miss$i), first_miss$col), "rows dropped")
+  }
+  if (any(inf)) {
+    add("infinite", sum(inf), sprintf(
+      "%d row(s) with infinite values (first at %s, column %s: %s)",
+      sum(inf), where(first_inf$i), first_inf$col, format(first_inf$value)),
+      "rows dropped")
+  }
+  bad <- miss | inf
   if (any(bad)) {
-    add("missing", sum(bad), sprintf("%d row(s) with missing or non-numeric values (first at row %d)",
-                                     sum(bad), which(bad)[1L]), "dropped")
     x <- x[!bad, , drop = FALSE]
     if (!is.null(time)) time <- time[!bad]
+    if (!is.null(rows)) rows <- rows[!bad] else rows <- which(!bad)
   }
-  if (nrow(x) < 2L) abort("fewer than 2 valid samples in ", source, ".")
+  if (nrow(x) < 2L) {
+    abort("fewer than 2 valid samples in ", source, ".", class = "too_short")
+  }
 
   gaps <- data.frame(after = integer(), t = numeric(), length = numeric())
   jitter_rms <- NA_real_
@@ -320,24 +480,29 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
     if (is.unsorted(t)) {
       back <- sum(diff(t) < 0)
       o <- order(t, method = "radix")
-      add("out-of-order", back, sprintf("%d step(s) go back in time (first at row %d)",
-                                        back, which(diff(t) < 0)[1L] + 1L),
+      add("out-of-order", back, sprintf("%d step(s) go back in time (first at %s)",
+                                        back, where(which(diff(t) < 0)[1L] + 1L)),
           "rows sorted by time")
       x <- x[o, , drop = FALSE]
       t <- t[o]
+      if (!is.null(rows)) rows <- rows[o]
     }
     dup <- c(FALSE, diff(t) == 0)
     if (any(dup)) {
-      add("duplicate", sum(dup), sprintf("%d duplicated stamp(s) (first at t = %.6g s)",
-                                         sum(dup), t[which(dup)[1L]]),
+      add("duplicate", sum(dup), sprintf("%d duplicated stamp(s) (first at t = %.6g s, %s)",
+                                         sum(dup), t[which(dup)[1L]],
+                                         where(which(dup)[1L])),
           "later rows with the same stamp dropped")
       x <- x[!dup, , drop = FALSE]
       t <- t[!dup]
     }
     t <- t - t[1L]
     steps <- diff(t)
-    if (!length(steps)) abort("fewer than 2 distinct timestamps in ", source, ".")
+    if (!length(steps)) {
+      abort("fewer than 2 distinct timestamps in ", source, ".", class = "too_short")
+    }
     dt_med <- stats::median(steps)
+    check_stamp_rate(1 / dt_med, time_label, source)
     is_gap <- steps > 1.5 * dt_med
     regular <- steps[!is_gap]
     jitter_rms <- sqrt(mean((regular - dt_med)^2))
@@ -358,7 +523,7 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
         abort(source, ": ", detail, ". Use gap = \"segments\" to split the ",
               "record at the gaps (analyze_imu() then uses the longest ",
               "gap-free segment, or each with segment = \"each\"), or gap = ",
-              "\"ignore\" to treat the samples as contiguous.")
+              "\"ignore\" to treat the samples as contiguous.", class = "gap")
       }
       add("gap", length(gi), detail,
           if (gap == "segments") sprintf("split into %d segments", length(gi) + 1L)
@@ -383,13 +548,19 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
     dt <- 1 / freq
   }
 
-  # Convert to SI.
+  # Units: accelerometers checked against gravity, gyroscopes against the
+  # noise levels of real gyros (R/units.R); then everything to SI.
+  uc <- check_imu_units(x, sensors, in_units, freq, units_assumed,
+                        units_source, source, quiet = quiet_units)
+  in_units <- uc$units
   for (j in seq_along(ch)) {
     f <- lookup_unit(in_units[[j]], "units", sensor = sensors[[j]], kind = "rate")
     if (f$to_si != 1) x[, j] <- x[, j] * f$to_si
   }
   si <- ifelse(sensors == "gyro", "rad/s", "m/s^2")
   names(si) <- ch
+  uc <- check_gyro_noise(x, sensors, in_units, freq, uc$checks, source,
+                         assumed = units_assumed)
 
   rec <- list(data = x, time = t, freq = freq, dt = dt, sensors = sensors,
               units = in_units, si_units = si, time_unit = time_unit,
@@ -397,6 +568,7 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
               sampling = list(dt_median = if (is.null(time)) dt else dt_med,
                               jitter_rms = jitter_rms, jitter_rel = jitter_rel,
                               gaps = gaps),
+              unit_checks = uc,
               file = source, name = basename(source))
   class(rec) <- "imu_record"
   if (nrow(problems)) {
@@ -406,6 +578,23 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
          class = "record_problems")
   }
   rec
+}
+
+# A rate no IMU has, for the unit the stamps were read in: stop, naming
+# the column and the unit that would give a plausible rate.
+check_stamp_rate <- function(rate, label, source) {
+  if (is.null(label) || (rate <= 1e5 && rate >= 1e-3)) return(invisible())
+  per <- c(s = 1, ms = 1e3, us = 1e6, ns = 1e9)
+  cur <- per[[label$unit]]
+  alt <- names(per)[rate * per / cur >= 0.1 & rate * per / cur <= 1e5]
+  abort(source, ": the stamps of ", label$what, ", read as ", label$unit,
+        if (!isTRUE(label$declared)) " (detected)", ", give a sampling rate of ",
+        format(signif(rate, 4)), " Hz (from line ", label$line %||% 1L,
+        " on), which no IMU has.",
+        if (length(alt)) paste0(" They look like ", alt[1L], ": use time_unit = \"",
+                                alt[1L], "\"."),
+        " (Or give the rate with `freq = ` and no time column.)",
+        class = "time_unit")
 }
 
 #' @export
@@ -451,31 +640,6 @@ record_segment <- function(x, segment = "longest") {
   x$data[seg$start[i]:seg$end[i], , drop = FALSE]
 }
 
-split_fields <- function(line, sep) {
-  f <- if (identical(sep, "")) strsplit(trimws(line), "[[:space:]]+")[[1L]]
-  else trimws(strsplit(line, sep, fixed = TRUE)[[1L]])
-  gsub("^[\"']|[\"']$", "", f)
-}
-
-clean_names <- function(x) {
-  x <- tolower(trimws(x))
-  x <- sub("^#+[[:space:]]*", "", x)
-  x <- gsub("\\[[^]]*\\]|\\([^)]*\\)", "", x)
-  x <- trimws(x)
-  gsub("[[:space:]]+", "_", x)
-}
-
-# Units written in brackets in a header, e.g. "[rad s^-1]", "[m s^-2]", "[ns]".
-bracket_units <- function(x) {
-  u <- ifelse(grepl("\\[[^]]*\\]", x), sub("^.*\\[([^]]*)\\].*$", "\\1", x), NA)
-  u <- trimws(u)
-  map <- c("rad s^-1" = "rad/s", "rad/s" = "rad/s", "deg s^-1" = "deg/s",
-           "deg/s" = "deg/s", "m s^-2" = "m/s^2", "m/s^2" = "m/s^2",
-           "m/s2" = "m/s^2", "g" = "g", "ns" = "ns", "us" = "us",
-           "ms" = "ms", "s" = "s")
-  unname(ifelse(u %in% names(map), map[u], NA_character_))
-}
-
 # Recognized channel names -> (standard name, sensor, layout).
 known_channel <- function(clean) {
   name <- rep(NA_character_, length(clean))
@@ -500,27 +664,6 @@ known_channel <- function(clean) {
   a <- is.na(sensor) & grepl("^(acc|alpha)", clean)
   sensor[a] <- "accel"; name[a] <- clean[a]
   list(name = name, sensor = sensor, layout = layout)
-}
-
-pick_columns <- function(spec, raw, clean, arg) {
-  if (is.numeric(spec)) {
-    if (any(spec < 1 | spec > length(raw) | spec != round(spec))) {
-      abort("`", arg, "` indices must be in 1..", length(raw), ".")
-    }
-    return(as.integer(spec))
-  }
-  if (!is.character(spec)) {
-    abort("`", arg, "` must be column names or indices, not ",
-          describe_type(spec), ".")
-  }
-  i <- match(spec, raw)
-  j <- match(clean_names(spec), clean)
-  i[is.na(i)] <- j[is.na(i)]
-  if (anyNA(i)) {
-    abort("`", arg, "`: column(s) ", paste(spec[is.na(i)], collapse = ", "),
-          " not found; the file has ", paste(raw, collapse = ", "), ".")
-  }
-  i
 }
 
 resolve_units <- function(units, ch, sensors) {
@@ -551,30 +694,3 @@ resolve_units <- function(units, ch, sensors) {
   out
 }
 
-# Seconds relative to the first valid stamp; integer stamps in ms/us/ns are
-# split into whole seconds and the remainder so that no digit is lost.
-stamps_to_seconds <- function(txt, num, unit) {
-  scale <- c(s = 1, ms = 1e-3, us = 1e-6, ns = 1e-9)[[unit]]
-  k <- c(s = 0L, ms = 3L, us = 6L, ns = 9L)[[unit]]
-  ok <- !is.na(num)
-  if (k == 0L || !any(ok) || !all(grepl("^[0-9]+$", txt[ok]))) {
-    return((num - num[ok][1L]) * scale)
-  }
-  nc <- nchar(txt)
-  hi <- suppressWarnings(as.numeric(substr(txt, 1L, nc - k)))
-  hi[is.na(hi) & ok] <- 0
-  lo <- as.numeric(substr(txt, pmax(nc - k + 1L, 1L), nc))
-  i <- which(ok)[1L]
-  (hi - hi[i]) + (lo - lo[i]) * scale
-}
-
-guess_time_unit <- function(t, hdr, layout) {
-  if (!is.na(hdr) && hdr %in% c("s", "ms", "us", "ns")) return(hdr)
-  if (layout %in% c("kalibr", "euroc")) return("ns")
-  big <- max(abs(t), na.rm = TRUE)
-  if (big > 1e17) return("ns")
-  if (big > 1e14) return("us")
-  if (big > 1e11) return("ms")
-  st <- stats::median(abs(diff(t)), na.rm = TRUE)
-  if (st < 0.5) "s" else if (st < 500) "ms" else if (st < 5e5) "us" else "ns"
-}

@@ -222,3 +222,118 @@ si_unit <- function(sensor, kind) {
   tab <- unit_table()
   tab$si[tab$sensor == sensor & tab$kind == kind][1L]
 }
+
+# Units checked on the data (read_imu(), imu_record()). Accelerometers: a
+# static record shows gravity, |mean a| = 1 g = 9.80665 m/s^2 (CGPM 1901),
+# so three axes tell their unit. Returns the (possibly detected) units and a
+# table of what was checked.
+gravity_units <- c("m/s^2" = 9.80665, "g" = 1, "mg" = 1000)
+
+check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
+                            source, quiet = FALSE) {
+  ch <- colnames(x)
+  src <- rep(if (assumed) "assumed" else units_source, length(ch))
+  evidence <- rep(NA_character_, length(ch))
+  acc <- which(sensors == "accel")
+  said <- NULL
+  if (length(acc) == 3L) {
+    u <- unique(units[acc])
+    r <- sqrt(sum(colMeans(x[, acc, drop = FALSE])^2))
+    hit <- names(gravity_units)[abs(r / gravity_units - 1) <= 0.1]
+    if (length(u) == 1L && is.finite(r)) {
+      evidence[acc] <- sprintf("|mean a| = %.5g %s on 3 axes", r, u)
+      if (length(hit) && hit != u) {
+        if (assumed) {
+          units[acc] <- hit
+          src[acc] <- "gravity"
+          evidence[acc] <- sprintf("|mean a| = %.5g %s on 3 axes (gravity)", r, hit)
+          said <- sprintf("accelerometers read as %s: their mean has norm %.5g, gravity in %s",
+                          hit, r, hit)
+        } else {
+          warn(source, ": the accelerometers' mean has norm ", format(signif(r, 5)),
+               " ", u, ", which is gravity in ", hit, ", not in ", u,
+               " (1 g = 9.80665 m/s^2 on a static record); the samples look like ",
+               hit, ": give units = c(accel = \"", hit, "\") if so.",
+               class = "accel_units")
+          evidence[acc] <- paste0(evidence[acc], ": looks like ", hit)
+        }
+      } else if (length(hit)) {
+        if (assumed) {
+          src[acc] <- "gravity"
+          said <- sprintf("accelerometers in %s, as gravity confirms (|mean a| = %.5g)",
+                          hit, r)
+        }
+        evidence[acc] <- paste0(evidence[acc], " (gravity)")
+      }
+    }
+  }
+  if (assumed && !quiet) {
+    message(basename(source), ": no units given; assuming rad/s for ",
+            "gyroscopes", if (is.null(said)) " and m/s^2 for accelerometers",
+            " (set `units`)", if (!is.null(said)) paste0("; ", said), ".")
+  } else if (!is.null(said) && any(src == "gravity" & units != "m/s^2")) {
+    message(basename(source), ": ", said, ".")
+  }
+  list(units = units,
+       checks = data.frame(channel = ch, sensor = unname(sensors),
+                           unit = unname(units), source = src,
+                           evidence = evidence, stringsAsFactors = FALSE))
+}
+
+# Gyroscopes: white noise N from the Allan deviation at about 1 s (N = ADEV
+# sqrt(tau) where white noise dominates; IEEE Std 952 Annex C). Real gyros
+# span about 1e-4 deg/sqrt(h) (navigation grade) to a few deg/sqrt(h)
+# (consumer MEMS); outside 1e-5..60 the unit is almost surely wrong.
+gyro_noise_range <- c(1e-5, 60)
+# A static gyro reads its bias plus Earth's rate (7.3e-5 rad/s): MEMS biases
+# reach a few deg/s, never 1 rad/s (57 deg/s).
+gyro_mean_limit <- 1
+
+check_gyro_noise <- function(x, sensors, units, freq, checks, source,
+                             assumed = FALSE) {
+  gy <- which(sensors == "gyro")
+  if (!length(gy)) return(checks)
+  to_dph <- 180 / pi * 60
+  n <- nrow(x)
+  m <- max(1L, min(as.integer(round(freq)), n %/% 10L))
+  k <- n %/% m
+  if (k < 10L) return(checks)
+  msgs <- character()
+  for (j in gy) {
+    av <- col_block_avar(x, j, m)
+    N <- sqrt(av * m / freq) * to_dph
+    if (!is.finite(N) || N == 0) next
+    mean_rate <- abs(mean(x[, j]))
+    checks$evidence[j] <- sprintf("N ~ %.3g deg/sqrt(h) from ADEV at %.3g s; |mean| %.3g rad/s",
+                                  N, m / freq, mean_rate)
+    if (N > gyro_noise_range[2L] || N < gyro_noise_range[1L] ||
+        mean_rate > gyro_mean_limit) {
+      cur <- lookup_unit(units[[j]], sensor = "gyro", kind = "rate")$to_si
+      cand <- c("deg/s", "rad/s", "deg/h", "mrad/s")
+      f <- vapply(cand, function(u) lookup_unit(u, sensor = "gyro", kind = "rate")$to_si, 0)
+      alt <- N * f / cur
+      ok <- cand[alt >= 1e-4 & alt <= 30 & cand != units[[j]]]
+      checks$evidence[j] <- paste0(checks$evidence[j], ": implausible")
+      msgs <- c(msgs, sprintf("%s: white noise N ~ %.3g deg/sqrt(h)%s if the samples are %s%s",
+                              colnames(x)[j], N,
+                              if (mean_rate > gyro_mean_limit)
+                                sprintf(" and a mean rate of %.3g rad/s", mean_rate) else "",
+                              units[[j]],
+                              if (length(ok)) sprintf("; as %s it would be %.3g", ok[1L],
+                                                      alt[match(ok[1L], cand)]) else ""))
+      attr(msgs, "alt") <- c(attr(msgs, "alt"), if (length(ok)) ok[1L])
+    }
+  }
+  if (length(msgs)) {
+    alt <- attr(msgs, "alt")
+    warn(source, ": the gyroscope units look wrong (real gyros span ",
+         gyro_noise_range[1L], " to ", gyro_noise_range[2L],
+         " deg/sqrt(h) of white noise, and a static one reads less than ",
+         gyro_mean_limit, " rad/s):\n", paste0("  - ", msgs, collapse = "\n"),
+         if (length(alt)) paste0("\nGive units = c(gyro = \"", alt[1L], "\") ",
+                                 "(CLI: --gyro-units ", alt[1L], ") if they are ",
+                                 alt[1L], "."),
+         class = "gyro_units")
+  }
+  checks
+}

@@ -1,10 +1,17 @@
-# Timings of the noise-model fit and of the white-noise covariance kernel.
-# Measures the installed package (compiled -O2; pkgload::load_all() builds
-# with -O0, which is several times slower for Eigen code):
+# Timings of the noise-model fit, the closed loop and the white-noise
+# covariance kernel. Measures the installed package (compiled -O2;
+# pkgload::load_all() builds with -O0, which is several times slower for
+# Eigen code):
 #   R CMD INSTALL . && Rscript bench/bench-avfit.R
-# Prints one row per case: what was timed, the size, and the median elapsed
-# seconds over `reps` runs (2 threads at most).
-library(allanvar)
+# ALLANVAR_LIB=<library> measures the allanvar installed there instead (to
+# compare two versions in one session of the machine).
+# Prints one row per case: what was timed, the size, the median elapsed
+# seconds over `reps` runs (2 threads at most) and the ratio to R's sum(x)
+# on a vector of 1e6 doubles timed in the same run.
+lib <- Sys.getenv("ALLANVAR_LIB")
+if (nzchar(lib)) library(allanvar, lib.loc = lib) else library(allanvar)
+cat("allanvar", format(utils::packageVersion("allanvar")), "from",
+    dirname(system.file(package = "allanvar")), "\n")
 avar_white_cov <- allanvar:::avar_white_cov
 options(allanvar.threads = 2L)
 reps <- 3L
@@ -18,6 +25,9 @@ add <- function(case, size, sec) {
   rows[[length(rows) + 1L]] <<- data.frame(case = case, size = size,
                                            seconds = signif(sec, 3))
 }
+y <- rnorm(1e6)
+yard <- median(vapply(1:50, function(i) system.time(for (k in 1:20) sum(y))[["elapsed"]] / 20, 0))
+add("sum(x) (yardstick)", "n=1e6", yard)
 f <- 100
 for (n in c(1e5, 1e6)) {
   m_oct <- 2^(0:floor(log2(n / 3)))
@@ -43,4 +53,11 @@ for (tm in list(c("N", "B", "K"), c("N", "B", "K", "gm"), c("N", "gm", "gm"),
   add(paste("avfit", paste(tm, collapse = "+"), "correlation = TRUE"),
       sprintf("%d taus", nrow(a)), time_it(avfit(a, tm, correlation = TRUE)))
 }
-print(do.call(rbind, rows), row.names = FALSE)
+fit <- avfit(a, c("N", "B", "K"))
+add("avrefine (curve only), from N+B+K", sprintf("%d taus", nrow(a)),
+    time_it(avrefine(fit)))
+add("avrefine with the raw series, from N+B+K", sprintf("%d taus, n=%d", nrow(a), n),
+    time_it(avrefine(fit, data = x)))
+out <- do.call(rbind, rows)
+out$x_sum <- signif(out$seconds / yard, 3)
+print(out, row.names = FALSE)

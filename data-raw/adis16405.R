@@ -71,6 +71,8 @@ for (k in 1:3) {
       effects = if (nrow(st)) paste(st$effect, collapse = ", ") else "",
       unconfirmed = sum(isFALSE(st$confirmed) | st$confirmed %in% FALSE),
       final_terms = paste(ref$terms, collapse = ","),
+      converged = fit0$convergence$converged && ref$convergence$converged,
+      failed_refits = NROW(ref$refine$failures),
       stringsAsFactors = FALSE))
     fits[[id]] <- list(datasheet = fit0, refined = ref)
     cat(sprintf("%-14s chi2 %8.1f -> %7.2f  rms %5.1f%% -> %5.1f%%  [%s]  %.0f s\n", id,

@@ -136,6 +136,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// dynamic_sums_cpp
+Rcpp::NumericMatrix dynamic_sums_cpp(const Rcpp::NumericVector& x, SEXP y, const Rcpp::NumericVector& m, const Rcpp::NumericVector& nterms, const Rcpp::List& options);
+RcppExport SEXP _allanvar_dynamic_sums_cpp(SEXP xSEXP, SEXP ySEXP, SEXP mSEXP, SEXP ntermsSEXP, SEXP optionsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< SEXP >::type y(ySEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type nterms(ntermsSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type options(optionsSEXP);
+    rcpp_result_gen = Rcpp::wrap(dynamic_sums_cpp(x, y, m, nterms, options));
+    return rcpp_result_gen;
+END_RCPP
+}
 // allan_edf_cpp
 Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m, const Rcpp::NumericVector& n, double L, const Rcpp::IntegerVector& alpha, const Rcpp::LogicalVector& exact);
 RcppExport SEXP _allanvar_allan_edf_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP LSEXP, SEXP alphaSEXP, SEXP exactSEXP) {
@@ -164,12 +178,189 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// lz4_decompress_cpp
+Rcpp::RawVector lz4_decompress_cpp(const Rcpp::RawVector& x, double expected);
+RcppExport SEXP _allanvar_lz4_decompress_cpp(SEXP xSEXP, SEXP expectedSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< double >::type expected(expectedSEXP);
+    rcpp_result_gen = Rcpp::wrap(lz4_decompress_cpp(x, expected));
+    return rcpp_result_gen;
+END_RCPP
+}
+// mcap_records
+Rcpp::List mcap_records(const Rcpp::RawVector& buf, double start, double end);
+RcppExport SEXP _allanvar_mcap_records(SEXP bufSEXP, SEXP startSEXP, SEXP endSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
+    Rcpp::traits::input_parameter< double >::type start(startSEXP);
+    Rcpp::traits::input_parameter< double >::type end(endSEXP);
+    rcpp_result_gen = Rcpp::wrap(mcap_records(buf, start, end));
+    return rcpp_result_gen;
+END_RCPP
+}
+// mcap_chunk_raw
+Rcpp::RawVector mcap_chunk_raw(const Rcpp::RawVector& buf, double off, double len);
+RcppExport SEXP _allanvar_mcap_chunk_raw(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
+    Rcpp::traits::input_parameter< double >::type off(offSEXP);
+    Rcpp::traits::input_parameter< double >::type len(lenSEXP);
+    rcpp_result_gen = Rcpp::wrap(mcap_chunk_raw(buf, off, len));
+    return rcpp_result_gen;
+END_RCPP
+}
+// mcap_imu
+Rcpp::List mcap_imu(const Rcpp::RawVector& buf, const Rcpp::IntegerVector& op, const Rcpp::NumericVector& off, const Rcpp::NumericVector& len, const Rcpp::IntegerVector& ids, const Rcpp::IntegerVector& enc);
+RcppExport SEXP _allanvar_mcap_imu(SEXP bufSEXP, SEXP opSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP idsSEXP, SEXP encSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type op(opSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type off(offSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type len(lenSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type ids(idsSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type enc(encSEXP);
+    rcpp_result_gen = Rcpp::wrap(mcap_imu(buf, op, off, len, ids, enc));
+    return rcpp_result_gen;
+END_RCPP
+}
+// csv_field_faults
+Rcpp::List csv_field_faults(const Rcpp::RawVector& bytes, int sep, int expected);
+RcppExport SEXP _allanvar_csv_field_faults(SEXP bytesSEXP, SEXP sepSEXP, SEXP expectedSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type bytes(bytesSEXP);
+    Rcpp::traits::input_parameter< int >::type sep(sepSEXP);
+    Rcpp::traits::input_parameter< int >::type expected(expectedSEXP);
+    rcpp_result_gen = Rcpp::wrap(csv_field_faults(bytes, sep, expected));
+    return rcpp_result_gen;
+END_RCPP
+}
+// int64_rel_seconds
+Rcpp::NumericVector int64_rel_seconds(const Rcpp::NumericVector& x, double origin, double per_second);
+RcppExport SEXP _allanvar_int64_rel_seconds(SEXP xSEXP, SEXP originSEXP, SEXP per_secondSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< double >::type origin(originSEXP);
+    Rcpp::traits::input_parameter< double >::type per_second(per_secondSEXP);
+    rcpp_result_gen = Rcpp::wrap(int64_rel_seconds(x, origin, per_second));
+    return rcpp_result_gen;
+END_RCPP
+}
+// int64_to_double
+Rcpp::NumericVector int64_to_double(const Rcpp::NumericVector& x);
+RcppExport SEXP _allanvar_int64_to_double(SEXP xSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    rcpp_result_gen = Rcpp::wrap(int64_to_double(x));
+    return rcpp_result_gen;
+END_RCPP
+}
+// col_first_nonfinite
+Rcpp::NumericVector col_first_nonfinite(const Rcpp::NumericMatrix& x);
+RcppExport SEXP _allanvar_col_first_nonfinite(SEXP xSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type x(xSEXP);
+    rcpp_result_gen = Rcpp::wrap(col_first_nonfinite(x));
+    return rcpp_result_gen;
+END_RCPP
+}
+// col_block_avar
+double col_block_avar(const Rcpp::NumericMatrix& x, int j, double m);
+RcppExport SEXP _allanvar_col_block_avar(SEXP xSEXP, SEXP jSEXP, SEXP mSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< int >::type j(jSEXP);
+    Rcpp::traits::input_parameter< double >::type m(mSEXP);
+    rcpp_result_gen = Rcpp::wrap(col_block_avar(x, j, m));
+    return rcpp_result_gen;
+END_RCPP
+}
+// decode_imu_blobs
+Rcpp::NumericMatrix decode_imu_blobs(const Rcpp::List& blobs, int encoding, const Rcpp::NumericVector& recv_ns);
+RcppExport SEXP _allanvar_decode_imu_blobs(SEXP blobsSEXP, SEXP encodingSEXP, SEXP recv_nsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type blobs(blobsSEXP);
+    Rcpp::traits::input_parameter< int >::type encoding(encodingSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type recv_ns(recv_nsSEXP);
+    rcpp_result_gen = Rcpp::wrap(decode_imu_blobs(blobs, encoding, recv_ns));
+    return rcpp_result_gen;
+END_RCPP
+}
+// stamp_rel_seconds
+Rcpp::NumericVector stamp_rel_seconds(const Rcpp::NumericVector& sec, const Rcpp::NumericVector& nsec, double origin);
+RcppExport SEXP _allanvar_stamp_rel_seconds(SEXP secSEXP, SEXP nsecSEXP, SEXP originSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type sec(secSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type nsec(nsecSEXP);
+    Rcpp::traits::input_parameter< double >::type origin(originSEXP);
+    rcpp_result_gen = Rcpp::wrap(stamp_rel_seconds(sec, nsec, origin));
+    return rcpp_result_gen;
+END_RCPP
+}
+// rosbag_records
+Rcpp::List rosbag_records(const Rcpp::RawVector& buf, double start, double end);
+RcppExport SEXP _allanvar_rosbag_records(SEXP bufSEXP, SEXP startSEXP, SEXP endSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
+    Rcpp::traits::input_parameter< double >::type start(startSEXP);
+    Rcpp::traits::input_parameter< double >::type end(endSEXP);
+    rcpp_result_gen = Rcpp::wrap(rosbag_records(buf, start, end));
+    return rcpp_result_gen;
+END_RCPP
+}
+// rosbag_chunk_imu
+Rcpp::List rosbag_chunk_imu(const Rcpp::RawVector& buf, double off, double len, std::string compression, double size, const Rcpp::IntegerVector& conns);
+RcppExport SEXP _allanvar_rosbag_chunk_imu(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP compressionSEXP, SEXP sizeSEXP, SEXP connsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
+    Rcpp::traits::input_parameter< double >::type off(offSEXP);
+    Rcpp::traits::input_parameter< double >::type len(lenSEXP);
+    Rcpp::traits::input_parameter< std::string >::type compression(compressionSEXP);
+    Rcpp::traits::input_parameter< double >::type size(sizeSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type conns(connsSEXP);
+    rcpp_result_gen = Rcpp::wrap(rosbag_chunk_imu(buf, off, len, compression, size, conns));
+    return rcpp_result_gen;
+END_RCPP
+}
 // allan_type_table_cpp
 Rcpp::DataFrame allan_type_table_cpp();
 RcppExport SEXP _allanvar_allan_type_table_cpp() {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     rcpp_result_gen = Rcpp::wrap(allan_type_table_cpp());
+    return rcpp_result_gen;
+END_RCPP
+}
+// zstd_available_cpp
+bool zstd_available_cpp();
+RcppExport SEXP _allanvar_zstd_available_cpp() {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    rcpp_result_gen = Rcpp::wrap(zstd_available_cpp());
+    return rcpp_result_gen;
+END_RCPP
+}
+// zstd_decompress_cpp
+Rcpp::RawVector zstd_decompress_cpp(const Rcpp::RawVector& x, double expected);
+RcppExport SEXP _allanvar_zstd_decompress_cpp(SEXP xSEXP, SEXP expectedSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< double >::type expected(expectedSEXP);
+    rcpp_result_gen = Rcpp::wrap(zstd_decompress_cpp(x, expected));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -185,9 +376,25 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
+    {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
+    {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
+    {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
+    {"_allanvar_mcap_chunk_raw", (DL_FUNC) &_allanvar_mcap_chunk_raw, 3},
+    {"_allanvar_mcap_imu", (DL_FUNC) &_allanvar_mcap_imu, 6},
+    {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
+    {"_allanvar_int64_rel_seconds", (DL_FUNC) &_allanvar_int64_rel_seconds, 3},
+    {"_allanvar_int64_to_double", (DL_FUNC) &_allanvar_int64_to_double, 1},
+    {"_allanvar_col_first_nonfinite", (DL_FUNC) &_allanvar_col_first_nonfinite, 1},
+    {"_allanvar_col_block_avar", (DL_FUNC) &_allanvar_col_block_avar, 3},
+    {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
+    {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
+    {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},
+    {"_allanvar_rosbag_chunk_imu", (DL_FUNC) &_allanvar_rosbag_chunk_imu, 6},
     {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 0},
+    {"_allanvar_zstd_available_cpp", (DL_FUNC) &_allanvar_zstd_available_cpp, 0},
+    {"_allanvar_zstd_decompress_cpp", (DL_FUNC) &_allanvar_zstd_decompress_cpp, 2},
     {NULL, NULL, 0}
 };
 

@@ -5,6 +5,9 @@ suppressPackageStartupMessages({
   library(allanvar)
 })
 options(allanvar.threads = 2L)
+# Snapshot tests (the wording of errors) run here as they do on CI; only
+# CRAN skips them.
+Sys.setenv(NOT_CRAN = "true")
 results <- testthat::test_dir(
   "tests/testthat", package = "allanvar", load_package = "installed",
   reporter = testthat::ProgressReporter$new(show_praise = FALSE),

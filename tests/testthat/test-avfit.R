@@ -110,10 +110,10 @@ test_that("model EDF agrees with Monte Carlo (white noise, both estimators)", {
   expect_equal(mc_edf[2], th_n, tolerance = 0.25)
   expect_equal(th_n, 2 * 255^2 / (3 * 255 - 1))
   # Greenhall's white-FM value approaches the exact one at larger m
-  expect_equal(edf_greenhall_noavar(64, nn + 1, 0),
+  expect_equal(allan_edf_cpp(allan_type_code("standard"), 64, 63, nn + 1, 0L, FALSE),
                2 * 63^2 / (3 * 63 - 1), tolerance = 0.1)
   # SP 1065 flicker FM at m = 1 keeps the square (no EDF < 1)
-  expect_gt(edf_simple_oavar(1, 1001, -1), 100)
+  expect_gt(edf_power_law(1, 1000, "overlapping", -1), 100)
 })
 
 test_that("avfit accepts allan(), avar() and plain tables", {
@@ -188,9 +188,10 @@ test_that("methods: coef, vcov, confint, predict, logLik, AIC, BIC, print, plot"
   expect_equal(AIC(fit), -2 * as.numeric(logLik(fit)) + 6)
   expect_equal(BIC(fit), -2 * as.numeric(logLik(fit)) + 3 * log(nrow(tab)))
   expect_equal(nrow(fit$steps), 0)
-  expect_named(fit$steps, c("effect", "tau_from", "tau_to", "evidence",
-                            "chi2_before", "chi2_after", "rms_before",
-                            "rms_after"))
+  expect_named(fit$steps, c("effect", "label", "tau_from", "tau_to", "params",
+                            "evidence", "confirmed", "chi2_before",
+                            "chi2_after", "rms_before", "rms_after",
+                            "crit_before", "crit_after"))
   expect_output(print(fit), "chi2/dof")
   expect_output(print(summary(fit)), "correlation time")
   pdf(NULL)
@@ -221,7 +222,7 @@ test_that("white-noise covariance kernel: exact values, strided sums, Monte Carl
   M <- floor(nn / m) - 1
   expect_equal(2 / m^2 / diag(C), 2 * M^2 / (3 * M - 1))
   Co <- avar_white_cov(m, nn, TRUE, 2L)
-  expect_equal(2 / m^2 / diag(Co), edf_simple_oavar(m, nn + 1, 0), tolerance = 0.02)
+  expect_equal(2 / m^2 / diag(Co), edf_power_law(m, nn, "overlapping", 0), tolerance = 0.02)
   # brute-force R sum for a long pair (the C++ sum is strided there)
   brute <- function(mi, mj, n) {
     w <- function(t, mm) ifelse(t >= 0 & t < mm, -1 / mm,
@@ -358,4 +359,28 @@ test_that("several nonlinear terms: the search finds the global optimum", {
   fit <- avfit(oav_table(x, f), c("N", "gm"), n = 2^16, freq = f,
                fixed = c(gm1.sigma = 0))
   expect_true(is.na(fit$se["gm1.tc"]))
+})
+
+test_that("avfit() and its methods raise classed errors with stable wording", {
+  tab <- data.frame(tau = m_oct / f, avar = av_model(m_oct / f, c(N = 1), f))
+  fit <- avfit(tab, "N", n = n, freq = f)
+  expect_snapshot(error = TRUE, {
+    avfit()
+    avfit(tab, "Z", n = n, freq = f)
+    avfit(tab, c("N", "N"), n = n, freq = f)
+    avfit(tab, "N", n = n, freq = f, start = c(X = 1))
+    avfit(tab, "N", n = n, freq = f, tau_range = 1)
+    avfit(tab[1:2, ], c("N", "B", "K"), n = n, freq = f)
+    avfit(tab, "N", n = n, freq = f, bias_correct = NA)
+    avfit(tab, "N", n = n, freq = f, taus = 3)
+    avfit(fit, "N", freq = 10)
+    residuals(fit, type = "raw")
+    predict(fit, -1)
+    confint(fit, "B")
+  })
+  expect_error(avfit(tab, "Z", n = n, freq = f), class = "allanvar_error_argument")
+  expect_error(avfit(1:3), class = "allanvar_error_curve")
+  expect_error(avfit(tab[1:2, ], c("N", "B", "K"), n = n, freq = f),
+               class = "allanvar_error_curve")
+  expect_error(av_model(1, c(X = 1)), class = "allanvar_error_argument")
 })

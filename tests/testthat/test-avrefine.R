@@ -121,3 +121,35 @@ test_that("the loop runs on one measured ADIS16405 axis", {
   }
   expect_lte(ref$chi2, fit$chi2)
 })
+
+test_that("avrefine() errors are classed and worded", {
+  x <- avsim(2e4, 100, N = 0.01, seed = 1)
+  fit <- avfit(curve_of(x), terms = "N")
+  expect_snapshot(error = TRUE, {
+    avrefine()
+    avrefine(list())
+    avrefine(fit, candidates = "X")
+    avrefine(fit, max_steps = -1)
+    avrefine(fit, criterion = "WIC")
+    avrefine(fit, data = letters)
+    avrefine(fit, data = ts(rnorm(1000), frequency = 10))
+  })
+  expect_error(avrefine(fit, candidates = "X"), class = "allanvar_error_argument")
+})
+
+test_that("a refit that fails is recorded as a classed condition, not swallowed", {
+  # four points: a model of N and K leaves two degrees of freedom, so a
+  # refit with a Gauss-Markov term has none left and fails
+  x <- avsim(2e4, 100, N = 0.01, K = 1e-2, seed = 2)
+  a <- allan(x, 100, taus = c(0.01, 0.1, 1, 10))
+  tab <- data.frame(tau = a$tau, avar = a$avar * c(1, 5, 1, 1), edf = a$edf)
+  fit <- avfit(tab, c("N", "K"))
+  ref <- avrefine(fit, candidates = "gm", max_steps = 1)
+  fl <- ref$refine$failures
+  expect_gt(nrow(fl), 0)
+  expect_named(fl, c("step", "effect", "stage", "message", "condition"))
+  expect_true(all(vapply(fl$condition, inherits, logical(1),
+                         c("allanvar_error_refit", "allanvar_warning_refit"))))
+  expect_true(all(fl$step == 1L))
+  expect_output(print(ref), "refit\\(s\\) failed")
+})

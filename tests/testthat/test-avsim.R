@@ -73,3 +73,17 @@ test_that("avsim checks its arguments", {
   expect_error(avsim(100, 10, seed = "a"), "`seed`")
   expect_equal(length(avsim(100, 10)), 100)
 })
+
+test_that("avsim() errors are classed and worded", {
+  expect_snapshot(error = TRUE, {
+    avsim()
+    avsim(1, 10, N = 1)
+    avsim(100, 10, N = -1)
+    avsim(100, 10, gm = list(sigma = 1))
+    avsim(100, 10, gm = list(sigma = 1, tc = -1))
+    avsim(100, 10, sinusoid = list(amp = 1, f0 = 6))
+    avsim(100, 10, X = 1)
+    avsim(100, 10, 0.1)
+  })
+  expect_error(avsim(100, 10, X = 1), class = "allanvar_error_argument")
+})

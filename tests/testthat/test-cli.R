@@ -128,3 +128,111 @@ test_that("options describe other layouts; bad options are refused", {
   expect_error(allanvar:::cli_run(character()), "no input file")
   expect_output(allanvar_cli("--help"), "Usage: allanvar")
 })
+
+cli_csv <- function(n = 3000, freq = 100, seed = 4) {
+  set.seed(seed)
+  f <- tempfile(fileext = ".csv")
+  d <- data.frame(time = (0:(n - 1)) / freq, p = rnorm(n, sd = 0.02),
+                  q = rnorm(n, sd = 0.02), r = rnorm(n, sd = 0.02))
+  utils::write.csv(d, f, row.names = FALSE)
+  f
+}
+
+test_that("the CLI's errors and warnings name its flags, not R arguments", {
+  f <- cli_csv()
+  out <- tempfile("cli")
+  on.exit(unlink(c(f, out), recursive = TRUE))
+  # no recognizable gyro columns -> the flags to choose them
+  expect_error(allanvar:::cli_run(c(f, "--out", out, "--quiet")),
+               "--gyro-cols / --accel-cols", class = "allanvar_error_no_columns")
+  # no time column -> --time-col / --rate
+  f2 <- tempfile(fileext = ".csv")
+  on.exit(unlink(f2), add = TRUE)
+  writeLines(c("a,gyro_x", "1,0.1", "2,0.2"), f2)
+  err <- expect_error(allanvar:::cli_run(c(f2, "--out", out, "--quiet")),
+                      class = "allanvar_error_no_time")
+  expect_match(conditionMessage(err), "--time-col")
+  expect_match(conditionMessage(err), "--rate")
+  expect_no_match(conditionMessage(err), "`")
+  # seconds declared as ns -> --time-unit s
+  err <- expect_error(allanvar:::cli_run(c(f, "--out", out, "--quiet", "--gyro-cols",
+                                           "p,q,r", "--time-unit", "ns")),
+                      class = "allanvar_error_time_unit")
+  expect_match(conditionMessage(err), "--time-unit s")
+  expect_false(dir.exists(out))
+  # deg/s data taken as rad/s -> a loud warning naming --gyro-units
+  g <- tempfile(fileext = ".csv")
+  on.exit(unlink(g), add = TRUE)
+  n <- 6000
+  set.seed(5)
+  utils::write.csv(data.frame(time = (0:(n - 1)) / 100, gx = rnorm(n, sd = 0.3),
+                              gy = rnorm(n, sd = 0.3)), g, row.names = FALSE)
+  msgs <- character()
+  capture.output(withCallingHandlers(
+    allanvar:::cli_run(c(g, "--out", out, "--gyro-cols", "gx,gy", "--no-refine",
+                         "--quiet")),
+    message = function(m) {
+      msgs <<- c(msgs, conditionMessage(m))
+      invokeRestart("muffleMessage")
+    }))
+  w <- grep("gyroscope units look wrong", msgs, value = TRUE)
+  expect_length(w, 1L)
+  expect_match(w, "--gyro-units deg/s")
+  expect_no_match(w, "units = c")
+  expect_true(any(grepl("assuming rad/s.*--gyro-units / --accel-units", msgs)))
+})
+
+test_that("--terms, --axis, --gap and units are validated, naming the flag", {
+  f <- cli_csv()
+  on.exit(unlink(f))
+  expect_error(allanvar:::cli_run(c(f, "--terms", "N,X")),
+               "--terms: unknown term\\(s\\) X", class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(c(f, "--axis", "worst")), "--axis must be one of")
+  expect_error(allanvar:::cli_run(c(f, "--gap", "skip")), "--gap must be one of")
+  expect_error(allanvar:::cli_run(c(f, "--gyro-units", "furlong/s")),
+               "--gyro-units \"furlong/s\" is not a known gyro unit")
+  expect_error(allanvar:::cli_run(c(f, "--width", "-3")), "--width must be")
+  expect_identical(allanvar:::cli_terms("n,b,K,gm"), c("N", "B", "K", "gm"))
+})
+
+test_that("--out is validated and a failed run writes nothing", {
+  f <- cli_csv()
+  on.exit(unlink(f))
+  expect_error(allanvar:::cli_run(c(f, "--out=")), "--out must name a directory",
+               class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(c(f, "--out", f)), "is a file",
+               class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(c(f, "--out", "/")), "root",
+               class = "allanvar_error_cli")
+  # a 2-row file fails in the analysis: no output at all, not 2 of 4
+  two <- tempfile(fileext = ".csv")
+  writeLines(c("time,gyro_x", "0,0.001", "0.01,0.002"), two)
+  out <- tempfile("cli")
+  on.exit(unlink(c(two, out), recursive = TRUE), add = TRUE)
+  expect_error(suppressMessages(capture.output(
+    allanvar:::cli_run(c(two, "--out", out, "--quiet", "--no-refine")))))
+  expect_false(dir.exists(out) && length(list.files(out)) > 0)
+  # with a good file first and the bad one second: still nothing written
+  expect_error(suppressMessages(capture.output(suppressWarnings(
+    allanvar:::cli_run(c(f, two, "--out", out, "--quiet", "--no-refine",
+                         "--gyro-cols", "p,q,r"))))))
+  expect_length(list.files(out), 0L)
+})
+
+test_that("--width/--height size the PNG; --topic reads a bag", {
+  f <- ros_fixture("imu_lz4.bag")
+  out <- tempfile("cli")
+  on.exit(unlink(out, recursive = TRUE))
+  err <- expect_error(allanvar:::cli_run(c(f, "--out", out, "--quiet")),
+                      class = "allanvar_error_topic")
+  expect_match(conditionMessage(err), "choose one with --topic")
+  capture.output(res <- suppressMessages(suppressWarnings(allanvar:::cli_run(c(
+    f, "--topic", "/imu0", "--out", out, "--quiet", "--no-refine",
+    "--width", "900", "--height", "450")))))
+  png <- readBin(file.path(out, "allan_deviation.png"), "raw", 24)
+  # PNG IHDR: width and height as big-endian 32-bit integers at bytes 17-24
+  be32 <- function(r) sum(as.numeric(r) * 256^(3:0))
+  expect_identical(c(be32(png[17:20]), be32(png[21:24])), c(900, 450))
+  expect_length(res$files, 4L)
+  expect_equal(res$analyses[[1]]$freq, 200, tolerance = 1e-9)
+})

@@ -66,3 +66,14 @@ test_that("write_datasheet() writes the long and wide CSV", {
   expect_true(any(grepl("N \\[deg/sqrt\\(h\\)\\]", readLines(f))))
   expect_error(write_datasheet(1, f), "imu_datasheet")
 })
+
+test_that("datasheet() and write_datasheet() errors are classed and worded", {
+  a <- sim_analysis()
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  expect_snapshot(error = TRUE, {
+    datasheet(a, average = NA)
+    write_datasheet(1, f)
+    write_datasheet(a, f, format = "tall")
+  })
+})

@@ -110,3 +110,24 @@ test_that("write_kalibr_yaml() takes the worst axis of an analysis and says so",
   expect_identical(unique(fp$unit[fp$sensor == "accel" & fp$parameter == "sigma_d"]),
                    "m/s^2")
 })
+
+test_that("write_kalibr_yaml() and filter_params() errors are classed and worded", {
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  vals <- list(gyroscope_noise_density = 1.7e-4, gyroscope_random_walk = 2e-5,
+               accelerometer_noise_density = 2e-3,
+               accelerometer_random_walk = 3e-3, update_rate = 200)
+  expect_snapshot(error = TRUE, {
+    write_kalibr_yaml()
+    write_kalibr_yaml(vals[-1], f)
+    write_kalibr_yaml(vals, f, inflate = 0.5)
+    write_kalibr_yaml(vals, f, axis = "min")
+    write_kalibr_yaml("x", f)
+    filter_params()
+    filter_params(c(N = 1))
+    filter_params(c(N = 1), dt = -1)
+    filter_params("x", dt = 1)
+    filter_params(c(N = 1), dt = 1, bias_instability = "none")
+  })
+  expect_error(filter_params(c(N = 1)), class = "allanvar_error_missing_argument")
+})

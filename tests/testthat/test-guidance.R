@@ -49,3 +49,8 @@ test_that("a record long enough for K gives no K or B guidance", {
   rd <- a$channels$gyro_x$readings
   expect_equal(rd$value[rd$term == "K"], 1e-2, tolerance = 0.3)
 })
+
+test_that("imu_guidance() errors are classed and worded", {
+  expect_snapshot(error = TRUE, imu_guidance(1))
+  expect_error(imu_guidance(1), class = "allanvar_error_argument")
+})

@@ -1,5 +1,6 @@
 # General discrete formula for a stationary rate with autocovariance gamma(h)
-# (noise-models.md section 1), an independent reference for the closed forms.
+# (Zhang 2008; vignette("noise-terms")), an independent reference for the
+# closed forms.
 av_from_acf <- function(m, gamma) {
   i <- seq_len(m - 1)
   (m * (gamma(0) - gamma(m)) +
@@ -16,7 +17,7 @@ test_that("flicker table matches direct numerical integration", {
     ref <- 2 / pi * I
     expect_equal(av_model(m, c(B = 1), freq = 1), ref, tolerance = 1e-8)
   }
-  # published ratios to the plateau (noise-models.md)
+  # published ratios to the plateau (vignette("noise-terms"))
   r <- av_model(c(1, 2, 4, 8, 16), c(B = 1), freq = 1) / pl
   expect_equal(r, c(1.443, 1.154, 1.050, 1.015, 1.0046), tolerance = 1e-3)
   expect_equal(av_model(1, c(B = 1), freq = 1) / pl, 1 / log(2), tolerance = 1e-9)
@@ -105,7 +106,8 @@ test_that("terms add in variance; by_term gives the parts", {
 
 test_that("catalogue listing and argument checks", {
   tt <- av_terms()
-  expect_setequal(unique(tt$term), c("Q", "N", "B", "K", "R", "gm", "sinusoid"))
+  expect_setequal(unique(tt$term), c("Q", "N", "B", "K", "R", "gm", "sinusoid",
+                                     "filter", "resonance"))
   expect_equal(tt$unit[tt$parameter == "N"], "u*sqrt(s)")
   expect_equal(tt$slope[tt$term == "K"], 0.5)
   expect_error(av_model(-1, c(N = 1)), "`tau`")
@@ -119,4 +121,47 @@ test_that("catalogue listing and argument checks", {
                  "sinusoid1.amp", "sinusoid1.f0"))
   expect_error(check_terms(c("N", "N")), "only gm and sinusoid")
   expect_error(check_terms("Z"), "unknown term")
+})
+
+test_that("av_model() errors are classed and worded", {
+  expect_snapshot(error = TRUE, {
+    av_model(c(N = 1))
+    av_model(-1, c(N = 1))
+    av_model(1, c(X = 1))
+    av_model(1, c(gm1.sigma = 1))
+    av_model(1, c(N = -1))
+    av_model(1, c(gm1.sigma = 1, gm1.tc = 0))
+    av_model(1, 1)
+  })
+})
+
+test_that("the catalogue's autocovariances and PSDs give its AV forms", {
+  # autocovariance route (discrete forms) for every entry that defines one
+  pars <- list(Q = NULL, N = NULL, gm = c(tc = 0.4), sinusoid = c(f0 = 3.3))
+  for (k in names(pars)) {
+    e <- allanvar:::effect_entry(k)
+    expect_false(is.null(e$acf))
+    for (m in c(1, 2, 7, 40)) {
+      expect_equal(e$basis(m / 100, 0.01, pars[[k]]),
+                   av_from_acf(m, function(h) e$acf(h, 0.01, pars[[k]])),
+                   tolerance = 1e-9, label = paste(k, m))
+    }
+  }
+  # PSD route (continuous forms): AV = 4 int S(f) sin^4(pi f tau)/(pi f tau)^2 df,
+  # in x = pi f tau, period by period, plus the tail (mean of sin^4 is 3/8)
+  av_psd <- function(tau, S) {
+    g <- function(x) S(x / (pi * tau)) * sin(x)^4 / x^2
+    body <- sum(vapply(0:299, function(k)
+      integrate(g, k * pi, (k + 1) * pi, rel.tol = 1e-10)$value, 0))
+    4 / (pi * tau) * (body + S(300 / tau) * 3 / 8 / (300 * pi))
+  }
+  pars <- list(N = NULL, B = NULL, K = NULL, gm = c(tc = 0.4))
+  for (k in names(pars)) {
+    e <- allanvar:::effect_entry(k)
+    for (tau in c(0.05, 1, 20)) {
+      expect_equal(av_psd(tau, function(f) e$psd(f, pars[[k]])),
+                   e$basis(tau, NULL, pars[[k]]), tolerance = 2e-3,
+                   label = paste(k, tau))
+    }
+  }
 })

@@ -66,3 +66,83 @@ test_that("av_units() lists every unit with its SI unit", {
   expect_true(all(tab$to_si[tab$unit == tab$si] == 1))
   expect_setequal(av_units("accel", "K")$si, "m/s^3/sqrt(Hz)")
 })
+
+# Unit checks on the data. A static IMU of our own making: white gyro noise
+# N (deg/sqrt(h)) and a bias, accelerometers holding gravity on z.
+static_imu <- function(n = 6000, freq = 100, N_dph = 2, bias_dps = 0.2,
+                       tilt = c(0.01, -0.02), seed = 1) {
+  set.seed(seed)
+  sd_dps <- N_dph / 60 * sqrt(freq)            # white: sd = N sqrt(f)
+  g <- matrix(rnorm(3 * n, bias_dps, sd_dps), n)
+  a <- cbind(tilt[1] + rnorm(n, sd = 0.003), tilt[2] + rnorm(n, sd = 0.003),
+             sqrt(1 - sum(tilt^2)) + rnorm(n, sd = 0.003))
+  colnames(g) <- c("gyro_x", "gyro_y", "gyro_z")
+  colnames(a) <- c("accel_x", "accel_y", "accel_z")
+  list(gyro_dps = g, accel_g = a, freq = freq)
+}
+
+test_that("accelerometer units are read from gravity: g and m/s^2 inputs", {
+  s <- static_imu()
+  # in g, no units given: detected, said, recorded, converted
+  expect_message(r <- imu_record(cbind(s$gyro_dps * pi / 180, s$accel_g), freq = 100),
+                 "accelerometers read as g")
+  expect_identical(unname(r$units[4:6]), rep("g", 3))
+  expect_identical(unique(r$unit_checks$source[4:6]), "gravity")
+  expect_equal(sqrt(sum(colMeans(r$data[, 4:6])^2)), 9.80665, tolerance = 1e-3)
+  # in m/s^2: confirmed, no change
+  m <- cbind(s$gyro_dps * pi / 180, s$accel_g * 9.80665)
+  r2 <- imu_record(m, freq = 100)
+  expect_identical(unname(r2$units[4:6]), rep("m/s^2", 3))
+  expect_identical(unique(r2$unit_checks$source[4:6]), "gravity")
+  expect_equal(r2$data, r$data, tolerance = 1e-12)
+  # in mg
+  expect_message(r3 <- imu_record(cbind(s$gyro_dps * pi / 180, s$accel_g * 1000),
+                                  freq = 100), "read as mg")
+  expect_equal(r3$data[, 4:6], r$data[, 4:6], tolerance = 1e-12)
+  # given units that gravity contradicts: a classed warning, units kept
+  expect_warning(r4 <- imu_record(cbind(s$gyro_dps * pi / 180, s$accel_g), freq = 100,
+                                  units = c(accel = "m/s^2")),
+                 "look like g", class = "allanvar_warning_accel_units")
+  expect_identical(unname(r4$units[4]), "m/s^2")
+  # read_imu says it in its message too
+  f <- tempfile(fileext = ".csv")
+  on.exit(unlink(f))
+  utils::write.csv(data.frame(time = (0:5999) / 100, s$gyro_dps * pi / 180, s$accel_g), f,
+                   row.names = FALSE)
+  expect_message(r5 <- read_imu(f), "no units given.*accelerometers read as g")
+  expect_identical(unname(r5$units[4:6]), rep("g", 3))
+})
+
+test_that("gyro units are checked against real gyros: deg/s and rad/s inputs", {
+  s <- static_imu()
+  acc <- s$accel_g * 9.80665
+  # deg/s samples (N = 2 deg/sqrt(h)) taken as rad/s: N looks 57 times too large
+  w <- expect_warning(imu_record(cbind(s$gyro_dps, acc), freq = 100),
+                      class = "allanvar_warning_gyro_units")
+  expect_match(conditionMessage(w), "gyro_x: white noise N ~ 1[0-9]{2} deg/sqrt\\(h\\)")
+  expect_match(conditionMessage(w), "units = c\\(gyro = \"deg/s\"\\)")
+  # the same samples declared deg/s, or converted to rad/s: no warning, N ~ 2
+  expect_silent(r <- imu_record(cbind(s$gyro_dps, acc), freq = 100,
+                                units = c(gyro = "deg/s", accel = "m/s^2")))
+  expect_match(r$unit_checks$evidence[1], "N ~ 2")
+  expect_silent(imu_record(cbind(s$gyro_dps * pi / 180, acc), freq = 100))
+  # a large bias in deg/s taken as rad/s (white noise alone plausible)
+  s2 <- static_imu(N_dph = 0.3, bias_dps = 2)
+  expect_warning(imu_record(cbind(s2$gyro_dps, acc), freq = 100),
+                 "mean rate", class = "allanvar_warning_gyro_units")
+})
+
+test_that("the measured ADIS16405 (deg/s, g) is recognized", {
+  skip_if_no_shared()
+  m <- readRDS(shared_file("adis16405_unit1.rds"))[1:60000, ]
+  colnames(m) <- c("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
+  w <- NULL
+  r <- withCallingHandlers(
+    suppressMessages(imu_record(m, freq = 100)),
+    allanvar_warning_gyro_units = function(c) {
+      w <<- conditionMessage(c)
+      invokeRestart("muffleWarning")
+    })
+  expect_match(w, "as deg/s it would be")
+  expect_identical(unname(r$units[4:6]), rep("g", 3))
+})

@@ -1,13 +1,4 @@
-two_records <- function() {
-  n <- 2e4
-  r1 <- imu_record(cbind(gyro_x = avsim(n, 100, N = 1e-3, K = 1e-3, seed = 1),
-                         accel_x = avsim(n, 100, N = 1e-2, K = 1e-2, seed = 2)),
-                   freq = 100, name = "rec1")
-  r2 <- imu_record(cbind(gyro_x = avsim(n, 100, N = 2e-3, K = 1e-3, seed = 3),
-                         accel_x = avsim(n, 100, N = 3e-2, K = 1e-2, seed = 4)),
-                   freq = 100, name = "rec2")
-  list(r1, r2)
-}
+# analyze_imu(): per-axis orchestration over future.
 
 test_that("every axis gets its own curve on one tau grid, fit and readings", {
   recs <- two_records()
@@ -74,18 +65,6 @@ test_that("file paths are read and analysed; bad input is refused", {
   expect_error(analyze_imu(two_records()[[1]], channels = "gyro_q"), "not in")
 })
 
-test_that("plot() draws both sensors with units and reading markers", {
-  a <- suppressWarnings(analyze_imu(two_records()[[1]], progress = FALSE))
-  f <- tempfile(fileext = ".png")
-  on.exit(unlink(f))
-  grDevices::png(f, width = 1000, height = 500)
-  expect_invisible(plot(a))
-  plot(a, sensor = "gyro", units = "datasheet")
-  grDevices::dev.off()
-  expect_gt(file.size(f), 1000)
-  expect_error(plot(a, sensor = "mag"), "`sensor`")
-})
-
 test_that("effects the closed loop adds reach the datasheet", {
   x <- avsim(2e4, 100, N = 1e-3, K = 1e-3, gm = list(sigma = 0.02, tc = 2), seed = 1)
   r <- imu_record(cbind(gyro_x = as.numeric(x)), freq = 100)
@@ -102,30 +81,16 @@ test_that("effects the closed loop adds reach the datasheet", {
                sig^2 * (1 - exp(-0.02 / tc)))
 })
 
-test_that("white-like Gauss-Markov terms are folded into N, once", {
-  curve <- data.frame(tau = 2^(0:8) / 100, adev = 1e-3 / sqrt(2^(0:8) / 100),
-                      upper = 1.1e-3 / sqrt(2^(0:8) / 100))
-  cf <- c(N = 3e-4, B = 0, K = 0, gm1.sigma = 5e-3, gm1.tc = 0.005,
-          gm2.sigma = 1e-3, gm2.tc = 20)
-  rd <- allanvar:::channel_readings(curve, cf, "gyro")
-  # N^2 + 2 sigma^2 Tc (gm1 only; gm2 has Tc = 20 s)
-  expect_equal(rd$value[rd$term == "N"], sqrt(3e-4^2 + 2 * 5e-3^2 * 0.005))
-  expect_match(rd$method[rd$term == "N"], "white-like GM")
-  # B = 0 in the fit: min ADEV / 0.664 at the minimum's tau
-  expect_equal(rd$value[rd$term == "B"], min(curve$adev) / sqrt(2 * log(2) / pi))
-  expect_equal(rd$tau[rd$term == "B"], 2.56)
-  # with a fitted curve, B is read at its minimum; without, only reliable
-  # taus (edf >= 10) count
-  rd2 <- allanvar:::channel_readings(curve, cf, "gyro",
-                                     fitted = data.frame(tau = curve$tau,
-                                                         fitted = (curve$tau - 0.3)^2 + 1))
-  expect_equal(rd2$tau[rd2$term == "B"], 0.32)
-  curve$edf <- c(rep(50, 6), 5, 2, 1)
-  rd3 <- allanvar:::channel_readings(curve, c(N = 1e-3), "gyro")
-  expect_equal(rd3$tau[rd3$term == "B"], 0.32)
-  expect_equal(rd3$value[rd3$term == "B"], curve$adev[6] / sqrt(2 * log(2) / pi))
-  expect_match(rd$method[rd$term == "K"], "upper bound")
-  g <- allanvar:::gm_terms(cf, drop_white = TRUE)
-  expect_identical(names(g), c("gm1.sigma", "gm1.tc"))
-  expect_equal(unname(g), c(1e-3, 20))
+test_that("analyze_imu() errors are classed and worded", {
+  r <- two_records()[[1]]
+  expect_snapshot(error = TRUE, {
+    analyze_imu()
+    analyze_imu(1)
+    analyze_imu(character())
+    analyze_imu(r, refine = NA)
+    analyze_imu(r, progress = "yes")
+    analyze_imu(r, channels = "gyro_q")
+    analyze_imu(r, refine_args = 1)
+  })
+  expect_error(analyze_imu(1), class = "allanvar_error_argument")
 })

@@ -1,0 +1,271 @@
+# Orchestration: analyze_imu() runs, for every axis of one or more
+# recordings, allan() -> avfit() -> avrefine() -> readings, one future per
+# axis, and assembles the analysis (datasheet, guidance).
+
+#' Analyse IMU recordings axis by axis
+#'
+#' For every channel (axis) of one or more recordings: the Allan deviation
+#' curve on one tau grid ([allan()]), a noise-model fit ([avfit()] with
+#' `terms`), the closed-loop refinement ([avrefine()], when `refine = TRUE`),
+#' the datasheet readings N, B, K and the guidance on record length
+#' ([imu_guidance()]). Axes are never averaged (see `average` in
+#' [datasheet()]).
+#'
+#' Channels are analysed in parallel with [future.apply::future_lapply()],
+#' so the call runs on whatever [future::plan()] is set (sequential by
+#' default, `multisession`, a cluster, ...), with `future.seed = TRUE`:
+#' results do not depend on the plan.
+#'
+#' Readings (typed columns `source`, `is_bound`, `folded`; the `method`
+#' column says the same in words): N is
+#' the fitted white-noise coefficient, the -1/2 line's value at tau = 1 s;
+#' Gauss-Markov terms the refinement added with Tc < 0.1 s are white noise
+#' at tau >= 1 s (their AV tends to 2 sigma^2 Tc / tau) and are folded in,
+#' N = sqrt(N^2 + sum 2 sigma^2 Tc). K is the fitted rate random walk (the
+#' +1/2 line's value at tau = 3 s) and B the fitted bias instability,
+#' reported with the tau where it is read: the minimum of the fitted Allan
+#' deviation (the flat region), or without a fit the minimum of the
+#' measured one among the taus with at least 10 degrees of freedom.
+#' A term the fit lacks or sets to 0 (for K: or whose standard error
+#' exceeds it) is read by the IEEE 952 slope lines
+#' instead: N and K from the tangent lines of slope -1/2 and +1/2,
+#' B = min ADEV / 0.664; with no +1/2 region, K is given as the upper bound
+#' min over tau of upper(tau) sqrt(3 / tau) (see [imu_guidance()]).
+#'
+#' @param x An [imu_record()] (from [read_imu()]), a list of them, or a
+#'   character vector of file paths (read with [read_imu()] and `read_args`).
+#' @param taus,type Passed to [allan()]: the tau grid (the same for every
+#'   channel of a record) and the estimator.
+#' @param terms Terms to fit, passed to [avfit()]; `NULL` (default) for the
+#'   datasheet model N, B, K.
+#' @param refine Run [avrefine()] on each fit to identify effects the model
+#'   misses (logical).
+#' @param segment Which gap-free segment to use: `"longest"` (default),
+#'   `"each"` (every segment analysed as its own record) or a number.
+#' @param channels Optional channel names to analyse (default: all).
+#' @param progress Report progress, one message per axis. Default: on in
+#'   interactive sessions unless `options(allanvar.progress = FALSE)`.
+#' @param read_args A list of arguments for [read_imu()] when `x` holds
+#'   file paths.
+#' @param refine_args A list of further arguments for [avrefine()] (for
+#'   example `candidates` or `max_steps`).
+#' @param ... Further arguments passed to [avfit()].
+#' @return For one recording, an object of class `"imu_analysis"`: a list
+#'   with `name`, `freq`, `n` (samples used), `duration` (s), `record` (the
+#'   record's `problems`, `segments`, `units`, `file`), `channels` (one entry
+#'   per axis: `channel`, `sensor`, `unit`, `curve` (the [allan()] result),
+#'   `fit` (the [avfit()]/[avrefine()] result or `NULL`), `fit_error` (the
+#'   message of a fit or refinement that failed, its condition in
+#'   `fit_condition`), `coef` (SI), `readings` (data frame `term`, `value`,
+#'   `unit`, `tau`, `method`, `source` (`"fit"`, `"slope"`, `"bound"` or
+#'   `"none"`), `is_bound`, `folded` (fitted terms folded into the value),
+#'   `role`, `slope`, `adev`) and `guidance`), and `datasheet`
+#'   ([datasheet()]). For
+#'   several recordings, a list of those, of class `"imu_analysis_list"`.
+#' @seealso [plot.imu_analysis()], [datasheet()], [write_kalibr_yaml()],
+#'   [filter_params()], [allanvar_cli()].
+#' @export
+#' @examples
+#' \donttest{
+#' set.seed(1)
+#' m <- cbind(gyro_x = rnorm(1e4, sd = 0.01), accel_x = rnorm(1e4, sd = 0.002))
+#' r <- imu_record(m, freq = 100)
+#' a <- analyze_imu(r, refine = FALSE, progress = FALSE)
+#' a
+#' }
+analyze_imu <- function(x, taus = "octave", type = "overlapping",
+                        terms = NULL, refine = TRUE,
+                        segment = "longest", channels = NULL,
+                        progress = interactive() &&
+                          isTRUE(getOption("allanvar.progress", TRUE)),
+                        read_args = list(), refine_args = list(), ...) {
+  check_present(missing(x), "x", "an imu_record, a list of them or file paths")
+  if (!is.logical(refine) || length(refine) != 1L || is.na(refine)) {
+    abort("`refine` must be TRUE or FALSE, not ", format_value(refine), ".",
+          class = "argument")
+  }
+  if (!is.logical(progress) || length(progress) != 1L || is.na(progress)) {
+    abort("`progress` must be TRUE or FALSE, not ", format_value(progress), ".",
+          class = "argument")
+  }
+  if (!is.list(refine_args) || (length(refine_args) && is.null(names(refine_args)))) {
+    abort("`refine_args` must be a named list of avrefine() arguments, not ",
+          describe_type(refine_args), ".", class = "argument")
+  }
+  records <- as_record_list(x, read_args)
+  records <- split_segments(records, segment)
+  single <- length(records) == 1L
+
+  # One job per (record, channel): the unit of parallel work.
+  jobs <- list()
+  for (i in seq_along(records)) {
+    r <- records[[i]]
+    ch <- colnames(r$data)
+    if (!is.null(channels)) {
+      miss <- setdiff(channels, ch)
+      if (length(miss)) {
+        abort("`channels`: ", paste(miss, collapse = ", "), " not in ",
+              r$name, " (", paste(ch, collapse = ", "), ").", class = "argument")
+      }
+      ch <- channels
+    }
+    for (chn in ch) {
+      jobs[[length(jobs) + 1L]] <- list(
+        record = i, name = r$name, channel = chn, sensor = r$sensors[[chn]],
+        unit = r$si_units[[chn]], x = r$data[, chn], freq = r$freq)
+    }
+  }
+  n_jobs <- length(jobs)
+  for (k in seq_along(jobs)) jobs[[k]]$label <- sprintf("[%d/%d] %s: %s", k,
+                                                        n_jobs, jobs[[k]]$name,
+                                                        jobs[[k]]$channel)
+  opts <- list(taus = taus, type = type, terms = terms, refine = refine,
+               progress = progress, fit_args = list(...),
+               refine_args = refine_args)
+  # One future per axis: axes differ in cost (the refinement), so this
+  # balances the workers, and progress arrives as each axis finishes.
+  # future.seed = TRUE can leave the caller's RNG kind at L'Ecuyer-CMRG
+  # (when no seed existed yet): the caller's RNG state is restored.
+  restore <- save_rng()
+  on.exit(restore(), add = TRUE)
+  results <- future.apply::future_lapply(jobs, analyze_channel, opts = opts,
+                                         future.seed = TRUE,
+                                         future.scheduling = Inf)
+
+  out <- lapply(seq_along(records), function(i) {
+    r <- records[[i]]
+    res <- results[vapply(jobs, function(j) j$record == i, logical(1))]
+    names(res) <- vapply(res, function(z) z$channel, "")
+    a <- list(name = r$name, freq = r$freq, n = nrow(r$data),
+              duration = nrow(r$data) / r$freq,
+              record = list(file = r$file, problems = r$problems,
+                            segments = r$segments, units = r$units,
+                            sampling = r$sampling),
+              channels = res, call = match.call())
+    class(a) <- "imu_analysis"
+    a$datasheet <- datasheet(a)
+    g <- imu_guidance(a)
+    if (nrow(g)) {
+      msg <- paste0(r$name, ": the record is short for some readings:\n",
+                    paste0("  - ", g$channel, ": ", g$message, collapse = "\n"))
+      warning(structure(class = c("allanvar_guidance", "allanvar_warning",
+                                  "warning", "condition"),
+                        list(message = msg, call = NULL)))
+    }
+    a
+  })
+  if (single) return(out[[1L]])
+  names(out) <- vapply(out, function(a) a$name, "")
+  class(out) <- "imu_analysis_list"
+  out
+}
+
+# The work for one axis; runs on a future worker, so it only uses its
+# arguments and the package's namespace.
+analyze_channel <- function(job, opts) {
+  if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
+  curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
+  fit <- NULL
+  failure <- NULL
+  # A fit or refinement that fails is kept in the result (fit_error,
+  # fit_condition) and reported by the guidance; the readings then come
+  # from the slope lines (or the unrefined fit).
+  fit <- tryCatch(
+    do.call(avfit, c(list(curve, terms = opts$terms), opts$fit_args)),
+    error = function(e) {
+      failure <<- list(message = conditionMessage(e), condition = e)
+      NULL
+    })
+  if (!is.null(fit) && opts$refine) {
+    # The raw series lets avrefine() confirm an effect in the data itself.
+    fit <- tryCatch(
+      do.call(avrefine, c(list(fit, data = job$x), opts$refine_args)),
+      error = function(e) {
+        failure <<- list(message = paste("avrefine():", conditionMessage(e)),
+                         condition = e)
+        fit
+      })
+  }
+  coef <- if (is.null(fit)) numeric() else fit$coefficients
+  readings <- channel_readings(curve, coef, job$sensor, se = fit_se(fit),
+                               fitted = if (!is.null(fit)) fit$data)
+  res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
+              freq = job$freq, n = length(job$x), curve = curve, fit = fit,
+              fit_error = failure$message, fit_condition = failure$condition,
+              coef = coef, readings = readings)
+  res$guidance <- imu_guidance(res)
+  res
+}
+
+as_record_list <- function(x, read_args) {
+  if (inherits(x, "imu_record")) return(list(x))
+  if (is.character(x)) {
+    if (!length(x)) {
+      abort("`x` is an empty character vector; give file paths.",
+            class = "argument")
+    }
+    return(lapply(x, function(f) do.call(read_imu, c(list(f), read_args))))
+  }
+  if (is.list(x) && length(x) && all(vapply(x, inherits, logical(1), "imu_record"))) {
+    nm <- names(x)
+    if (!is.null(nm)) for (i in seq_along(x)) if (nzchar(nm[i])) x[[i]]$name <- nm[i]
+    return(unname(x))
+  }
+  abort("`x` must be an imu_record (see read_imu() and imu_record()), a list ",
+        "of them, or file paths; not ", describe_type(x), ".",
+        class = "argument")
+}
+
+split_segments <- function(records, segment) {
+  out <- list()
+  for (r in records) {
+    if (identical(segment, "each") && nrow(r$segments) > 1L) {
+      for (i in seq_len(nrow(r$segments))) {
+        s <- r
+        s$data <- record_segment(r, i)
+        s$name <- sprintf("%s[segment %d]", r$name, i)
+        s$segments <- r$segments[i, , drop = FALSE]
+        out[[length(out) + 1L]] <- s
+      }
+    } else {
+      seg <- if (identical(segment, "each")) "longest" else segment
+      s <- r
+      s$data <- record_segment(r, seg)
+      out[[length(out) + 1L]] <- s
+    }
+  }
+  nm <- vapply(out, function(r) r$name, "")
+  if (anyDuplicated(nm)) {
+    for (i in seq_along(out)) out[[i]]$name <- sprintf("%s#%d", nm[i], i)
+  }
+  out
+}
+
+#' @export
+print.imu_analysis <- function(x, ...) {
+  cat(sprintf("<imu_analysis> %s: %d channels, %d samples at %.6g Hz (%.3g h)\n",
+              x$name, length(x$channels), x$n, x$freq, x$duration / 3600))
+  if (nrow(x$record$problems)) {
+    cat("record problems: ", paste(x$record$problems$type, collapse = ", "),
+        " (see $record$problems)\n", sep = "")
+  }
+  print(x$datasheet)
+  g <- unlist(lapply(x$channels, function(cc) if (length(cc$guidance))
+    paste0(cc$channel, ": ", cc$guidance)))
+  if (length(g)) {
+    cat("\nGuidance:\n")
+    cat(paste0("  - ", g, "\n"), sep = "")
+  }
+  invisible(x)
+}
+
+#' @export
+print.imu_analysis_list <- function(x, ...) {
+  cat(sprintf("<imu_analysis_list> %d recordings\n\n", length(x)))
+  for (a in x) {
+    print(a)
+    cat("\n")
+  }
+  invisible(x)
+}
+

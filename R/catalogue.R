@@ -1,0 +1,266 @@
+# The effect catalogue: one entry per effect of the noise model, holding
+# every fact about it. The fit, the simulator, the closed loop (tracing,
+# raw-data evidence), the readings, the exports and the plots ask the
+# catalogue; no other file switches on effect kinds. Adding an effect is one
+# call to register_effect() (the built-in entries live in R/effect-*.R).
+#
+# An entry is a list built by new_effect(); its fields:
+#   name        kind name, letters only ("N", "gm"); the word used in `terms`
+#   title       a few words
+#   component   "av": a stationary (or stationary-increment) term whose
+#                 expected AV adds to the model, fitted by avfit();
+#               "series": a deterministic non-stationary effect (a step, a
+#                 warm-up, outliers) detected and corrected in the series
+#                 rather than added to the AV
+#   params      data frame from effect_param(): name, role ("amp" or
+#                 "nonlinear"), unit, meaning, profile ("smooth" or
+#                 "oscillatory": how the AV varies with a nonlinear
+#                 parameter, which sets the search grid), print_unit
+#   repeatable  may appear several times in a model (gm1, gm2, ...)
+#   variants    NULL, or a function(variant) returning the fields that
+#                 replace the entry's for that variant (NULL when the variant
+#                 is unknown): a family of filters, a harmonic set with a
+#                 variable number of components. Written "kind:variant" in
+#                 `terms` and "kind<i>_<variant>" in coefficient labels.
+#   slope, psd_alpha, formula, signature   descriptive facts (av_terms())
+#   basis(tau, tau0, nl)   AV per squared amplitude; a vector, or a matrix
+#                 with one column per amplitude parameter; tau0 = NULL gives
+#                 the continuous IEEE 952 form
+#   psd(f, nl)  two-sided IEEE rate PSD per squared amplitude, or NULL
+#   acf(h, tau0, nl)  autocovariance of the sampled rate per squared
+#                 amplitude at lag h samples, or NULL (not stationary)
+#   sim(n, tau0, amp, nl)  n rate samples (amp: named amplitudes)
+#   sim_check(par, freq, arg)  extra checks of avsim() arguments, or NULL
+#   edf_alpha(tau, tau0, nl)  power-law exponent used for the EDF at each
+#                 tau; NA marks a deterministic term (no estimation variance)
+#   nl_range(tau, freq)  named list of c(lo, hi): where each nonlinear
+#                 parameter is searched
+#   trace(ctx)  from a residual signature (see trace.R) to list(init =
+#                 start values, score = how well it matches), or NULL
+#   propose(raw, tau, sig)  candidates read from the raw-data diagnostics
+#                 alone: a list of list(init, tau_from, tau_to, note, score)
+#   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
+#                 the raw series says about a fitted instance
+#   peak_tau(par)  characteristic tau of an instance (where its residual
+#                 signature sits), or NULL
+#   reading     NULL, or how the entry is read off a curve for a datasheet:
+#                 list(symbol, role, tau, slope, anchor, unit, bound,
+#                 resolve, pch, legend, slope_method) (see readings.R)
+#   fold        NULL, or list(into = role, when(par), amount(par), note):
+#                 an instance that shows as part of another reading (a GM
+#                 with Tc well below 1 s is white noise at tau >= 1 s)
+#   discrete(par, dt, units, opts)  rows of a discrete-time filter model
+#                 (filter_params()), or NULL
+#   describe(values)  datasheet text for the instances of this kind added by
+#                 the loop (values: data frame, one row per instance)
+#   detect(x, freq), remove(x, freq, par)  for "series" components
+
+.catalogue <- new.env(parent = emptyenv())
+
+# The entries, in their canonical order (the order of the coefficients).
+catalogue <- function() {
+  if (is.null(.catalogue$entries)) {
+    .catalogue$entries <- list()
+    for (e in builtin_effects()) register_effect(e)
+  }
+  .catalogue$entries
+}
+
+builtin_effects <- function() {
+  list(effect_quantization(), effect_white(), effect_flicker(),
+       effect_random_walk(), effect_ramp(), effect_gauss_markov(),
+       effect_sinusoid(), effect_filter(), effect_resonance())
+}
+
+#' Register an effect in the catalogue (internal)
+#'
+#' `entry` is built by [new_effect()]; it is validated and appended (or,
+#' with `replace = TRUE`, replaces the entry of the same name). Returns the
+#' validated entry invisibly. `unregister_effect()` removes one.
+#' @noRd
+register_effect <- function(entry, replace = FALSE) {
+  entry <- validate_effect(entry)
+  entries <- catalogue()
+  if (entry$name %in% names(entries) && !replace) {
+    abort("The catalogue already has an effect \"", entry$name,
+          "\"; use replace = TRUE.", class = "catalogue")
+  }
+  entries[[entry$name]] <- entry
+  .catalogue$entries <- entries
+  invisible(entry)
+}
+
+unregister_effect <- function(name) {
+  entries <- catalogue()
+  if (!name %in% names(entries)) {
+    abort("The catalogue has no effect \"", name, "\".", class = "catalogue")
+  }
+  if (name %in% vapply(builtin_effects(), `[[`, "", "name")) {
+    abort("\"", name, "\" is a built-in effect and cannot be removed.",
+          class = "catalogue")
+  }
+  .catalogue$entries <- entries[names(entries) != name]
+  invisible(NULL)
+}
+
+# One parameter of an entry.
+effect_param <- function(name, role = c("amp", "nonlinear"), unit, meaning,
+                         profile = NA_character_, print_unit = FALSE) {
+  role <- role[1L]
+  data.frame(name = name, role = role, unit = unit, meaning = meaning,
+             profile = profile, print_unit = print_unit,
+             stringsAsFactors = FALSE)
+}
+
+# An entry with every optional field present (NULL or NA when absent).
+new_effect <- function(name, title, params, component = "av",
+                       repeatable = FALSE, variants = NULL,
+                       slope = NA_real_, psd_alpha = NA_real_,
+                       formula = "", signature = "",
+                       basis = NULL, psd = NULL, acf = NULL, sim = NULL,
+                       sim_check = NULL, edf_alpha = NULL, nl_range = NULL,
+                       trace = NULL, propose = NULL, evidence = NULL,
+                       peak_tau = NULL, reading = NULL, fold = NULL,
+                       discrete = NULL, describe = NULL, detect = NULL,
+                       remove = NULL) {
+  list(name = name, title = title, params = params, component = component,
+       repeatable = repeatable, variants = variants, slope = slope,
+       psd_alpha = psd_alpha, formula = formula, signature = signature,
+       basis = basis, psd = psd, acf = acf, sim = sim, sim_check = sim_check,
+       edf_alpha = edf_alpha, nl_range = nl_range, trace = trace,
+       propose = propose, evidence = evidence, peak_tau = peak_tau,
+       reading = reading, fold = fold, discrete = discrete,
+       describe = describe, detect = detect, remove = remove)
+}
+
+validate_effect <- function(e) {
+  bad <- function(...) abort("Effect entry ", encodeString(e$name %||% "?", quote = '"'),
+                             ": ", ..., class = "catalogue")
+  if (!is.list(e) || !is.character(e$name) || length(e$name) != 1L ||
+      !grepl("^[A-Za-z]+$", e$name)) {
+    abort("An effect entry needs a `name` made of letters only.",
+          class = "catalogue")
+  }
+  if (!is.character(e$title) || length(e$title) != 1L) bad("`title` must be a string.")
+  if (!identical(e$component, "av") && !identical(e$component, "series")) {
+    bad("`component` must be \"av\" or \"series\".")
+  }
+  p <- e$params
+  need <- c("name", "role", "unit", "meaning")
+  if (!is.data.frame(p) || !all(need %in% names(p)) || !nrow(p)) {
+    bad("`params` must be a data frame with columns ",
+        paste(need, collapse = ", "), " (see effect_param()).")
+  }
+  if (is.null(p$profile)) p$profile <- NA_character_
+  if (is.null(p$print_unit)) p$print_unit <- FALSE
+  if (anyDuplicated(p$name) || !all(grepl("^[A-Za-z][A-Za-z0-9_]*$", p$name))) {
+    bad("parameter names must be unique identifiers.")
+  }
+  if (!all(p$role %in% c("amp", "nonlinear"))) {
+    bad("parameter roles must be \"amp\" or \"nonlinear\".")
+  }
+  e$params <- p
+  fun_ok <- function(f) is.null(f) || is.function(f)
+  for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
+              "nl_range", "trace", "propose", "evidence", "peak_tau",
+              "discrete", "describe", "detect", "remove")) {
+    if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
+  }
+  if (!is.null(e$variants) && !is.function(e$variants)) {
+    bad("`variants` must be a function(variant) or NULL.")
+  }
+  if (!is.function(e$sim)) bad("`sim` (the simulator) is required.")
+  if (identical(e$component, "av")) {
+    if (!any(p$role == "amp")) bad("an AV term needs an amplitude parameter.")
+    if (!is.function(e$basis)) bad("`basis` (the expected AV) is required.")
+    if (!is.function(e$edf_alpha)) bad("`edf_alpha` is required.")
+    if (any(p$role == "nonlinear") && !is.function(e$nl_range)) {
+      bad("`nl_range` is required with nonlinear parameters.")
+    }
+    if (any(p$role == "nonlinear" & !p$profile %in% c("smooth", "oscillatory"))) {
+      bad("nonlinear parameters need profile \"smooth\" or \"oscillatory\".")
+    }
+  } else if (!is.function(e$detect) || !is.function(e$remove)) {
+    bad("a series effect needs `detect` and `remove`.")
+  }
+  if (!is.logical(e$repeatable) || length(e$repeatable) != 1L || is.na(e$repeatable)) {
+    bad("`repeatable` must be TRUE or FALSE.")
+  }
+  if (!is.null(e$reading)) {
+    rneed <- c("symbol", "role", "unit")
+    if (!is.list(e$reading) || !all(rneed %in% names(e$reading))) {
+      bad("`reading` needs ", paste(rneed, collapse = ", "), ".")
+    }
+  }
+  if (!is.null(e$fold) && !all(c("into", "when", "amount") %in% names(e$fold))) {
+    bad("`fold` needs into, when and amount.")
+  }
+  if (is.null(e$describe)) e$describe <- function(values) e$name
+  # Coefficients are written bare ("N") when the entry is a single
+  # parameter named as the effect; otherwise "label.param" ("gm1.tc").
+  e$bare <- !e$repeatable && is.null(e$variants) && nrow(p) == 1L &&
+    p$name == e$name
+  e
+}
+
+`%||%` <- function(a, b) if (is.null(a)) b else a
+
+# ---- queries ----------------------------------------------------------------
+
+# Kinds, in canonical order; by default those avfit() can fit.
+effect_kinds <- function(component = "av") {
+  cat <- catalogue()
+  keep <- vapply(cat, function(e) e$component %in% component, logical(1))
+  names(cat)[keep]
+}
+
+# The entry of `kind`, resolved for `variant` (NULL for none).
+effect_entry <- function(kind, variant = NULL) {
+  e <- catalogue()[[kind]]
+  if (is.null(e)) {
+    abort("Unknown noise term \"", kind, "\".", class = "model")
+  }
+  if (is.null(variant) || is.na(variant) || !nzchar(variant)) return(e)
+  if (is.null(e$variants)) {
+    abort("The effect \"", kind, "\" has no variants; \"", kind, ":",
+          variant, "\" is not a term.", class = "model")
+  }
+  over <- e$variants(variant)
+  if (is.null(over)) {
+    abort("The effect \"", kind, "\" has no variant \"", variant, "\".",
+          class = "model")
+  }
+  e[names(over)] <- over
+  e$variant <- variant
+  e$bare <- FALSE
+  validate_effect(e)
+}
+
+# Entries whose `field` is not NULL, in canonical order.
+entries_with <- function(field) {
+  Filter(function(e) !is.null(e[[field]]), catalogue())
+}
+
+# The readings the catalogue defines (one per entry with a `reading`), in
+# canonical order: data frame symbol, role, kind.
+reading_entries <- function() {
+  es <- entries_with("reading")
+  data.frame(symbol = vapply(es, function(e) e$reading$symbol, ""),
+             role = vapply(es, function(e) e$reading$role, ""),
+             kind = vapply(es, `[[`, "", "name"), stringsAsFactors = FALSE,
+             row.names = NULL)
+}
+
+# The entry that provides reading `role` ("white", "flicker", "random_walk").
+reading_entry <- function(role) {
+  for (e in entries_with("reading")) if (identical(e$reading$role, role)) return(e)
+  NULL
+}
+
+# The datasheet model: the kinds that provide a reading (N, B, K).
+datasheet_terms <- function() reading_entries()$kind
+
+reading_symbol <- function(role) {
+  e <- reading_entry(role)
+  if (is.null(e)) NA_character_ else e$reading$symbol
+}

@@ -1,0 +1,234 @@
+# Terms and coefficient vectors of a model, and the model's expected AV,
+# built from the catalogue: which instances a `terms` vector asks for, how
+# their coefficients are named, and the basis matrix the fit solves with.
+#
+# A term is "kind" or "kind:variant"; an instance's label is the kind
+# ("N"), numbered for repeatable kinds ("gm1"), with "_variant" appended
+# for a variant. Coefficients are named "label.param", or bare ("N") for a
+# single-parameter entry named as its parameter.
+
+# Split "kind:variant" -> list(kind, variant ("" for none)).
+split_term <- function(terms) {
+  kind <- sub(":.*$", "", terms)
+  variant <- ifelse(grepl(":", terms, fixed = TRUE), sub("^[^:]*:", "", terms), "")
+  list(kind = kind, variant = variant)
+}
+
+# Validate a `terms` vector (repeatable kinds may repeat) and return it in
+# canonical (catalogue) order.
+check_terms <- function(terms, arg = "terms") {
+  kinds <- effect_kinds()
+  if (!is.character(terms) || length(terms) == 0L || anyNA(terms)) {
+    abort("`", arg, "` must be a character vector of term names (",
+          paste(kinds, collapse = ", "), "), not ", describe_type(terms), ".",
+          class = "argument")
+  }
+  sp <- split_term(terms)
+  bad <- setdiff(sp$kind, kinds)
+  if (length(bad)) {
+    abort("`", arg, "` contains unknown term ", encodeString(bad[1], quote = '"'),
+          "; known terms are ", paste(kinds, collapse = ", "), ".",
+          class = "argument")
+  }
+  for (i in which(nzchar(sp$variant))) effect_entry(sp$kind[i], sp$variant[i])
+  rep_ok <- vapply(sp$kind, function(k) effect_entry(k)$repeatable, logical(1))
+  single <- terms[!rep_ok]
+  if (anyDuplicated(sp$kind[!rep_ok])) {
+    rep_kinds <- kinds[vapply(kinds, function(k) effect_entry(k)$repeatable, logical(1))]
+    abort("`", arg, "` repeats \"", single[duplicated(sp$kind[!rep_ok])][1],
+          "\"; only ", and_list(rep_kinds),
+          " may appear more than once.", class = "argument")
+  }
+  terms[order(match(sp$kind, kinds))]
+}
+
+# Labels of the term instances: c("N", "gm", "gm") -> c("N", "gm1", "gm2").
+term_labels <- function(terms) {
+  terms <- check_terms(terms)
+  sp <- split_term(terms)
+  lab <- sp$kind
+  for (k in unique(sp$kind)) {
+    i <- which(sp$kind == k)
+    lab[i] <- instance_labels(effect_entry(k), length(i))
+  }
+  ifelse(nzchar(sp$variant), paste0(lab, "_", sp$variant), lab)
+}
+
+# Labels of `count` instances of entry `e` (any component): the kind, or the
+# kind numbered for a repeatable entry.
+instance_labels <- function(e, count) {
+  if (e$repeatable) paste0(e$name, seq_len(count)) else rep(e$name, count)
+}
+
+# Kind and variant of labels: "gm2" -> ("gm", ""), "fwn1_ma" -> ("fwn", "ma").
+parse_labels <- function(labels) {
+  base <- sub("_.*$", "", labels)
+  list(kind = sub("[0-9]+$", "", base),
+       variant = ifelse(grepl("_", labels, fixed = TRUE), sub("^[^_]*_", "", labels), ""))
+}
+
+# Coefficient names of one instance.
+coef_names <- function(e, label) {
+  if (isTRUE(e$bare)) e$params$name else paste0(label, ".", e$params$name)
+}
+
+#' Layout of the coefficient vector for a set of terms (internal).
+#'
+#' One row per coefficient: `name` (e.g. "gm1.tc"), `label` (term instance,
+#' "gm1"), `kind` ("gm"), `variant` ("" for none), `param` ("tc"), `role`
+#' ("amp" or "nonlinear"), `unit`.
+#' @noRd
+coef_layout <- function(terms) {
+  terms <- check_terms(terms)
+  labs <- term_labels(terms)
+  sp <- split_term(terms)
+  rows <- lapply(seq_along(terms), function(i) {
+    e <- effect_entry(sp$kind[i], sp$variant[i])
+    p <- e$params
+    data.frame(name = coef_names(e, labs[i]), label = labs[i], kind = sp$kind[i],
+               variant = sp$variant[i], param = p$name, role = p$role,
+               unit = p$unit, stringsAsFactors = FALSE)
+  })
+  do.call(rbind, rows)
+}
+
+# The terms a layout was built from, e.g. c("N", "gm", "gm").
+layout_terms <- function(lay) {
+  u <- lay[!duplicated(lay$label), , drop = FALSE]
+  ifelse(nzchar(u$variant), paste0(u$kind, ":", u$variant), u$kind)
+}
+
+# Term strings from coefficient names: c("N", "gm1.sigma", "gm1.tc") ->
+# c("N", "gm").
+terms_from_coef <- function(names) {
+  lab <- unique(sub("\\..*$", "", names))
+  pl <- parse_labels(lab)
+  ifelse(nzchar(pl$variant), paste0(pl$kind, ":", pl$variant), pl$kind)
+}
+
+# Check a named coefficient vector against the catalogue; returns its
+# layout with a `value` column.
+check_coef <- function(coef, arg = "coef") {
+  if (is.list(coef) && !is.data.frame(coef)) coef <- unlist(coef)
+  if (!is.numeric(coef) || is.null(names(coef)) || any(!nzchar(names(coef))) ||
+      anyNA(coef)) {
+    abort("`", arg, "` must be a named numeric vector of coefficients such as ",
+          "c(N = 1e-3, B = 1e-4, gm1.sigma = 0.01, gm1.tc = 10), not ",
+          describe_type(coef), ".", class = "argument")
+  }
+  terms <- terms_from_coef(names(coef))
+  kinds <- split_term(terms)$kind
+  bad <- setdiff(kinds, effect_kinds())
+  if (length(bad)) {
+    abort("`", arg, "` has a coefficient for the unknown term \"", bad[1],
+          "\"; see av_terms().", class = "argument")
+  }
+  lay <- coef_layout(terms)
+  # Labels as given by the user (gm1, gm3) may not be 1..k: map by label in
+  # order of appearance within each kind.
+  ulab <- unique(sub("\\..*$", "", names(coef)))
+  ulab <- ulab[order(match(parse_labels(ulab)$kind, effect_kinds()))]
+  lay$label <- ulab[match(lay$label, unique(lay$label))]
+  bare <- vapply(seq_len(nrow(lay)), function(i) {
+    isTRUE(effect_entry(lay$kind[i], lay$variant[i])$bare)
+  }, logical(1))
+  lay$name <- ifelse(bare, lay$param, paste0(lay$label, ".", lay$param))
+  miss <- setdiff(lay$name, names(coef))
+  if (length(miss)) {
+    abort("`", arg, "` lacks the coefficient ", miss[1], ".", class = "argument")
+  }
+  extra <- setdiff(names(coef), lay$name)
+  if (length(extra)) {
+    abort("`", arg, "` has an unknown coefficient ", extra[1], ".",
+          class = "argument")
+  }
+  val <- coef[lay$name]
+  if (any(val[lay$role == "amp"] < 0)) {
+    abort("`", arg, "`: amplitudes must be non-negative.", class = "argument")
+  }
+  if (any(val[lay$role == "nonlinear"] <= 0)) {
+    nl <- unique(lay[lay$role == "nonlinear", c("kind", "param")])
+    abort("`", arg, "`: ", paste0(nl$kind, " ", nl$param, collapse = ", "),
+          " must be positive.", class = "argument")
+  }
+  lay$value <- unname(val)
+  lay
+}
+
+# ---- evaluating a model -----------------------------------------------------
+
+# A model plan: per instance its resolved entry and the names of its
+# amplitude and nonlinear coefficients, built once per layout so that the
+# fit's many evaluations do not re-read the layout.
+model_plan <- function(lay) {
+  labs <- unique(lay$label)
+  lapply(labs, function(l) {
+    rows <- lay[lay$label == l, , drop = FALSE]
+    e <- effect_entry(rows$kind[1L], rows$variant[1L])
+    list(label = l, entry = e,
+         amp = rows$name[rows$role == "amp"],
+         nl = rows$name[rows$role == "nonlinear"],
+         nl_param = rows$param[rows$role == "nonlinear"])
+  })
+}
+
+# Basis matrix: AV per squared amplitude, one column per amplitude
+# coefficient, rows are tau. `values` is a named vector holding (at least)
+# the nonlinear coefficients.
+plan_basis <- function(plan, tau, tau0, values) {
+  amps <- unlist(lapply(plan, `[[`, "amp"))
+  out <- matrix(0, length(tau), length(amps), dimnames = list(NULL, amps))
+  for (p in plan) {
+    nl <- if (length(p$nl)) stats::setNames(values[p$nl], p$nl_param) else NULL
+    out[, p$amp] <- p$entry$basis(tau, tau0, nl)
+  }
+  out
+}
+
+# Per-instance AV contributions (matrix, columns = term labels).
+model_components <- function(tau, tau0, lay, plan = model_plan(lay)) {
+  values <- stats::setNames(lay$value, lay$name)
+  Bm <- plan_basis(plan, tau, tau0, values)
+  out <- matrix(0, length(tau), length(plan),
+                dimnames = list(NULL, vapply(plan, `[[`, "", "label")))
+  for (j in seq_along(plan)) {
+    a <- plan[[j]]$amp
+    out[, j] <- Bm[, a, drop = FALSE] %*% (values[a]^2)
+  }
+  out
+}
+
+# Power-law exponent per instance at each tau, for the EDF (matrix like
+# model_components()); NA marks a deterministic term.
+model_alpha <- function(tau, tau0, lay, plan = model_plan(lay)) {
+  values <- stats::setNames(lay$value, lay$name)
+  out <- matrix(NA_real_, length(tau), length(plan),
+                dimnames = list(NULL, vapply(plan, `[[`, "", "label")))
+  for (j in seq_along(plan)) {
+    p <- plan[[j]]
+    nl <- if (length(p$nl)) stats::setNames(values[p$nl], p$nl_param) else NULL
+    out[, j] <- p$entry$edf_alpha(tau, tau0, nl)
+  }
+  out
+}
+
+# The parameters of one instance as a named vector (names without the label
+# prefix: sigma, tc, or the kind for a bare coefficient).
+instance_params <- function(coef, lay, label) {
+  rows <- lay[lay$label == label, , drop = FALSE]
+  stats::setNames(unname(coef[rows$name]), rows$param)
+}
+
+# Label a new instance of `term` gets next to `terms`: "gm" -> "gm2" when one
+# gm is already there.
+new_label <- function(terms, term) {
+  all <- c(terms, term)
+  ord <- order(match(split_term(all)$kind, effect_kinds()))
+  term_labels(all)[ord == length(all)]
+}
+
+# "a", "a and b", "a, b and c".
+and_list <- function(x) {
+  if (length(x) <= 1L) return(paste(x))
+  paste(paste(x[-length(x)], collapse = ", "), "and", x[length(x)])
+}

@@ -1,0 +1,132 @@
+# Catalogue entries of the sensor's own filtering (issue 9, items 1-2): white
+# noise through the sensor's low-pass filter ("filter", a family of
+# variants), and a narrow-band random process ("resonance"). The math,
+# simulators and raw-data evidence live in R/filter-noise.R and
+# R/resonance.R; this file states the facts the catalogue asks for.
+
+# The filter spec of a fitted instance: variant and nonlinear values.
+filter_spec_of <- function(variant, nl, tau0) {
+  switch(variant,
+    ma = list(family = "ma", L = max(1, nl[["L"]])),
+    lp1 = , lp2 = list(family = variant, fc = nl[["fc"]], freq = 1 / tau0))
+}
+
+# One variant's fields: the nonlinear parameter (L in samples for the
+# moving average, fc in Hz for the low-passes) and its search range.
+filter_variant <- function(variant) {
+  nlp <- switch(variant,
+    ma = effect_param("L", "nonlinear", "samples",
+                      "averaging window in output periods (may be fractional)",
+                      profile = "smooth"),
+    lp1 = , lp2 = effect_param("fc", "nonlinear", "Hz", "hertz (-3 dB cutoff)",
+                               profile = "smooth", print_unit = TRUE),
+    NULL)
+  if (is.null(nlp)) return(NULL)
+  list(
+    params = rbind(effect_param("Nf", "amp", "u*sqrt(s)",
+                                "rate unit x sqrt(second) (white level at DC, as N)"),
+                   nlp),
+    nl_range = function(tau, freq) {
+      if (variant == "ma") list(L = c(1.001, 64))
+      else list(fc = c(freq / 2000, if (variant == "lp2") 0.499 * freq else 0.5 * freq))
+    },
+    formula = paste0("N^2 x exact AV of the ", variant,
+                     " filter's autocovariance (unit DC gain)")
+  )
+}
+
+effect_filter <- function() {
+  base <- filter_variant("ma")
+  basis <- function(variant) {
+    force(variant)
+    function(tau, tau0, nl) {
+      out <- 1 / tau
+      d <- discrete_tau(tau, tau0)
+      if (any(d)) {
+        sp <- filter_spec_of(variant, nl, tau0)
+        out[d] <- filter_av(tau[d] / tau0, sp, tau0)
+      }
+      out
+    }
+  }
+  entry <- function(variant) {
+    v <- filter_variant(variant)
+    if (is.null(v)) return(NULL)
+    c(v, list(
+      basis = basis(variant),
+      acf = function(h, tau0, nl) filter_acf(filter_spec_of(variant, nl, tau0), tau0, h),
+      sim = function(n, tau0, amp, nl) {
+        sim_filtered_white(n, tau0, amp[[1L]], filter_spec_of(variant, nl, tau0))
+      },
+      evidence = function(par, raw, x, freq) {
+        if (is.null(x)) return(list(text = "", support = NA))
+        sp <- filter_spec_of(variant, par, 1 / freq)
+        filter_raw_support(sp, par[["Nf"]], filter_evidence(x, freq),
+                           stats::var(x), freq)
+      }
+    ))
+  }
+  e <- new_effect(
+    name = "filter", title = "white noise through the sensor's filter",
+    params = base$params, variants = entry,
+    slope = -0.5, psd_alpha = 0,
+    formula = base$formula,
+    signature = paste("ADEV below the white -1/2 line at the first taus",
+                      "(AV = N^2/tau - 3C/tau^2 beyond the filter's length);",
+                      "positive short-lag ACF; periodogram rolling off towards Nyquist"),
+    basis = basis("ma"),
+    acf = function(h, tau0, nl) filter_acf(filter_spec_of("ma", nl, tau0), tau0, h),
+    sim = function(n, tau0, amp, nl) {
+      sim_filtered_white(n, tau0, amp[[1L]], filter_spec_of("ma", nl, tau0))
+    },
+    edf_alpha = function(tau, tau0, nl) rep(0, length(tau)),
+    nl_range = base$nl_range,
+    trace = function(ctx) {
+      # the model's white line runs above the first points
+      if (ctx$kind != "short_end" || ctx$sign >= 0) return(NULL)
+      list(init = list(L = 2), score = 2)
+    },
+    evidence = entry("ma")$evidence,
+    # the filter keeps the DC level: N is the white reading
+    fold = list(into = "white", when = function(par) TRUE,
+                amount = function(par) par[["Nf"]]^2,
+                note = "white level of the filtered term"),
+    describe = function(values) "filter (the sensor's averaging)"
+  )
+  e
+}
+
+effect_resonance <- function() {
+  new_effect(
+    name = "resonance", title = "narrow-band random process (a resonance)",
+    params = rbind(
+      effect_param("sigma", "amp", "u", "rate unit (standard deviation)"),
+      effect_param("fr", "nonlinear", "Hz", "hertz (centre frequency)",
+                   profile = "oscillatory", print_unit = TRUE),
+      effect_param("tc", "nonlinear", "s", "second (damping time; FWHM 1/(pi tc))",
+                   profile = "smooth", print_unit = TRUE)),
+    repeatable = FALSE, slope = NA_real_, psd_alpha = NA_real_,
+    formula = "Re of the AR(1) form with the complex pole exp(-tau0/tc + 2 pi i fr tau0)",
+    signature = paste("a bump at tau ~ 0.37/fr with nulls like a sinusoid's but",
+                      "damped; a broad periodogram band at fr of width 1/(pi tc)"),
+    basis = function(tau, tau0, nl) {
+      if (is.null(tau0)) tau0 <- min(tau) / 4
+      resonance_av(pmax(tau / tau0, 1), tau0, 1, nl[["fr"]], nl[["tc"]])
+    },
+    acf = function(h, tau0, nl) resonance_acf(h, tau0, 1, nl[["fr"]], nl[["tc"]]),
+    sim = function(n, tau0, amp, nl) sim_resonance(n, tau0, amp[[1L]], nl[["fr"]], nl[["tc"]]),
+    edf_alpha = function(tau, tau0, nl) rep(0, length(tau)),
+    nl_range = function(tau, freq) {
+      hi <- if (is.null(freq)) 0.5 / min(tau) else 0.499 * freq
+      list(fr = c(hi / 100, hi), tc = c(min(tau) / 2, max(tau)))
+    },
+    evidence = function(par, raw, x, freq) {
+      if (is.null(x)) return(list(text = "", support = NA))
+      resonance_raw_support(par[["sigma"]], par[["fr"]], par[["tc"]], find_bands(x, freq))
+    },
+    peak_tau = function(par) 0.371 / par[["fr"]],
+    describe = function(values) {
+      sprintf("resonance (%s Hz)", paste(signif(values$fr, 3), collapse = ", "))
+    }
+  )
+}

@@ -1,0 +1,139 @@
+# Catalogue entry of the first-order Gauss-Markov process (exponentially
+# correlated noise, the sampled AR(1)). Derivation and checks:
+# vignette("noise-terms").
+
+# Signature constants of the continuous form (checked in test-terms.R):
+gm_peak_ratio <- 1.893        # GM ADEV peak at tau = 1.893 Tc
+gm_peak_adev <- 0.6174        # ... where ADEV = 0.6174 sigma
+
+# AR(1) exact discrete form, numerically stable:
+# AV(m) / sigma^2 = [m - 3 phi - m phi^2 + 4 phi^(m+1) - phi^(2m+1)] /
+#                   [m^2 (1 - phi)^2],  phi = exp(-tau0 / tc).
+# Written with E_j = 1 - phi^j = -expm1(-j eps) to limit cancellation; for
+# m * eps < 1e-5 the first-order form eps (2 m^2 + 1) / (3 m) is used
+# (the RRW-like short-tau limit, relative error ~ m * eps).
+gm_basis_discrete <- function(m, eps) {
+  E <- function(j) -expm1(-j * eps)
+  num <- 3 * E(1) + m * E(2) - 4 * E(m + 1) + E(2 * m + 1)
+  out <- num / (m^2 * E(1)^2)
+  small <- m * eps < 1e-5
+  out[small] <- (eps * (2 * m^2 + 1) / (3 * m))[small]
+  out
+}
+
+# Continuous form: (tc/tau)^2 [2x - 3 + 4 e^-x - e^-2x], x = tau / tc; series
+# for small x (the bracket is (2/3) x^3 - x^4/2 + ...).
+gm_basis_continuous <- function(tau, tc) {
+  x <- tau / tc
+  br <- 2 * x - 3 + 4 * exp(-x) - exp(-2 * x)
+  small <- x < 0.05
+  if (any(small)) {
+    xs <- x[small]
+    s <- 0
+    for (k in 3:14) s <- s + (-1)^k * xs^k * (4 - 2^k) / factorial(k)
+    br[small] <- s
+  }
+  br / x^2
+}
+
+sim_gm <- function(n, tau0, sigma, tc) {
+  phi <- exp(-tau0 / tc)
+  w <- stats::rnorm(n, sd = sigma * sqrt(1 - phi^2))
+  w[1L] <- stats::rnorm(1L, sd = sigma)            # stationary start
+  as.numeric(stats::filter(w, phi, method = "recursive"))
+}
+
+# Discrete-time model of a GM for a filter with step dt:
+# x[k] = phi x[k-1] + w[k], Var(w) = sigma^2 (1 - phi^2).
+gm_discrete_rows <- function(term, sigma, tc, dt, unit, how) {
+  phi <- exp(-dt / tc)
+  rbind(
+    discrete_row(term, "phi", phi, "1", tc, "s",
+                 paste0(how, "Gauss-Markov: x[k] = phi * x[k-1] + w[k], phi = exp(-dt / Tc)")),
+    discrete_row(term, "q_d", sigma^2 * (1 - phi^2), paste0("(", unit("rate"), ")^2"),
+                 sigma, unit("rate"),
+                 paste0(how, "driving-noise variance Var(w[k]) = q_d = sigma^2 * (1 - phi^2)")))
+}
+
+# Raw-data evidence for a fitted GM: an exponential ACF of block means near
+# its Tc, or for Tc of a few samples the raw lag-1 autocorrelation.
+evidence_gm <- function(par, raw, x, freq) {
+  tc <- par[["tc"]] %||% NA_real_
+  sigma <- par[["sigma"]] %||% NA_real_
+  if (is.finite(tc) && tc * freq < 4) {
+    # Tc of a few samples or less: the GM is the sample-to-sample
+    # correlation itself; compare its lag-1 ACF with the raw one.
+    phi <- exp(-1 / (tc * freq))
+    pred <- if (is.finite(sigma)) sigma^2 * phi / stats::var(x) else NA_real_
+    ok <- is.finite(pred) && raw$acf1_z > 3 && raw$acf1 > pred / 3 &&
+      raw$acf1 < 3 * pred
+    return(list(text = sprintf(
+      "raw lag-1 ACF %.3f (z = %.0f) against %.3f predicted by the fitted GM",
+      raw$acf1, raw$acf1_z, pred), support = ok))
+  }
+  if (!is.finite(tc) || tc * freq * 40 / 8 > length(x)) {
+    return(list(text = "record too short for an ACF check", support = NA))
+  }
+  a <- acf_exponential(x, freq, tc)
+  if (is.finite(a$tc) && a$z > 5) {
+    list(text = sprintf("exponential ACF of %s-sample means, Tc = %s s (z = %.1f)",
+                        a$m, format_num(a$tc), a$z),
+         support = a$tc > tc / 2 && a$tc < tc * 2)
+  } else {
+    list(text = sprintf("no exponential ACF near Tc = %s s (z = %.1f)",
+                        format_num(tc), a$z), support = FALSE)
+  }
+}
+
+effect_gauss_markov <- function() {
+  new_effect(
+    name = "gm", title = "first-order Gauss-Markov process",
+    params = rbind(
+      effect_param("sigma", "amp", "u", "rate unit (stationary standard deviation)"),
+      effect_param("tc", "nonlinear", "s", "second (correlation time)",
+                   profile = "smooth", print_unit = TRUE)),
+    repeatable = TRUE, slope = NA_real_, psd_alpha = NA_real_,
+    formula = paste("AR(1) exact: sigma^2 [m - 3phi - m phi^2 + 4 phi^(m+1)",
+                    "- phi^(2m+1)] / [m^2 (1-phi)^2], phi = exp(-tau0/tc)"),
+    signature = paste("a bump: slope +1/2 for tau << tc, -1/2 for tau >> tc;",
+                      "peak ADEV 0.6174 sigma at tau = 1.893 tc;",
+                      "exponential ACF"),
+    basis = function(tau, tau0, nl) {
+      tc <- nl[["tc"]]
+      out <- gm_basis_continuous(tau, tc)
+      d <- discrete_tau(tau, tau0)
+      if (any(d)) out[d] <- gm_basis_discrete(tau[d] / tau0, tau0 / tc)
+      out
+    },
+    psd = function(f, nl) 2 * nl[["tc"]] / (1 + (2 * pi * f * nl[["tc"]])^2),
+    acf = function(h, tau0, nl) exp(-abs(h) * tau0 / nl[["tc"]]),
+    sim = function(n, tau0, amp, nl) sim_gm(n, tau0, amp[[1L]], nl[["tc"]]),
+    # random-walk-like well below Tc, flicker-like around it, white above
+    edf_alpha = function(tau, tau0, nl) {
+      tc <- nl[["tc"]]
+      ifelse(tau < 0.5 * tc, -2, ifelse(tau < 3 * tc, -1, 0))
+    },
+    nl_range = function(tau, freq) list(tc = c(min(tau) / 4, max(tau) * 4)),
+    trace = function(ctx) {
+      if (ctx$sign <= 0 || !is.finite(ctx$emax) ||
+          !ctx$kind %in% c("bump", "long_end", "short_end", "oscillation")) {
+        return(NULL)
+      }
+      list(init = list(tc = ctx$tau_max / gm_peak_ratio,
+                       sigma = sqrt(ctx$emax) / gm_peak_adev),
+           score = if (ctx$kind == "bump") 2 else 1)
+    },
+    evidence = evidence_gm,
+    peak_tau = function(par) gm_peak_ratio * par[["tc"]],
+    # Tc well below 1 s: white noise at every tau >= 1 s, AV -> 2 sigma^2 Tc / tau.
+    fold = list(into = "white", when = function(par) is.finite(par[["tc"]]) && par[["tc"]] < 0.1,
+                amount = function(par) 2 * par[["sigma"]]^2 * par[["tc"]],
+                note = "white-like GM (Tc < 0.1 s)"),
+    discrete = function(par, dt, unit, opts) {
+      gm_discrete_rows(opts$label, par[["sigma"]], par[["tc"]], dt, unit, "")
+    },
+    describe = function(values) {
+      sprintf("gm (Tc = %s s)", paste(signif(values$tc, 3), collapse = ", "))
+    }
+  )
+}

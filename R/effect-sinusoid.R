@@ -1,0 +1,104 @@
+# Catalogue entry of a sinusoidal disturbance (vibration, a periodic
+# environment). Derivation and checks: vignette("noise-terms").
+
+# Signature constants of the continuous form (checked in test-terms.R):
+sin_peak_ratio <- 0.3710      # sinusoid first ADEV peak at tau = 0.371 / f0
+sin_peak_adev <- 0.7246       # ... where ADEV = 0.7246 A
+
+# Raw-data evidence: a periodogram line near f0.
+evidence_sinusoid <- function(par, raw, x, freq) {
+  l <- raw$lines
+  f0 <- par[["f0"]] %||% NA_real_
+  res <- attr(l, "resolution") %||% 0
+  if (nrow(l) && is.finite(f0)) {
+    near <- which(abs(l$f0 - f0) <= max(0.25 * f0, 2 * res))
+    j <- near[which.max(l$ratio[near])]
+    if (length(near)) {
+      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)",
+                                 format_num(l$f0[j], 4), format_num(l$amp[j]),
+                                 l$p_value[j]),
+                  support = TRUE))
+    }
+  }
+  if (is.finite(f0) && f0 < 4 * res) {
+    return(list(text = sprintf("f0 = %s Hz is below the periodogram resolution",
+                               format_num(f0)), support = NA))
+  }
+  list(text = sprintf("no periodogram line near %s Hz", format_num(f0)),
+       support = FALSE)
+}
+
+effect_sinusoid <- function() {
+  new_effect(
+    name = "sinusoid", title = "sinusoidal disturbance",
+    params = rbind(
+      effect_param("amp", "amp", "u", "rate unit (amplitude)"),
+      effect_param("f0", "nonlinear", "Hz", "hertz (frequency)",
+                   profile = "oscillatory", print_unit = TRUE)),
+    repeatable = TRUE, slope = -1, psd_alpha = NA_real_,
+    formula = paste("amp^2 sin^4(pi f0 m tau0) / (m^2 sin^2(pi f0 tau0)),",
+                    "phase-averaged"),
+    signature = paste("nulls at tau = k / f0; first peak 0.7246 amp at",
+                      "tau = 0.371 / f0; envelope slope -1;",
+                      "periodogram line at f0"),
+    basis = function(tau, tau0, nl) {
+      f0 <- nl[["f0"]]
+      x <- pi * f0 * tau
+      out <- sin(x)^4 / x^2
+      d <- discrete_tau(tau, tau0)
+      if (any(d)) {
+        s1 <- sin(pi * f0 * tau0)^2
+        out[d] <- if (s1 < 1e-300) 0 else
+          sin(x[d])^4 / ((tau[d] / tau0)^2 * s1)
+      }
+      out
+    },
+    # phase-averaged: E[A^2 sin(a) sin(a + 2 pi f0 h tau0)] = A^2 cos(.) / 2
+    acf = function(h, tau0, nl) cos(2 * pi * nl[["f0"]] * h * tau0) / 2,
+    sim = function(n, tau0, amp, nl) {
+      amp[[1L]] * sin(2 * pi * nl[["f0"]] * tau0 * seq_len(n) +
+                        stats::runif(1L, 0, 2 * pi))
+    },
+    sim_check = function(par, freq, arg) {
+      if (any(par$f0 >= freq / 2)) {
+        abort("`", arg, "` frequencies `f0` must be below the Nyquist frequency ",
+              "freq / 2 = ", format(freq / 2), " Hz.", class = "argument")
+      }
+    },
+    # deterministic: treated as adding no estimation variance
+    edf_alpha = function(tau, tau0, nl) rep(NA_real_, length(tau)),
+    nl_range = function(tau, freq) {
+      hi <- if (is.null(freq)) 2 / min(tau) else 0.499 * freq
+      list(f0 = c(min(0.2 / max(tau), hi / 10), hi))
+    },
+    trace = function(ctx) {
+      if (ctx$sign <= 0 || !is.finite(ctx$emax) ||
+          !ctx$kind %in% c("bump", "long_end", "short_end", "oscillation")) {
+        return(NULL)
+      }
+      list(init = list(f0 = sin_peak_ratio / ctx$tau_max,
+                       amp = sqrt(ctx$emax) / sin_peak_adev),
+           score = if (ctx$kind == "oscillation") 3 else 1)
+    },
+    propose = function(raw, tau, sig) {
+      lines <- raw$lines
+      out <- list()
+      if (is.null(lines) || !nrow(lines)) return(out)
+      for (j in seq_len(min(nrow(lines), 3L))) {
+        f0 <- lines$f0[j]
+        t1 <- sin_peak_ratio / f0
+        if (t1 < min(tau) / 2 || t1 > max(tau)) next
+        out[[length(out) + 1L]] <- list(
+          init = list(f0 = f0, amp = lines$amp[j]), tau_from = t1 / 2,
+          tau_to = 2 / f0, score = 2,
+          note = sprintf("proposed by a periodogram line at %s Hz", format_num(f0)))
+      }
+      out
+    },
+    evidence = evidence_sinusoid,
+    peak_tau = function(par) sin_peak_ratio / par[["f0"]],
+    describe = function(values) {
+      sprintf("sinusoid (f0 = %s Hz)", paste(signif(values$f0, 3), collapse = ", "))
+    }
+  )
+}

@@ -1,0 +1,523 @@
+# Filtered white noise: white rate noise seen through the sensor's own
+# low-pass (decimation/averaging) filter. The math, the simulator and the
+# raw-data evidence of one effect (issue 9, item 1); the catalogue entry
+# reads these functions.
+#
+# Normalisation. The filter has unit DC gain, so N keeps its meaning: N^2 is
+# the two-sided rate PSD at f = 0 (the -1/2 line of the ADEV at long tau, the
+# white level a navigation filter needs). The filter only bends the curve at
+# tau of a few samples: the AV falls below N^2/tau there.
+#
+# A filter is a list `spec` with `family` and its parameters:
+#   ma        moving average over L output periods; L >= 1 may be fractional
+#             (a sensor averaging a fast internal stream over a window a bit
+#             longer than its output period). Autocovariance triangular,
+#             g(k) ~ max(L - |k|, 0), exactly that of the L-tap moving
+#             average for whole L.
+#   bartlett  n cascaded moving averages of L taps (L whole; n = 2 is the
+#             triangular/Bartlett window).
+#   lp1       first-order low-pass y_k = a y_{k-1} + (1 - a) w_k, with a
+#             set so that the PSD is -3 dB at fc (Hz).
+#   lp2       second-order Butterworth low-pass (bilinear transform,
+#             pre-warped: -3 dB exactly at fc).
+#   fir       given FIR coefficients h (scaled to sum 1).
+
+# ---- specification -----------------------------------------------------------
+
+filter_families <- function() c("ma", "bartlett", "lp1", "lp2", "fir")
+
+# Build and check a filter specification. `freq` (Hz) is needed for the
+# cutoff families (fc must lie below the Nyquist frequency).
+filter_spec <- function(family, L = NULL, n = 2L, fc = NULL, h = NULL,
+                        freq = NULL) {
+  family <- check_choice(family, filter_families(), "family")
+  switch(family,
+    ma = list(family = "ma", L = check_number(L, "L", 1, 1e6)),
+    bartlett = list(family = "bartlett",
+                    L = check_number(L, "L", 1, 1e5, integer = TRUE),
+                    n = check_number(n, "n", 1, 8, integer = TRUE)),
+    lp1 = , lp2 = {
+      freq <- check_freq(freq)
+      hi <- freq / 2
+      fc <- check_number(fc, "fc", 0, hi, open = family == "lp2")
+      if (fc <= 0) {
+        abort("`fc` must be a single positive number (cutoff in Hz), not ",
+              format_value(fc), ".", class = "argument")
+      }
+      list(family = family, fc = fc, freq = freq)
+    },
+    fir = {
+      if (!is.numeric(h) || length(h) < 1L || anyNA(h) || any(!is.finite(h))) {
+        abort("`h` must be a numeric vector of FIR coefficients, not ",
+              describe_type(h), ".", class = "argument")
+      }
+      if (!(sum(h) > 0)) {
+        abort("`h` must have a positive sum (a low-pass with gain at DC); ",
+              "its sum is ", format(sum(h)), ".", class = "argument")
+      }
+      list(family = "fir", h = as.double(h) / sum(h))
+    }
+  )
+}
+
+# ---- autocovariance ------------------------------------------------------------
+
+# FIR taps of a spec whose autocovariance has finite support (NULL for the
+# IIR families and for fractional ma, whose autocovariance is given
+# directly).
+filter_taps <- function(spec) {
+  switch(spec$family,
+    ma = if (spec$L == round(spec$L)) rep(1 / spec$L, spec$L) else NULL,
+    bartlett = {
+      h <- rep(1 / spec$L, spec$L)
+      out <- 1
+      for (i in seq_len(spec$n)) out <- stats::convolve(out, rev(h), type = "open")
+      out
+    },
+    fir = spec$h,
+    NULL)
+}
+
+# Autocovariance of the unit-DC FIR taps at lags 0..length(h)-1.
+taps_acov <- function(h) {
+  L <- length(h)
+  if (L == 1L) return(h^2)
+  vapply(0:(L - 1L), function(k) sum(h[1:(L - k)] * h[(1 + k):L]), 0)
+}
+
+# Rational (pole-residue) form of the IIR families: H(z) = c0 +
+# sum_j r_j / (1 - p_j z^-1). For unit-variance white input the
+# autocovariance is g(k) = sum_l A_l p_l^|k| + d0 [k == 0] with
+# A_l = r_l (c0 + sum_j r_j / (1 - p_j p_l)) and
+# g(0) = c0^2 + 2 c0 sum r + sum_jl r_j r_l / (1 - p_j p_l)
+# (sum the impulse response products; complex for conjugate poles).
+filter_rational <- function(spec) {
+  tau0 <- 1 / spec$freq
+  w <- 2 * pi * spec$fc * tau0
+  if (spec$family == "lp1") {
+    # |H|^2 = (1-a)^2 / (1 - 2a cos w + a^2) = 1/2  =>  a^2 - 2a(2 - cos w) + 1 = 0
+    cw <- cos(w)
+    a <- (2 - cw) - sqrt((2 - cw)^2 - 1)
+    return(list(c0 = 0, r = 1 - a + 0i, p = a + 0i))
+  }
+  # Butterworth, bilinear with pre-warping: K = tan(pi fc tau0).
+  K <- tan(w / 2)
+  den <- 1 + sqrt(2) * K + K^2
+  b <- c(1, 2, 1) * K^2 / den
+  a1 <- 2 * (K^2 - 1) / den
+  a2 <- (1 - sqrt(2) * K + K^2) / den
+  p <- polyroot(c(a2, a1, 1))             # roots of z^2 + a1 z + a2
+  # H(z) = (b0 + b1 z^-1 + b2 z^-2) / ((1 - p1 z^-1)(1 - p2 z^-1))
+  c0 <- b[3] / a2
+  # residues: r_j = lim (1 - p_j z^-1) (H(z) - c0) at z = p_j
+  r <- vapply(1:2, function(j) {
+    z <- p[j]
+    num <- b[1] + b[2] / z + b[3] / z^2 - c0 * (1 + a1 / z + a2 / z^2)
+    num / (1 - p[3L - j] / z)
+  }, 0i)
+  list(c0 = c0, r = r, p = p)
+}
+
+# Geometric parts of the autocovariance of a rational filter (unit white
+# input): list(A, p, d0).
+rational_acov <- function(rat) {
+  r <- rat$r
+  p <- rat$p
+  G <- outer(r, r) / (1 - outer(p, p))
+  A <- r * (rat$c0 + colSums(r / (1 - outer(p, p))))
+  g0 <- rat$c0^2 + 2 * rat$c0 * sum(r) + sum(G)
+  list(A = A, p = p, d0 = Re(g0 - sum(A)))
+}
+
+# Autocovariance of filtered white noise with N = 1 (units 1/s) at integer
+# lags `lags`, for a spec and sample period tau0. Scaled so that
+# tau0 * sum_k g(k) = 1 (unit DC level).
+filter_acf <- function(spec, tau0, lags) {
+  lags <- abs(lags)
+  if (spec$family == "ma") {
+    L <- spec$L
+    fl <- floor(L)
+    tot <- L + 2 * (fl * L - fl * (fl + 1) / 2)      # sum_k max(L - |k|, 0)
+    return(pmax(L - lags, 0) / (tot * tau0))
+  }
+  h <- filter_taps(spec)
+  if (!is.null(h)) {
+    g <- taps_acov(h)
+    out <- numeric(length(lags))
+    ok <- lags < length(g)
+    out[ok] <- g[lags[ok] + 1L]
+    return(out / tau0)
+  }
+  ra <- rational_acov(filter_rational(spec))
+  g <- vapply(lags, function(k) Re(sum(ra$A * ra$p^k)), 0) + ra$d0 * (lags == 0)
+  # unit DC level: sum_k g(k) = H(1)^2 = 1 for unit input variance
+  g / tau0
+}
+
+# Lags beyond which the autocovariance is zero (FIR, ma) or Inf (IIR).
+filter_support <- function(spec) {
+  if (spec$family == "ma") return(ceiling(spec$L))
+  h <- filter_taps(spec)
+  if (!is.null(h)) length(h) else Inf
+}
+
+# ---- exact discrete Allan variance ----------------------------------------------
+
+# AV(m) of a stationary series whose autocovariance g(k) (k = 0, 1, ...) is
+# zero from lag K = length(g) on (noise-models.md section 1):
+#   AV(m) = {m [g(0) - g(m)] + sum_{i=1}^{m-1} i [2g(m-i) - g(i) - g(2m-i)]} / m^2.
+# It needs lags < 2m only, and for m >= K collapses to
+#   AV(m) = S / m - 3 C / m^2,  S = g(0) + 2 sum_{j>=1} g(j),  C = sum_j j g(j),
+# so each m costs O(min(m, K)). m must be whole here.
+acov_av <- function(m, g) {
+  K <- length(g)
+  gz <- function(k) {
+    out <- numeric(length(k))
+    ok <- k < K
+    out[ok] <- g[k[ok] + 1L]
+    out
+  }
+  S <- g[1L] + 2 * sum(g[-1L])
+  C <- sum(seq_len(K - 1L) * g[-1L])
+  vapply(m, function(mm) {
+    if (mm >= K) return(S / mm - 3 * C / mm^2)
+    i <- seq_len(mm - 1L)
+    s <- mm * (g[1L] - gz(mm))
+    if (mm > 1L) s <- s + sum(i * (2 * gz(mm - i) - gz(i) - gz(2 * mm - i)))
+    s / mm^2
+  }, 0)
+}
+
+# AV(m) of g(k) = A p^|k| (the AR(1) / Gauss-Markov form; p may be
+# complex, then the caller sums conjugate pairs):
+#   A [m - 3p - m p^2 + 4 p^(m+1) - p^(2m+1)] / [m^2 (1 - p)^2].
+geometric_av <- function(m, A, p) {
+  A * (m - 3 * p - m * p^2 + 4 * p^(m + 1) - p^(2 * m + 1)) / (m^2 * (1 - p)^2)
+}
+
+# Expected AV of filtered white noise with N = 1 at cluster sizes m (the AV
+# per N^2, units 1/s; multiply by N^2). Closed forms for every family: the
+# FIR/ma families through acov_av(), the IIR families through their
+# pole-residue autocovariance (a white part d0/m plus geometric parts). For
+# fractional m (curves from other tools) the FIR path interpolates AV
+# linearly between the whole m around it below the support and uses the
+# smooth form S/m - 3C/m^2 above it.
+filter_av <- function(m, spec, tau0) {
+  if (spec$family %in% c("lp1", "lp2")) {
+    ra <- rational_acov(filter_rational(spec))
+    out <- ra$d0 / m
+    for (j in seq_along(ra$p)) out <- out + geometric_av(m, ra$A[j], ra$p[j])
+    return(Re(out) / tau0)
+  }
+  K <- filter_support(spec)
+  g <- filter_acf(spec, tau0, 0:(K - 1L))
+  whole <- abs(m - round(m)) < 1e-9
+  out <- numeric(length(m))
+  if (any(whole)) out[whole] <- acov_av(round(m[whole]), g)
+  frac <- which(!whole)
+  if (length(frac)) {
+    mf <- m[frac]
+    big <- mf >= K
+    S <- g[1L] + 2 * sum(g[-1L])
+    C <- sum(seq_len(K - 1L) * g[-1L])
+    out[frac[big]] <- S / mf[big] - 3 * C / mf[big]^2
+    sm <- frac[!big]
+    if (length(sm)) {
+      lo <- pmax(floor(m[sm]), 1)
+      w <- m[sm] - lo
+      out[sm] <- (1 - w) * acov_av(lo, g) + w * acov_av(lo + 1, g)
+    }
+  }
+  out
+}
+
+# ---- spectrum and bandwidth ------------------------------------------------------
+
+# Two-sided rate PSD per N^2 at frequencies f (Hz): 1 at f = 0.
+filter_psd <- function(f, spec, tau0) {
+  w <- 2 * pi * f * tau0
+  if (spec$family %in% c("lp1", "lp2")) {
+    rat <- filter_rational(spec)
+    z <- exp(1i * w)
+    H <- rat$c0
+    for (j in seq_along(rat$p)) H <- H + rat$r[j] / (1 - rat$p[j] / z)
+    return(Mod(H)^2)
+  }
+  K <- filter_support(spec)
+  g <- filter_acf(spec, tau0, 0:(K - 1L)) * tau0
+  out <- rep(g[1L], length(w))
+  for (k in seq_len(K - 1L)) out <- out + 2 * g[k + 1L] * cos(k * w)
+  pmax(out, 0)
+}
+
+# Bandwidth of the filter: the -3 dB frequency of the PSD (the first f where
+# it falls to half its DC level; NA when it stays above half up to the
+# Nyquist frequency) and the noise-equivalent bandwidth g(0) / (2 N^2)
+# (one-sided, Hz; fs/2 for an unfiltered white sensor).
+filter_bandwidth <- function(spec, tau0) {
+  fn <- 0.5 / tau0
+  f <- seq(0, fn, length.out = 2049L)
+  s <- filter_psd(f, spec, tau0) - 0.5
+  i <- which(s <= 0)[1L]
+  f3 <- if (is.na(i)) NA_real_ else if (s[i] == 0) f[i] else
+    stats::uniroot(function(x) filter_psd(x, spec, tau0) - 0.5,
+                   c(f[i - 1L], f[i]), tol = 1e-10 * fn)$root
+  enbw <- filter_acf(spec, tau0, 0) / 2
+  list(f3db = f3, enbw = enbw, nyquist = fn)
+}
+
+# ---- simulation ------------------------------------------------------------------
+
+# n samples of filtered white noise with white level N (rate unit sqrt(s)).
+# FIR families: convolution of white noise with the taps (a start-up of
+# length(h) - 1 samples is drawn and dropped, so every sample is stationary).
+# Fractional ma: the process is the MA(q) whose autocovariance is the
+# triangle, drawn by circulant embedding (exact for a finite-support
+# autocovariance with a non-negative spectrum). IIR: the recursion started
+# from a long burn-in (until the impulse response has decayed below 1e-12).
+sim_filtered_white <- function(n, tau0, N, spec) {
+  sd <- N / sqrt(tau0)
+  h <- filter_taps(spec)
+  if (!is.null(h)) {
+    L <- length(h)
+    w <- stats::rnorm(n + L - 1L, sd = sd)
+    y <- stats::filter(w, h, method = "convolution", sides = 1L)
+    return(as.numeric(y[L:(n + L - 1L)]))
+  }
+  if (spec$family == "ma") {
+    K <- filter_support(spec)
+    g <- filter_acf(spec, tau0, 0:(K - 1L)) * N^2
+    return(sim_circulant(n, g))
+  }
+  rat <- filter_rational(spec)
+  rho <- max(Mod(rat$p))
+  burn <- if (rho > 0) ceiling(log(1e-12) / log(rho)) else 0L
+  w <- stats::rnorm(n + burn, sd = sd)
+  if (spec$family == "lp1") {
+    a <- Re(rat$p[1L])
+    y <- stats::filter((1 - a) * w, a, method = "recursive")
+  } else {
+    K <- tan(pi * spec$fc * tau0)
+    den <- 1 + sqrt(2) * K + K^2
+    b <- c(1, 2, 1) * K^2 / den
+    a1 <- 2 * (K^2 - 1) / den
+    a2 <- (1 - sqrt(2) * K + K^2) / den
+    v <- stats::filter(w, b, method = "convolution", sides = 1L)
+    v[1:2] <- b[1] * w[1:2]
+    y <- stats::filter(v, c(-a1, -a2), method = "recursive")
+  }
+  as.numeric(y[(burn + 1L):(burn + n)])
+}
+
+# Gaussian series with autocovariance g(0..K-1) (zero beyond) by circulant
+# embedding (Dietrich & Newsam 1997; Wood & Chan 1994).
+sim_circulant <- function(n, g) {
+  K <- length(g)
+  M <- stats::nextn(2L * (n + K))
+  row <- numeric(M)
+  row[seq_len(K)] <- g
+  row[M - seq_len(K - 1L) + 1L] <- g[-1L]
+  lam <- Re(stats::fft(row))
+  lam[lam < 0 & lam > -1e-10 * max(lam)] <- 0
+  if (any(lam < 0)) abort("The autocovariance is not embeddable.", class = "internal")
+  z <- complex(real = stats::rnorm(M), imaginary = stats::rnorm(M))
+  y <- stats::fft(sqrt(lam / M) * z)
+  Re(y)[seq_len(n)]
+}
+
+# ---- raw-data evidence -------------------------------------------------------------
+
+# Sample autocorrelation at lags 0..max_lag by FFT (O(n log n)); zero
+# padding by max_lag is enough to keep the circular wrap off those lags.
+acf_lags <- function(x, max_lag) {
+  n <- length(x)
+  x <- x - mean(x)
+  nfft <- stats::nextn(n + max_lag + 1L)
+  f <- stats::fft(c(x, numeric(nfft - n)))
+  a <- Re(stats::fft(Mod(f)^2, inverse = TRUE))[seq_len(max_lag + 1L)] / nfft
+  a / a[1L]
+}
+
+# Lag-1 autocorrelation of the family as a function of its parameter, and
+# its inverse (the start value read from the raw ACF).
+filter_rho1 <- function(spec, tau0) {
+  g <- filter_acf(spec, tau0, 0:1)
+  g[2L] / g[1L]
+}
+
+# Start value of a family's parameter from the lag-1 autocorrelation r1 of
+# the filter's part of the series (see filter_evidence()): ma L = 1/(1 - r1)
+# (for every L >= 1); lp1 a = r1; bartlett and lp2 by inverting their r1
+# numerically. NULL when r1 is out of the family's range.
+filter_start <- function(r1, family, freq) {
+  tau0 <- 1 / freq
+  if (!is.finite(r1) || r1 <= 0 || r1 >= 1) return(NULL)
+  switch(family,
+    ma = list(L = 1 / (1 - r1)),
+    lp1 = {
+      # a = r1; cutoff where |H|^2 = 1/2.
+      a <- r1
+      cw <- 1 - (1 - a)^2 / (2 * a)
+      if (cw < -1) return(NULL)
+      list(fc = acos(cw) / (2 * pi * tau0))
+    },
+    lp2 = {
+      f <- function(fc) filter_rho1(list(family = "lp2", fc = fc, freq = freq), tau0) - r1
+      lo <- freq * 1e-4
+      hi <- freq * 0.499
+      if (f(lo) * f(hi) > 0) return(NULL)
+      list(fc = stats::uniroot(f, c(lo, hi), tol = 1e-8 * freq)$root)
+    },
+    bartlett = {
+      # two cascaded L-tap averages: triangular taps L - |k|, k = -(L-1)..L-1
+      Ls <- 1:512
+      r <- vapply(Ls, function(L) {
+        h <- L - abs(seq.int(-(L - 1L), L - 1L))
+        sum(h[-1L] * h[-length(h)]) / sum(h^2)
+      }, 0)
+      list(L = Ls[which.min(abs(r - r1))], n = 2L)
+    },
+    NULL)
+}
+
+#' Raw-data evidence of a sensor filter (internal)
+#'
+#' The sensor's filter makes successive samples of white noise correlated
+#' over a few lags and rolls the periodogram off towards the Nyquist
+#' frequency. Slow processes (random walk, flicker, Gauss-Markov with Tc of
+#' many samples) also raise the sample autocorrelation, but almost equally
+#' at every short lag: their contribution is read from the level of the
+#' autocorrelation at lags `base_lags` (beyond any filter of interest) and
+#' subtracted, which leaves the filter's short-lag part. Standard errors
+#' are Bartlett's \eqn{\sqrt{(1 + 2\sum_{j<k} r_j^2)/n}} for each lag.
+#'
+#' @return list: `acf` (data.frame lag, r (sample ACF), excess (r minus the
+#'   slow-process level), se, z), `base` (slow-process level), `r1` (lag-1
+#'   excess), `length` (last lag whose excess is significant: the filter
+#'   length in samples), `psd_ratio` (Welch PSD near Nyquist over the PSD in
+#'   the white band around fs/20, the roll-off), `filtered` (TRUE when the
+#'   lag-1 excess is significantly positive), `start` (start values per
+#'   family, from the lag-1 excess).
+#' @noRd
+filter_evidence <- function(x, freq, max_lag = 16L, base_lags = 24:48,
+                            z_level = 5) {
+  n <- length(x)
+  tau0 <- 1 / freq
+  K <- max(max(base_lags), max_lag)
+  r <- acf_lags(x, K)[-1L]
+  base <- stats::median(r[base_lags])
+  se <- sqrt((1 + 2 * cumsum(c(0, r[seq_len(max_lag - 1L)]^2))) / n)
+  se_base <- 1.25 / sqrt(n * length(base_lags))
+  exc <- r[seq_len(max_lag)] - base
+  z <- exc / sqrt(se^2 + se_base^2)
+  sig <- which(z > z_level)
+  len <- if (length(sig) && sig[1L] == 1L) {
+    run <- which(diff(c(sig, Inf)) != 1L)[1L]
+    sig[run]
+  } else 0L
+  # Roll-off of the periodogram: mean PSD in the top 5% of the band over the
+  # mean PSD in [fs/25, fs/15] (white-dominated for sensors whose slow
+  # processes sit below 1 Hz).
+  w <- welch_psd_lin(x, freq, seg = min(512L, 2^floor(log2(n / 8))))
+  top <- w$f > 0.95 * freq / 2
+  mid <- w$f > freq / 25 & w$f < freq / 15
+  ratio <- mean(w$psd[top]) / mean(w$psd[mid])
+  r1 <- exc[1L]
+  start <- lapply(stats::setNames(nm = c("ma", "bartlett", "lp1", "lp2")),
+                  function(fam) filter_start(r1 / (1 - base), fam, freq))
+  list(acf = data.frame(lag = seq_len(max_lag), r = r[seq_len(max_lag)],
+                        excess = exc, se = sqrt(se^2 + se_base^2), z = z),
+       base = base, r1 = r1, z1 = z[1L], length = len, psd_ratio = ratio,
+       filtered = isTRUE(z[1L] > z_level), start = start)
+}
+
+# Welch periodogram (Hann, 50% overlap, segments demeaned), one-sided PSD in
+# u^2/Hz, in O(n log seg): the segments are the columns of one matrix and
+# mvfft transforms them together.
+welch_psd_lin <- function(x, freq, seg) {
+  n <- length(x)
+  seg <- as.integer(min(seg, 2^floor(log2(n))))
+  hop <- seg %/% 2L
+  starts <- seq.int(1L, n - seg + 1L, by = hop)
+  win <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
+  U <- sum(win^2)
+  half <- seg %/% 2L + 1L
+  acc <- numeric(half)
+  # Chunks of columns keep the memory bounded for long records.
+  chunk <- max(1L, (2^22) %/% seg)
+  for (c0 in seq.int(1L, length(starts), by = chunk)) {
+    st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
+    idx <- outer(seq_len(seg) - 1L, st, `+`)
+    X <- matrix(x[idx], nrow = seg)
+    X <- (X - rep(colMeans(X), each = seg)) * win
+    acc <- acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
+  }
+  k <- length(starts)
+  p <- acc / k / (freq * U)
+  p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
+  nu <- 2 * k / (1 + 2 * 0.167^2 * (k - 1) / k)
+  list(f = (seq_len(half) - 1) * freq / seg, psd = p, nu = nu, seg = seg,
+       df = freq / seg, k = k)
+}
+
+# ---- reading the filter from a curve or checking it against the data ----------
+
+# Start value of a family's parameter from a curve alone: the ratio
+# q = AV(tau0) tau0 / N^2 of the first point to the white line through the
+# longer taus (1 for white noise, less for a filter). For ma, L = (1/q + 2)/3
+# when L <= 2 (AV(1) = N^2 / (tau0 (3L - 2))); otherwise, and for the other
+# families, by inverting filter_av(1) numerically. NULL when q is not in
+# (0, 1).
+filter_start_from_curve <- function(q, family, freq) {
+  tau0 <- 1 / freq
+  if (!is.finite(q) || q <= 0 || q >= 1) return(NULL)
+  av1 <- function(p) {
+    sp <- switch(family,
+      ma = list(family = "ma", L = p),
+      bartlett = list(family = "bartlett", L = max(1L, round(p)), n = 2L),
+      lp1 = list(family = "lp1", fc = p, freq = freq),
+      lp2 = list(family = "lp2", fc = p, freq = freq))
+    filter_av(1, sp, tau0) * tau0 - q
+  }
+  switch(family,
+    ma = {
+      if (q >= 0.25) return(list(L = (1 / q + 2) / 3))
+      list(L = stats::uniroot(av1, c(2, 1e4), tol = 1e-9)$root)
+    },
+    bartlett = {
+      Ls <- 1:256
+      v <- vapply(Ls, av1, 0)
+      list(L = Ls[which.min(abs(v))], n = 2L)
+    },
+    lp1 = , lp2 = {
+      lo <- freq * 1e-4
+      hi <- freq * if (family == "lp1") 0.5 else 0.4999
+      if (av1(lo) * av1(hi) > 0) return(NULL)
+      list(fc = stats::uniroot(av1, c(lo, hi), tol = 1e-9 * freq)$root)
+    },
+    NULL)
+}
+
+# What the raw data say about a fitted filter: the lag-1 autocorrelation the
+# filter predicts for the whole series, N^2 g(1) / var(x), against the raw
+# one's filter part (filter_evidence(): the excess over the slow-process
+# level). Supported when the raw excess is significant (z > 5) and within a
+# factor 1.5 of the prediction; contradicted when the raw data show no
+# short-lag correlation (z < 2) or disagree by more than a factor 3;
+# otherwise undecided.
+filter_raw_support <- function(spec, N, fe, var_x, freq) {
+  tau0 <- 1 / freq
+  pred <- N^2 * filter_acf(spec, tau0, 1) / var_x
+  obs <- fe$r1
+  z <- fe$z1
+  ratio <- obs / pred
+  support <- if (is.finite(z) && z > 5 && is.finite(ratio) && ratio > 1 / 1.5 &&
+                 ratio < 1.5) TRUE
+    else if (!is.finite(z) || z < 2 || !is.finite(ratio) || ratio < 1 / 3 ||
+             ratio > 3) FALSE
+    else NA
+  list(text = sprintf(paste("raw lag-1 autocorrelation beyond the slow processes",
+                            "%.3f (z = %.0f) against %.3f predicted by the filter"),
+                      obs, z, pred),
+       support = support)
+}

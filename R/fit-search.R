@@ -1,0 +1,257 @@
+# The search of the noise-model fit: for fixed nonlinear parameters the
+# squared amplitudes come from a non-negative Gauss-Newton solve (C++,
+# src/avfit.cpp); the nonlinear parameters (catalogue `nl_range`) are
+# profiled on log grids, refined by one-dimensional optimisation and, with
+# several, jointly by Nelder-Mead. Every knob is in avfit_control().
+
+#' Settings of the noise-model search
+#'
+#' Every tuning constant of the search [avfit()] runs, in one object.
+#'
+#' The nonlinear parameters (Gauss-Markov correlation times, sinusoid
+#' frequencies) are profiled: with the amplitudes solved for at each value,
+#' each parameter is first searched on a log grid over its range (the
+#' catalogue's `nl_range`: `grid_smooth` points for parameters the Allan
+#' variance varies smoothly with, such as `tc`; `grid_oscillatory` for
+#' those it oscillates with, such as `f0`), or, when it has a start value,
+#' on `grid_start` points within a factor `start_span` of it; the best grid
+#' point is refined by [stats::optimize()] to `tol` (in log units). Terms
+#' enter greedily; with several nonlinear parameters, `cycles` passes refine
+#' each within a factor `local_span` of its value, and Nelder-Mead
+#' ([stats::optim()], `maxit` iterations, relative tolerance `reltol`)
+#' refines them jointly. The greedy order matters, so up to `max_orders`
+#' orders (rotations and their reverses) are tried. For each set of
+#' nonlinear values the squared amplitudes are found by at most
+#' `inner_maxit` Gauss-Newton steps, stopping when the objective falls by
+#' less than `inner_tol` relatively. When the EDF comes from the model, the
+#' fit is repeated `edf_passes` times (the first with white-noise EDF).
+#'
+#' @param grid_smooth,grid_oscillatory,grid_start Grid sizes (whole
+#'   numbers, at least 3).
+#' @param start_span Factor (> 1) either side of a start value covered by
+#'   its grid.
+#' @param local_span Factor (> 1) either side of the current value searched
+#'   when refining.
+#' @param tol Tolerance of the one-dimensional refinement (log units).
+#' @param maxit Maximum Nelder-Mead iterations.
+#' @param reltol Relative convergence tolerance of Nelder-Mead.
+#' @param cycles Passes over the nonlinear parameters.
+#' @param max_orders Greedy entry orders tried.
+#' @param inner_maxit Maximum Gauss-Newton steps of the amplitude solve.
+#' @param inner_tol Relative tolerance of the amplitude solve.
+#' @param edf_passes Fits when the EDF is derived from the model (at least
+#'   1).
+#' @return An object of class `"avfit_control"`: a list of the settings.
+#' @seealso [avfit()]
+#' @export
+#' @examples
+#' avfit_control()
+#' x <- avsim(2^15, 100, N = 0.01, gm = list(sigma = 0.01, tc = 2), seed = 1)
+#' fit <- avfit(allan(x, 100), c("N", "gm"),
+#'              control = avfit_control(grid_smooth = 20))
+#' fit$convergence
+avfit_control <- function(grid_smooth = 40L, grid_oscillatory = 120L,
+                          grid_start = 13L, start_span = 4, local_span = 1.5,
+                          tol = 1e-7, maxit = 400L, reltol = 1e-10,
+                          cycles = 2L, max_orders = 6L, inner_maxit = 100L,
+                          inner_tol = 1e-12, edf_passes = 2L) {
+  out <- list(
+    grid_smooth = check_number(grid_smooth, "grid_smooth", 3, 1e5, integer = TRUE),
+    grid_oscillatory = check_number(grid_oscillatory, "grid_oscillatory", 3, 1e5,
+                                    integer = TRUE),
+    grid_start = check_number(grid_start, "grid_start", 3, 1e5, integer = TRUE),
+    start_span = check_number(start_span, "start_span", 1, Inf, open = TRUE),
+    local_span = check_number(local_span, "local_span", 1, Inf, open = TRUE),
+    tol = check_number(tol, "tol", 0, 1, open = TRUE),
+    maxit = check_number(maxit, "maxit", 1, 1e7, integer = TRUE),
+    reltol = check_number(reltol, "reltol", 0, 1, open = TRUE),
+    cycles = check_number(cycles, "cycles", 1, 100, integer = TRUE),
+    max_orders = check_number(max_orders, "max_orders", 1, 1000, integer = TRUE),
+    inner_maxit = check_number(inner_maxit, "inner_maxit", 1, 1e7, integer = TRUE),
+    inner_tol = check_number(inner_tol, "inner_tol", 0, 1, open = TRUE),
+    edf_passes = check_number(edf_passes, "edf_passes", 1, 10, integer = TRUE))
+  structure(out, class = "avfit_control")
+}
+
+#' @export
+print.avfit_control <- function(x, ...) {
+  cat("<avfit_control>\n")
+  v <- vapply(x, function(v) format(v), "")
+  cat(paste0("  ", format(names(v)), " = ", v, "\n"), sep = "")
+  invisible(x)
+}
+
+check_control <- function(control) {
+  if (is.null(control)) return(avfit_control())
+  if (is.list(control) && !inherits(control, "avfit_control")) {
+    return(do.call(avfit_control, control))
+  }
+  if (!inherits(control, "avfit_control")) {
+    abort("`control` must be avfit_control() or a list of its arguments, not ",
+          describe_type(control), ".", class = "argument")
+  }
+  control
+}
+
+# The fitting problem at fixed EDF: log data, weights, the model plan.
+fit_problem <- function(data, tau0, lay, bias_correct, corr) {
+  y <- log(data$avar) - if (bias_correct) log_bias(data$edf) else 0
+  s <- log_sd(data$edf)
+  list(data = data, tau0 = tau0, lay = lay, plan = model_plan(lay), y = y,
+       s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct)
+}
+
+# Solve for the squared amplitudes at nonlinear values `nlv` (named by
+# coefficient). `off`: instance labels left out (amplitude 0) for this
+# solve. Returns c (named by free amplitude coefficient), objective,
+# iterations, converged and the layout with the nonlinear values set.
+solve_amps <- function(pr, nlv, control, off = NULL) {
+  lay <- pr$lay
+  if (length(nlv)) lay$value[match(names(nlv), lay$name)] <- nlv
+  values <- stats::setNames(lay$value, lay$name)
+  Bm <- plan_basis(pr$plan, pr$data$tau, pr$tau0, values)
+  amp <- lay[lay$role == "amp", , drop = FALSE]
+  free <- amp$name[!amp$fixed & !amp$label %in% off]
+  offset <- numeric(nrow(pr$data))
+  for (i in which(amp$fixed)) offset <- offset + amp$value[i]^2 * Bm[, amp$name[i]]
+  cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
+  if (!length(free)) {
+    obj <- if (all(offset > 0)) sum(wmul(pr$W, pr$y - log(offset))^2) else Inf
+    return(list(c = cc, objective = obj, iterations = 0L, converged = TRUE,
+                layout = lay))
+  }
+  r <- avfit_log_nnls(Bm[, free, drop = FALSE], offset, pr$y, pr$W,
+                      numeric(length(free)), control$inner_maxit,
+                      control$inner_tol)
+  cc[free] <- r$c
+  list(c = cc, objective = r$objective, iterations = r$iterations,
+       converged = r$converged, layout = lay)
+}
+
+# The profile search. `start`: named start values of nonlinear
+# coefficients; `prev`: the result of a previous pass (its values start this
+# one and only local refinement is done). Returns the layout with every
+# value set, the objective and the convergence record.
+fit_search <- function(pr, start, prev, control) {
+  lay <- pr$lay
+  freq <- if (is.null(pr$tau0)) NULL else 1 / pr$tau0
+  nlrows <- which(lay$role == "nonlinear" & !lay$fixed)
+  nlv <- stats::setNames(numeric(length(nlrows)), lay$name[nlrows])
+  evals <- 0L
+  obj <- function(lognl, off = NULL) {
+    evals <<- evals + 1L
+    solve_amps(pr, stats::setNames(exp(lognl), names(nlv)), control, off)$objective
+  }
+  nm <- NULL
+  if (length(nlrows)) {
+    ranges <- lapply(nlrows, function(i) {
+      e <- effect_entry(lay$kind[i], lay$variant[i])
+      e$nl_range(pr$data$tau, freq)[[lay$param[i]]]
+    })
+    profile <- vapply(nlrows, function(i) {
+      p <- effect_entry(lay$kind[i], lay$variant[i])$params
+      p$profile[p$name == lay$param[i]]
+    }, "")
+    # initial values: previous pass, start, or grid centre
+    for (k in seq_along(nlrows)) {
+      nm_k <- names(nlv)[k]
+      nlv[k] <- if (!is.null(prev)) prev$layout$value[prev$layout$name == nm_k] else
+        if (!is.null(start) && nm_k %in% names(start)) start[[nm_k]] else
+          sqrt(prod(ranges[[k]]))
+    }
+    # a parameter with a start (given, or from the previous pass) is refined
+    # locally; the others are searched on the grid first
+    has_start <- names(nlv) %in% names(start)
+    search <- function(order) {
+      lognl <- log(nlv)
+      cycles <- if (length(nlrows) > 1L) control$cycles else 1L
+      for (cy in seq_len(cycles)) {
+        for (pos in seq_along(order)) {
+          k <- order[pos]
+          # first cycle: terms not searched yet stay out of the model (greedy)
+          later <- if (cy == 1L) {
+            j <- order[seq_along(order) > pos]
+            lay$label[nlrows[j[!has_start[j]]]]
+          } else NULL
+          f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
+          if (cy > 1L || !is.null(prev)) {
+            lo <- lognl[k] - log(control$local_span)
+            hi <- lognl[k] + log(control$local_span)
+          } else {
+            # a start value: a short grid around it; otherwise the whole range
+            ng <- if (has_start[k]) control$grid_start else
+              control[[paste0("grid_", profile[k])]]
+            g <- if (has_start[k]) {
+              lognl[k] + seq(-log(control$start_span), log(control$start_span),
+                             length.out = ng)
+            } else {
+              seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
+            }
+            vals <- vapply(g, f1, 0)
+            i <- which.min(vals)
+            lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
+            lognl[k] <- g[i]
+          }
+          o <- stats::optimize(f1, c(lo, hi), tol = control$tol)
+          if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
+        }
+      }
+      nm <- NULL
+      if (length(nlrows) > 1L) {
+        o <- stats::optim(lognl, obj, method = "Nelder-Mead",
+                          control = list(reltol = control$reltol,
+                                         maxit = control$maxit))
+        nm <- list(convergence = o$convergence, count = o$counts[["function"]])
+        if (o$value <= obj(lognl)) lognl <- o$par
+      }
+      list(lognl = lognl, value = obj(lognl), nm = nm)
+    }
+    # The greedy search depends on the order in which the terms enter; with
+    # several unstarted nonlinear terms try each rotation of the order (and
+    # its reverse) and keep the best objective.
+    K <- length(nlrows)
+    orders <- list(seq_len(K))
+    if (is.null(prev) && sum(!has_start) > 1L) {
+      rot <- lapply(seq_len(K) - 1L, function(r) (seq_len(K) + r - 1L) %% K + 1L)
+      orders <- unique(c(rot, lapply(rot, rev)))
+      if (length(orders) > control$max_orders) orders <- orders[seq_len(control$max_orders)]
+    }
+    # Orders that end in the same optimum (the same terms, labelled in
+    # another order) tie to within rounding: the first order keeps it.
+    best <- NULL
+    for (ord in orders) {
+      r <- search(ord)
+      if (is.null(best) || r$value < best$value - 1e-9 * max(1, abs(best$value))) {
+        best <- r
+      }
+    }
+    nlv[] <- exp(best$lognl)
+    nm <- best$nm
+  }
+  sol <- solve_amps(pr, nlv, control)
+  lay2 <- sol$layout
+  amprows <- which(lay2$role == "amp" & !lay2$fixed)
+  lay2$value[amprows] <- sqrt(pmax(sol$c[lay2$name[amprows]], 0))
+  list(layout = lay2, objective = sol$objective,
+       convergence = search_convergence(sol, nm, evals, control))
+}
+
+# What the search says about its own convergence: the final amplitude solve
+# and, with several nonlinear parameters, Nelder-Mead.
+search_convergence <- function(sol, nm, evals, control) {
+  msg <- character()
+  if (!isTRUE(sol$converged)) {
+    msg <- c(msg, sprintf(
+      "the amplitude solve stopped after %d Gauss-Newton steps (inner_maxit = %d) before converging",
+      sol$iterations, control$inner_maxit))
+  }
+  if (!is.null(nm) && nm$convergence != 0L) {
+    msg <- c(msg, sprintf(
+      "Nelder-Mead stopped after %d evaluations (maxit = %d) before converging",
+      nm$count, control$maxit))
+  }
+  list(converged = !length(msg),
+       iterations = if (is.null(nm)) as.integer(sol$iterations) else as.integer(nm$count),
+       evaluations = as.integer(evals),
+       message = if (length(msg)) paste(msg, collapse = "; ") else "converged")
+}

@@ -1,0 +1,88 @@
+# The uncertainty of a fit: the covariance of the free parameters from the
+# Gauss-Newton information of the standardized log residuals, in the
+# reported parameterisation (amplitudes; nonlinear parameters in their own
+# units), scaled by max(1, chi2/dof).
+
+# Jacobian of ln AV with respect to the free parameters (amplitudes, or c =
+# a^2 for amplitudes at 0; nonlinear parameters in their own units).
+jacobian_lnav <- function(lay, tau, tau0, plan = model_plan(lay)) {
+  values <- stats::setNames(lay$value, lay$name)
+  Bm <- plan_basis(plan, tau, tau0, values)
+  tot <- model_total(lay, tau, tau0, plan)
+  free <- which(!lay$fixed)
+  Jm <- matrix(0, length(tau), length(free),
+               dimnames = list(NULL, lay$name[free]))
+  at_zero <- logical(length(free))
+  for (k in seq_along(free)) {
+    i <- free[k]
+    if (lay$role[i] == "amp") {
+      a <- lay$value[i]
+      b <- Bm[, lay$name[i]]
+      if (a > 0) {
+        Jm[, k] <- 2 * a * b / tot
+      } else {
+        Jm[, k] <- b / tot
+        at_zero[k] <- TRUE
+      }
+    } else {
+      h <- 1e-5
+      lp <- lay; lp$value[i] <- lay$value[i] * exp(h)
+      lm <- lay; lm$value[i] <- lay$value[i] * exp(-h)
+      dp <- log(model_total(lp, tau, tau0, plan))
+      dm <- log(model_total(lm, tau, tau0, plan))
+      Jm[, k] <- (dp - dm) / (2 * h) / lay$value[i]
+    }
+  }
+  list(J = Jm, at_zero = at_zero, free = free)
+}
+
+model_total <- function(lay, tau, tau0, plan = model_plan(lay)) {
+  rowSums(model_components(tau, tau0, lay, plan))
+}
+
+# Pseudo-inverse of a symmetric PSD matrix, equilibrated first: parameters
+# differ by many orders of magnitude (c = K^2 ~ 1e-8 next to tc ~ 10 s).
+pinv <- function(A) {
+  dg <- sqrt(pmax(diag(A), 0))
+  dg[dg == 0] <- 1
+  As <- A / outer(dg, dg)
+  pinv_raw(As) / outer(dg, dg)
+}
+
+pinv_raw <- function(A) {
+  e <- eigen((A + t(A)) / 2, symmetric = TRUE)
+  d <- e$values
+  keep <- d > max(d) * 1e-12
+  if (!any(keep)) return(matrix(NA_real_, nrow(A), ncol(A)))
+  e$vectors[, keep, drop = FALSE] %*% (t(e$vectors[, keep, drop = FALSE]) / d[keep])
+}
+
+# Covariance matrix (all coefficients; fixed ones 0) of a fit with layout
+# `lay` at the taus `tau`, whitening W and chi2 per dof `chi2`. An
+# amplitude at its bound 0 gets sqrt(SE(c)) as its standard error and no
+# covariance; a nonlinear parameter of a term whose amplitudes are all 0 is
+# not identified (NA).
+fit_vcov <- function(lay, tau, tau0, W, chi2, plan = model_plan(lay)) {
+  jj <- jacobian_lnav(lay, tau, tau0, plan)
+  Js <- -wmul(W, jj$J)
+  V <- pinv(crossprod(Js)) * max(1, if (is.na(chi2)) 1 else chi2)
+  vc <- matrix(0, nrow(lay), nrow(lay), dimnames = list(lay$name, lay$name))
+  fn <- lay$name[jj$free]
+  vfree <- V
+  dimnames(vfree) <- list(fn, fn)
+  if (any(jj$at_zero)) {
+    zn <- fn[jj$at_zero]
+    sez <- sqrt(sqrt(pmax(diag(V)[jj$at_zero], 0)))
+    vfree[zn, ] <- 0
+    vfree[, zn] <- 0
+    diag(vfree)[match(zn, fn)] <- sez^2
+  }
+  vc[fn, fn] <- vfree
+  for (i in which(lay$role == "nonlinear" & !lay$fixed)) {
+    a <- lay$value[lay$label == lay$label[i] & lay$role == "amp"]
+    if (!any(a > 0)) {
+      vc[i, ] <- vc[, i] <- NA_real_
+    }
+  }
+  vc
+}

@@ -1,0 +1,102 @@
+# How the fit weighs the points of a curve: the equivalent degrees of
+# freedom (EDF) of each AV estimate under the model, the chi-square bias and
+# spread of ln AV-hat, the white-noise correlation between points and the
+# whitening matrix built from them.
+#
+# The EDF comes from the one EDF engine of allan() (src/edf.cpp through
+# allan_edf_direct() in R/edf.R): each term instance gets the EDF of its
+# power-law exponent (catalogue `edf_alpha`), and the terms are combined as
+# nu = (sum_k AV_k)^2 / sum_k (AV_k^2 / nu_k); deterministic terms (alpha NA)
+# add no variance.
+
+log_bias <- function(edf) digamma(edf / 2) - log(edf / 2)
+log_sd <- function(edf) sqrt(trigamma(edf / 2))
+
+# The estimator name the EDF engine knows for avfit's `type`.
+engine_type <- function(type) if (identical(type, "overlapping")) "overlapping" else "standard"
+
+# EDF of the AV estimates at cluster sizes m (rounded to whole samples) for
+# power-law noise of rate-PSD exponent `alpha` (one value): n samples, L
+# phase points (n + 1 for rate input). NA where the estimator has no term.
+edf_power_law <- function(m, n, type, alpha, L = n + 1) {
+  et <- engine_type(type)
+  mm <- pmax(round(m), 1)
+  nt <- allan_nterms(et, mm, L)
+  out <- rep(NA_real_, length(m))
+  ok <- is.finite(nt) & nt >= 1
+  if (any(ok)) {
+    out[ok] <- allan_edf_direct(et, mm[ok], nt[ok], L,
+                                rep(as.integer(alpha), sum(ok)))
+  }
+  out
+}
+
+# Mixture EDF of a model: `comp` the per-instance AV (matrix, one column per
+# instance), `alpha` their exponents (matrix of the same shape, or a
+# scalar); nu = (sum AV_k)^2 / sum(AV_k^2 / nu_k). Floored at 1 and never
+# more than the number of samples.
+edf_model <- function(m, n, type, comp, alpha, L = n + 1) {
+  comp <- as.matrix(comp)
+  alpha <- matrix(alpha, nrow(comp), ncol(comp))
+  tot <- rowSums(comp)
+  den <- numeric(nrow(comp))
+  for (k in seq_len(ncol(comp))) {
+    for (a in unique(stats::na.omit(alpha[, k]))) {
+      i <- which(alpha[, k] == a)
+      den[i] <- den[i] + comp[i, k]^2 / edf_power_law(m[i], n, type, a, L)
+    }
+  }
+  e <- tot^2 / den
+  # a model of deterministic terms only: white-noise EDF
+  bad <- !is.finite(e)
+  if (any(bad)) e[bad] <- edf_power_law(m[bad], n, type, 0, L)
+  pmin(pmax(e, 1), n)
+}
+
+# Correlation matrix of the AV estimates at cluster sizes m for white rate
+# noise (exact Gaussian moments, C++).
+white_corr <- function(m, n, type) {
+  C <- avar_white_cov(as.double(round(m)), as.double(n),
+                      type == "overlapping", allanvar_threads())
+  d <- sqrt(diag(C))
+  R <- C / outer(d, d)
+  R[!is.finite(R)] <- 0
+  diag(R) <- 1
+  R
+}
+
+# Whitening matrix W with ||W r||^2 = r' Sigma^-1 r, Sigma = diag(s) R diag(s).
+# Independent points: W is diagonal and is kept as its diagonal, a
+# one-column matrix (a dense J x J diagonal is 800 MB at J = 10,000); apply
+# it with wmul(), which src/avfit.cpp mirrors.
+whitening <- function(s, corr) {
+  if (is.null(corr)) return(matrix(1 / s, ncol = 1L))
+  Sig <- corr * outer(s, s)
+  U <- chol_or_null(Sig)
+  # nearly coincident taus can make Sigma numerically singular: add a ridge
+  ridge <- 1e-10
+  while (is.null(U) && ridge < 1e-2) {
+    U <- chol_or_null(Sig + diag(ridge * s^2, length(s)))
+    ridge <- ridge * 100
+  }
+  if (is.null(U)) return(diag(1 / s, length(s)))
+  t(backsolve(U, diag(length(s))))
+}
+
+# W %*% v for a whitening matrix or a diagonal one kept as a column.
+wmul <- function(W, v) {
+  v <- as.matrix(v)
+  if (ncol(W) == 1L && nrow(W) == nrow(v) && nrow(v) > 1L) W[, 1L] * v else W %*% v
+}
+
+# log-determinant term of the whitening: -2 sum log diag(W).
+w_logdet <- function(W) {
+  d <- if (ncol(W) == 1L && nrow(W) > 1L) W[, 1L] else diag(W)
+  -2 * sum(log(d))
+}
+
+# Cholesky factor, or NULL when the matrix is not numerically positive
+# definite (the caller then regularises).
+chol_or_null <- function(A) {
+  tryCatch(chol(A), error = function(e) NULL)
+}

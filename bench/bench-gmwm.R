@@ -1,0 +1,122 @@
+# allanvar's Allan-variance fit against GMWM (Guerrier et al. 2013, JASA;
+# CRAN simts) on composite simulations: white noise + rate random walk +
+# Gauss-Markov. Relative RMSE of every parameter over seeds, at 1e5 and
+# 1e6 samples. The series come from the generator written below (not
+# avsim()), so neither method is scored on its own simulator.
+#
+#   R CMD INSTALL . && Rscript bench/bench-gmwm.R [seeds_1e5] [seeds_1e6]
+#
+# simts is installed into a temporary library (or into
+# $ALLANVAR_BENCH_LIB when set, to keep it between runs); the time the
+# install takes is printed. Debian's prebuilt r-cran-rcpparmadillo saves
+# most of the compile time: apt-get install -y r-cran-rcpparmadillo
+# r-cran-scales r-cran-broom r-cran-dplyr r-cran-tidyr first.
+library(allanvar)
+args <- as.integer(commandArgs(TRUE))
+seeds <- c(if (length(args) >= 1L) args[1L] else 20L,
+           if (length(args) >= 2L) args[2L] else 10L)
+
+lib <- Sys.getenv("ALLANVAR_BENCH_LIB", tempfile("simts-lib"))
+dir.create(lib, showWarnings = FALSE, recursive = TRUE)
+.libPaths(c(lib, .libPaths()))
+if (!requireNamespace("simts", quietly = TRUE)) {
+  t_inst <- system.time(
+    utils::install.packages("simts", lib = lib, repos = "https://cloud.r-project.org",
+                            Ncpus = 2L, quiet = TRUE))[["elapsed"]]
+  cat(sprintf("simts installed into %s in %.0f s\n", lib, t_inst))
+}
+stopifnot(requireNamespace("simts", quietly = TRUE))
+cat(sprintf("simts %s\n", utils::packageVersion("simts")))
+
+freq <- 100
+tau0 <- 1 / freq
+# Two composites: K clearly above the GM at long tau ("strong K"), and K
+# level with the GM's tail at the longest tau of a 1e5 record ("weak K").
+scenarios <- list(
+  "strong K" = c(N = 0.01, K = 1e-3, sigma = 0.02, tc = 2),
+  "weak K" = c(N = 0.01, K = 2e-4, sigma = 0.02, tc = 2))
+truth <- scenarios[[1L]]
+
+# Our own generator: white (sd N / sqrt(tau0)), random walk (increments
+# K sqrt(tau0)), AR(1) started from its stationary law.
+gen <- function(n, seed) {
+  set.seed(seed)
+  phi <- exp(-tau0 / truth[["tc"]])
+  w <- rnorm(n, sd = truth[["sigma"]] * sqrt(1 - phi^2))
+  w[1] <- rnorm(1, sd = truth[["sigma"]])
+  rnorm(n, sd = truth[["N"]] / sqrt(tau0)) +
+    cumsum(rnorm(n, sd = truth[["K"]] * sqrt(tau0))) +
+    as.numeric(stats::filter(w, phi, method = "recursive"))
+}
+
+fit_allanvar <- function(x) {
+  f <- avfit(allan(x, freq), terms = c("N", "K", "gm"))
+  cf <- coef(f)
+  c(N = cf[["N"]], K = cf[["K"]], sigma = cf[["gm1.sigma"]], tc = cf[["gm1.tc"]])
+}
+
+# simts works per sample: WN sigma2 = N^2 / tau0; RW gamma2 = K^2 tau0;
+# AR1 (phi, innovation variance s2): sigma^2 = s2 / (1 - phi^2),
+# tc = -tau0 / log(phi).
+fit_gmwm <- function(x) {
+  g <- simts::gmwm(simts::AR1() + simts::WN() + simts::RW(), data = x)
+  est <- g$estimate[, 1]
+  nm <- rownames(g$estimate)
+  phi <- est[[which(nm == "AR1")]]
+  s2 <- est[[which(nm == "SIGMA2")]]
+  c(N = sqrt(est[[which(nm == "WN")]] * tau0),
+    K = sqrt(est[[which(nm == "RW")]] / tau0),
+    sigma = sqrt(s2 / (1 - phi^2)),
+    tc = -tau0 / log(phi))
+}
+
+rel_rmse <- function(est) {
+  rel <- sweep(est, 2L, truth[colnames(est)], "/") - 1
+  100 * sqrt(colMeans(rel^2))
+}
+# median absolute relative error: the typical error, which a few wild
+# estimates do not dominate
+rel_mdae <- function(est) {
+  rel <- sweep(est, 2L, truth[colnames(est)], "/") - 1
+  100 * apply(abs(rel), 2L, stats::median)
+}
+
+rows <- list()
+mdae <- list()
+for (sc in names(scenarios)) {
+truth <- scenarios[[sc]]
+for (k in 1:2) {
+  n <- c(1e5, 1e6)[k]
+  ea <- eg <- matrix(NA_real_, seeds[k], 4L, dimnames = list(NULL, names(truth)))
+  ta <- tg <- numeric(seeds[k])
+  for (s in seq_len(seeds[k])) {
+    x <- gen(n, 1000L * k + s)
+    ta[s] <- system.time(ea[s, ] <- fit_allanvar(x))[["elapsed"]]
+    tg[s] <- system.time(eg[s, ] <- tryCatch(fit_gmwm(x),
+                                             error = function(e) rep(NA_real_, 4L)))[["elapsed"]]
+  }
+  ok <- stats::complete.cases(eg)
+  rows[[length(rows) + 1L]] <- data.frame(
+    scenario = sc, n = n, method = c("allanvar", "gmwm"), seeds = c(seeds[k], sum(ok)),
+    rbind(rel_rmse(ea), rel_rmse(eg[ok, , drop = FALSE])),
+    median_s = c(median(ta), median(tg)), check.names = FALSE)
+  mdae[[length(mdae) + 1L]] <- data.frame(
+    scenario = sc, n = n, method = c("allanvar", "gmwm"),
+    rbind(rel_mdae(ea), rel_mdae(eg[ok, , drop = FALSE])), check.names = FALSE)
+}
+}
+out <- do.call(rbind, rows)
+for (sc in names(scenarios)) {
+  tr <- scenarios[[sc]]
+  cat(sprintf("%s: N = %g, K = %g, GM sigma = %g, tc = %g s; %g Hz\n", sc,
+              tr[["N"]], tr[["K"]], tr[["sigma"]], tr[["tc"]], freq))
+}
+cat("Relative RMSE of each parameter, percent (lower is better):\n")
+num <- c("N", "K", "sigma", "tc")
+out[num] <- lapply(out[num], function(v) signif(v, 3))
+out$median_s <- signif(out$median_s, 3)
+print(out, row.names = FALSE)
+md <- do.call(rbind, mdae)
+md[num] <- lapply(md[num], function(v) signif(v, 3))
+cat("\nMedian absolute relative error, percent:\n")
+print(md, row.names = FALSE)

@@ -1,0 +1,81 @@
+# Raw-data diagnostics and evidence (evidence.R), on series of known
+# construction.
+
+test_that("a periodogram line is found at f0 with its amplitude and significance", {
+  set.seed(2)
+  n <- 2e5
+  t <- seq_len(n) / 100
+  x <- rnorm(n, sd = 0.1) + 0.02 * sin(2 * pi * 0.5 * t + 1)
+  d <- avdiagnose(x, 100)
+  expect_s3_class(d, "avdiagnose")
+  expect_equal(d$lines$f0[1], 0.5, tolerance = 0.01)
+  expect_equal(d$lines$amp[1], 0.02, tolerance = 0.1)
+  expect_lt(d$lines$p_value[1], 1e-10)
+  ev <- raw_evidence("sinusoid", list(f0 = 0.52), d, x, 100)
+  expect_true(ev$support)
+  ev <- raw_evidence("sinusoid", list(f0 = 2), d, x, 100)
+  expect_false(ev$support)
+  # White noise: no line in most seeds at the 1e-3 family-wise level.
+  fa <- vapply(1:5, function(s) {
+    set.seed(s)
+    nrow(spectral_lines(rnorm(5e4), 100))
+  }, 0)
+  expect_lte(sum(fa > 0), 1)
+})
+
+test_that("the quantization grid and the -1/2 lag-1 ACF are recognised", {
+  set.seed(3)
+  xq <- round(rnorm(1e5) / 0.05) * 0.05
+  g <- quantization_grid(xq)
+  expect_true(g$quantized)
+  expect_equal(g$step, 0.05, tolerance = 1e-9)
+  expect_equal(g$on_grid, 1)
+  expect_false(quantization_grid(rnorm(1e5))$quantized)
+  # Differenced uniform noise (quantization Q) has lag-1 ACF -1/2 exactly.
+  y <- diff(runif(1e5 + 1)) * 100
+  d <- avdiagnose(y, 100)
+  expect_equal(d$acf1, -0.5, tolerance = 0.03)
+  expect_equal(round(d$noise_id$alpha[1]), 2)
+  expect_true(raw_evidence("Q", list(Q = 1), d, y, 100)$support)
+})
+
+test_that("exponential ACF gives Tc; trend and lag-1 noise id are right", {
+  set.seed(4)
+  n <- 1e6
+  phi <- exp(-1 / (100 * 10))
+  g <- as.numeric(stats::filter(rnorm(n, sd = 0.05 * sqrt(1 - phi^2)), phi, "recursive"))
+  y <- rnorm(n, sd = 0.1) + g
+  a <- acf_exponential(y, 100, 7)
+  expect_equal(a$tc, 10, tolerance = 0.2)
+  w <- rnorm(n, sd = 0.1)
+  expect_false(isTRUE(raw_evidence("gm", list(tc = 7), avdiagnose(w, 100), w, 100)$support))
+  # Ramp of 1e-5 u/s over 10000 s in white noise.
+  t <- seq_len(n) / 100
+  tr <- linear_trend(w + 1e-5 * t, 100)
+  expect_true(tr$significant)
+  expect_equal(tr$slope, 1e-5, tolerance = 0.05)
+  expect_false(linear_trend(w, 100)$significant)
+  expect_equal(lag1_noise_id(w, 10), 0, tolerance = 0.1)
+  expect_equal(round(lag1_noise_id(cumsum(rnorm(n)), 10)), -2)
+})
+
+test_that("avdiagnose validates its arguments and prints", {
+  expect_error(avdiagnose(), "`x` is missing")
+  expect_error(avdiagnose(rnorm(1000), -1), "`freq` must be a single positive")
+  expect_error(avdiagnose(letters, 1), "`x` must be a numeric vector")
+  expect_error(avdiagnose(rnorm(10), 1), "at least 256")
+  x <- stats::ts(round(rnorm(5000) / 0.1) * 0.1, frequency = 50)
+  d <- avdiagnose(x)
+  expect_equal(d$freq, 50)
+  expect_output(print(d), "Quantized: step 0.1")
+})
+
+test_that("avdiagnose() errors are classed and worded", {
+  expect_snapshot(error = TRUE, {
+    avdiagnose()
+    avdiagnose(rnorm(1000), -1)
+    avdiagnose(letters, 1)
+    avdiagnose(rep(1, 10), 1)
+    avdiagnose(rnorm(1000), 1, alpha = 2)
+  })
+})

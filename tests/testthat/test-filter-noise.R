@@ -1,0 +1,197 @@
+# Filtered white noise. References written here, independent of the
+# package: the Allan difference as a linear functional of the white input
+# (its variance is sigma^2 times the sum of its squared weights), impulse
+# responses from stats::filter, and series generated with stats::filter.
+
+# Exact AV of white noise (variance s2 per sample) through impulse
+# response h: the Allan difference at cluster m is sum_i c_i w_i with
+# c = h convolved with the kernel (+1/m x m, -1/m x m); AV = s2 sum c^2 / 2.
+av_linear <- function(h, m, s2) {
+  vapply(m, function(mm) {
+    k <- c(rep(1 / mm, mm), rep(-1 / mm, mm))
+    c <- stats::convolve(h, rev(k), type = "open")
+    s2 * sum(c^2) / 2
+  }, 0)
+}
+
+
+tau0 <- 0.01
+m <- c(1, 2, 3, 4, 5, 7, 8, 16, 33, 100)
+
+test_that("the exact AV of every filter family matches the linear-functional reference", {
+  # moving average of 4 taps
+  h <- rep(1 / 4, 4)
+  expect_equal(filter_av(m, filter_spec("ma", L = 4), tau0), av_linear(h, m, 1 / tau0),
+               tolerance = 1e-12)
+  # Bartlett: two cascaded 3-tap averages
+  h2 <- stats::convolve(rep(1 / 3, 3), rev(rep(1 / 3, 3)), type = "open")
+  expect_equal(filter_av(m, filter_spec("bartlett", L = 3, n = 2), tau0),
+               av_linear(h2, m, 1 / tau0), tolerance = 1e-12)
+  # given FIR coefficients (scaled to unit DC gain)
+  hf <- c(0.5, 1, 0.3, -0.1)
+  expect_equal(filter_av(m, filter_spec("fir", h = hf), tau0),
+               av_linear(hf / sum(hf), m, 1 / tau0), tolerance = 1e-12)
+  # first-order low-pass: y = a y[-1] + (1 - a) w, a from the -3 dB point
+  fc <- 8
+  w <- 2 * pi * fc * tau0
+  a <- (2 - cos(w)) - sqrt((2 - cos(w))^2 - 1)
+  h1 <- (1 - a) * a^(0:3999)
+  expect_equal(filter_av(m, filter_spec("lp1", fc = fc, freq = 100), tau0),
+               av_linear(h1, m, 1 / tau0), tolerance = 1e-10)
+  # second-order Butterworth by the bilinear transform
+  K <- tan(pi * fc * tau0)
+  den <- 1 + sqrt(2) * K + K^2
+  b <- c(1, 2, 1) * K^2 / den
+  ar <- c(-2 * (K^2 - 1) / den, -(1 - sqrt(2) * K + K^2) / den)
+  hb <- as.numeric(stats::filter(c(b, numeric(3997)), ar, method = "recursive"))
+  expect_equal(filter_av(m, filter_spec("lp2", fc = fc, freq = 100), tau0),
+               av_linear(hb, m, 1 / tau0), tolerance = 1e-10)
+})
+
+test_that("a fractional moving average is the MA whose autocovariance is the triangle", {
+  # L = 1.25: lag-1 autocorrelation 1 - 1/L = 0.2, i.e. an MA(1) with
+  # weights (1, w), w / (1 + w^2) = 0.2
+  wt <- (1 - sqrt(1 - 4 * 0.2^2)) / (2 * 0.2)
+  h <- c(1, wt) / (1 + wt)
+  expect_equal(filter_av(m, filter_spec("ma", L = 1.25), tau0),
+               av_linear(h, m, 1 / tau0), tolerance = 1e-12)
+})
+
+test_that("N keeps its meaning: the AV tends to N^2 / tau and the PSD is N^2 at DC", {
+  specs <- list(filter_spec("ma", L = 1.3), filter_spec("ma", L = 6),
+                filter_spec("bartlett", L = 4), filter_spec("lp1", fc = 5, freq = 100),
+                filter_spec("lp2", fc = 12, freq = 100),
+                filter_spec("fir", h = c(1, 2, 1)))
+  for (sp in specs) {
+    mm <- 1e5
+    expect_equal(filter_av(mm, sp, tau0) * mm * tau0, 1, tolerance = 1e-3)
+    expect_equal(filter_psd(0, sp, tau0), 1, tolerance = 1e-12)
+    # below the white line at short tau: the filter removes power
+    expect_lt(filter_av(1, sp, tau0), 1 / tau0)
+  }
+})
+
+test_that("low-pass filters are -3 dB at their cutoff; bandwidths are reported", {
+  for (fc in c(2, 10, 30)) {
+    for (fam in c("lp1", "lp2")) {
+      bw <- filter_bandwidth(filter_spec(fam, fc = fc, freq = 100), tau0)
+      expect_equal(bw$f3db, fc, tolerance = 1e-6)
+    }
+  }
+  # a 4-tap average: -3 dB near 0.443 fs / 4 (the boxcar's, slightly above in
+  # discrete time)
+  bw <- filter_bandwidth(filter_spec("ma", L = 4), tau0)
+  ref <- stats::uniroot(function(f) (sin(4 * pi * f * tau0) / (4 * sin(pi * f * tau0)))^2 - 0.5,
+                        c(1, 20))$root
+  expect_equal(bw$f3db, ref, tolerance = 1e-6)
+  # unfiltered white: noise-equivalent bandwidth is fs/2
+  expect_equal(filter_bandwidth(filter_spec("fir", h = 1), tau0)$enbw, 50)
+})
+
+test_that("simulated filtered white noise has the exact AV (Monte Carlo)", {
+  set.seed(11)
+  n <- 2e5
+  for (sp in list(filter_spec("ma", L = 1.2), filter_spec("lp2", fc = 15, freq = 100))) {
+    x <- sim_filtered_white(n, tau0, 0.02, sp)
+    mm <- c(1, 2, 4, 8)
+    emp <- vapply(mm, function(k) {
+      s <- stats::filter(x, rep(1 / k, k), sides = 1)
+      s <- s[!is.na(s)]
+      d <- s[-(1:k)] - s[seq_len(length(s) - k)]
+      mean(d^2) / 2
+    }, 0)
+    expect_equal(emp, 0.02^2 * filter_av(mm, sp, tau0), tolerance = 0.03)
+  }
+})
+
+test_that("start values read from the raw ACF recover each family within 10%", {
+  set.seed(3)
+  n <- 2e5
+  w <- rnorm(n + 10)
+  # MA of 4 taps, with a random walk beside it
+  x <- as.numeric(stats::filter(w, rep(0.25, 4), sides = 1))[-(1:3)] +
+    cumsum(rnorm(n + 7, sd = 2e-3))
+  ev <- filter_evidence(x, 100)
+  expect_true(ev$filtered)
+  expect_equal(ev$length, 3L)
+  expect_equal(ev$start$ma$L, 4, tolerance = 0.1)
+  # first-order low-pass at 10 Hz
+  fc <- 10
+  a <- (2 - cos(2 * pi * fc / 100)) - sqrt((2 - cos(2 * pi * fc / 100))^2 - 1)
+  y <- as.numeric(stats::filter((1 - a) * w, a, method = "recursive"))[-(1:10)]
+  ev <- filter_evidence(y, 100)
+  expect_equal(ev$start$lp1$fc, fc, tolerance = 0.1)
+  # fractional average of L = 1.2 samples (an MA(1) with weights 1, w)
+  wt <- (1 - sqrt(1 - 4 * (1 / 6)^2)) / (2 / 6)
+  z <- as.numeric(stats::filter(w, c(1, wt), sides = 1))[-1]
+  ev <- filter_evidence(z, 100)
+  expect_equal(ev$start$ma$L, 1.2, tolerance = 0.1)
+  expect_equal(ev$length, 1L)
+  # Bartlett: two cascaded 5-tap averages (triangular taps over 9 samples)
+  tri <- c(1:5, 4:1) / 25
+  b <- as.numeric(stats::filter(w, tri, sides = 1))[-(1:8)]
+  expect_equal(filter_evidence(b, 100)$start$bartlett$L, 5)
+  # second-order Butterworth at 15 Hz (bilinear, written out here)
+  K <- tan(pi * 15 / 100)
+  den <- 1 + sqrt(2) * K + K^2
+  v <- as.numeric(stats::filter(w, c(1, 2, 1) * K^2 / den, sides = 1))[-(1:2)]
+  y2 <- as.numeric(stats::filter(v, c(-2 * (K^2 - 1) / den, -(1 - sqrt(2) * K + K^2) / den),
+                                 method = "recursive"))[-(1:50)]
+  expect_equal(filter_evidence(y2, 100)$start$lp2$fc, 15, tolerance = 0.1)
+})
+
+test_that("slow processes raise the ACF but are not read as a filter", {
+  hits <- 0L
+  for (seed in 1:10) {
+    set.seed(seed)
+    n <- 1e5
+    # white + random walk + Gauss-Markov (Tc = 2 s) strong at the sample level
+    phi <- exp(-0.01 / 2)
+    gm <- as.numeric(stats::filter(rnorm(n, sd = 0.3 * sqrt(1 - phi^2)), phi,
+                                   method = "recursive"))
+    x <- rnorm(n) + cumsum(rnorm(n, sd = 5e-3)) + gm
+    ev <- filter_evidence(x, 100)
+    # the raw lag-1 ACF is clearly positive ...
+    expect_gt(ev$acf$r[1], 0.05)
+    hits <- hits + ev$filtered
+  }
+  # ... but the filter's part is not
+  expect_lte(hits, 1L)
+})
+
+test_that("bad filter specifications are refused with classed errors", {
+  expect_error(filter_spec("boxcar", L = 2), class = "allanvar_error_argument")
+  expect_error(filter_spec("ma", L = 0.5), class = "allanvar_error_argument")
+  expect_error(filter_spec("lp2", fc = 60, freq = 100), class = "allanvar_error_argument")
+  expect_error(filter_spec("lp1", fc = 0, freq = 100), class = "allanvar_error_argument")
+  expect_error(filter_spec("fir", h = c(1, -1)), class = "allanvar_error_argument")
+  expect_snapshot(filter_spec("lp2", fc = 60, freq = 100), error = TRUE)
+})
+
+test_that("a curve alone gives the filter's start value from its first point", {
+  tau0 <- 0.01
+  for (sp in list(filter_spec("ma", L = 1.2), filter_spec("ma", L = 4),
+                  filter_spec("lp1", fc = 12, freq = 100),
+                  filter_spec("lp2", fc = 20, freq = 100))) {
+    q <- filter_av(1, sp, tau0) * tau0
+    st <- filter_start_from_curve(q, sp$family, 100)
+    par <- if (sp$family == "ma") "L" else "fc"
+    expect_equal(st[[par]], sp[[par]], tolerance = 1e-6)
+  }
+  expect_equal(filter_start_from_curve(q = 1 / (3 * 1.2 - 2), "ma", 100)$L, 1.2)
+  expect_null(filter_start_from_curve(1.1, "ma", 100))
+})
+
+test_that("the raw data support a fitted filter, and contradict one on white noise", {
+  set.seed(8)
+  n <- 1e5
+  w <- rnorm(n + 3, sd = 0.1)
+  x <- as.numeric(stats::filter(w, rep(0.25, 4), sides = 1))[-(1:3)]
+  fe <- filter_evidence(x, 100)
+  N <- 0.1 * sqrt(0.01)                 # white level of the input
+  ok <- filter_raw_support(filter_spec("ma", L = 4), N, fe, var(x), 100)
+  expect_true(ok$support)
+  wrong <- filter_raw_support(filter_spec("ma", L = 4), N,
+                              filter_evidence(rnorm(n, sd = 0.05), 100), 0.05^2, 100)
+  expect_false(wrong$support)
+})

@@ -1,0 +1,53 @@
+# The search and its settings: avfit_control(); a fit records whether it
+# converged.
+
+f <- 100
+nn <- 2^16
+ms <- unique(round(10^seq(0, log10(nn / 4), by = 0.1)))
+exact <- function(coef) data.frame(tau = ms / f, avar = av_model(ms / f, coef, f))
+
+test_that("avfit_control() holds every knob, with the documented defaults", {
+  ctl <- avfit_control()
+  expect_s3_class(ctl, "avfit_control")
+  expect_identical(unlist(ctl[c("grid_smooth", "grid_oscillatory", "grid_start",
+                                "maxit", "inner_maxit", "edf_passes")]),
+                   c(grid_smooth = 40L, grid_oscillatory = 120L, grid_start = 13L,
+                     maxit = 400L, inner_maxit = 100L, edf_passes = 2L))
+  expect_output(print(ctl), "grid_smooth")
+  # a list of arguments is accepted in avfit(control =)
+  fit <- avfit(exact(c(N = 0.01, gm1.sigma = 0.01, gm1.tc = 3)), c("N", "gm"),
+               n = nn, freq = f, bias_correct = FALSE,
+               control = list(grid_smooth = 20))
+  expect_identical(fit$control$grid_smooth, 20L)
+  expect_equal(unname(coef(fit)["gm1.tc"]), 3, tolerance = 1e-4)
+  expect_snapshot(error = TRUE, {
+    avfit_control(grid_smooth = 2)
+    avfit_control(maxit = 0)
+    avfit_control(start_span = 1)
+    avfit(exact(c(N = 0.01)), "N", n = nn, freq = f, control = "fast")
+  })
+})
+
+test_that("a fit that did not converge says so (maxit = 1)", {
+  tab <- exact(c(N = 0.01, gm1.sigma = 0.02, gm1.tc = 0.5, gm2.sigma = 0.005,
+                 gm2.tc = 100))
+  ok <- avfit(tab, c("N", "gm", "gm"), n = nn, freq = f)
+  expect_true(ok$convergence$converged)
+  expect_identical(ok$convergence$message, "converged")
+  expect_gt(ok$convergence$evaluations, 100)
+  expect_false(any(grepl("NOT converge", capture.output(print(ok)))))
+  # Nelder-Mead stopped after one iteration
+  bad <- avfit(tab, c("N", "gm", "gm"), n = nn, freq = f,
+               control = avfit_control(maxit = 1))
+  expect_false(bad$convergence$converged)
+  expect_match(bad$convergence$message, "Nelder-Mead stopped .* \\(maxit = 1\\)")
+  expect_output(print(bad), "The fit did NOT converge: Nelder-Mead")
+  expect_output(print(summary(bad)), "did NOT converge")
+  # the amplitude solve stopped after one Gauss-Newton step
+  x <- avsim(nn, f, N = 0.01, B = 0.002, K = 1e-4, seed = 8)
+  bad2 <- avfit(allan(x, f), control = avfit_control(inner_maxit = 1))
+  expect_false(bad2$convergence$converged)
+  expect_match(bad2$convergence$message, "amplitude solve stopped after 1 ")
+  expect_output(print(bad2), "did NOT converge")
+  expect_true(avfit(allan(x, f))$convergence$converged)
+})

@@ -1,0 +1,106 @@
+# Spectral lines and harmonic sets. Series built here with base R (sin,
+# sign, rnorm, cumsum), not with the package's simulator.
+
+test_that("a square wave is one source: f, 3f, 5f, each within the resolution", {
+  set.seed(21)
+  freq <- 100
+  n <- 2e5
+  t <- seq_len(n) / freq
+  f <- 0.73
+  x <- rnorm(n, sd = 0.5) + 0.1 * sign(sin(2 * pi * f * t + 1)) +
+    cumsum(rnorm(n, sd = 1e-3))
+  l <- harmonic_sets(find_lines(x, freq))
+  res <- attr(l, "resolution")
+  for (k in c(1, 3, 5)) {
+    j <- match_line(k * f, l)
+    expect_false(is.na(j))
+    expect_lte(abs(l$f0[j] - k * f), res)
+    expect_equal(l$harmonic[j], k)
+    expect_equal(l$kind[j], "line")
+  }
+  s <- l$source[match_line(f, l)]
+  # 3f, 5f (and 7f when it clears the threshold) join the fundamental
+  expect_gte(sum(l$source == s), 3L)
+  expect_true(all(l$harmonic[l$source == s] %% 2 == 1))
+  expect_equal(unique(l$pattern[l$source == s]), "odd")
+  # Fourier amplitudes of a square wave of amplitude a: 4a / (pi k)
+  expect_equal(l$amp[match_line(f, l)], 0.4 / pi, tolerance = 0.1)
+  # no line is matched halfway between harmonics (the old 25% rule would)
+  expect_true(is.na(match_line(4 * f, l)))
+})
+
+test_that("a resonance (a broad band) is not read as a line", {
+  set.seed(22)
+  freq <- 100
+  n <- 2e5
+  # damped oscillator at 20 Hz, Tc = 0.08 s, written as a real AR(2) here
+  r <- exp(-0.01 / 0.08)
+  w0 <- 2 * pi * 20 / freq
+  u <- rnorm(n)
+  z <- as.numeric(stats::filter(u, c(2 * r * cos(w0), -r^2), method = "recursive"))
+  x <- rnorm(n) + z / stats::sd(z) * 0.8
+  l <- find_lines(x, freq)
+  expect_false(any(l$kind == "line" & abs(l$f0 - 20) < 3))
+  b <- find_bands(x, freq)
+  expect_equal(nrow(b), 1L)
+  expect_equal(b$f_center, 20, tolerance = 0.05)
+  # a real line beside the band survives; bins of the band do not
+  y <- x + 0.1 * sin(2 * pi * 7.3 * seq_len(n) / freq)
+  l <- lines_outside_bands(find_lines(y, freq), find_bands(y, freq))
+  expect_false(is.na(match_line(7.3, l)))
+  expect_false(any(l$f0 > b$f_from & l$f0 < b$f_to))
+})
+
+test_that("white plus random walk shows no line in 10 seeds (at most one false alarm)", {
+  hits <- 0L
+  for (seed in 1:10) {
+    set.seed(100 + seed)
+    n <- 5e4
+    x <- rnorm(n) + cumsum(rnorm(n, sd = 0.01))
+    hits <- hits + (nrow(find_lines(x, 100)) > 0L)
+  }
+  expect_lte(hits, 1L)
+})
+
+test_that("the visible band follows the curve's tau range and the Nyquist frequency", {
+  b <- visible_band(0.01, 1000, 100)
+  expect_equal(unname(b), c(1e-3, 50))
+  b <- visible_band(0.1, 100)
+  expect_equal(unname(b), c(0.01, 5))
+  l <- data.frame(f0 = c(0.001, 0.5, 20, 60))
+  v <- visible_lines(l, 0.1, 100, 100)
+  expect_equal(v$visible, c(FALSE, TRUE, FALSE, FALSE))
+})
+
+test_that("the sparse running median is exact at its anchors", {
+  # anchors every width/4 bins (O(n) in all), linear in between
+  set.seed(5)
+  v <- rnorm(5000)
+  sm <- sparse_running_median(v, function(i) 41L)
+  ex <- stats::runmed(v, 41, endrule = "keep")
+  anchors <- seq(101, 4891, by = 10)
+  expect_equal(sm[anchors], ex[anchors])
+  expect_true(all(sm[anchors + 5] <= pmax(ex[anchors], ex[anchors + 10]) + 1e-12))
+})
+
+test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinusoid", {
+  set.seed(41)
+  n <- 2e5
+  freq <- 100
+  t <- seq_len(n) / freq
+  phi <- exp(-1 / (freq * 5))
+  gm <- as.numeric(stats::filter(rnorm(n, sd = 0.02 * sqrt(1 - phi^2)), phi,
+                                 method = "recursive"))
+  x <- rnorm(n, sd = 0.1) + gm + 0.03 * sin(2 * pi * 0.2 * t + 0.4)
+  # the line hides the exponential ACF ...
+  expect_true(is.na(acf_exponential(x, freq, 5)$tc))
+  l <- find_lines(x, freq)
+  expect_false(is.na(match_line(0.2, l)))
+  y <- remove_lines(x, freq, l$f0[l$kind == "line"])
+  # ... which shows once the line is taken out
+  a <- acf_exponential(y, freq, 5)
+  expect_equal(a$tc, 5, tolerance = 0.3)
+  expect_gt(a$z, 5)
+  # and the line is gone from the periodogram
+  expect_true(is.na(match_line(0.2, find_lines(y, freq))))
+})

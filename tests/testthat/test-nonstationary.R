@@ -1,0 +1,135 @@
+# Bias steps, warm-up and spikes. Series built here with base R: white
+# noise, a random walk (cumsum), a Gauss-Markov process (stats::filter),
+# plus the deterministic effect.
+
+gen_base <- function(n, white = 0.1, rw = 5e-5, seed) {
+  set.seed(seed)
+  rnorm(n, sd = white) + cumsum(rnorm(n, sd = rw))
+}
+
+test_that("a bias step is found: time within 1% of the record, size within 20%", {
+  n <- 2e5
+  freq <- 100
+  for (seed in 1:3) {
+    x <- gen_base(n, seed = seed)
+    at <- 123457
+    x[at:n] <- x[at:n] + 0.03
+    st <- detect_steps(x, freq)
+    expect_equal(nrow(st), 1L)
+    expect_lt(abs(st$index - at), 0.01 * n)
+    expect_equal(st$size, 0.03, tolerance = 0.2)
+    # the corrected series has no step left
+    expect_equal(nrow(detect_steps(remove_steps(x, st), freq)), 0L)
+  }
+})
+
+test_that("two steps of opposite sign are both found", {
+  n <- 2e5
+  x <- gen_base(n, seed = 7)
+  x[50001:n] <- x[50001:n] + 0.04
+  x[150001:n] <- x[150001:n] - 0.05
+  st <- detect_steps(x, 100)
+  expect_equal(nrow(st), 2L)
+  expect_lt(max(abs(st$index - c(50001, 150001))), 0.01 * n)
+  expect_equal(st$size, c(0.04, -0.05), tolerance = 0.2)
+})
+
+test_that("red noise and sinusoids are not read as steps (at most 1 in 10 seeds)", {
+  n <- 1e5
+  freq <- 100
+  t <- seq_len(n) / freq
+  hits <- 0L
+  for (seed in 1:10) {
+    set.seed(200 + seed)
+    phi <- exp(-0.01 / 30)
+    gm <- as.numeric(stats::filter(rnorm(n, sd = 0.05 * sqrt(1 - phi^2)), phi,
+                                   method = "recursive"))
+    # strong random walk, a slow Gauss-Markov and a slow sinusoid
+    x <- rnorm(n, sd = 0.1) + cumsum(rnorm(n, sd = 5e-4)) + gm +
+      0.05 * sin(2 * pi * 0.01 * t)
+    hits <- hits + (nrow(detect_steps(x, freq)) > 0L)
+  }
+  expect_lte(hits, 1L)
+})
+
+test_that("an exponential warm-up is found with its time constant within 30%", {
+  n <- 5e5
+  freq <- 100
+  t <- (seq_len(n) - 1) / freq
+  for (seed in 1:3) {
+    x <- gen_base(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / 100)
+    w <- detect_warmup(x, freq)
+    expect_true(w$present)
+    expect_equal(w$tc, 100, tolerance = 0.3)
+    expect_equal(w$amplitude, 0.1, tolerance = 0.3)
+  }
+  # controls: no warm-up in white + random walk
+  hits <- 0L
+  for (seed in 11:20) {
+    hits <- hits + detect_warmup(gen_base(2e5, rw = 2e-4, seed = seed), freq)$present
+  }
+  expect_lte(hits, 1L)
+})
+
+test_that("spikes are all found and none invented, also on quantized data", {
+  n <- 2e5
+  freq <- 100
+  for (seed in 1:3) {
+    x <- gen_base(n, seed = seed)
+    at <- sort(sample.int(n, 12))
+    x[at] <- x[at] + sample(c(-1, 1), 12, TRUE) * runif(12, 1, 3)
+    q <- round(x / 0.05) * 0.05              # on a 0.05 grid, sd = 2 steps
+    for (y in list(x, q)) {
+      sp <- detect_spikes(y, freq)
+      expect_equal(sp$index, at)
+    }
+    clean <- remove_spikes(x, detect_spikes(x, freq))
+    expect_equal(nrow(detect_spikes(clean, freq)), 0L)
+  }
+  # controls: Gaussian, filtered and coarsely quantized noise without spikes
+  hits <- 0L
+  for (seed in 1:10) {
+    x <- gen_base(n, seed = 300 + seed)
+    f <- as.numeric(stats::filter(x, rep(0.25, 4), sides = 1))[-(1:3)]
+    q <- round(x / 0.1) * 0.1                 # sd = 1 step
+    hits <- hits + (nrow(detect_spikes(x, freq)) > 0L) +
+      (nrow(detect_spikes(f, freq)) > 0L) + (nrow(detect_spikes(q, freq)) > 0L)
+  }
+  expect_lte(hits, 1L)
+})
+
+test_that("spikes inflate the short-tau Allan deviation; the correction removes it", {
+  n <- 2e5
+  x <- gen_base(n, seed = 9)
+  at <- sample.int(n, 40)
+  xs <- x
+  xs[at] <- xs[at] + 2
+  ba <- adev_before_after(xs, remove_spikes(xs, detect_spikes(xs, 100)), 100)
+  # 40 spikes of 2 in 2e5 samples of sd 0.1: AV(tau0) grows by
+  # 40 * 2^2 / (2e5 * 0.1^2) = 8%, ADEV by about 4%
+  expect_equal(ba$change[1], sqrt(1.08) - 1, tolerance = 0.3)
+  ref <- allan(x, 100, taus = ba$tau)$adev
+  expect_equal(ba$adev_corrected, ref, tolerance = 1e-3)
+})
+
+test_that("a ramp is not a step, and a short pulse is a transient, not two steps", {
+  n <- 2e5
+  freq <- 100
+  x <- gen_base(n, seed = 12)
+  # a ramp of 1 over 300 s in the middle: far above the noise at the
+  # longest windows (z ~ 20), but a slow change, not a step
+  r <- x + 1 * pmin(pmax((seq_len(n) - 90000) / 30000, 0), 1)
+  st <- detect_steps(r, freq)
+  expect_equal(nrow(st), 0L)
+  expect_gte(attr(st, "rejected"), 1L)
+  # a pulse of 0.05 lasting 30 s
+  p <- x
+  p[80001:83000] <- p[80001:83000] + 0.05
+  st <- detect_steps(p, freq)
+  expect_equal(nrow(st), 0L)
+  pu <- attr(st, "pulses")
+  expect_equal(nrow(pu), 1L)
+  expect_equal(pu$start, 800, tolerance = 0.01)
+  expect_equal(pu$end, 830, tolerance = 0.01)
+  expect_equal(pu$size, 0.05, tolerance = 0.2)
+})

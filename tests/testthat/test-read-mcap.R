@@ -1,0 +1,60 @@
+# MCAP files read without ROS; fixtures from tools/make-bag-fixtures.R.
+
+test_that("MCAP with uncompressed, lz4 and zstd chunks gives the CSV's record", {
+  ref <- read_imu(ros_fixture("imu.csv"))
+  for (cmp in c("none", "lz4", "zstd", "ros1")) {
+    if (cmp == "zstd" && !allanvar:::zstd_available_cpp()) {
+      expect_error(read_imu(ros_fixture("imu_zstd.mcap"), topic = "/imu0"),
+                   "libzstd", class = "allanvar_error_dependency")
+      next
+    }
+    r <- read_imu(ros_fixture(paste0("imu_", cmp, ".mcap")), topic = "/imu0")
+    expect_identical(r$layout, "mcap")
+    expect_identical(unname(r$data), unname(ref$data))
+    expect_identical(r$time, ref$time)
+    expect_identical(r$freq, ref$freq)
+    expect_equal(nrow(r$problems), 0L)
+  }
+})
+
+test_that("MCAP topics come from the summary, with their message counts", {
+  tp <- imu_topics(ros_fixture("imu_lz4.mcap"))
+  expect_identical(tp$topic, c("/imu0", "/imu1", "/temperature"))
+  expect_identical(tp$type[1], "sensor_msgs/msg/Imu")
+  expect_identical(tp$messages, c(300, 20, 5))
+  expect_identical(tp$encoding[1], "cdr")
+  expect_error(read_imu(ros_fixture("imu_lz4.mcap")), "2 IMU topics",
+               class = "allanvar_error_topic")
+})
+
+test_that("zstd decoding matches the reference zstd tool", {
+  skip_if_not(allanvar:::zstd_available_cpp(), "built without libzstd")
+  skip_if(!nzchar(Sys.which("zstd")), "the zstd command is not installed")
+  set.seed(2)
+  x <- c(as.raw(sample(0:255, 5e4, TRUE)), rep(charToRaw("imu"), 3e4))
+  i <- tempfile(); o <- tempfile()
+  on.exit(unlink(c(i, o)))
+  writeBin(x, i)
+  system2("zstd", c("-q", "-f", i, "-o", o))
+  expect_identical(allanvar:::zstd_decompress_cpp(readBin(o, "raw", file.size(o)),
+                                                  length(x)), x)
+})
+
+test_that("without libzstd only zstd chunks are refused, saying what to install", {
+  skip_if_not_installed("callr")
+  skip_if_not(installed_allanvar(), "needs the installed package")
+  f <- normalizePath(ros_fixture("imu_zstd.mcap"))
+  g <- normalizePath(ros_fixture("imu_lz4.mcap"))
+  res <- callr::r(function(f, g) {
+    e <- tryCatch(allanvar::read_imu(f, topic = "/imu0"), error = function(e) e)
+    list(avail = allanvar:::zstd_available_cpp(), class = class(e),
+         msg = conditionMessage(e),
+         lz4 = nrow(allanvar::read_imu(g, topic = "/imu0")$data))
+  }, args = list(f = f, g = g), env = c(callr::rcmd_safe_env(),
+                                         ALLANVAR_DISABLE_ZSTD = "1"),
+  libpath = .libPaths())
+  expect_false(res$avail)
+  expect_true("allanvar_error_dependency" %in% res$class)
+  expect_match(res$msg, "libzstd")
+  expect_equal(res$lz4, 300L)
+})

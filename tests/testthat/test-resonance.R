@@ -1,0 +1,77 @@
+# The resonance (narrow-band) process. References: the Allan difference as
+# a linear functional of the autocovariance (the covariance of two window
+# means written out as a double sum), numerical integration of the PSD, and
+# a real AR(2) generator written here.
+
+av_double_sum <- function(m, g) {
+  # AV = [Var(mean1) + Var(mean2) - 2 Cov(mean1, mean2)] / 2 with
+  # mean1, mean2 adjacent windows of m samples
+  vapply(m, function(mm) {
+    i <- 0:(mm - 1)
+    v <- sum(outer(i, i, function(a, b) g(abs(a - b)))) / mm^2
+    c12 <- sum(outer(i, i + mm, function(a, b) g(abs(a - b)))) / mm^2
+    (2 * v - 2 * c12) / 2
+  }, 0)
+}
+
+test_that("the exact AV of a resonance matches the autocovariance double sum", {
+  tau0 <- 0.01
+  g <- function(h) resonance_acf(h, tau0, 0.7, 19, 0.05)
+  m <- c(1, 2, 3, 5, 8, 13, 40)
+  expect_equal(resonance_av(m, tau0, 0.7, 19, 0.05), av_double_sum(m, g),
+               tolerance = 1e-10)
+  # f_r = 0 is the Gauss-Markov process
+  phi <- exp(-tau0 / 2)
+  gm <- 0.3^2 * (m - 3 * phi - m * phi^2 + 4 * phi^(m + 1) - phi^(2 * m + 1)) /
+    (m^2 * (1 - phi)^2)
+  expect_equal(resonance_av(m, tau0, 0.3, 0, 2), gm, tolerance = 1e-10)
+})
+
+test_that("the resonance PSD integrates to its variance and peaks at f_r", {
+  tau0 <- 0.01
+  f <- seq(-50, 50, length.out = 200001)
+  p <- resonance_psd(f, tau0, 0.7, 19, 0.05)
+  expect_equal(sum(p) * diff(f[1:2]), 0.49, tolerance = 1e-4)
+  pos <- f > 0
+  expect_equal(f[pos][which.max(p[pos])], 19, tolerance = 0.01)
+})
+
+test_that("simulated resonance has the stated variance and autocorrelation", {
+  set.seed(31)
+  x <- sim_resonance(2e5, 0.01, 0.7, 19, 0.05)
+  expect_equal(stats::var(x), 0.49, tolerance = 0.03)
+  r <- stats::acf(x, lag.max = 3, plot = FALSE)$acf[2:4]
+  expect_equal(r, resonance_acf(1:3, 0.01, 1, 19, 0.05), tolerance = 0.03)
+})
+
+test_that("band start values recover the resonance from an independent generator", {
+  set.seed(32)
+  n <- 2e5
+  r <- exp(-0.01 / 0.08)
+  w0 <- 2 * pi * 20 / 100
+  # Re of a complex AR(1) is the AR(2) below with an MA(1) input
+  e1 <- rnorm(n)
+  e2 <- rnorm(n)
+  u <- e1 - r * cos(w0) * c(0, e1[-n]) - r * sin(w0) * c(0, e2[-n])
+  z <- as.numeric(stats::filter(u, c(2 * r * cos(w0), -r^2), method = "recursive"))
+  z <- z / sqrt(1 / (1 - r^2))        # unit variance
+  x <- rnorm(n) + 0.8 * z
+  b <- find_bands(x, 100)
+  s <- resonance_start(b[1, ])
+  expect_equal(s$fr, 20, tolerance = 0.05)
+  expect_equal(s$sigma, 0.8, tolerance = 0.3)
+  expect_equal(s$tc, 0.08, tolerance = 0.5)
+})
+
+test_that("the raw data support a resonance where a band is, and contradict one elsewhere", {
+  set.seed(33)
+  n <- 2e5
+  r <- exp(-0.01 / 0.08)
+  w0 <- 2 * pi * 20 / 100
+  z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
+  x <- rnorm(n) + 0.8 * z / stats::sd(z)
+  b <- find_bands(x, 100)
+  expect_true(resonance_raw_support(0.8, 20, 0.08, b)$support)
+  expect_false(resonance_raw_support(0.8, 7, 0.08, b)$support)
+  expect_false(resonance_raw_support(0.8, 20, 0.08, find_bands(rnorm(n), 100))$support)
+})
