@@ -45,6 +45,30 @@ edf_interpolate_cpp <- function(m, sub, es, alpha) {
     .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
 }
 
+pdev_sums_cpp <- function(v, rate, m, threads) {
+    .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads)
+}
+
+theo1_sums_cpp <- function(v, rate, m, threads) {
+    .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads)
+}
+
+theo1_all_cpp <- function(v, rate, kmax_d) {
+    .Call(`_allanvar_theo1_all_cpp`, v, rate, kmax_d)
+}
+
+mtie_cpp <- function(v, rate, m) {
+    .Call(`_allanvar_mtie_cpp`, v, rate, m)
+}
+
+tierms_sums_cpp <- function(v, rate, m, threads) {
+    .Call(`_allanvar_tierms_sums_cpp`, v, rate, m, threads)
+}
+
+total_sums_cpp <- function(v, rate, m, hadamard, threads) {
+    .Call(`_allanvar_total_sums_cpp`, v, rate, m, hadamard, threads)
+}
+
 allan_type_table_cpp <- function() {
     .Call(`_allanvar_allan_type_table_cpp`)
 }

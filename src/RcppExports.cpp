@@ -152,6 +152,83 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// pdev_sums_cpp
+Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
+RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(pdev_sums_cpp(v, rate, m, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
+// theo1_sums_cpp
+Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
+RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_sums_cpp(v, rate, m, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
+// theo1_all_cpp
+Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate, double kmax_d);
+RcppExport SEXP _allanvar_theo1_all_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP kmax_dSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< double >::type kmax_d(kmax_dSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_all_cpp(v, rate, kmax_d));
+    return rcpp_result_gen;
+END_RCPP
+}
+// mtie_cpp
+Rcpp::NumericVector mtie_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m);
+RcppExport SEXP _allanvar_mtie_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    rcpp_result_gen = Rcpp::wrap(mtie_cpp(v, rate, m));
+    return rcpp_result_gen;
+END_RCPP
+}
+// tierms_sums_cpp
+Rcpp::NumericVector tierms_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
+RcppExport SEXP _allanvar_tierms_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(tierms_sums_cpp(v, rate, m, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
+// total_sums_cpp
+Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, bool hadamard, int threads);
+RcppExport SEXP _allanvar_total_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP hadamardSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< bool >::type hadamard(hadamardSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(total_sums_cpp(v, rate, m, hadamard, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
 // allan_type_table_cpp
 Rcpp::DataFrame allan_type_table_cpp();
 RcppExport SEXP _allanvar_allan_type_table_cpp() {
@@ -174,6 +251,12 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
+    {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 4},
+    {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 4},
+    {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 3},
+    {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
+    {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
+    {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 5},
     {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 0},
     {NULL, NULL, 0}
 };

@@ -1,0 +1,109 @@
+// Parabolic deviation of allan(type = "pdev") (Vernotte, Lenczner,
+// Bourgeois & Rubiola 2016, "The parabolic variance (PVAR): a wavelet
+// variance based on the least-square fit", IEEE TUFFC 63(4), eq. 16 as
+// rewritten by Vernotte et al. 2020):
+//   PVAR(m tau0) = 72 / (M m^4 (m tau0)^2) sum_{i<M} S_i^2,  M = L - 2m,
+//   S_i = sum_{k<m} ((m - 1)/2 - k) (x(i + k) - x(i + m + k)),
+// and PVAR(tau0) = AVAR(tau0) (the weights vanish at m = 1).
+// With P the prefix sums of x and PP those of P, 2 S_i = F(i) - F(i + m),
+// F(i) = 2 (PP(i + m) - PP(i + 1)) - (m - 1) (P(i) + P(i + m)): O(1) per
+// term. P and PP are built per block of about 2m terms from the local phase
+// (src/local-phase.h; PVAR ignores a linear phase term), so they stay of
+// the size of the local wander and the differences lose nothing.
+#include "local-phase.h"
+#include "parallel.h"
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace {
+
+struct Item {
+  size_t tau;
+  R_xlen_t i0, i1;  // terms [i0, i1)
+};
+
+}  // namespace
+
+// Sums of (2 S_i)^2 (m >= 2) or of squared second differences (m = 1) over
+// the terms of every m, for one channel.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
+                                  const Rcpp::NumericVector& m, int threads) {
+  const allanvar::PhaseInput in{v.begin(), v.size(), rate};
+  const R_xlen_t L = in.length();
+  const std::vector<double> ms(m.begin(), m.end());
+  std::vector<Item> items;
+  for (size_t t = 0; t < ms.size(); ++t) {
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
+    const R_xlen_t M = mm == 1 ? L - 2 : L - 2 * mm;
+    if (mm < 1 || M < 1) continue;
+    const R_xlen_t B = std::max<R_xlen_t>(2 * mm, 1024);
+    for (R_xlen_t i0 = 0; i0 < M; i0 += B)
+      items.push_back(Item{t, i0, std::min(M, i0 + B)});
+  }
+  std::vector<double> part(items.size(), 0.0);
+  const int nw = std::max(1, threads);
+  std::vector<std::vector<double> > rbuf(nw), pbuf(nw), ppbuf(nw);
+  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nw,
+                         [&](R_xlen_t it, int w) {
+    const Item& I = items[it];
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[I.tau]);
+    const R_xlen_t nb = I.i1 - I.i0;
+    std::vector<double>& r = rbuf[w];
+    if (mm == 1) {
+      r.resize(nb + 2);
+      allanvar::local_phase(in, I.i0, nb + 2, r.data());
+      double s = 0;
+      for (R_xlen_t i = 0; i < nb; ++i) {
+        const double d = (r[i + 2] + r[i]) - 2.0 * r[i + 1];
+        s += d * d;
+      }
+      part[it] = s;
+      return;
+    }
+    const R_xlen_t len = nb + 2 * mm - 1;  // phase points used
+    r.resize(len);
+    allanvar::local_phase(in, I.i0, len, r.data());
+    std::vector<double>& P = pbuf[w];
+    std::vector<double>& PP = ppbuf[w];
+    P.resize(len + 1);
+    PP.resize(len + 1);
+    P[0] = PP[0] = 0;
+    for (R_xlen_t j = 0; j < len; ++j) {
+      P[j + 1] = P[j] + r[j];
+      PP[j + 1] = PP[j] + P[j];
+    }
+    const double k1 = static_cast<double>(mm - 1);
+    auto F = [&](R_xlen_t i) {
+      return 2.0 * (PP[i + mm] - PP[i + 1]) - k1 * (P[i] + P[i + mm]);
+    };
+    double s0 = 0, s1 = 0;
+    R_xlen_t i = 0;
+    for (; i + 2 <= nb; i += 2) {
+      const double d0 = F(i) - F(i + mm);
+      const double d1 = F(i + 1) - F(i + 1 + mm);
+      s0 += d0 * d0;
+      s1 += d1 * d1;
+    }
+    for (; i < nb; ++i) {
+      const double d = F(i) - F(i + mm);
+      s0 += d * d;
+    }
+    part[it] = s0 + s1;
+  });
+  Rcpp::NumericVector out(ms.size(), NA_REAL);
+  std::vector<double> tot(ms.size(), 0.0), cor(ms.size(), 0.0);
+  std::vector<bool> any(ms.size(), false);
+  for (size_t it = 0; it < items.size(); ++it) {
+    const size_t t = items[it].tau;
+    double s, e;
+    allanvar::phase_two_sum(tot[t], part[it], s, e);
+    tot[t] = s;
+    cor[t] += e;
+    any[t] = true;
+  }
+  for (size_t t = 0; t < ms.size(); ++t)
+    if (any[t]) out[t] = tot[t] + cor[t];
+  return out;
+}
