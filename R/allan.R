@@ -109,7 +109,7 @@
 #' plot(av)
 #' allan(cbind(x = y, z = 2 * y), type = "modified", taus = "decade")
 allan <- function(x, freq, taus = "octave", type = "overlapping",
-                  input = "rate", conf = 0.683) {
+                  input = "rate", conf = 0.683, debias = TRUE) {
   check_present(missing(x), "x", "the samples")
   if (missing(freq)) {
     if (!stats::is.ts(x)) {
@@ -119,9 +119,13 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     freq <- stats::frequency(x)
   }
   freq <- check_freq(freq)
-  type <- check_choice(type, allan_types, "type")
+  type <- allan_canonical_type(check_choice(type, allan_type_names(), "type"))
   input <- check_choice(input, c("rate", "integrated"), "input")
   conf <- check_number(conf, "conf", 0, 1, open = TRUE)
+  if (type %in% allan_extra_types) {
+    debias <- check_true_false(debias, "debias")
+    return(allan_extra(x, freq, taus, type, input, conf, debias))
+  }
   ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)
   N <- ch$N
   rate <- input == "rate"
