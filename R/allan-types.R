@@ -4,6 +4,91 @@
 # Allan-family types. allan() checks its arguments and hands these types to
 # allan_extra(), which returns the same data frame as for the other types.
 
+#' @name allan
+#' @rdname allan
+#' @section Further statistics:
+#' The phase \eqn{x} is as above (for `input = "rate"`, in the rate unit
+#' times seconds: seconds for fractional-frequency input), \eqn{L} its number
+#' of points, \eqn{\tau = m\tau_0}.
+#' * `"tdev"`: time deviation, \eqn{\tau \cdot}MDEV\eqn{/\sqrt 3} (NIST SP
+#'   1065 eq. 15), in the phase unit; EDF and noise type of `"modified"`.
+#' * `"mtotdev"`, `"ttotdev"`, `"htotdev"`: the modified, time and Hadamard
+#'   total deviations (SP 1065 eqs. 27-29): for each window of \eqn{3m}
+#'   phase points (frequency values for `"htotdev"`) the line through the
+#'   means of its halves is removed, the window is extended at both ends by
+#'   even reflection, and the modified (Hadamard) second (third) differences
+#'   of all \eqn{6m} positions are averaged; \eqn{L - 3m + 1} windows
+#'   (\eqn{L - 3m} for `"htotdev"`, which is the overlapping Hadamard
+#'   deviation at \eqn{m = 1}). `"ttotdev"` is \eqn{\tau/\sqrt3} times
+#'   `"mtotdev"`, in the phase unit. Largest \eqn{m}: \eqn{L/3}.
+#' * `"theo1"`: Theo1 (SP 1065 eq. 30), defined at even \eqn{m}, for the
+#'   averaging time \eqn{\tau = 0.75\,m\tau_0}, which is what the `tau`
+#'   column reports (`m` keeps the averaging factor). Grids (`"octave"`,
+#'   `"decade"`, `"all"`) keep their even \eqn{m} (octave: 2, 4, 8, ...;
+#'   \eqn{m \le L - 1}); a number of points per decade is rounded to even
+#'   \eqn{m}; tau in seconds are Theo1 averaging times, \eqn{m = 2\,
+#'   \mathrm{round}(\tau f / 1.5)}. `n` is the number of squared terms,
+#'   \eqn{(L - m) m / 2}.
+#' * `"theobr"`: Theo1 times TheoBR's bias-removal factor (SP 1065 eq. 33),
+#'   the mean of \eqn{\mathrm{AVAR}(9 + 3i) / \mathrm{Theo1}(12 + 4i)} over
+#'   \eqn{i = 0, \dots, \lfloor L/6 - 3 \rfloor}: an estimate of the Allan
+#'   variance to \eqn{\tau = 0.75 (L-1)\tau_0} without a noise model
+#'   (Howe & Tasset 2004; as Stable32).
+#' * `"theoh"`: the hybrid of SP 1065 sec. 5.2.17: the overlapping Allan
+#'   deviation at \eqn{m \le 0.2 (L - 1)}, then TheoBR at the even \eqn{m}
+#'   whose \eqn{0.75 m} exceeds the last Allan \eqn{m} (so the `tau` column
+#'   jumps from \eqn{m\tau_0} to \eqn{0.75 m\tau_0}). Numeric `taus` up to
+#'   \eqn{0.2 (L-1)\tau_0} select Allan rows, longer ones TheoBR rows.
+#' * `"mtie"`: the largest peak-to-peak phase excursion in any window of
+#'   \eqn{m + 1} points (SP 1065 sec. 5.2.18; Stable32's MTIE); `n` is the
+#'   number of windows, \eqn{L - m}.
+#' * `"tierms"`: \eqn{\sqrt{\langle (x_{i+m} - x_i)^2 \rangle}} over the
+#'   \eqn{L - m} pairs (SP 1065 sec. 5.2.19).
+#' * `"pdev"`: the parabolic deviation of Vernotte et al. (2016), from the
+#'   least-squares frequency estimates over two adjacent intervals;
+#'   \eqn{L - 2m} terms; equal to `"overlapping"` at \eqn{m = 1}.
+#'
+#' For `"mtie"` and `"tierms"` the `adev` column holds the time error
+#' itself (`avar` its square) and there is no interval (`lower`, `upper`,
+#' `edf` and `alpha` are `NA`); for `"tdev"` and `"ttotdev"` it is a time
+#' deviation. `print()` says the unit and `plot()` labels its axis.
+#'
+#' **Bias corrections** (`debias = TRUE`, the default, NIST SP 1065's
+#' convention and that of its NBS14 table): `"mtotdev"` and `"ttotdev"`
+#' variances are divided by 0.94, 0.83, 0.73, 0.70, 0.69 for noise
+#' exponents \eqn{\alpha = 2, \dots, -2}; `"htotdev"` (for \eqn{m > 1}) by
+#' \eqn{1 + a}, \eqn{a} = -0.005, -0.149, -0.229, -0.283, -0.321 for
+#' \eqn{\alpha = 0, \dots, -4}; `"theo1"` is multiplied by
+#' \eqn{a + b/(0.75m)^c}, Howe & Tasset's ratio of the Allan variance to
+#' Theo1 (1 for white FM). The noise type is the one identified at each
+#' tau (column `alpha`). `debias = FALSE` gives the raw estimators, as
+#' Stable32 1.60 reports MTOT and TTOT (Stable32 1.53 corrected them, and
+#' corrects HTOT; Python allantools never corrects). `"theobr"` and
+#' `"theoh"` are bias-removed by construction.
+#'
+#' **Intervals** use the EDF approximations published for each statistic:
+#' MTOT and TTOT \eqn{b L/m - c} (SP 1065 Table 11), HTOT
+#' \eqn{(L/m)/(b_0 + b_1 m/L)} for FM noise from \eqn{m = 16} (Howe et al.
+#' 2000) and the overlapping Allan EDF otherwise, Theo1 and TheoBR Howe and
+#' Peppler's formulas in \eqn{0.75 m}, PDEV the modified Allan EDF.
+#'
+#' **Cost**: MTIE builds a table of window extremes level by level
+#' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
+#' \eqn{O(L)} per tau; the Total family \eqn{O(L m)} per tau; Theo1
+#' \eqn{O(L m)} per tau, and TheoBR's factor \eqn{O(L^2)} once (Lewis's
+#' recurrence, evaluated in double-double arithmetic).
+#' @param debias For `"mtotdev"`, `"ttotdev"`, `"htotdev"` and `"theo1"`:
+#'   apply NIST SP 1065's noise-dependent bias correction (default `TRUE`);
+#'   see "Further statistics". Ignored by the other types.
+#' @examples
+#' # clock phase (seconds) sampled at 1 Hz: time deviation and MTIE
+#' set.seed(2)
+#' x <- cumsum(rnorm(2000, sd = 1e-9))
+#' allan(x, 1, type = "tdev", input = "integrated")
+#' allan(x, 1, type = "mtie", input = "integrated")
+#' allan(x, 1, type = "theo1", input = "integrated", taus = "decade")
+NULL
+
 # The further types, in the order the documentation lists them.
 allan_extra_types <- c("tdev", "mtotdev", "ttotdev", "htotdev", "theo1",
                        "theobr", "theoh", "mtie", "tierms", "pdev")
@@ -16,6 +101,48 @@ allan_type_aliases <- c(adev = "standard", oadev = "overlapping",
 # Every name `type` accepts.
 allan_type_names <- function() {
   c(allan_types, allan_extra_types, names(allan_type_aliases))
+}
+
+# What each further type's deviation column holds, for print() and plot().
+allan_type_title <- function(type) {
+  switch(type,
+    tdev = "time deviation TDEV",
+    mtotdev = "modified total deviation",
+    ttotdev = "time total deviation TTOT",
+    htotdev = "Hadamard total deviation",
+    theo1 = "Theo1 deviation",
+    theobr = "bias-removed Theo1 deviation (TheoBR)",
+    theoh = "TheoH deviation (Allan, then TheoBR)",
+    mtie = "maximum time interval error MTIE",
+    tierms = "rms time interval error TIE rms",
+    pdev = "parabolic deviation",
+    type
+  )
+}
+
+# The header print() shows for a further type: the statistic, its unit for
+# the time-error types, the bias convention.
+allan_extra_header <- function(x) {
+  a <- attributes(x)
+  type <- a$type
+  nch <- if ("channel" %in% names(x)) length(unique(x$channel)) else 1L
+  time <- identical(allan_type_prop(type, "unit"), "time")
+  sprintf("<allan> %s of %s input: N = %s at %s Hz%s%s%s%s",
+          allan_type_title(type), a$input, format(a$N, big.mark = ","),
+          format(a$freq), if (nch > 1L) sprintf(", %d channels", nch) else "",
+          if (type %in% c("mtie", "tierms")) "" else
+            sprintf("; %s%% intervals", format(100 * a$conf)),
+          if (time) paste0("; `adev` is a time in the phase unit (seconds ",
+                           "for phase in s or fractional-frequency input)")
+          else "",
+          if (isTRUE(a$debias)) "; bias-corrected (NIST SP 1065)" else
+            if (identical(a$debias, FALSE)) "; not bias-corrected" else "")
+}
+
+# The y-axis label plot() uses for a further type.
+allan_extra_ylab <- function(type) {
+  time <- identical(allan_type_prop(type, "unit"), "time")
+  paste0(allan_type_title(type), if (time) " (s)" else "")
 }
 
 # The canonical name of a type (aliases resolved).
@@ -73,7 +200,7 @@ allan_theo_taus <- function(taus, freq, maxm) {
     if (is.character(taus)) return(m[m %% 2 == 0])
     return(sort(unique(pmax(2, 2 * round(m / 2)))))
   }
-  m0 <- allan_taus(taus, freq, .Machine$integer.max)  # validates `taus`
+  m0 <- suppressWarnings(allan_taus(taus, freq, .Machine$integer.max))  # validates
   if (!length(m0)) return(numeric(0))
   m <- 2 * round(as.double(taus) * freq / 1.5)
   bad <- m < 2 | m > maxm
@@ -87,12 +214,12 @@ allan_theo_taus <- function(taus, freq, maxm) {
 }
 
 # TheoH's two parts (NIST SP 1065 sec. 5.2.17): the overlapping Allan
-# variance at m <= 0.2 (L - 1) (up to 20% of the record), then ThéoBR at the
+# variance at m <= 0.2 (L - 1) (up to 20% of the record), then TheoBR at the
 # even m whose Theo1 averaging time 0.75 m lies beyond the last Allan m.
 allan_theoh_taus <- function(taus, freq, L) {
   k <- floor(0.2 * (L - 1))
   if (is.numeric(taus) && (length(taus) > 1L || inherits(taus, "AsIs"))) {
-    m0 <- allan_taus(taus, freq, .Machine$integer.max)
+    m0 <- suppressWarnings(allan_taus(taus, freq, .Machine$integer.max))
     if (!length(m0)) return(list(avar = numeric(0), theo = numeric(0)))
     t <- as.double(taus) * freq
     ma <- round(t[t <= k])
@@ -102,7 +229,7 @@ allan_theoh_taus <- function(taus, freq, L) {
     ma <- ma[ma >= 1]
     if (length(t) > length(ma) + length(mt)) {
       warn(length(t) - length(ma) - length(mt),
-           " of the requested tau values lie outside the ThéoH range and ",
+           " of the requested tau values lie outside the TheoH range and ",
            "were dropped.", class = "taus_dropped")
     }
     return(list(avar = sort(unique(ma)), theo = sort(unique(mt))))
@@ -148,7 +275,7 @@ debias_factor <- function(type, alpha, m) {
 #  * HTOT: (N/m) / (b0 + b1 m/N) for the FM noises from m = 16 (Howe et
 #    al. 2000, Table 1, rows alpha = 0, -1, ..., -4: the mapping Stable32's
 #    limits confirm), else the overlapping Allan EDF as Stable32 does;
-#  * Theo1 (and ThéoBR): Howe & Peppler's formulas in tau = 0.75 m;
+#  * Theo1 (and TheoBR): Howe & Peppler's formulas in tau = 0.75 m;
 #  * PDEV: the modified Allan EDF (the estimators share their overlapping
 #    structure; Vernotte et al. 2016 give no closed form).
 # N is the number of phase points; alpha the noise exponent of each row.
@@ -315,7 +442,7 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
         } else {
           kf <- theobr_factor(v, freq, rate, L)
           if (!is.finite(kf)) {
-            abort("ThéoBR needs at least 19 phase points (", L, " given).",
+            abort("TheoBR needs at least 19 phase points (", L, " given).",
                   class = "argument")
           }
           t1 <- t1 * kf
@@ -355,7 +482,7 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   a$alpha[match(mm, a$m)]
 }
 
-# ThéoBR's bias-removal factor (NIST SP 1065 eq. 33): the mean over
+# TheoBR's bias-removal factor (NIST SP 1065 eq. 33): the mean over
 # i = 0..n, n = floor(N/6 - 3), of AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),
 # two estimates at the same averaging time. Theo1 at every needed m comes
 # from the all-k recurrence (src/theo.cpp), AVAR from the overlapping

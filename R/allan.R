@@ -88,7 +88,11 @@
 #'   vector of tau in seconds (rounded to whole clusters; wrap a single tau
 #'   in [I()]). Reported tau is \eqn{m / freq}.
 #' @param type One of `"overlapping"` (default), `"standard"`,
-#'   `"modified"`, `"hadamard"`, `"ohadamard"`, `"total"`.
+#'   `"modified"`, `"hadamard"`, `"ohadamard"`, `"total"`, or a further
+#'   statistic (`"tdev"`, `"mtotdev"`, `"ttotdev"`, `"htotdev"`, `"theo1"`,
+#'   `"theobr"`, `"theoh"`, `"mtie"`, `"tierms"`, `"pdev"`; see "Further
+#'   statistics"). allantools' names are accepted too: `"adev"`, `"oadev"`,
+#'   `"mdev"`, `"hdev"`, `"ohdev"`, `"totdev"`.
 #' @param input `"rate"` (default) or `"integrated"`.
 #' @param conf Confidence level of the interval, in (0, 1); the default
 #'   0.683 is one sigma.
@@ -225,6 +229,7 @@ print.allan <- function(x, digits = 4, ...) {
 
 allan_header <- function(x) {
   a <- attributes(x)
+  if (a$type %in% allan_extra_types) return(allan_extra_header(x))
   nch <- if ("channel" %in% names(x)) length(unique(x$channel)) else 1L
   sprintf("<allan> %s variance of %s input: N = %s at %s Hz%s; %s%% intervals",
           a$type, a$input, format(a$N, big.mark = ","), format(a$freq),
@@ -284,9 +289,12 @@ plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
     ylab <- switch(type, standard = , overlapping = "Allan deviation",
                    modified = "modified Allan deviation",
                    hadamard = , ohadamard = "Hadamard deviation",
-                   total = "total deviation")
+                   total = "total deviation", allan_extra_ylab(type))
   }
-  if (is.null(main)) main <- paste0(type, " (", 100 * attr(x, "conf"), "% CI)")
+  if (is.null(main)) {
+    main <- if (type %in% c("mtie", "tierms")) type else
+      paste0(type, " (", 100 * attr(x, "conf"), "% CI)")
+  }
   ok <- is.finite(d$adev) & d$adev > 0
   ylim <- range(c(d$lower[ok], d$upper[ok], d$adev[ok]), finite = TRUE)
   graphics::plot(d$tau[ok], d$adev[ok], type = "n", log = "xy", xlab = xlab,
