@@ -1,5 +1,5 @@
 # Compare allan()'s further statistics (TDEV, MTOT, TTOT, HTOT, Theo1,
-# ThéoH, MTIE, TIE rms) with every Stable32 run in the test suites of the
+# TheoH, MTIE, TIE rms) with every Stable32 run in the test suites of the
 # Python packages allantools (github.com/aewallin/allantools, tests/) and
 # allantoolkit (gitlab/github amv213/allantoolkit, tests/assets/).
 #
@@ -131,9 +131,9 @@ stable32_type_cases <- function() {
 # Types with a noise-dependent bias correction are computed raw and
 # compared both raw and corrected with the noise type Stable32 printed (the
 # runs differ: Stable32 1.53 corrected MTOT and TTOT, 1.60 did not); the
-# convention that matches more rows is the file's. A ThéoH table is
+# convention that matches more rows is the file's. A TheoH table is
 # compared column by column: its Allan part with the overlapping AVAR, its
-# Thêo1 column with allan(type = "theobr").
+# Theo1 column with allan(type = "theobr").
 check_stable32_run <- function(x, tau0, kind, run, path) {
   tab <- read_stable32(path)
   v <- tab$values
@@ -151,7 +151,7 @@ check_stable32_run <- function(x, tau0, kind, run, path) {
                alpha = alpha, convention = convention)
   }
   if (ncol(v) == 8L) {
-    # ThéoH: AF, tau, #, ThéoH tau, sigma, Thêo1 dev, min, max
+    # TheoH: AF, tau, #, TheoH tau, sigma, Theo1 dev, min, max
     out <- list()
     ia <- which(v[, 5] > 0)
     if (length(ia)) {
@@ -267,7 +267,7 @@ check_stable32_types <- function(roots = strsplit(Sys.getenv("ALLANVAR_PEER_DATA
   # last-digit ties: within 0.51 of a unit (Stable32 rounds a few of these
   # the other way)
   d$value_tie <- ok_s32 & !is.na(d$ours) & !d$value_ok & u <= 0.51
-  # Stable32 prints Thêo1's count with 5 digits, and the record length as
+  # Stable32 prints Theo1's count with 5 digits, and the record length as
   # the count of its non-"fast" MTIE runs
   tol <- ifelse(d$type == "theo1", 0.5 * 10^(floor(log10(pmax(1, d$n_s32))) - 4),
                 0)
