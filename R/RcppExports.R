@@ -65,8 +65,8 @@ tierms_sums_cpp <- function(v, rate, m, threads) {
     .Call(`_allanvar_tierms_sums_cpp`, v, rate, m, threads)
 }
 
-total_sums_cpp <- function(v, rate, m, hadamard, threads) {
-    .Call(`_allanvar_total_sums_cpp`, v, rate, m, hadamard, threads)
+total_sums_cpp <- function(v, rate, m, hadamard, threads, method = 0L) {
+    .Call(`_allanvar_total_sums_cpp`, v, rate, m, hadamard, threads, method)
 }
 
 allan_type_table_cpp <- function() {

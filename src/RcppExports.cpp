@@ -216,8 +216,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // total_sums_cpp
-Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, bool hadamard, int threads);
-RcppExport SEXP _allanvar_total_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP hadamardSEXP, SEXP threadsSEXP) {
+Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, bool hadamard, int threads, int method);
+RcppExport SEXP _allanvar_total_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP hadamardSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
@@ -225,7 +225,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< bool >::type hadamard(hadamardSEXP);
     Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(total_sums_cpp(v, rate, m, hadamard, threads));
+    Rcpp::traits::input_parameter< int >::type method(methodSEXP);
+    rcpp_result_gen = Rcpp::wrap(total_sums_cpp(v, rate, m, hadamard, threads, method));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -256,7 +257,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 3},
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
     {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
-    {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 5},
+    {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 6},
     {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 0},
     {NULL, NULL, 0}
 };

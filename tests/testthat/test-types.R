@@ -271,3 +271,21 @@ test_that("print says the statistic and the unit; plot labels the axis", {
     expect_true(labels[[ty]] %in% s, label = ty)
   }
 })
+
+test_that("the Total family's closed form equals its direct evaluation", {
+  set.seed(15)
+  N <- 4000
+  sets <- list(wpm = rnorm(N), wfm = cumsum(rnorm(N)),
+               rwfm = cumsum(cumsum(rnorm(N))),
+               drift = 1e6 + 1e3 * (1:N) + 0.01 * (1:N)^2 + cumsum(rnorm(N)))
+  m <- c(8, 9, 16, 31, 100, 257, 1000, 1333)
+  for (nm in names(sets)) {
+    x <- sets[[nm]]
+    for (h in c(FALSE, TRUE)) {
+      mm <- if (h) m[m <= (N - 1) / 3] else m
+      direct <- total_sums_cpp(x, FALSE, mm, h, 2L, 1L)
+      fast <- total_sums_cpp(x, FALSE, mm, h, 2L, 2L)
+      expect_lt(max(abs(fast / direct - 1)), 1e-10, label = paste(nm, h))
+    }
+  }
+})
