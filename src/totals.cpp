@@ -199,7 +199,7 @@ Plan make_plan(R_xlen_t m) {
 }
 
 struct FastScratch {
-  std::vector<double> Z, ZZ, M1, M2, PE;
+  std::vector<double> Z, ZZ, M1, M2, PE, zn, beta, T;
   std::vector<std::vector<double> > LP;  // lags 0, m, 2m
 };
 
@@ -244,23 +244,40 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
     return 0.5 * (m2 + (sg - 2 * A) * m1 + (A * A - sg * A) * m0);
   };
   const double bden = static_cast<double>(h) * static_cast<double>(n3 - h);
+  // per window: Z(n), the slope beta_n and T_n; then one pass over the
+  // windows per plan item, so that each pass streams through a few arrays
+  // (a pass per window over all items would touch ~250 scattered places)
+  w.zn.resize(nb);
+  w.beta.resize(nb);
+  w.T.resize(nb);
   double total = 0;
   for (R_xlen_t n = 0; n < nb; ++n) {
     const double zn = Z[n];
     const double beta =
         ((Z[n + n3] - Z[n + n3 - h]) - (Z[n + h] - Z[n])) / bden;
     const double T = (Z[n + n3] - zn) - beta * qk(n3 - 1);
-    double q = P.tt * T * T;
-    for (const PlanItem& it : P.items) {
-      const R_xlen_t a = it.a, b = it.b;
-      const double cnt = static_cast<double>(b - a + 1);
-      double v;
-      if (it.kind == ITEM_TS) {
-        const double sumS = W(n + a + 1, n + b + 1) - cnt * zn - beta * it.q1;
-        v = T * sumS;
-      } else if (it.kind == ITEM_SAME) {
-        const R_xlen_t c = it.c;
-        const std::vector<double>& L = w.LP[c / m];
+    w.zn[n] = zn;
+    w.beta[n] = beta;
+    w.T[n] = T;
+    total += P.tt * T * T;
+  }
+  const double* zv = w.zn.data();
+  const double* bv = w.beta.data();
+  const double* Tv = w.T.data();
+  for (const PlanItem& it : P.items) {
+    const R_xlen_t a = it.a, b = it.b;
+    const double cnt = static_cast<double>(b - a + 1);
+    double acc = 0;
+    if (it.kind == ITEM_TS) {
+      for (R_xlen_t n = 0; n < nb; ++n) {
+        const double sumS = W(n + a + 1, n + b + 1) - cnt * zv[n] - bv[n] * it.q1;
+        acc += Tv[n] * sumS;
+      }
+    } else if (it.kind == ITEM_SAME) {
+      const R_xlen_t c = it.c;
+      const double* L = w.LP[c / m].data();
+      for (R_xlen_t n = 0; n < nb; ++n) {
+        const double zn = zv[n], beta = bv[n];
         const double uu = L[n + b + 2] - L[n + a + 1] -
                           zn * (W(n + a + 1, n + b + 1) + W(n + a + 1 - c, n + b + 1 - c)) +
                           cnt * zn * zn;
@@ -270,9 +287,12 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
         // sum q_{t-c} U_t: u = n + t + 1, t - c = u - (n + 1 + c)
         const double qu2 = MQ(static_cast<double>(n + 1 + c), 1, n + a + 1,
                               n + b + 1) - zn * it.q2;
-        v = uu - beta * (qu1 + qu2) + beta * beta * it.qq;
-      } else {
-        const R_xlen_t e = it.c;
+        acc += uu - beta * (qu1 + qu2) + beta * beta * it.qq;
+      }
+    } else {
+      const R_xlen_t e = it.c;
+      for (R_xlen_t n = 0; n < nb; ++n) {
+        const double zn = zv[n], beta = bv[n];
         // the anti-diagonal products of Z are added for the whole block below
         const double uu = -zn * (W(n + a + 1, n + b + 1) + W(n + e + 1 - b, n + e + 1 - a)) +
                           cnt * zn * zn;
@@ -281,11 +301,10 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
         const double qu1 = MQ(A, -1, n + e + 1 - b, n + e + 1 - a) - zn * it.q1;
         // sum q_{e-t} U_t: u = n + t + 1, e - t = A - u
         const double qu2 = MQ(A, -1, n + a + 1, n + b + 1) - zn * it.q2;
-        v = uu - beta * (qu1 + qu2) + beta * beta * it.qq;
+        acc += uu - beta * (qu1 + qu2) + beta * beta * it.qq;
       }
-      q += it.coef * v;
     }
-    total += q;
+    total += it.coef * acc;
   }
   // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t)
   const double* PE = w.PE.data();
@@ -323,7 +342,11 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
     const R_xlen_t nwin = hadamard ? L - 3 * mm : L - 3 * mm + 1;
     if (mm < 1 || nwin < 1) continue;
-    const R_xlen_t B = std::max<R_xlen_t>(1, (R_xlen_t(1) << 16) / mm);
+    // direct: about 2^16 m work per item; closed form: whole sub-blocks
+    // of 4m windows (its cost per sub-block is O(m))
+    const bool fst = method == 2 || (method == 0 && mm >= kFastFrom);
+    const R_xlen_t B = fst ? 4 * mm * std::max<R_xlen_t>(1, 4096 / mm)
+                           : std::max<R_xlen_t>(1, (R_xlen_t(1) << 16) / mm);
     for (R_xlen_t n0 = 0; n0 < nwin; n0 += B)
       items.push_back(Item{t, n0, std::min(nwin, n0 + B)});
   }
