@@ -329,8 +329,11 @@ allan_extra <- function(x, freq, taus, type, input, conf, debias) {
   ch <- allan_channels(x, min_n = if (rate) 2L else 3L)
   N <- ch$N
   L <- if (rate) N + 1 else N
+  col <- function(j) {
+    if (ch$nc == 1L) ch$values else ch$values[(j - 1) * N + seq_len(N)]
+  }
   for (j in seq_len(ch$nc)) {
-    v <- ch$values[(j - 1) * N + seq_len(N)]
+    v <- col(j)
     bad <- first_nonfinite(v)
     if (bad > 0) {
       abort("`x` must contain only finite numbers; found ", format(v[bad]),
@@ -359,7 +362,7 @@ allan_extra <- function(x, freq, taus, type, input, conf, debias) {
   }
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {
-    v <- ch$values[(j - 1) * N + seq_len(N)]
+    v <- col(j)
     d <- extra_channel(v, freq, m, theo_row, type, rate, L, conf, debias)
     if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
     d$alpha <- d$alpha_
@@ -433,8 +436,13 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
       av <- rep(NA_real_, length(m))
       mt <- m[theo_row]
       if (length(mt)) {
-        t1 <- theo1_sums_cpp(v, rate, mt, threads) /
-          (0.75 * (L - mt) * mt^2) * sc_rate
+        # many m: the all-k recurrence (O(L kmax)) beats m-by-m sums
+        T <- if (length(mt) > 40L) {
+          theo1_all_cpp(v, rate, max(mt) / 2)[mt / 2]
+        } else {
+          theo1_sums_cpp(v, rate, mt, threads)
+        }
+        t1 <- T / (0.75 * (L - mt) * mt^2) * sc_rate
         alpha[theo_row] <- extra_alpha(v, freq, round(0.75 * mt), "overlapping",
                                        input, L)
         if (type == "theo1") {

@@ -7,9 +7,9 @@
 // and PVAR(tau0) = AVAR(tau0) (the weights vanish at m = 1).
 // With P the prefix sums of x and PP those of P, 2 S_i = F(i) - F(i + m),
 // F(i) = 2 (PP(i + m) - PP(i + 1)) - (m - 1) (P(i) + P(i + m)): O(1) per
-// term. P and PP are built per block of about 2m terms from the local phase
-// (src/local-phase.h; PVAR ignores a linear phase term), so they stay of
-// the size of the local wander and the differences lose nothing.
+// term. P and PP are built per block of about 2m terms from the phase
+// re-centred on the block (PVAR ignores a linear phase term), so they stay
+// of the size of the local wander and the differences lose nothing.
 #include "local-phase.h"
 #include "parallel.h"
 #include <algorithm>
@@ -38,56 +38,66 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
     const R_xlen_t M = mm == 1 ? L - 2 : L - 2 * mm;
     if (mm < 1 || M < 1) continue;
-    const R_xlen_t B = std::max<R_xlen_t>(2 * mm, 1024);
+    // blocks of a few m: the prefix sums then cancel by at most (span/m)^2.5
+    const R_xlen_t B = std::max<R_xlen_t>(2 * mm, std::min<R_xlen_t>(1024, 32 * mm));
     for (R_xlen_t i0 = 0; i0 < M; i0 += B)
       items.push_back(Item{t, i0, std::min(M, i0 + B)});
   }
   std::vector<double> part(items.size(), 0.0);
   const int nw = std::max(1, threads);
-  std::vector<std::vector<double> > rbuf(nw), pbuf(nw), ppbuf(nw);
+  std::vector<std::vector<double> > pbuf(nw), ppbuf(nw), fbuf(nw);
+  // the phase once, split hi + lo; each block re-centres it (its first
+  // point and the chord's slope removed), exact differences on the hi grid
+  allanvar::SplitPhase X;
+  allanvar::split_phase(in, X);
+  const double* hx = X.hi.data();
+  const double* lx = X.lo.data();
   allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nw,
                          [&](R_xlen_t it, int w) {
     const Item& I = items[it];
     const R_xlen_t mm = static_cast<R_xlen_t>(ms[I.tau]);
     const R_xlen_t nb = I.i1 - I.i0;
-    std::vector<double>& r = rbuf[w];
+    const R_xlen_t a = I.i0;
     if (mm == 1) {
-      r.resize(nb + 2);
-      allanvar::local_phase(in, I.i0, nb + 2, r.data());
       double s = 0;
-      for (R_xlen_t i = 0; i < nb; ++i) {
-        const double d = (r[i + 2] + r[i]) - 2.0 * r[i + 1];
+      for (R_xlen_t i = a; i < a + nb; ++i) {
+        const double d = ((hx[i + 2] + hx[i]) - 2.0 * hx[i + 1]) +
+                         ((lx[i + 2] + lx[i]) - 2.0 * lx[i + 1]);
         s += d * d;
       }
       part[it] = s;
       return;
     }
     const R_xlen_t len = nb + 2 * mm - 1;  // phase points used
-    r.resize(len);
-    allanvar::local_phase(in, I.i0, len, r.data());
+    const double slope = ((hx[a + len - 1] - hx[a]) + (lx[a + len - 1] - lx[a])) /
+                         static_cast<double>(len - 1);
     std::vector<double>& P = pbuf[w];
     std::vector<double>& PP = ppbuf[w];
+    std::vector<double>& F = fbuf[w];
     P.resize(len + 1);
     PP.resize(len + 1);
     P[0] = PP[0] = 0;
     for (R_xlen_t j = 0; j < len; ++j) {
-      P[j + 1] = P[j] + r[j];
+      const double r = ((hx[a + j] - hx[a]) + (lx[a + j] - lx[a])) -
+                       slope * static_cast<double>(j);
+      P[j + 1] = P[j] + r;
       PP[j + 1] = PP[j] + P[j];
     }
     const double k1 = static_cast<double>(mm - 1);
-    auto F = [&](R_xlen_t i) {
-      return 2.0 * (PP[i + mm] - PP[i + 1]) - k1 * (P[i] + P[i + mm]);
-    };
+    const R_xlen_t nf = nb + mm;
+    F.resize(nf);
+    for (R_xlen_t i = 0; i < nf; ++i)
+      F[i] = 2.0 * (PP[i + mm] - PP[i + 1]) - k1 * (P[i] + P[i + mm]);
     double s0 = 0, s1 = 0;
     R_xlen_t i = 0;
     for (; i + 2 <= nb; i += 2) {
-      const double d0 = F(i) - F(i + mm);
-      const double d1 = F(i + 1) - F(i + 1 + mm);
+      const double d0 = F[i] - F[i + mm];
+      const double d1 = F[i + 1] - F[i + 1 + mm];
       s0 += d0 * d0;
       s1 += d1 * d1;
     }
     for (; i < nb; ++i) {
-      const double d = F(i) - F(i + mm);
+      const double d = F[i] - F[i + mm];
       s0 += d * d;
     }
     part[it] = s0 + s1;

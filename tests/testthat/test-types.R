@@ -289,3 +289,14 @@ test_that("the Total family's closed form equals its direct evaluation", {
     }
   }
 })
+
+test_that("PDEV keeps its digits on long random-walk records", {
+  set.seed(16)
+  N <- 4000
+  for (x in list(cumsum(cumsum(rnorm(N))), cumsum(rnorm(N)) + 1e-3 * (1:N)^2)) {
+    m <- c(2, 3, 8, 64, 500, 1999)
+    p <- allan(x, 1, taus = m, type = "pdev", input = "integrated")
+    ref <- vapply(m, function(k) ref_pvar(x, k), 0)
+    expect_lt(max(abs(p$avar / ref - 1)), 1e-10)
+  }
+})
