@@ -40,11 +40,25 @@
 #' \sqrt{\nu \hat\sigma^2/\chi^2_{p}(\nu)}]}, \eqn{p = (1 - conf)/2}, with
 #' \eqn{\nu} the equivalent degrees of freedom (`edf`). The noise type
 #' (power-law exponent \eqn{\alpha} of the rate PSD) is identified at every
-#' tau by Riley's lag-1 autocorrelation method, applied to the first 4096
-#' cluster averages (rate input, linearly detrended) or decimated phase
-#' points (integrated input, quadratically detrended), differencing at most
-#' twice (three times for Hadamard types). Where fewer than 30 points are
-#' available the type identified at the nearest shorter tau is used. Then:
+#' tau from that tau's data alone, as NIST SP 1065 (section 5.6) and Stable32
+#' do it:
+#' * while the decimated series has at least 64 points (cluster averages of
+#'   rate input, linearly detrended; every m-th phase point of integrated
+#'   input, quadratically detrended), Riley and Greenhall's lag-1
+#'   autocorrelation method over the whole series, differencing at most
+#'   twice (three times for Hadamard types). Stable32 and allantools start
+#'   at 30 points; between 30 and 63 the lag-1 autocorrelation misreads
+#'   white FM often enough to push the 68% coverage below 0.65 (Monte
+#'   Carlo, N = 1024), so B1 is used there too;
+#' * below that, Barnes' B1 ratio (standard over Allan variance of the
+#'   cluster averages); where it points to phase noise, the ratio R(n) of
+#'   the modified to the Allan variance picks among white and flicker PM and
+#'   the three FM types;
+#' * with fewer than three cluster averages (or phase noise that R(n) cannot
+#'   check), the type is unknown: `alpha` is `NA` and the EDF is the
+#'   smallest over the admissible types (the widest interval).
+#'
+#' Then:
 #' * for white (\eqn{\alpha = 0}) or random-walk (\eqn{\alpha = -2}) rate
 #'   noise and \eqn{m \le 64}, the EDF is exact for the discrete process,
 #'   from the Gaussian fourth moments (Isserlis) of the estimator's terms.
@@ -52,9 +66,16 @@
 #'   EDF of sampled white noise at small \eqn{m} (782 instead of 666 at
 #'   \eqn{m = 1}, \eqn{N = 1000}), which would make the intervals too short;
 #' * otherwise, Greenhall and Riley's general algorithm (2004, PTTI);
-#' * for `"total"`, the overlapping EDF, or, for \eqn{m \ge 8} and
-#'   \eqn{\alpha \in \{0, -1, -2\}}, the larger of it and NIST SP 1065's
-#'   \eqn{b (L-1)/m - c} approximation.
+#' * for `"total"`: white and flicker PM, NIST SP 1065 Table 5 (as Stable32);
+#'   white, flicker and random-walk FM, the larger of the overlapping EDF and
+#'   SP 1065 Table 7's \eqn{b (L-1)/m - c} for \eqn{m \ge 8}, the
+#'   overlapping EDF below (at \eqn{m = 1} the Total terms are the
+#'   overlapping ones, so Table 7's 1500 at \eqn{L = 1001} would overstate
+#'   the EDF 666 of sampled white FM).
+#'
+#' Long grids (more than 200 taus) identify the noise and evaluate the EDF at
+#' every \eqn{m \le 64} and 40 taus per decade above; the other rows take
+#' the type of the nearest such tau and a log-log interpolation of its EDF.
 #'
 #' @section Methods:
 #' `print()` shows a header line and the table (`digits`, default 4);
@@ -100,7 +121,8 @@
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
 #'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
 #'   has several columns, `channel` (the column name; rows stacked channel by
-#'   channel), and last `alpha` (the integer noise exponent behind the EDF).
+#'   channel), and last `alpha` (the integer noise exponent behind the EDF;
+#'   `NA` where too few points identify it).
 #'   Attributes: `freq`, `type`, `input`, `N` (samples per channel), `conf`.
 #' @seealso [avar()], [avarn()] and [avari()] for the results of
 #'   'allanvar' 1.1.

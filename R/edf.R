@@ -6,7 +6,7 @@
 #    noise at small m, where Greenhall's continuous-time model overstates
 #    the EDF (782 instead of 666 for white noise, m = 1, N = 1000);
 #  * Greenhall & Riley (2004) general algorithm otherwise;
-#  * NIST SP 1065 Table 11 for the total variance at m >= 8.
+#  * NIST SP 1065 Tables 5 and 7 for the total variance (src/edf.cpp).
 
 # Where the noise id and the EDF are evaluated directly: every row of a
 # short curve; for long ones ("all"), every m <= 64 plus 40 points per
@@ -21,17 +21,26 @@ allan_subset <- function(m) {
 }
 
 # EDF for every row of a curve. alpha_int: identified noise exponent at the
-# rows `sub` (NA where the data were too few: filled from the nearest
-# shorter tau, else the nearest longer one).
+# rows `sub`; NA where the data were too few to tell (fewer than three
+# averaged frequencies): such a row gets the smallest EDF over the exponents
+# the type admits (the widest interval) and alpha NA. No row takes its type
+# from another row.
 allan_edf <- function(type, m, n, L, alpha_int, sub = seq_along(m)) {
   tab <- allan_type_table()
   d <- tab$d[match(type, tab$name)]
-  a <- alpha_int
-  if (all(is.na(a))) a[] <- 0L
-  for (i in seq_along(a)) if (is.na(a[i]) && i > 1) a[i] <- a[i - 1]
-  for (i in rev(seq_along(a))) if (is.na(a[i])) a[i] <- a[i + 1]
-  a <- pmin(2L, pmax(if (d == 3) -4L else -2L, as.integer(a)))
-  es <- allan_edf_direct(type, m[sub], n[sub], L, a)
+  lo <- if (d == 3) -4L else -2L
+  a <- pmin(2L, pmax(lo, as.integer(alpha_int)))
+  es <- rep(NA_real_, length(sub))
+  known <- !is.na(a)
+  if (any(known)) {
+    es[known] <- allan_edf_direct(type, m[sub][known], n[sub][known], L,
+                                  a[known])
+  }
+  for (i in which(!known)) {
+    es[i] <- min(vapply(lo:2L, function(al) {
+      allan_edf_direct(type, m[sub][i], n[sub][i], L, al)
+    }, 0))
+  }
   if (length(sub) == length(m)) {
     return(list(edf = pmax(es, 1e-3), alpha = a))
   }
@@ -40,28 +49,18 @@ allan_edf <- function(type, m, n, L, alpha_int, sub = seq_along(m)) {
                       as.integer(a))
 }
 
-# EDF at the rows where it is evaluated directly (src/edf.cpp).
+# EDF at the rows where it is evaluated directly (src/edf.cpp): type
+# "standard", "overlapping", ... (allan()'s names), cluster sizes m, terms n,
+# L phase points, integer noise exponents alpha. Where no formula gives a
+# positive finite EDF the number of terms is used (the total type: 1.5
+# (L - 1)/m, NIST SP 1065 Table 7's white-FM value).
 allan_edf_direct <- function(type, m, n, L, alpha) {
+  alpha <- as.integer(alpha)
   exact <- alpha %in% c(0L, -2L) & m <= 64
-  if (type != "total") {
-    e <- allan_edf_cpp(allan_type_code(type), m, n, L, alpha, exact)
-    return(ifelse(is.finite(e) & e > 0, e, n))
-  }
-  # total: the overlapping EDF (the same terms at small m), or at m >= 8 the
-  # larger of it and NIST SP 1065's b (L - 1)/m - c
-  no <- L - 2 * m
-  oav <- rep(NA_real_, length(m))
-  ok <- no >= 1
-  if (any(ok)) {
-    oav[ok] <- allan_edf_cpp(allan_type_code("overlapping"), m[ok], no[ok], L,
-                             alpha[ok], exact[ok])
-  }
-  b <- c(1.50, 1.17, 0.93)[match(alpha, c(0L, -1L, -2L))]
-  cc <- c(0, 0.22, 0.36)[match(alpha, c(0L, -1L, -2L))]
-  tab <- b * (L - 1) / m - cc
-  e <- ifelse(m < 8 | is.na(tab), oav, pmax(oav, tab, na.rm = TRUE))
-  e <- ifelse(is.na(e), tab, e)
-  ifelse(is.finite(e) & e > 0, e, 1.5 * (L - 1) / m)
+  e <- allan_edf_cpp(allan_type_code(type), as.double(m), as.double(n),
+                     as.double(L), alpha, exact)
+  fallback <- if (type == "total") 1.5 * (L - 1) / m else n
+  ifelse(is.finite(e) & e > 0, e, fallback)
 }
 
 # Chi-square confidence limits of the deviation (NIST SP 1065 eq. 45). For

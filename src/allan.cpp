@@ -8,6 +8,7 @@
 // huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
 // drift or length of the record.
 #include "checks.h"
+#include "noise_id.h"
 #include "opts-allan.h"
 #include "parallel.h"
 #include "types.h"
@@ -423,29 +424,26 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
 // blocks, so the data are read once. `lev` carries, per level, the last
 // cluster sum and the running sum of squared differences.
 struct Level {
-  double ph = 0, pl = 0;
+  double ph = 0, pl = 0;  // the last cluster sum
+  double fh = 0, fl = 0;  // the first one
   bool has = false;
   Acc acc;
   double s = 0;
   R_xlen_t cnt = 0;
-  std::vector<double> idh, idl;  // first cluster sums, for noise id
+  bool keep = false;     // keep every cluster sum (a noise id is asked here)
+  std::vector<double> z;  // the cluster sums, for noise id
 };
 
-const R_xlen_t kIdMax = 4096;  // cluster sums kept per level for noise id
-// Fewer points leave r1 too noisy (its standard error is 1/sqrt(n)): a
-// mis-identified type then shortens the interval; such taus inherit the type
-// found at the nearest shorter tau instead.
-const size_t kIdMin = 64;
-
 // Consume n dd values at level j: accumulate squared differences, keep the
-// first few for noise id, and pair them into level j+1 in place.
+// cluster sums for noise id when asked, and pair them into level j+1 in
+// place.
 inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
                            bool pair) {
   double s = 0;
   R_xlen_t i = 0;
   if (!L.has && n > 0) {
-    L.ph = h[0];
-    L.pl = l[0];
+    L.ph = L.fh = h[0];
+    L.pl = L.fl = l[0];
     L.has = true;
     i = 1;
   }
@@ -459,10 +457,8 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
   L.ph = ph;
   L.pl = pl;
   L.acc.add(s);
-  for (R_xlen_t k = 0; k < n && static_cast<R_xlen_t>(L.idh.size()) < kIdMax;
-       ++k) {
-    L.idh.push_back(h[k]);
-    L.idl.push_back(l[k]);
+  if (L.keep) {
+    for (R_xlen_t k = 0; k < n; ++k) L.z.push_back(h[k] + l[k]);
   }
   if (!pair) return 0;
   const R_xlen_t n2 = n / 2;
@@ -501,7 +497,8 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
 // at a block boundary (one per thread), whose per-level sums are then
 // joined with the one difference that straddles the cut.
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
-                     std::vector<Level>& lev, int threads, bool main) {
+                     const std::vector<bool>& keep, std::vector<Level>& lev,
+                     int threads, bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -509,26 +506,25 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
   const int P = (threads > 1 && nblocks >= 8) ? 2 : 1;
   const R_xlen_t cut[3] = {0, P == 2 ? (nblocks / 2) * B : N, N};
   std::vector<std::vector<Level> > part(P, std::vector<Level>(jin + 1));
+  for (int p = 0; p < P; ++p)
+    for (int j = 0; j <= jin; ++j) part[p][j].keep = keep[j];
   std::vector<std::vector<double> > th(P), tl(P);
   run_items(P, threads, main, [&](R_xlen_t p) {
     octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p]);
   });
   lev.assign(J + 1, Level());
+  for (int j = 0; j <= J; ++j) lev[j].keep = keep[j];
   for (int j = 0; j <= jin; ++j) {
     Level& L = lev[j];
-    L = part[0][j];
+    L = std::move(part[0][j]);
     if (P == 2) {
       const Level& R = part[1][j];
       L.acc.add(R.acc.value());
       if (L.has && R.has) {
-        const double d = (R.idh[0] - L.ph) + (R.idl[0] - L.pl);
+        const double d = (R.fh - L.ph) + (R.fl - L.pl);
         L.acc.add(d * d);
       }
-      for (size_t k = 0; k < R.idh.size() &&
-                         static_cast<R_xlen_t>(L.idh.size()) < kIdMax; ++k) {
-        L.idh.push_back(R.idh[k]);
-        L.idl.push_back(R.idl[k]);
-      }
+      L.z.insert(L.z.end(), R.z.begin(), R.z.end());
       if (R.has) {
         L.ph = R.ph;
         L.pl = R.pl;
@@ -548,74 +544,53 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
   }
 }
 
-// ---- noise identification (Riley's lag-1 autocorrelation method) ----
-
-// Residuals of v after a least-squares polynomial of degree deg (Gram-Schmidt
-// on 1, t, t^2).
-void detrend(std::vector<double>& v, int deg) {
-  const size_t n = v.size();
-  std::vector<std::vector<double> > basis;
-  for (int p = 0; p <= deg; ++p) {
-    std::vector<double> b(n);
-    const double mid = 0.5 * (static_cast<double>(n) - 1);
-    for (size_t i = 0; i < n; ++i) {
-      const double t = (static_cast<double>(i) - mid) / (mid + 1);
-      b[i] = p == 0 ? 1.0 : p == 1 ? t : t * t;
-    }
-    for (auto& q : basis) {
-      double dot = 0;
-      for (size_t i = 0; i < n; ++i) dot += b[i] * q[i];
-      for (size_t i = 0; i < n; ++i) b[i] -= dot * q[i];
-    }
-    double nn = 0;
-    for (size_t i = 0; i < n; ++i) nn += b[i] * b[i];
-    nn = std::sqrt(nn);
-    if (nn > 0)
-      for (size_t i = 0; i < n; ++i) b[i] /= nn;
-    double dot = 0;
-    for (size_t i = 0; i < n; ++i) dot += v[i] * b[i];
-    for (size_t i = 0; i < n; ++i) v[i] -= dot * b[i];
-    basis.push_back(b);
-  }
-}
-
-// Returns alpha (continuous) and sets alpha_int; NaN when too few points.
-double noise_id(std::vector<double> v, bool phase, int dmax, int& alpha_int) {
-  alpha_int = NA_INTEGER;
-  if (v.size() < kIdMin) return NA_REAL;
-  detrend(v, phase ? 2 : 1);
-  int d = 0;
-  for (;;) {
-    const size_t n = v.size();
-    double mu = 0;
-    for (double x : v) mu += x;
-    mu /= static_cast<double>(n);
-    double a = 0, b = 0;
-    for (size_t i = 0; i < n; ++i) {
-      b += (v[i] - mu) * (v[i] - mu);
-      if (i + 1 < n) a += (v[i] - mu) * (v[i + 1] - mu);
-    }
-    const double r1 = b > 0 ? a / b : 0.0;
-    const double rho = r1 / (1.0 + r1);
-    if (rho < 0.25 || d >= dmax || n < 4) {
-      const double add = phase ? 2.0 : 0.0;
-      alpha_int = static_cast<int>(-std::nearbyint(2 * rho) - 2.0 * d + add);
-      return -2.0 * (rho + d) + add;
-    }
-    for (size_t i = 0; i + 1 < n; ++i) v[i] = v[i + 1] - v[i];
-    v.pop_back();
-    ++d;
-  }
-}
-
-// X value at index k from a split.
-inline double xval(const Split& X, R_xlen_t k) { return X.hi[k] + X.lo[k]; }
+// ---- noise identification (src/noise_id.h) at the rows `mid` ----
 
 struct Channel {
   std::vector<double> sums, alpha;
-  std::vector<int> alpha_int;
+  std::vector<int> alpha_int, id_method;
   R_xlen_t bad = 0;  // 1-based position of the first NA/NaN/Inf, or 0
 };
+
+inline void store_id(const allanvar::NoiseId& id, Channel& out, size_t j) {
+  out.alpha[j] = id.alpha;
+  out.alpha_int[j] = id.alpha_int;
+  out.id_method[j] = id.method;
+}
+
+// Noise id of the standard octave kernel: from the cluster sums it kept
+// (level 0: the samples themselves); R(n) from the running sum of v - c.
+void octave_noise_id(const double* v, R_xlen_t N, double c,
+                     const std::vector<Level>& lev,
+                     const std::vector<R_xlen_t>& mid, int dmax,
+                     Channel& out) {
+  allanvar::RnCache rn;
+  for (size_t j = 0; j < mid.size(); ++j) {
+    const R_xlen_t m = mid[j];
+    int lj = 0;
+    while ((static_cast<R_xlen_t>(1) << lj) < m) ++lj;
+    const double* z = lj == 0 ? v : lev[lj].z.data();
+    const R_xlen_t n = lj == 0 ? N : static_cast<R_xlen_t>(lev[lj].z.size());
+    allanvar::NoiseId id;
+    if (n >= allanvar::kAcfMinPoints) {
+      id = allanvar::acf_noise_id(z, n, false, dmax);
+    } else {
+      id = allanvar::b1_noise_id(z, n, false, m, dmax, [&]() {
+        if (rn.empty()) {
+          rn.init(N + 1);
+          long double x = 0;
+          rn.push(0.0);
+          for (R_xlen_t i = 0; i < N; ++i) {
+            x += v[i] - c;
+            rn.push(static_cast<double>(x));
+          }
+        }
+        return rn.ratio(m);
+      });
+    }
+    store_id(id, out, j);
+  }
+}
 
 // One channel: sums of squares for every m, and the noise id per m.
 void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
@@ -628,14 +603,21 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   out.sums.assign(nt, 0.0);
   out.alpha.assign(ni, NA_REAL);
   out.alpha_int.assign(ni, NA_INTEGER);
+  out.id_method.assign(ni, allanvar::NOISE_ID_NONE);
   const int dmax = allanvar::estimator_info(type).d;
   if (type == STANDARD && rate && octave) {
     // Any constant works as the centre here (cluster sums are double-double
     // and constants cancel); NaN or Inf shows up in the sums.
     int J = 0;
     while ((static_cast<R_xlen_t>(1) << (J + 1)) <= ms.back()) ++J;
+    std::vector<bool> keep(J + 1, false);
+    for (R_xlen_t m : mid) {
+      int lj = 0;
+      while ((static_cast<R_xlen_t>(1) << lj) < m) ++lj;
+      if (lj > 0 && lj <= J) keep[lj] = true;
+    }
     std::vector<Level> lev;
-    standard_octave(v, N, v[0], J, lev, threads, main);
+    standard_octave(v, N, v[0], J, keep, lev, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
@@ -645,13 +627,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
       out.sums[j] = lev[lj].acc.value();
     }
-    for (size_t j = 0; j < ni; ++j) {
-      int lj = 0;
-      while ((static_cast<R_xlen_t>(1) << lj) < mid[j]) ++lj;
-      std::vector<double> id(lev[lj].idh.size());
-      for (size_t i = 0; i < id.size(); ++i) id[i] = lev[lj].idh[i] + lev[lj].idl[i];
-      out.alpha[j] = noise_id(id, false, dmax, out.alpha_int[j]);
-    }
+    octave_noise_id(v, N, v[0], lev, mid, dmax, out);
     return;
   }
 
@@ -685,37 +661,25 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     case OHADAMARD: overlapped<3>(X, ms, nterms, threads, main, o); break;
     case TOTAL: total(X, ms, threads, main, o); break;
   }
-  // Noise id: cluster sums (rate) or decimated phase (integrated) of the
-  // first kIdMax clusters. With MODIFIED, X holds one more level of sums.
-  const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
+  // Noise id from the phase: X itself, or with MODIFIED (one more level of
+  // sums) its first differences. Frequency data at m = 1 are the samples.
+  const double* h = X.hi.data();
+  const double* l = X.lo.data();
+  const bool two = type == MODIFIED;
+  auto phase = [h, l, two](R_xlen_t k) -> double {
+    return two ? (h[k + 1] - h[k]) + (l[k + 1] - l[k]) : h[k] + l[k];
+  };
+  const R_xlen_t Lp = rate ? N + 1 : N;
+  allanvar::RnCache rn;
   for (size_t j = 0; j < ni; ++j) {
     const R_xlen_t m = mid[j];
-    std::vector<double> id;
-    const bool two = (type == MODIFIED);
-    for (R_xlen_t i = 0; i < kIdMax; ++i) {
-      if (rate) {
-        // cluster sum over samples [i m, (i+1) m)
-        const R_xlen_t a = i * m, b = (i + 1) * m;
-        if (b > N) break;
-        if (two) {
-          const double dh = (X.hi[b + 1] - X.hi[b]) - (X.hi[a + 1] - X.hi[a]);
-          const double dl = (X.lo[b + 1] - X.lo[b]) - (X.lo[a + 1] - X.lo[a]);
-          id.push_back(dh + dl);
-        } else {
-          id.push_back((X.hi[b] - X.hi[a]) + (X.lo[b] - X.lo[a]));
-        }
-      } else {
-        const R_xlen_t a = i * m;
-        if (a >= N) break;
-        if (two) {
-          id.push_back((X.hi[a + 1] - X.hi[a]) + (X.lo[a + 1] - X.lo[a]));
-        } else {
-          id.push_back(xval(X, a));
-        }
-      }
+    allanvar::NoiseId id;
+    if (m == 1 && N >= allanvar::kAcfMinPoints) {
+      id = allanvar::acf_noise_id(v, N, !rate, dmax);
+    } else {
+      id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn);
     }
-    (void)L;
-    out.alpha[j] = noise_id(id, !rate, dmax, out.alpha_int[j]);
+    store_id(id, out, j);
   }
 }
 
@@ -752,12 +716,13 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
     });
   }
   Rcpp::NumericMatrix sums(nt, nc), alpha(ni, nc);
-  Rcpp::IntegerMatrix alpha_int(ni, nc);
+  Rcpp::IntegerMatrix alpha_int(ni, nc), id_method(ni, nc);
   for (R_xlen_t i = 0; i < nc; ++i) {
     for (size_t j = 0; j < nt; ++j) sums(j, i) = ch[i].sums[j];
     for (size_t j = 0; j < ni; ++j) {
       alpha(j, i) = ch[i].alpha[j];
       alpha_int(j, i) = ch[i].alpha_int[j];
+      id_method(j, i) = ch[i].id_method[j];
     }
   }
   Rcpp::NumericVector bad(nc);
@@ -765,6 +730,7 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
   return Rcpp::List::create(Rcpp::Named("sums") = sums,
                             Rcpp::Named("alpha") = alpha,
                             Rcpp::Named("alpha_int") = alpha_int,
+                            Rcpp::Named("id_method") = id_method,
                             Rcpp::Named("bad") = bad);
 }
 

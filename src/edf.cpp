@@ -175,30 +175,75 @@ double discrete(int type, long m, double n, bool rw) {
   return n * n * c0 * c0 / den;
 }
 
+// NIST SP 1065 Table 5 (after Howe, Allan & Barnes; Stein 1985): the simple
+// EDF of the overlapping Allan variance, N phase points. Flicker FM at
+// m = 1 keeps the square of (N - 2) (allantools drops it).
+double edf_simple_oavar(double N, double m, int alpha) {
+  switch (alpha) {
+    case 2: return (N + 1) * (N - 2 * m) / (2 * (N - m));
+    case 1:
+      return std::exp(std::sqrt(std::log((N - 1) / (2 * m)) *
+                                std::log((2 * m + 1) * (N - 1) / 4)));
+    case 0:
+      return (3 * (N - 1) / (2 * m) - 2 * (N - 2) / N) * 4 * m * m /
+             (4 * m * m + 5);
+    case -1:
+      if (m == 1) return 2 * (N - 2) * (N - 2) / (2.3 * N - 4.9);
+      return 5 * N * N / (4 * m * (N + 3 * m));
+    default:
+      return (N - 2) / m * ((N - 1) * (N - 1) - 3 * m * (N - 1) + 4 * m * m) /
+             ((N - 3) * (N - 3));
+  }
+}
+
+// The total variance (NIST SP 1065 section 5.2.11): Table 7,
+// b (N - 1)/m - c, for white, flicker and random-walk FM; for white and
+// flicker PM, as Stable32, the simple overlapping EDF of Table 5. Below
+// m = 8 the Total terms are (almost) the overlapping ones, and so is their
+// EDF: Table 7's 1.5 (N - 1)/m would claim 1500 at m = 1, N = 1001 where
+// the exact value for sampled white FM is 666 (the same terms as the
+// overlapping AV, whose Table 5 value is 666 too).
+double edf_total(double m, double L, int alpha, double oav_edf) {
+  if (alpha >= 1) return edf_simple_oavar(L, m, alpha);
+  const double b = alpha == 0 ? 1.50 : alpha == -1 ? 1.17 : 0.93;
+  const double c = alpha == 0 ? 0.0 : alpha == -1 ? 0.22 : 0.36;
+  const double tab = b * (L - 1) / m - c;
+  if (m < 8 && std::isfinite(oav_edf) && oav_edf > 0) return oav_edf;
+  return std::isfinite(oav_edf) && oav_edf > tab ? oav_edf : tab;
+}
+
 }  // namespace
 
 // EDF per row: estimator code (src/types.h), cluster size m, number of
 // terms n, phase points L, noise exponent alpha; exact discrete moments when
-// `exact` (white or random-walk rate noise at small m), Greenhall otherwise.
-// The total type is not handled here (R/edf.R combines the overlapping EDF
-// with NIST SP 1065's table for it).
+// `exact` (white or random-walk rate noise at small m), Greenhall otherwise;
+// the total type by edf_total() over the overlapping EDF.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m,
                                   const Rcpp::NumericVector& n, double L,
                                   const Rcpp::IntegerVector& alpha,
                                   const Rcpp::LogicalVector& exact) {
-  if (!allanvar::valid_estimator(type) || type == allanvar::TOTAL)
+  if (!allanvar::valid_estimator(type))
     Rcpp::stop("internal: no EDF kernel for estimator code %d", type);
-  const allanvar::EstimatorInfo& info = allanvar::estimator_info(type);
+  const bool total = type == allanvar::TOTAL;
+  const int base = total ? static_cast<int>(allanvar::OVERLAPPING) : type;
+  const allanvar::EstimatorInfo& info = allanvar::estimator_info(base);
   const R_xlen_t k = m.size();
   Rcpp::NumericVector out(k);
   for (R_xlen_t i = 0; i < k; ++i) {
-    if (exact[i]) {
-      out[i] = discrete(type, static_cast<long>(m[i]), n[i], alpha[i] == -2);
-    } else {
-      out[i] = greenhall(alpha[i], info.d, m[i], L, info.overlapping,
-                         info.modified);
+    // the total type: the overlapping EDF where it has terms
+    const double ni = total ? L - 2 * m[i] : n[i];
+    double e = NA_REAL;
+    if (ni >= 1) {
+      if (exact[i]) {
+        e = discrete(base, static_cast<long>(m[i]), ni, alpha[i] == -2);
+      } else {
+        e = greenhall(alpha[i], info.d, m[i], L, info.overlapping,
+                      info.modified);
+      }
     }
+    if (total) e = edf_total(m[i], L, alpha[i], e);
+    out[i] = std::isfinite(e) && e > 0 ? e : NA_REAL;
   }
   return out;
 }

@@ -50,15 +50,30 @@ test_that("the exact discrete EDF matches Monte Carlo variances", {
 })
 
 test_that("Riley's lag-1 autocorrelation identifies power-law noise", {
+  # The lag-1 ACF is read wherever the decimated series has >= 30 points;
+  # rows with fewer (the last one or two octaves here) are identified by B1
+  # and R(n) from their own few points (tested below), no longer copied
+  # from a shorter tau, so the assertions hold on the ACF rows.
+  acf <- function(a, phase = FALSE) {
+    N <- attr(a, "N")
+    (if (phase) (N - 1) %/% a$m + 1 else N %/% a$m) >= 30
+  }
   set.seed(22)
   w <- rnorm(1e5)
-  expect_true(all(allan(w, 1)$alpha == 0))
-  expect_true(all(allan(cumsum(w), 1)$alpha == -2))
-  expect_gte(mean(allan(diff(c(0, w)), 1)$alpha == 2), 0.8)
-  expect_true(all(allan(w, 1, input = "integrated")$alpha == 2))
-  expect_true(all(allan(cumsum(w), 1, input = "integrated")$alpha == 0))
+  a <- allan(w, 1)
+  expect_equal(sum(acf(a)), 12)
+  expect_true(all(a$alpha[acf(a)] == 0))
+  a <- allan(cumsum(w), 1)
+  expect_true(all(a$alpha[acf(a)] == -2))
+  a <- allan(diff(c(0, w)), 1)
+  expect_gte(mean(a$alpha[acf(a)] == 2), 0.8)
+  a <- allan(w, 1, input = "integrated")
+  expect_true(all(a$alpha[acf(a, TRUE)] == 2))
+  a <- allan(cumsum(w), 1, input = "integrated")
+  expect_true(all(a$alpha[acf(a, TRUE)] == 0))
   for (type in allan_types) {
-    expect_true(all(allan(w, 1, type = type)$alpha == 0), info = type)
+    a <- allan(w, 1, type = type)
+    expect_true(all(a$alpha[acf(a)] == 0), info = type)
   }
 })
 
