@@ -61,7 +61,8 @@
 #' \eqn{\alpha = 0, \dots, -4}; `"theo1"` is multiplied by
 #' \eqn{a + b/(0.75m)^c}, Howe & Tasset's ratio of the Allan variance to
 #' Theo1 (1 for white FM). The noise type is the one identified at each
-#' tau (column `alpha`). `debias = FALSE` gives the raw estimators, as
+#' tau (column `alpha`); where it cannot be identified (`alpha` `NA`) the
+#' value is left uncorrected. `debias = FALSE` gives the raw estimators, as
 #' Stable32 1.60 reports MTOT and TTOT (Stable32 1.53 corrected them, and
 #' corrects HTOT; Python allantools never corrects). `"theobr"` and
 #' `"theoh"` are bias-removed by construction.
@@ -250,6 +251,12 @@ allan_theoh_taus <- function(taus, freq, L) {
 #  * Theo1: AVAR/Theo1 = a + b / (0.75 m)^c (Howe & Tasset, EFTF 2004,
 #    Table 1), multiply by it.
 debias_factor <- function(type, alpha, m) {
+  f <- debias_factor_known(type, alpha, m)
+  # no correction where the noise type is unknown (alpha NA)
+  ifelse(is.na(f), 1, f)
+}
+
+debias_factor_known <- function(type, alpha, m) {
   a <- pmin(2L, pmax(-2L, as.integer(alpha)))
   switch(type,
     mtotdev = , ttotdev = 1 / c(0.69, 0.70, 0.73, 0.83, 0.94)[a + 3L],
@@ -280,6 +287,25 @@ debias_factor <- function(type, alpha, m) {
 #    structure; Vernotte et al. 2016 give no closed form).
 # N is the number of phase points; alpha the noise exponent of each row.
 extra_edf <- function(type, m, L, alpha, n) {
+  a <- as.integer(alpha)
+  unknown <- is.na(a)
+  e <- rep(NA_real_, length(m))
+  if (any(!unknown)) {
+    e[!unknown] <- extra_edf_known(type, m[!unknown], L, a[!unknown],
+                                   n[!unknown])
+  }
+  # an unknown noise type: the smallest EDF over the admissible ones (the
+  # widest interval), as allan() does for the other types
+  lo <- if (type == "htotdev") -4L else -2L
+  for (i in which(unknown)) {
+    e[i] <- min(vapply(lo:2L, function(al) {
+      extra_edf_known(type, m[i], L, al, n[i])
+    }, 0))
+  }
+  e
+}
+
+extra_edf_known <- function(type, m, L, alpha, n) {
   N <- L
   a <- as.integer(alpha)
   e <- switch(type,

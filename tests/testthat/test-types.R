@@ -41,9 +41,15 @@ test_that("NBS14: Stable32 1.60's uncorrected MTOT, TTOT and Theo1", {
   expect_equal(th$tau, c(7.5, 75, 750))
   expect_equal(signif(th$adev, 5), c(1.0757e-01, 3.1789e-02, 5.0524e-03),
                tolerance = 0)
-  # white FM: Howe and Tasset's factor is 1, so the default changes nothing
-  expect_equal(allan(y, 1, taus = 0.75 * c(10, 100), type = "theo1")$adev,
-               th$adev[1:2])
+  # the default multiplies by Howe and Tasset's AVAR/Theo1 ratio for the
+  # noise type found at each tau: 1 for white FM
+  d <- allan(y, 1, taus = 0.75 * c(10, 100, 1000), type = "theo1")
+  f <- ifelse(is.na(d$alpha) | d$alpha == 0L, 1, c(2.70, 1.87)[match(d$alpha, -2:-1)] +
+                c(-1.53, -1.05)[match(d$alpha, -2:-1)] /
+                (0.75 * d$m)^c(0.85, 0.79)[match(d$alpha, -2:-1)])
+  expect_true(all(d$alpha %in% c(-2L, -1L, 0L, NA)))
+  expect_equal(d$adev, th$adev * sqrt(f), tolerance = 1e-14)
+  expect_equal(d$adev[1], th$adev[1])
 })
 
 test_that("NBS14: PDEV as SigmaTheta computes it (allantools' reference)", {
