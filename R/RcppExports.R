@@ -69,7 +69,7 @@ total_sums_cpp <- function(v, rate, m, hadamard, threads, method = 0L) {
     .Call(`_allanvar_total_sums_cpp`, v, rate, m, hadamard, threads, method)
 }
 
-allan_type_table_cpp <- function() {
-    .Call(`_allanvar_allan_type_table_cpp`)
+allan_type_table_cpp <- function(all = FALSE) {
+    .Call(`_allanvar_allan_type_table_cpp`, all)
 }
 

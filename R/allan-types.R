@@ -161,9 +161,19 @@ check_true_false <- function(x, arg) {
   x
 }
 
-# A property of a type from the table of src/types.h.
+# Every type's row of the table of src/types.h (allan_type_table() has the
+# Allan-family types of the sums kernel only), read once.
+allan_type_table_all <- local({
+  table <- NULL
+  function() {
+    if (is.null(table)) table <<- allan_type_table_cpp(TRUE)
+    table
+  }
+})
+
+# A property of a type from that table.
 allan_type_prop <- function(type, prop) {
-  tab <- allan_type_table()
+  tab <- allan_type_table_all()
   tab[[prop]][match(type, tab$name)]
 }
 

@@ -231,11 +231,12 @@ BEGIN_RCPP
 END_RCPP
 }
 // allan_type_table_cpp
-Rcpp::DataFrame allan_type_table_cpp();
-RcppExport SEXP _allanvar_allan_type_table_cpp() {
+Rcpp::DataFrame allan_type_table_cpp(bool all);
+RcppExport SEXP _allanvar_allan_type_table_cpp(SEXP allSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    rcpp_result_gen = Rcpp::wrap(allan_type_table_cpp());
+    Rcpp::traits::input_parameter< bool >::type all(allSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_type_table_cpp(all));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -258,7 +259,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
     {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
     {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 6},
-    {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 0},
+    {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 1},
     {NULL, NULL, 0}
 };
 

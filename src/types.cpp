@@ -2,9 +2,11 @@
 #include <Rcpp.h>
 #include "types.h"
 
+// all = FALSE: the Allan-family types of the sums kernel; TRUE: every type
+// allan() computes.
 // [[Rcpp::export(rng = false)]]
-Rcpp::DataFrame allan_type_table_cpp() {
-  const int n = allanvar::N_ESTIMATORS;
+Rcpp::DataFrame allan_type_table_cpp(bool all = false) {
+  const int n = all ? allanvar::N_TYPES : allanvar::N_ESTIMATORS;
   Rcpp::CharacterVector name(n);
   Rcpp::IntegerVector code(n), d(n);
   Rcpp::LogicalVector overlapping(n), modified(n), debias(n);

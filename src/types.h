@@ -15,8 +15,10 @@ enum Estimator {
   HADAMARD = 3,
   OHADAMARD = 4,
   TOTAL = 5,
-  // The further statistics of issue 10 (src/tie.cpp, src/pdev.cpp,
-  // src/totals.cpp, src/theo.cpp; R side in R/allan-types.R).
+  N_ESTIMATORS = 6,  // the Allan-family types of the sums kernel (allan.cpp)
+  // The further statistics of issue 10, with kernels of their own
+  // (src/tie.cpp, src/pdev.cpp, src/totals.cpp, src/theo.cpp; R side in
+  // R/allan-types.R).
   TDEV = 6,
   MTOTAL = 7,
   TTOTAL = 8,
@@ -27,7 +29,7 @@ enum Estimator {
   MTIE = 13,
   TIERMS = 14,
   PDEV = 15,
-  N_ESTIMATORS = 16
+  N_TYPES = 16
 };
 
 // What a type's deviation measures: fractional frequency (dimensionless for
@@ -46,7 +48,7 @@ struct EstimatorInfo {
 
 // Indexed by Estimator.
 inline const EstimatorInfo& estimator_info(int type) {
-  static const EstimatorInfo table[N_ESTIMATORS] = {
+  static const EstimatorInfo table[N_TYPES] = {
       {"standard", 2, false, false, UNIT_RATE, 1.0, false},
       {"overlapping", 2, true, false, UNIT_RATE, 1.0, false},
       {"modified", 2, true, true, UNIT_RATE, 1.0, false},
