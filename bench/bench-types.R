@@ -45,7 +45,20 @@ timed <- function(expr) {
 
 # allantools: one call per (type, N), timed inside Python
 py_path <- Sys.getenv("ALLANTOOLS_PATH", "/tmp/allantools")
-have_py <- nzchar(Sys.which("python3")) && nzchar(Sys.which("timeout")) &&
+# a python3 that has numpy (BENCH_PYTHON, Debian's, or the first on PATH)
+pythons <- unique(c(Sys.getenv("BENCH_PYTHON"), "/usr/bin/python3",
+                    unname(Sys.which("python3"))))
+pythons <- pythons[nzchar(pythons) & file.exists(pythons)]
+python <- NA_character_
+for (p in pythons) {
+  ok <- suppressWarnings(system2(p, c("-c", shQuote("import numpy")),
+                                 stdout = FALSE, stderr = FALSE))
+  if (ok == 0) {
+    python <- p
+    break
+  }
+}
+have_py <- !is.na(python) && nzchar(Sys.which("timeout")) &&
   dir.exists(file.path(py_path, "allantools"))
 py_time <- function(fun, file) {
   code <- sprintf(paste0(
@@ -53,7 +66,7 @@ py_time <- function(fun, file) {
     "import allantools as at; y = np.fromfile('%s'); t = time.time(); ",
     "at.%s(y, rate=1.0, data_type='freq', taus='octave'); ",
     "print(time.time() - t)"), py_path, file, fun)
-  out <- suppressWarnings(system2("timeout", c(py_timeout, "python3", "-c",
+  out <- suppressWarnings(system2("timeout", c(py_timeout, python, "-c",
                                                shQuote(code)),
                                   stdout = TRUE, stderr = FALSE))
   st <- attr(out, "status")
@@ -72,6 +85,7 @@ set.seed(1)
 big <- rnorm(max(sizes))
 rows <- list()
 stopped <- character(0)
+py_stopped <- character(0)
 for (N in sizes) {
   y <- big[seq_len(N)]
   s <- stats::median(vapply(1:51, function(i) system.time(sum(y))[["elapsed"]], 0))
@@ -87,7 +101,12 @@ for (N in sizes) {
       next
     }
     t <- timed(allan(y, 1, type = ty))
-    py <- if (have_py && ty %in% names(py_name)) py_time(py_name[[ty]], f) else NA
+    py <- if (have_py && ty %in% names(py_name) && !ty %in% py_stopped) {
+      py_time(py_name[[ty]], f)
+    } else {
+      NA
+    }
+    if (!is.na(py) && py > py_timeout / 4) py_stopped <- c(py_stopped, ty)
     rows[[length(rows) + 1L]] <- data.frame(type = ty, N = N,
                                             seconds = signif(t[1], 3),
                                             runs = t[2],
@@ -102,12 +121,13 @@ for (N in sizes) {
 }
 tab <- do.call(rbind, rows)
 tab$N <- format(tab$N, scientific = TRUE)
-tab$allantools[is.infinite(tab$allantools)] <- NA
+tab$allantools <- ifelse(is.infinite(tab$allantools),
+                         paste0(">", py_timeout), format(tab$allantools))
 cat(sprintf("bench-types: %s, %d cores, load %s; allantools %s\n",
             format(Sys.time(), "%Y-%m-%d %H:%M %Z"), parallel::detectCores(),
             paste(utils::head(scan("/proc/loadavg", quiet = TRUE), 3), collapse = " "),
             if (have_py) py_path else "not available"))
 cat("NA seconds: not run (the type took more than", cap,
-    "s at the previous size); NA allantools: not timed or over",
-    py_timeout, "s\n")
+    "s at the previous size); allantools NA: not timed (no such function or",
+    "a smaller size already timed out), >", py_timeout, ": timed out\n")
 print(tab, row.names = FALSE)
