@@ -112,7 +112,10 @@ for (N in sizes) {
                                             runs = t[2],
                                             ratio = round(t[1] / s, 1),
                                             allantools = signif(py, 3))
-    if (t[1] > cap) stopped <- c(stopped, ty)
+    # not run at the next size when it would take over 10 caps (the Theo
+    # family is O(N^2) at octave taus, the others about O(N log N))
+    p <- if (ty %in% c("theo1", "theobr", "theoh")) 2 else 1.1
+    if (t[1] > cap || t[1] * 10^p > 10 * cap) stopped <- c(stopped, ty)
   }
   rows[[length(rows) + 1L]] <- data.frame(type = "sum(x)", N = N,
                                           seconds = signif(s, 3), runs = 51,
@@ -128,6 +131,6 @@ cat(sprintf("bench-types: %s, %d cores, load %s; allantools %s\n",
             paste(utils::head(scan("/proc/loadavg", quiet = TRUE), 3), collapse = " "),
             if (have_py) py_path else "not available"))
 cat("NA seconds: not run (the type took more than", cap,
-    "s at the previous size); allantools NA: not timed (no such function or",
+    "s at the previous size, or would take more than", 10 * cap, "s here); allantools NA: not timed (no such function or",
     "a smaller size already timed out), >", py_timeout, ": timed out\n")
 print(tab, row.names = FALSE)
