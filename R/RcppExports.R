@@ -53,8 +53,8 @@ theo1_sums_cpp <- function(v, rate, m, threads) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads)
 }
 
-theo1_all_cpp <- function(v, rate, kmax_d) {
-    .Call(`_allanvar_theo1_all_cpp`, v, rate, kmax_d)
+theo1_all_cpp <- function(v, rate, kmax_d, need) {
+    .Call(`_allanvar_theo1_all_cpp`, v, rate, kmax_d, need)
 }
 
 mtie_cpp <- function(v, rate, m) {

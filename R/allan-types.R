@@ -474,7 +474,7 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
       if (length(mt)) {
         # many m: the all-k recurrence (O(L kmax)) beats m-by-m sums
         T <- if (length(mt) > 40L) {
-          theo1_all_cpp(v, rate, max(mt) / 2)[mt / 2]
+          theo1_all_cpp(v, rate, max(mt) / 2, mt / 2)[mt / 2]
         } else {
           theo1_sums_cpp(v, rate, mt, threads)
         }
@@ -542,7 +542,7 @@ theobr_factor <- function(v, freq, rate, L) {
   mt <- mt[ok]
   ma <- ma[ok]
   kmax <- max(mt) / 2
-  T <- theo1_all_cpp(v, rate, kmax)
+  T <- theo1_all_cpp(v, rate, kmax, mt / 2)
   th <- T[mt / 2] / (0.75 * (L - mt) * mt^2)
   input <- if (rate) "rate" else "integrated"
   a <- allan(v, 1, taus = I(ma), type = "overlapping", input = input)

@@ -112,6 +112,8 @@ for (N in sizes) {
                                             runs = t[2],
                                             ratio = round(t[1] / s, 1),
                                             allantools = signif(py, 3))
+    message(sprintf("%-12s %8.0e %10.4g s  %8.1f x sum  allantools %s", ty, N,
+                    t[1], t[1] / s, format(signif(py, 3))))
     # not run at the next size when it would take over 10 caps (the Theo
     # family is O(N^2) at octave taus, the others about O(N log N))
     p <- if (ty %in% c("theo1", "theobr", "theoh")) 2 else 1.1
@@ -128,7 +130,10 @@ tab$allantools <- ifelse(is.infinite(tab$allantools),
                          paste0(">", py_timeout), format(tab$allantools))
 cat(sprintf("bench-types: %s, %d cores, load %s; allantools %s\n",
             format(Sys.time(), "%Y-%m-%d %H:%M %Z"), parallel::detectCores(),
-            paste(utils::head(scan("/proc/loadavg", quiet = TRUE), 3), collapse = " "),
+            if (file.exists("/proc/loadavg")) {
+              paste(utils::head(strsplit(readLines("/proc/loadavg"), " ")[[1]], 3),
+                    collapse = " ")
+            } else "?",
             if (have_py) py_path else "not available"))
 cat("NA seconds: not run (the type took more than", cap,
     "s at the previous size, or would take more than", 10 * cap, "s here); allantools NA: not timed (no such function or",

@@ -179,14 +179,15 @@ BEGIN_RCPP
 END_RCPP
 }
 // theo1_all_cpp
-Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate, double kmax_d);
-RcppExport SEXP _allanvar_theo1_all_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP kmax_dSEXP) {
+Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate, double kmax_d, const Rcpp::NumericVector& need);
+RcppExport SEXP _allanvar_theo1_all_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP kmax_dSEXP, SEXP needSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
     Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
     Rcpp::traits::input_parameter< double >::type kmax_d(kmax_dSEXP);
-    rcpp_result_gen = Rcpp::wrap(theo1_all_cpp(v, rate, kmax_d));
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type need(needSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_all_cpp(v, rate, kmax_d, need));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -255,7 +256,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
     {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 4},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 4},
-    {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 3},
+    {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
     {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
     {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 6},

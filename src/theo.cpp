@@ -105,11 +105,39 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   return out;
 }
 
+// Exact products of the phase hi + lo for the recurrence: hi is split once
+// into 26-bit halves (Veltkamp), so hi_a hi_b = p + e exactly in 7 flops
+// (Dekker); the lo terms (2^-50 of the scale) enter e in plain double.
+struct PhaseProducts {
+  std::vector<double> h, h1, h2, l;
+  explicit PhaseProducts(const allanvar::SplitPhase& X)
+      : h(X.hi), h1(X.hi.size()), h2(X.hi.size()), l(X.lo) {
+    for (size_t j = 0; j < h.size(); ++j) allanvar::dd_split(h[j], h1[j], h2[j]);
+  }
+  // s + c += x_a x_b, compensated (Ogita, Rump & Oishi's Dot2 step)
+  inline void add(R_xlen_t a, R_xlen_t b, double& s, double& c) const {
+    const double p = h[a] * h[b];
+    const double e = ((h1[a] * h1[b] - p) + h1[a] * h2[b] + h2[a] * h1[b]) +
+                     h2[a] * h2[b] + (h[a] * l[b] + l[a] * h[b]);
+    const double t = s + p;
+    const double z = t - s;
+    c += ((s - (t - z)) + (p - z)) + e;
+    s = t;
+  }
+  DD prod(R_xlen_t a, R_xlen_t b) const {
+    double s = 0, c = 0;
+    add(a, b, s, c);
+    return DD(s) + DD(c);
+  }
+};
+
 // T_k for k = 1..kmax (kmax <= (L - 1) / 2) of one channel, by the
-// all-k recurrence (see the head of this file).
+// all-k recurrence (see the head of this file); T_k is assembled only at
+// the k in `need` (sorted; all k when empty), the other values are NA.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
-                                  double kmax_d) {
+                                  double kmax_d,
+                                  const Rcpp::NumericVector& need) {
   const allanvar::PhaseInput in{v.begin(), v.size(), rate};
   allanvar::SplitPhase X;
   allanvar::split_phase(in, X);
@@ -118,24 +146,37 @@ Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
   kmax = std::min(kmax, (N - 1) / 2);
   Rcpp::NumericVector out(std::max<R_xlen_t>(kmax, 0), NA_REAL);
   if (kmax < 1) return out;
-  // x as double-double; hi on the grid, lo the remainder
-  std::vector<DD> x(N);
-  for (R_xlen_t j = 0; j < N; ++j) x[j] = DD(X.hi[j], X.lo[j]);
-  auto prod = [&](R_xlen_t a, R_xlen_t b) { return x[a] * x[b]; };
+  std::vector<char> want(kmax + 1, need.size() == 0 ? 1 : 0);
+  for (R_xlen_t i = 0; i < need.size(); ++i) {
+    const R_xlen_t k = static_cast<R_xlen_t>(need[i]);
+    if (k >= 1 && k <= kmax) want[k] = 1;
+  }
+  const PhaseProducts x(X);
+  // running sums as (s, c) pairs: value s + c
+  struct Sum {
+    double s = 0, c = 0;
+    DD dd() const { return DD(s) + DD(c); }
+  };
   // C1[j] = sum_{i<j} x_i^2
   std::vector<DD> C1(N + 1);
-  for (R_xlen_t j = 0; j < N; ++j) C1[j + 1] = C1[j] + prod(j, j);
+  {
+    Sum a;
+    for (R_xlen_t j = 0; j < N; ++j) {
+      x.add(j, j, a.s, a.c);
+      C1[j + 1] = a.dd();
+    }
+  }
   auto Q0 = [&](R_xlen_t a, R_xlen_t b) { return C1[b] - C1[a]; };
   // full autocorrelation r(lag), grown two lags per step
   std::vector<DD> r(2 * kmax + 1);
   auto full = [&](R_xlen_t lag) {
-    DD s;
-    for (R_xlen_t j = 0; j + lag < N; ++j) s += prod(j, j + lag);
-    return s;
+    Sum a;
+    for (R_xlen_t j = 0; j + lag < N; ++j) x.add(j, j + lag, a.s, a.c);
+    return a.dd();
   };
   // head[lag]: pairs within x[0, 2k); tail[lag]: within x[N-2k, N);
   // triH[d]: pairs (c-d, c+d) with centre c < k; triT[d]: centre >= N-k.
-  std::vector<DD> head(2 * kmax + 1), tail(2 * kmax + 1), triH(kmax + 1),
+  std::vector<Sum> head(2 * kmax + 1), tail(2 * kmax + 1), triH(kmax + 1),
       triT(kmax + 1);
   R_xlen_t k = 0;  // arrays describe this k
   for (R_xlen_t kn = 1; kn <= kmax; ++kn) {
@@ -146,30 +187,31 @@ Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
     r[2 * k + 1] = full(2 * k + 1);
     r[2 * k + 2] = full(2 * k + 2);
     const R_xlen_t p = 2 * k, q = 2 * k + 1;  // new head points
-    for (R_xlen_t lag = 1; lag <= p; ++lag) head[lag] += prod(p - lag, p);
-    for (R_xlen_t lag = 1; lag <= q; ++lag) head[lag] += prod(q - lag, q);
+    for (R_xlen_t lag = 1; lag <= p; ++lag) x.add(p - lag, p, head[lag].s, head[lag].c);
+    for (R_xlen_t lag = 1; lag <= q; ++lag) x.add(q - lag, q, head[lag].s, head[lag].c);
     const R_xlen_t u = N - 2 * k - 1, w = N - 2 * k - 2;  // new tail points
     for (R_xlen_t lag = 1; u + lag < N && lag <= 2 * k + 1; ++lag)
-      tail[lag] += prod(u, u + lag);
+      x.add(u, u + lag, tail[lag].s, tail[lag].c);
     for (R_xlen_t lag = 1; w + lag < N && lag <= 2 * k + 2; ++lag)
-      tail[lag] += prod(w, w + lag);
+      x.add(w, w + lag, tail[lag].s, tail[lag].c);
     for (R_xlen_t d = 0; d <= k; ++d) {
-      triH[d] += prod(k - d, k + d);
-      triT[d] += prod(N - k - 1 - d, N - k - 1 + d);
+      x.add(k - d, k + d, triH[d].s, triH[d].c);
+      x.add(N - k - 1 - d, N - k - 1 + d, triT[d].s, triT[d].c);
     }
     k = kn;
+    if (!want[k]) continue;
     // assemble T_k
     const R_xlen_t M = N - 2 * k;
     DD T;
     for (R_xlen_t L = 1; L <= k; ++L) {
       const R_xlen_t d = k - L;
-      const DD A = Q0(0, M) + Q0(L, M + L) - DD(2) * (r[L] - tail[L]);
+      const DD A = Q0(0, M) + Q0(L, M + L) - DD(2) * (r[L] - tail[L].dd());
       const DD B = Q0(2 * k - L, N - L) + Q0(2 * k, N) -
-                   DD(2) * (r[L] - head[L]);
+                   DD(2) * (r[L] - head[L].dd());
       const DD mid = d == 0 ? Q0(k, N - k)
-                            : r[2 * d] - triH[d] - triT[d];
-      const DD C = (r[2 * k - L] - tail[2 * k - L]) - r[2 * k] - mid +
-                   (r[2 * k - L] - head[2 * k - L]);
+                            : r[2 * d] - triH[d].dd() - triT[d].dd();
+      const DD C = (r[2 * k - L] - tail[2 * k - L].dd()) - r[2 * k] - mid +
+                   (r[2 * k - L] - head[2 * k - L].dd());
       const DD term = A + B - DD(2) * C;
       T += DD(term.hi / static_cast<double>(L), term.lo / static_cast<double>(L));
     }
