@@ -69,6 +69,10 @@ mcap_imu <- function(buf, op, off, len, ids, enc) {
     .Call(`_allanvar_mcap_imu`, buf, op, off, len, ids, enc)
 }
 
+pdev_sums_cpp <- function(v, rate, m, threads) {
+    .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads)
+}
+
 csv_field_faults <- function(bytes, sep, expected) {
     .Call(`_allanvar_csv_field_faults`, bytes, sep, expected)
 }
@@ -105,8 +109,28 @@ rosbag_chunk_imu <- function(buf, off, len, compression, size, conns) {
     .Call(`_allanvar_rosbag_chunk_imu`, buf, off, len, compression, size, conns)
 }
 
-allan_type_table_cpp <- function() {
-    .Call(`_allanvar_allan_type_table_cpp`)
+theo1_sums_cpp <- function(v, rate, m, threads) {
+    .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads)
+}
+
+theo1_all_cpp <- function(v, rate, kmax_d, need) {
+    .Call(`_allanvar_theo1_all_cpp`, v, rate, kmax_d, need)
+}
+
+mtie_cpp <- function(v, rate, m) {
+    .Call(`_allanvar_mtie_cpp`, v, rate, m)
+}
+
+tierms_sums_cpp <- function(v, rate, m, threads) {
+    .Call(`_allanvar_tierms_sums_cpp`, v, rate, m, threads)
+}
+
+total_sums_cpp <- function(v, rate, m, hadamard, threads, method = 0L) {
+    .Call(`_allanvar_total_sums_cpp`, v, rate, m, hadamard, threads, method)
+}
+
+allan_type_table_cpp <- function(all = FALSE) {
+    .Call(`_allanvar_allan_type_table_cpp`, all)
 }
 
 zstd_available_cpp <- function() {

@@ -125,14 +125,19 @@
 #'   vector of tau in seconds (rounded to whole clusters; wrap a single tau
 #'   in [I()]). Reported tau is \eqn{m / freq}.
 #' @param type One of `"overlapping"` (default), `"standard"`,
-#'   `"modified"`, `"hadamard"`, `"ohadamard"`, `"total"`.
+#'   `"modified"`, `"hadamard"`, `"ohadamard"`, `"total"`, or a further
+#'   statistic (`"tdev"`, `"mtotdev"`, `"ttotdev"`, `"htotdev"`, `"theo1"`,
+#'   `"theobr"`, `"theoh"`, `"mtie"`, `"tierms"`, `"pdev"`; see "Further
+#'   statistics"). allantools' names are accepted too: `"adev"`, `"oadev"`,
+#'   `"mdev"`, `"hdev"`, `"ohdev"`, `"totdev"`.
 #' @param input `"rate"` (default) or `"integrated"`.
 #' @param conf Confidence level of the interval, in (0, 1); the default
 #'   0.683 is one sigma.
-#' @param gaps What NA/NaN in `x` mean: `"error"` (the default, as before)
-#'   or `"skip"`: they are missing samples (or phase points), and every term
-#'   that touches one is left out, as Stable32 and allantools' `gradev` do
-#'   (see the section Gaps). `Inf` is always an error.
+#' @param gaps What NA/NaN in `x` mean: `"skip"` (the default): they are
+#'   missing samples (or phase points), and every term that touches one is
+#'   left out, as Stable32 and allantools' `gradev` do (see the section Gaps;
+#'   the count of missing values is printed and kept in the attribute
+#'   `missing`); or `"error"`: refuse them. `Inf` is always an error.
 #' @return A data frame of class `c("allan", "data.frame")` with columns
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
 #'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
@@ -151,7 +156,8 @@
 #' plot(av)
 #' allan(cbind(x = y, z = 2 * y), type = "modified", taus = "decade")
 allan <- function(x, freq, taus = "octave", type = "overlapping",
-                  input = "rate", conf = 0.683, gaps = "error") {
+                  input = "rate", conf = 0.683, gaps = "skip",
+                  debias = TRUE) {
   check_present(missing(x), "x", "the samples")
   if (missing(freq)) {
     if (!stats::is.ts(x)) {
@@ -161,10 +167,14 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     freq <- stats::frequency(x)
   }
   freq <- check_freq(freq)
-  type <- check_choice(type, allan_types, "type")
+  type <- allan_canonical_type(check_choice(type, allan_type_names(), "type"))
   input <- check_choice(input, c("rate", "integrated"), "input")
   conf <- check_number(conf, "conf", 0, 1, open = TRUE)
-  gaps <- check_choice(gaps, c("error", "skip"), "gaps")
+  gaps <- check_choice(gaps, c("skip", "error"), "gaps")
+  if (type %in% allan_extra_types) {
+    debias <- check_true_false(debias, "debias")
+    return(allan_extra(x, freq, taus, type, input, conf, debias, gaps))
+  }
   ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)
   N <- ch$N
   rate <- input == "rate"
@@ -444,6 +454,7 @@ print.allan <- function(x, digits = 4, ...) {
 
 allan_header <- function(x) {
   a <- attributes(x)
+  if (a$type %in% allan_extra_types) return(allan_extra_header(x))
   nch <- if ("channel" %in% names(x)) length(unique(x$channel)) else 1L
   sprintf("<allan> %s variance of %s input: N = %s at %s Hz%s%s; %s%% intervals",
           a$type, a$input, format(a$N, big.mark = ","), format(a$freq),
@@ -506,9 +517,12 @@ plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
     ylab <- switch(type, standard = , overlapping = "Allan deviation",
                    modified = "modified Allan deviation",
                    hadamard = , ohadamard = "Hadamard deviation",
-                   total = "total deviation")
+                   total = "total deviation", allan_extra_ylab(type))
   }
-  if (is.null(main)) main <- paste0(type, " (", 100 * attr(x, "conf"), "% CI)")
+  if (is.null(main)) {
+    main <- if (type %in% c("mtie", "tierms")) type else
+      paste0(type, " (", 100 * attr(x, "conf"), "% CI)")
+  }
   ok <- is.finite(d$adev) & d$adev > 0
   ylim <- range(c(d$lower[ok], d$upper[ok], d$adev[ok]), finite = TRUE)
   graphics::plot(d$tau[ok], d$adev[ok], type = "n", log = "xy", xlab = xlab,

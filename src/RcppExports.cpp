@@ -228,6 +228,19 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// pdev_sums_cpp
+Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
+RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(pdev_sums_cpp(v, rate, m, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
 // csv_field_faults
 Rcpp::List csv_field_faults(const Rcpp::RawVector& bytes, int sep, int expected);
 RcppExport SEXP _allanvar_csv_field_faults(SEXP bytesSEXP, SEXP sepSEXP, SEXP expectedSEXP) {
@@ -335,12 +348,79 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// allan_type_table_cpp
-Rcpp::DataFrame allan_type_table_cpp();
-RcppExport SEXP _allanvar_allan_type_table_cpp() {
+// theo1_sums_cpp
+Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
+RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    rcpp_result_gen = Rcpp::wrap(allan_type_table_cpp());
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_sums_cpp(v, rate, m, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
+// theo1_all_cpp
+Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate, double kmax_d, const Rcpp::NumericVector& need);
+RcppExport SEXP _allanvar_theo1_all_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP kmax_dSEXP, SEXP needSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< double >::type kmax_d(kmax_dSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type need(needSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_all_cpp(v, rate, kmax_d, need));
+    return rcpp_result_gen;
+END_RCPP
+}
+// mtie_cpp
+Rcpp::NumericVector mtie_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m);
+RcppExport SEXP _allanvar_mtie_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    rcpp_result_gen = Rcpp::wrap(mtie_cpp(v, rate, m));
+    return rcpp_result_gen;
+END_RCPP
+}
+// tierms_sums_cpp
+Rcpp::NumericVector tierms_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
+RcppExport SEXP _allanvar_tierms_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(tierms_sums_cpp(v, rate, m, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
+// total_sums_cpp
+Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, bool hadamard, int threads, int method);
+RcppExport SEXP _allanvar_total_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP hadamardSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< bool >::type hadamard(hadamardSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    Rcpp::traits::input_parameter< int >::type method(methodSEXP);
+    rcpp_result_gen = Rcpp::wrap(total_sums_cpp(v, rate, m, hadamard, threads, method));
+    return rcpp_result_gen;
+END_RCPP
+}
+// allan_type_table_cpp
+Rcpp::DataFrame allan_type_table_cpp(bool all);
+RcppExport SEXP _allanvar_allan_type_table_cpp(SEXP allSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< bool >::type all(allSEXP);
+    rcpp_result_gen = Rcpp::wrap(allan_type_table_cpp(all));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -383,6 +463,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
     {"_allanvar_mcap_chunk_raw", (DL_FUNC) &_allanvar_mcap_chunk_raw, 3},
     {"_allanvar_mcap_imu", (DL_FUNC) &_allanvar_mcap_imu, 6},
+    {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 4},
     {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
     {"_allanvar_int64_rel_seconds", (DL_FUNC) &_allanvar_int64_rel_seconds, 3},
     {"_allanvar_int64_to_double", (DL_FUNC) &_allanvar_int64_to_double, 1},
@@ -392,7 +473,12 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},
     {"_allanvar_rosbag_chunk_imu", (DL_FUNC) &_allanvar_rosbag_chunk_imu, 6},
-    {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 0},
+    {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 4},
+    {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
+    {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
+    {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
+    {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 6},
+    {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 1},
     {"_allanvar_zstd_available_cpp", (DL_FUNC) &_allanvar_zstd_available_cpp, 0},
     {"_allanvar_zstd_decompress_cpp", (DL_FUNC) &_allanvar_zstd_decompress_cpp, 2},
     {NULL, NULL, 0}

@@ -202,7 +202,8 @@ test_that("arguments are checked with clear messages", {
   expect_error(allan(), "`x` is missing")
   expect_error(allan(rnorm(10)), "`freq` is missing")
   expect_error(allan(rnorm(10), -1), "`freq` must be a single positive number")
-  expect_error(allan(c(1, NA, 3), 1), "finite numbers; found NA at position 2")
+  expect_error(allan(c(1, NA, 3), 1, gaps = "error"),
+               "finite numbers; found NA at position 2")
   expect_error(allan(cbind(a = 1:5, b = c(1, 2, Inf, 4, 5)), 1),
                "position 3 of column 2")
   expect_error(allan(letters, 1), "must be a numeric vector")
@@ -439,9 +440,13 @@ test_that("gaps = \"skip\": every term that touches a missing value is left out"
   # without gaps, "skip" changes nothing
   w <- rnorm(500)
   expect_equal(allan(w, 1, gaps = "skip"), allan(w, 1))
-  # the default still refuses NA, and says what to do; Inf is never a gap
-  expect_error(allan(v, 1), class = "allanvar_error_values")
-  expect_error(allan(v, 1), "gaps = \"skip\"")
+  # skipping is the default; gaps = "error" refuses NA and says what to do;
+  # Inf is never a gap
+  expect_equal(suppressWarnings(allan(v, 1)),
+               suppressWarnings(allan(v, 1, gaps = "skip")))
+  expect_error(allan(v, 1, gaps = "error"), class = "allanvar_error_values")
+  expect_error(allan(v, 1, gaps = "error"), "gaps = \"skip\"")
+  expect_error(allan(v, 1, type = "tdev"), class = "allanvar_error_gaps")
   expect_error(allan(c(1, Inf, NA, 4, 5), 1, gaps = "skip"),
                "found Inf at position 2", class = "allanvar_error_values")
   expect_error(allan(v, 1, type = "total", gaps = "skip"),

@@ -1,0 +1,130 @@
+// Local phase segments for the kernels of the further statistics (TIE,
+// PDEV, the Total family, Theo1). Every one of those statistics is built
+// from phase differences over a bounded span, so a kernel works block by
+// block on x(a + j) - x(a) - c j, accumulated from the increments with
+// compensated sums: however large the frequency offset or the record, the
+// values stay of the size of the local phase wander and lose nothing to a
+// global running sum. The statistics that ignore a linear phase term (PDEV,
+// the Total family, Theo1) use the values as they are; TIE adds c j back.
+#ifndef ALLANVAR_LOCAL_PHASE_H
+#define ALLANVAR_LOCAL_PHASE_H
+
+#include <Rcpp.h>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace allanvar {
+
+// a + b = s + e exactly (Knuth's TwoSum).
+inline void phase_two_sum(double a, double b, double& s, double& e) {
+  s = a + b;
+  const double bb = s - a;
+  e = (a - (s - bb)) + (b - bb);
+}
+
+// The input as a phase sequence: rate samples y (x(0) = 0, x(j) = y(0) +
+// ... + y(j - 1), L = N + 1 points; the caller scales by tau0) or the
+// integrated values themselves (L = N).
+struct PhaseInput {
+  const double* v;
+  R_xlen_t n;  // samples
+  bool rate;
+  R_xlen_t length() const { return rate ? n + 1 : n; }
+  // increment x(i + 1) - x(i) as hi + lo, exactly
+  void increment(R_xlen_t i, double& hi, double& lo) const {
+    if (rate) {
+      hi = v[i];
+      lo = 0;
+    } else {
+      phase_two_sum(v[i + 1], -v[i], hi, lo);
+    }
+  }
+};
+
+// out[j] = x(a + j) - x(a) - c j for j in [0, len), with c the mean
+// increment over the segment (returned). The increments are exact
+// (TwoSum); the running sum is compensated, so out[] is the rounded exact
+// value of that difference.
+inline double local_phase(const PhaseInput& in, R_xlen_t a, R_xlen_t len,
+                          double* out) {
+  if (len <= 0) return 0.0;
+  double c = 0;
+  if (len > 1) {
+    // the mean increment, from the end points (any double c would do)
+    double s = 0, e = 0;
+    for (R_xlen_t l = 0; l < len - 1; ++l) {
+      double h, lo, t, te;
+      in.increment(a + l, h, lo);
+      phase_two_sum(s, h, t, te);
+      s = t;
+      e += te + lo;
+    }
+    c = (s + e) / static_cast<double>(len - 1);
+  }
+  double s = 0, e = 0;
+  out[0] = 0;
+  for (R_xlen_t l = 0; l < len - 1; ++l) {
+    double h, lo, r, re, t, te;
+    in.increment(a + l, h, lo);
+    phase_two_sum(h, -c, r, re);
+    phase_two_sum(s, r, t, te);
+    s = t;
+    e += te + re + lo;
+    out[l + 1] = s + e;
+  }
+  return c;
+}
+
+// The whole phase as hi + lo with the mean increment c removed:
+// X(j) = x(j) - x(0) - c j. hi lies on a grid of step q = 2^k with
+// |hi| <= 2^50 q, so integer combinations of hi with total weight <= 8 are
+// exact in double; lo (|lo| <= q/2) carries the rest. One compensated pass.
+struct SplitPhase {
+  std::vector<double> hi, lo;
+  double c = 0;  // removed slope per sample
+  R_xlen_t size() const { return static_cast<R_xlen_t>(hi.size()); }
+  double value(R_xlen_t j) const { return hi[j] + lo[j]; }
+};
+
+inline void split_phase(const PhaseInput& in, SplitPhase& out) {
+  const R_xlen_t L = in.length();
+  out.hi.assign(L, 0.0);
+  out.lo.assign(L, 0.0);
+  if (L < 2) return;
+  double s = 0, e = 0, bmin = 0, bmax = 0;
+  for (R_xlen_t l = 0; l < L - 1; ++l) {
+    double h, lo, t, te;
+    in.increment(l, h, lo);
+    if (l == 0 || h < bmin) bmin = h;
+    if (l == 0 || h > bmax) bmax = h;
+    phase_two_sum(s, h, t, te);
+    s = t;
+    e += te + lo;
+  }
+  const double c = (s + e) / static_cast<double>(L - 1);
+  out.c = c;
+  double bound = std::max(std::fabs(bmax - c), std::fabs(bmin - c)) + 1e-300;
+  bound *= static_cast<double>(L) * (1 + 1e-9);
+  int ex;
+  std::frexp(bound, &ex);
+  const double q = std::ldexp(1.0, ex - 50);
+  const double C = 1.5 * q * 4503599627370496.0;  // ulp(C) = q
+  s = 0;
+  e = 0;
+  for (R_xlen_t l = 0; l < L - 1; ++l) {
+    double h, lo, r, re, t, te;
+    in.increment(l, h, lo);
+    phase_two_sum(h, -c, r, re);
+    phase_two_sum(s, r, t, te);
+    s = t;
+    e += te + re + lo;
+    const double g = (s + C) - C;
+    out.hi[l + 1] = g;
+    out.lo[l + 1] = (s - g) + e;
+  }
+}
+
+}  // namespace allanvar
+
+#endif

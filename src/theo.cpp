@@ -1,0 +1,221 @@
+// Theo1 of allan(type = "theo1" / "theobr" / "theoh"): NIST SP 1065
+// sec. 5.2.15, eq. (30); D.A. Howe & T.K. Peppler, "Very long-term
+// frequency stability: estimation using a special-purpose statistic",
+// IFCS 2003. For even m = 2k and N phase points,
+//   Theo1(0.75 m tau0) = T_k / (0.75 (N - m) (m tau0)^2),
+//   T_k = sum_{i < N-m} sum_{L=1..k} (1/L) (x(i) - x(i+L) + x(i+m) - x(i+m-L))^2
+// (L = m/2 - delta of SP 1065's inner index).
+//
+// Two evaluations:
+//  * theo1_sums_cpp: T_k at the requested m, straight from the definition:
+//    for each L one pass of a four-point stencil over the phase split hi +
+//    lo (src/local-phase.h), exact on the hi grid. O(N k) per m.
+//  * theo1_all_cpp: T_k for every k = 1..kmax in O(N kmax + kmax^2), the
+//    complexity of the all-tau Allan variance, by the recurrence idea of
+//    B. Lewis, "A fast algorithm for calculation of Theo1" (IEEE TUFFC
+//    2021, arXiv:2106.04542): T_k expands into lag products of x, which are
+//    full autocorrelations minus partial sums over the first and last 2k
+//    points and over the pairs centred within k of either end; those
+//    partial sums grow by O(k) products from k to k + 1. The expansion
+//    cancels heavily (terms of size N var(x) for a result of size N k
+//    var(dx)), so every product and sum is carried in double-double
+//    (src/dd.h) on the exact hi + lo phase: the result agrees with the
+//    direct evaluation to about 1e-15 whatever the noise type.
+#include "dd.h"
+#include "local-phase.h"
+#include "parallel.h"
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace {
+
+using allanvar::DD;
+
+struct Item {
+  size_t tau;
+  R_xlen_t l0, l1;  // L in [l0, l1)
+};
+
+}  // namespace
+
+// T_k for each even m = 2k of one channel (NA where m > L - 1).
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
+                                   const Rcpp::NumericVector& m, int threads) {
+  const allanvar::PhaseInput in{v.begin(), v.size(), rate};
+  allanvar::SplitPhase X;
+  allanvar::split_phase(in, X);
+  const R_xlen_t N = in.length();
+  const std::vector<double> ms(m.begin(), m.end());
+  std::vector<Item> items;
+  for (size_t t = 0; t < ms.size(); ++t) {
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
+    if (mm < 2 || mm % 2 != 0 || mm > N - 1) continue;
+    const R_xlen_t k = mm / 2;
+    // about 2^22 stencil terms per item, for interrupt latency and balance
+    const R_xlen_t per =
+        std::max<R_xlen_t>(1, (R_xlen_t(1) << 22) / std::max<R_xlen_t>(1, N - mm));
+    for (R_xlen_t l0 = 1; l0 <= k; l0 += per)
+      items.push_back(Item{t, l0, std::min(k + 1, l0 + per)});
+  }
+  std::vector<double> part(items.size(), 0.0);
+  const double* h = X.hi.data();
+  const double* l = X.lo.data();
+  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()),
+                         std::max(1, threads), [&](R_xlen_t it, int) {
+    const Item& I = items[it];
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[I.tau]);
+    const R_xlen_t n = N - mm;
+    double acc = 0;
+    for (R_xlen_t b0 = 0; b0 < n; b0 += 4096) {
+      const R_xlen_t b1 = std::min(n, b0 + 4096);
+      for (R_xlen_t L = I.l0; L < I.l1; ++L) {
+        const R_xlen_t a = L, b = mm, c = mm - L;
+        double s0 = 0, s1 = 0;
+        R_xlen_t i = b0;
+        for (; i + 2 <= b1; i += 2) {
+          const double d0 = ((h[i] - h[i + a]) + (h[i + b] - h[i + c])) +
+                            ((l[i] - l[i + a]) + (l[i + b] - l[i + c]));
+          const double d1 =
+              ((h[i + 1] - h[i + 1 + a]) + (h[i + 1 + b] - h[i + 1 + c])) +
+              ((l[i + 1] - l[i + 1 + a]) + (l[i + 1 + b] - l[i + 1 + c]));
+          s0 += d0 * d0;
+          s1 += d1 * d1;
+        }
+        for (; i < b1; ++i) {
+          const double d = ((h[i] - h[i + a]) + (h[i + b] - h[i + c])) +
+                           ((l[i] - l[i + a]) + (l[i + b] - l[i + c]));
+          s0 += d * d;
+        }
+        acc += (s0 + s1) / static_cast<double>(L);
+      }
+    }
+    part[it] = acc;
+  });
+  Rcpp::NumericVector out(ms.size(), NA_REAL);
+  std::vector<DD> tot(ms.size());
+  std::vector<bool> any(ms.size(), false);
+  for (size_t it = 0; it < items.size(); ++it) {
+    tot[items[it].tau] += DD(part[it]);
+    any[items[it].tau] = true;
+  }
+  for (size_t t = 0; t < ms.size(); ++t)
+    if (any[t]) out[t] = tot[t].value();
+  return out;
+}
+
+// Exact products of the phase hi + lo for the recurrence: hi is split once
+// into 26-bit halves (Veltkamp), so hi_a hi_b = p + e exactly in 7 flops
+// (Dekker); the lo terms (2^-50 of the scale) enter e in plain double.
+struct PhaseProducts {
+  std::vector<double> h, h1, h2, l;
+  explicit PhaseProducts(const allanvar::SplitPhase& X)
+      : h(X.hi), h1(X.hi.size()), h2(X.hi.size()), l(X.lo) {
+    for (size_t j = 0; j < h.size(); ++j) allanvar::dd_split(h[j], h1[j], h2[j]);
+  }
+  // s + c += x_a x_b, compensated (Ogita, Rump & Oishi's Dot2 step)
+  inline void add(R_xlen_t a, R_xlen_t b, double& s, double& c) const {
+    const double p = h[a] * h[b];
+    const double e = ((h1[a] * h1[b] - p) + h1[a] * h2[b] + h2[a] * h1[b]) +
+                     h2[a] * h2[b] + (h[a] * l[b] + l[a] * h[b]);
+    const double t = s + p;
+    const double z = t - s;
+    c += ((s - (t - z)) + (p - z)) + e;
+    s = t;
+  }
+  DD prod(R_xlen_t a, R_xlen_t b) const {
+    double s = 0, c = 0;
+    add(a, b, s, c);
+    return DD(s) + DD(c);
+  }
+};
+
+// T_k for k = 1..kmax (kmax <= (L - 1) / 2) of one channel, by the
+// all-k recurrence (see the head of this file); T_k is assembled only at
+// the k in `need` (sorted; all k when empty), the other values are NA.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
+                                  double kmax_d,
+                                  const Rcpp::NumericVector& need) {
+  const allanvar::PhaseInput in{v.begin(), v.size(), rate};
+  allanvar::SplitPhase X;
+  allanvar::split_phase(in, X);
+  const R_xlen_t N = in.length();
+  R_xlen_t kmax = static_cast<R_xlen_t>(kmax_d);
+  kmax = std::min(kmax, (N - 1) / 2);
+  Rcpp::NumericVector out(std::max<R_xlen_t>(kmax, 0), NA_REAL);
+  if (kmax < 1) return out;
+  std::vector<char> want(kmax + 1, need.size() == 0 ? 1 : 0);
+  for (R_xlen_t i = 0; i < need.size(); ++i) {
+    const R_xlen_t k = static_cast<R_xlen_t>(need[i]);
+    if (k >= 1 && k <= kmax) want[k] = 1;
+  }
+  const PhaseProducts x(X);
+  // running sums as (s, c) pairs: value s + c
+  struct Sum {
+    double s = 0, c = 0;
+    DD dd() const { return DD(s) + DD(c); }
+  };
+  // C1[j] = sum_{i<j} x_i^2
+  std::vector<DD> C1(N + 1);
+  {
+    Sum a;
+    for (R_xlen_t j = 0; j < N; ++j) {
+      x.add(j, j, a.s, a.c);
+      C1[j + 1] = a.dd();
+    }
+  }
+  auto Q0 = [&](R_xlen_t a, R_xlen_t b) { return C1[b] - C1[a]; };
+  // full autocorrelation r(lag), grown two lags per step
+  std::vector<DD> r(2 * kmax + 1);
+  auto full = [&](R_xlen_t lag) {
+    Sum a;
+    for (R_xlen_t j = 0; j + lag < N; ++j) x.add(j, j + lag, a.s, a.c);
+    return a.dd();
+  };
+  // head[lag]: pairs within x[0, 2k); tail[lag]: within x[N-2k, N);
+  // triH[d]: pairs (c-d, c+d) with centre c < k; triT[d]: centre >= N-k.
+  std::vector<Sum> head(2 * kmax + 1), tail(2 * kmax + 1), triH(kmax + 1),
+      triT(kmax + 1);
+  R_xlen_t k = 0;  // arrays describe this k
+  for (R_xlen_t kn = 1; kn <= kmax; ++kn) {
+    if ((kn & 15) == 0 && allanvar::interrupt_pending())
+      throw Rcpp::internal::InterruptedException();
+    // advance k -> kn = k + 1
+    if (k == 0) r[0] = C1[N];
+    r[2 * k + 1] = full(2 * k + 1);
+    r[2 * k + 2] = full(2 * k + 2);
+    const R_xlen_t p = 2 * k, q = 2 * k + 1;  // new head points
+    for (R_xlen_t lag = 1; lag <= p; ++lag) x.add(p - lag, p, head[lag].s, head[lag].c);
+    for (R_xlen_t lag = 1; lag <= q; ++lag) x.add(q - lag, q, head[lag].s, head[lag].c);
+    const R_xlen_t u = N - 2 * k - 1, w = N - 2 * k - 2;  // new tail points
+    for (R_xlen_t lag = 1; u + lag < N && lag <= 2 * k + 1; ++lag)
+      x.add(u, u + lag, tail[lag].s, tail[lag].c);
+    for (R_xlen_t lag = 1; w + lag < N && lag <= 2 * k + 2; ++lag)
+      x.add(w, w + lag, tail[lag].s, tail[lag].c);
+    for (R_xlen_t d = 0; d <= k; ++d) {
+      x.add(k - d, k + d, triH[d].s, triH[d].c);
+      x.add(N - k - 1 - d, N - k - 1 + d, triT[d].s, triT[d].c);
+    }
+    k = kn;
+    if (!want[k]) continue;
+    // assemble T_k
+    const R_xlen_t M = N - 2 * k;
+    DD T;
+    for (R_xlen_t L = 1; L <= k; ++L) {
+      const R_xlen_t d = k - L;
+      const DD A = Q0(0, M) + Q0(L, M + L) - DD(2) * (r[L] - tail[L].dd());
+      const DD B = Q0(2 * k - L, N - L) + Q0(2 * k, N) -
+                   DD(2) * (r[L] - head[L].dd());
+      const DD mid = d == 0 ? Q0(k, N - k)
+                            : r[2 * d] - triH[d].dd() - triT[d].dd();
+      const DD C = (r[2 * k - L] - tail[2 * k - L].dd()) - r[2 * k] - mid +
+                   (r[2 * k - L] - head[2 * k - L].dd());
+      const DD term = A + B - DD(2) * C;
+      T += DD(term.hi / static_cast<double>(L), term.lo / static_cast<double>(L));
+    }
+    out[k - 1] = T.value();
+  }
+  return out;
+}

@@ -1,0 +1,431 @@
+// The Total family of allan(): modified total (MTOT, and TTOT = tau^2/3
+// MTOT) and Hadamard total (HTOT) variances, NIST SP 1065 sec. 5.2.12-14,
+// eqs. (27)-(29); D.A. Howe & F. Vernotte, "Generalization of the total
+// variance approach to the modified Allan variance", PTTI 1999; D.A. Howe et
+// al., "A total estimator of the Hadamard function used for GPS
+// operations", PTTI 2000.
+//
+// For each window of 3m consecutive points s (phase for MTOT, frequency for
+// HTOT): a line through the means of its two halves is removed, the result
+// s0 is extended at both ends by uninverted even reflection to 9m points,
+// and the 6m overlapping third differences (at spacing m) of its prefix
+// sums E are squared and summed: Q = sum_j (E(j+3m) - 3E(j+2m) + 3E(j+m) -
+// E(j))^2. The kernel returns sum over windows of Q; R/allan-types.R
+// normalises (MTOT: / (12 m^5 n tau^2/m^2), HTOT: / (36 m^3 n)).
+// O(m) per window; windows are processed in blocks of local phase
+// (src/local-phase.h; both statistics ignore a linear phase term).
+#include "local-phase.h"
+#include "parallel.h"
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace {
+
+struct Item {
+  size_t tau;
+  R_xlen_t n0, n1;  // windows [n0, n1)
+};
+
+// From this m on, the closed form (below) is faster than the direct sum.
+const R_xlen_t kFastFrom = 8;
+
+struct Scratch {
+  std::vector<double> r, s, S, E;
+};
+
+// Q of one window s[0, 3m) (overwritten).
+double window_q(double* s, R_xlen_t m, Scratch& w) {
+  const R_xlen_t n3 = 3 * m;
+  const R_xlen_t h = n3 / 2;
+  double a = 0, b = 0;
+  for (R_xlen_t t = 0; t < h; ++t) a += s[t];
+  for (R_xlen_t t = n3 - h; t < n3; ++t) b += s[t];
+  const double slope = (b - a) / static_cast<double>(h) /
+                       static_cast<double>(n3 - h);
+  // remove the line through the half means, centred to keep values small
+  const double mid = 0.5 * static_cast<double>(n3 - 1);
+  std::vector<double>& S = w.S;
+  S.resize(n3 + 1);
+  S[0] = 0;
+  for (R_xlen_t t = 0; t < n3; ++t)
+    S[t + 1] = S[t] + (s[t] - slope * (static_cast<double>(t) - mid));
+  const double T = S[n3];
+  std::vector<double>& E = w.E;
+  E.resize(9 * m + 1);
+  for (R_xlen_t t = 0; t <= n3; ++t) E[t] = T - S[n3 - t];
+  for (R_xlen_t t = 1; t <= n3; ++t) E[n3 + t] = T + S[t];
+  for (R_xlen_t t = 1; t <= n3; ++t) E[2 * n3 + t] = 3 * T - S[n3 - t];
+  double q0 = 0, q1 = 0;
+  const double* e = E.data();
+  R_xlen_t j = 0;
+  for (; j + 2 <= 6 * m; j += 2) {
+    const double d0 = (e[j + 3 * m] - e[j]) + 3.0 * (e[j + m] - e[j + 2 * m]);
+    const double d1 = (e[j + 1 + 3 * m] - e[j + 1]) +
+                      3.0 * (e[j + 1 + m] - e[j + 1 + 2 * m]);
+    q0 += d0 * d0;
+    q1 += d1 * d1;
+  }
+  for (; j < 6 * m; ++j) {
+    const double d = (e[j + 3 * m] - e[j]) + 3.0 * (e[j + m] - e[j + 2 * m]);
+    q0 += d * d;
+  }
+  return q0 + q1;
+}
+
+// ---- O(1) per window: the quadratic form in closed form ----
+//
+// With s0 the detrended window and S_k = s0_0 + ... + s0_k (S_k = 0 for
+// k < 0, T = S_{3m-1} for k >= 3m - 1), Q equals 2 (Toep + Hank) with
+//   Toep = sum_ab s0_a s0_b rho(a - b),  Hank = sum_ab s0_a s0_b rho(a + b + 1),
+// rho the circular autocorrelation (period 6m) of the kernel (1, -2, 1) x m
+// (the 9m-point extension is a window of the even periodic extension, and
+// the 6m differences cover one period). rho is piecewise linear with knots
+// at multiples of m, so both sums are combinations of
+//   sum_ab s_a s_b |a - b - c| = sum_t [T S_t + T S_{t-c} - 2 S_t S_{t-c}],
+//   sum_ab s_a s_b |a + b + 1 - c| = sum_t [T^2 - T S_t - T S_{e-t} + 2 S_t S_{e-t}]
+// (e = c - 2; sums over the t where a term is non-zero). On a block of
+// windows, S_k = Z(n+k+1) - Z(n) - beta_n k(k+1)/2 with Z the prefix sums of
+// the local series and beta_n the slope of the line through the half means,
+// so every sum over t is a difference of prefix sums (of Z, of u^j Z(u), of
+// Z(u) Z(u-c)); the products S_t S_{e-t} across a whole block of windows
+// are anti-diagonal sums of Z, one pass with prefix sums over every other
+// index. The block spans a few m, so prefix sums stay of the size of the
+// local wander and nothing cancels beyond a factor of about 50.
+
+enum ItemKind { ITEM_TS, ITEM_SAME, ITEM_ANTI };
+
+struct PlanItem {
+  int kind;
+  double coef;
+  R_xlen_t a, b;  // TS: k in [a, b]; SAME/ANTI: t in [a, b]
+  R_xlen_t c;     // SAME: lag c (S_t S_{t-c}); ANTI: e (S_t S_{e-t})
+  double q1, q2, qq;  // sums of q over the item's ranges (n-free parts)
+};
+
+struct Plan {
+  double tt = 0;  // coefficient of T^2
+  std::vector<PlanItem> items;
+};
+
+inline double qk(R_xlen_t k) { return 0.5 * static_cast<double>(k) * (k + 1); }
+
+// index state: 0 below 0 (S = 0), 1 inside [0, 3m-1], 2 above (S = T)
+inline int state(R_xlen_t i, R_xlen_t n3) { return i < 0 ? 0 : (i < n3 ? 1 : 2); }
+
+// Adds w * sum_t [T S_{i1} + T S_{i2} - 2 S_{i1} S_{i2}] over t in [t0, t1],
+// i1 = t, i2 = sgn * t + off (sgn = 1: SAME with lag c = -off; -1: ANTI,
+// e = off), splitting t where an index changes state.
+void add_gf(Plan& P, double w, R_xlen_t t0, R_xlen_t t1, int sgn, R_xlen_t off,
+            R_xlen_t n3) {
+  std::vector<R_xlen_t> cut = {t0, t1 + 1, 0, n3};
+  if (sgn == 1) {
+    cut.push_back(-off);
+    cut.push_back(n3 - off);
+  } else {
+    cut.push_back(off + 1);
+    cut.push_back(off - n3 + 1);
+  }
+  std::sort(cut.begin(), cut.end());
+  cut.erase(std::unique(cut.begin(), cut.end()), cut.end());
+  for (size_t z = 0; z + 1 < cut.size(); ++z) {
+    const R_xlen_t a = std::max(cut[z], t0), b = std::min(cut[z + 1] - 1, t1);
+    if (a > b) continue;
+    const R_xlen_t cnt = b - a + 1;
+    const int s1 = state(a, n3), s2 = state(sgn * a + off, n3);
+    // i2's k-range over the piece
+    const R_xlen_t k2a = std::min(sgn * a + off, sgn * b + off);
+    const R_xlen_t k2b = std::max(sgn * a + off, sgn * b + off);
+    auto ts = [&](double cf, R_xlen_t ka, R_xlen_t kb) {
+      PlanItem it{ITEM_TS, cf, ka, kb, 0, 0, 0, 0};
+      P.items.push_back(it);
+    };
+    // T S_{i1} + T S_{i2}
+    if (s1 == 1) ts(w, a, b);
+    if (s1 == 2) P.tt += w * cnt;
+    if (s2 == 1) ts(w, k2a, k2b);
+    if (s2 == 2) P.tt += w * cnt;
+    // -2 S_{i1} S_{i2}
+    if (s1 == 0 || s2 == 0) continue;
+    if (s1 == 2 && s2 == 2) {
+      P.tt -= 2 * w * cnt;
+    } else if (s1 == 2) {
+      ts(-2 * w, k2a, k2b);
+    } else if (s2 == 2) {
+      ts(-2 * w, a, b);
+    } else {
+      PlanItem it{sgn == 1 ? ITEM_SAME : ITEM_ANTI, -2 * w, a, b,
+                  sgn == 1 ? -off : off, 0, 0, 0};
+      P.items.push_back(it);
+    }
+  }
+}
+
+Plan make_plan(R_xlen_t m) {
+  const R_xlen_t n3 = 3 * m;
+  Plan P;
+  P.tt = 2.0 * (3.0 * m - 24.0 * m);
+  const double wf[3] = {-10, 15, -6};
+  for (int i = 0; i < 3; ++i) {
+    const R_xlen_t c = i * m;
+    add_gf(P, 2 * wf[i], 0, n3 - 1 + c, 1, -c, n3);
+  }
+  const double wh[5] = {7.5, -3, 1, -3, 7.5};
+  for (int i = 1; i <= 5; ++i) {
+    const R_xlen_t e = i * m - 2;
+    const R_xlen_t t0 = std::min<R_xlen_t>(0, e - n3 + 1);
+    const R_xlen_t t1 = std::max<R_xlen_t>(n3 - 1, e);
+    P.tt += 2 * wh[i - 1] * (t1 - t0 + 1);
+    add_gf(P, -2 * wh[i - 1], t0, t1, -1, e, n3);
+  }
+  for (PlanItem& it : P.items) {
+    if (it.kind == ITEM_TS) {
+      for (R_xlen_t k = it.a; k <= it.b; ++k) it.q1 += qk(k);
+    } else if (it.kind == ITEM_SAME) {
+      for (R_xlen_t t = it.a; t <= it.b; ++t) {
+        it.q1 += qk(t);
+        it.q2 += qk(t - it.c);
+        it.qq += qk(t) * qk(t - it.c);
+      }
+    } else {
+      for (R_xlen_t t = it.a; t <= it.b; ++t) {
+        it.q1 += qk(t);
+        it.q2 += qk(it.c - t);
+        it.qq += qk(t) * qk(it.c - t);
+      }
+    }
+  }
+  return P;
+}
+
+struct FastScratch {
+  std::vector<double> Z, ZZ, M1, M2, PE, zn, beta, T;
+  std::vector<std::vector<double> > LP;  // lags 0, m, 2m
+};
+
+// Sum of Q over windows n in [0, nb) of the local series z (3m values per
+// window).
+double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
+                    FastScratch& w) {
+  const R_xlen_t n3 = 3 * m, Lz = nb + n3 - 1;
+  const R_xlen_t h = n3 / 2;
+  std::vector<double>& Z = w.Z;
+  Z.resize(Lz + 1);
+  Z[0] = 0;
+  for (R_xlen_t i = 0; i < Lz; ++i) Z[i + 1] = Z[i] + z[i];
+  w.ZZ.resize(Lz + 2);
+  w.M1.resize(Lz + 2);
+  w.M2.resize(Lz + 2);
+  w.PE.resize(Lz + 1);
+  w.ZZ[0] = w.M1[0] = w.M2[0] = 0;
+  for (R_xlen_t u = 0; u <= Lz; ++u) {
+    const double du = static_cast<double>(u);
+    w.ZZ[u + 1] = w.ZZ[u] + Z[u];
+    w.M1[u + 1] = w.M1[u] + du * Z[u];
+    w.M2[u + 1] = w.M2[u] + du * du * Z[u];
+    w.PE[u] = Z[u] + (u >= 2 ? w.PE[u - 2] : 0.0);
+  }
+  w.LP.resize(3);
+  for (int i = 0; i < 3; ++i) {
+    const R_xlen_t c = i * m;
+    std::vector<double>& L = w.LP[i];
+    L.assign(Lz + 2, 0.0);
+    for (R_xlen_t u = 0; u <= Lz; ++u)
+      L[u + 1] = L[u] + (u >= c ? Z[u] * Z[u - c] : 0.0);
+  }
+  const double* ZZ = w.ZZ.data();
+  const double* M1 = w.M1.data();
+  const double* M2 = w.M2.data();
+  auto W = [&](R_xlen_t a, R_xlen_t b) { return ZZ[b + 1] - ZZ[a]; };
+  // sum over u in [u0, u1] of q(sg (u - A)) Z(u), q(x) = (x^2 + x) / 2
+  auto MQ = [&](double A, int sg, R_xlen_t u0, R_xlen_t u1) {
+    const double m0 = ZZ[u1 + 1] - ZZ[u0], m1 = M1[u1 + 1] - M1[u0],
+                 m2 = M2[u1 + 1] - M2[u0];
+    return 0.5 * (m2 + (sg - 2 * A) * m1 + (A * A - sg * A) * m0);
+  };
+  const double bden = static_cast<double>(h) * static_cast<double>(n3 - h);
+  // per window: Z(n), the slope beta_n and T_n; then one pass over the
+  // windows per plan item, so that each pass streams through a few arrays
+  // (a pass per window over all items would touch ~250 scattered places)
+  w.zn.resize(nb);
+  w.beta.resize(nb);
+  w.T.resize(nb);
+  double total = 0;
+  for (R_xlen_t n = 0; n < nb; ++n) {
+    const double zn = Z[n];
+    const double beta =
+        ((Z[n + n3] - Z[n + n3 - h]) - (Z[n + h] - Z[n])) / bden;
+    const double T = (Z[n + n3] - zn) - beta * qk(n3 - 1);
+    w.zn[n] = zn;
+    w.beta[n] = beta;
+    w.T[n] = T;
+    total += P.tt * T * T;
+  }
+  const double* zv = w.zn.data();
+  const double* bv = w.beta.data();
+  const double* Tv = w.T.data();
+  for (const PlanItem& it : P.items) {
+    const R_xlen_t a = it.a, b = it.b;
+    const double cnt = static_cast<double>(b - a + 1);
+    double acc = 0;
+    if (it.kind == ITEM_TS) {
+      for (R_xlen_t n = 0; n < nb; ++n) {
+        const double sumS = W(n + a + 1, n + b + 1) - cnt * zv[n] - bv[n] * it.q1;
+        acc += Tv[n] * sumS;
+      }
+    } else if (it.kind == ITEM_SAME) {
+      const R_xlen_t c = it.c;
+      const double* L = w.LP[c / m].data();
+      for (R_xlen_t n = 0; n < nb; ++n) {
+        const double zn = zv[n], beta = bv[n];
+        const double uu = L[n + b + 2] - L[n + a + 1] -
+                          zn * (W(n + a + 1, n + b + 1) + W(n + a + 1 - c, n + b + 1 - c)) +
+                          cnt * zn * zn;
+        // sum q_t U_{t-c}: u = n + t + 1 - c, t = u - (n + 1 - c)
+        const double qu1 = MQ(static_cast<double>(n + 1 - c), 1, n + a + 1 - c,
+                              n + b + 1 - c) - zn * it.q1;
+        // sum q_{t-c} U_t: u = n + t + 1, t - c = u - (n + 1 + c)
+        const double qu2 = MQ(static_cast<double>(n + 1 + c), 1, n + a + 1,
+                              n + b + 1) - zn * it.q2;
+        acc += uu - beta * (qu1 + qu2) + beta * beta * it.qq;
+      }
+    } else {
+      const R_xlen_t e = it.c;
+      for (R_xlen_t n = 0; n < nb; ++n) {
+        const double zn = zv[n], beta = bv[n];
+        // the anti-diagonal products of Z are added for the whole block below
+        const double uu = -zn * (W(n + a + 1, n + b + 1) + W(n + e + 1 - b, n + e + 1 - a)) +
+                          cnt * zn * zn;
+        const double A = static_cast<double>(n + e + 1);
+        // sum q_t U_{e-t}: u = n + e + 1 - t, t = A - u
+        const double qu1 = MQ(A, -1, n + e + 1 - b, n + e + 1 - a) - zn * it.q1;
+        // sum q_{e-t} U_t: u = n + t + 1, e - t = A - u
+        const double qu2 = MQ(A, -1, n + a + 1, n + b + 1) - zn * it.q2;
+        acc += uu - beta * (qu1 + qu2) + beta * beta * it.qq;
+      }
+    }
+    total += it.coef * acc;
+  }
+  // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t)
+  const double* PE = w.PE.data();
+  for (const PlanItem& it : P.items) {
+    if (it.kind != ITEM_ANTI) continue;
+    const R_xlen_t a = it.a, b = it.b, e = it.c;
+    double s = 0;
+    for (R_xlen_t u = a + 1; u <= nb + b; ++u) {
+      const R_xlen_t lo = std::max<R_xlen_t>(0, u - 1 - b);
+      const R_xlen_t hi = std::min<R_xlen_t>(nb - 1, u - 1 - a);
+      if (lo > hi) continue;
+      const R_xlen_t v0 = 2 * lo + e + 2 - u, v1 = 2 * hi + e + 2 - u;
+      s += Z[u] * (PE[v1] - (v0 >= 2 ? PE[v0 - 2] : 0.0));
+    }
+    total += it.coef * s;
+  }
+  return total;
+}
+
+}  // namespace
+
+// Sum over windows of Q for every m (MTOT when hadamard is FALSE: windows of
+// phase, L - 3m + 1 of them; HTOT when TRUE: windows of frequency (phase
+// increments), L - 3m of them), one channel. method: 0 chooses (the closed
+// form from m = kFastFrom), 1 the direct O(m) per window, 2 the closed form.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
+                                   const Rcpp::NumericVector& m, bool hadamard,
+                                   int threads, int method = 0) {
+  const allanvar::PhaseInput in{v.begin(), v.size(), rate};
+  const R_xlen_t L = in.length();
+  const std::vector<double> ms(m.begin(), m.end());
+  std::vector<Item> items;
+  for (size_t t = 0; t < ms.size(); ++t) {
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
+    const R_xlen_t nwin = hadamard ? L - 3 * mm : L - 3 * mm + 1;
+    if (mm < 1 || nwin < 1) continue;
+    // direct: about 2^16 m work per item; closed form: whole sub-blocks
+    // of 4m windows (its cost per sub-block is O(m))
+    const bool fst = method == 2 || (method == 0 && mm >= kFastFrom);
+    const R_xlen_t B = fst ? 4 * mm * std::max<R_xlen_t>(1, 4096 / mm)
+                           : std::max<R_xlen_t>(1, (R_xlen_t(1) << 16) / mm);
+    for (R_xlen_t n0 = 0; n0 < nwin; n0 += B)
+      items.push_back(Item{t, n0, std::min(nwin, n0 + B)});
+  }
+  std::vector<double> part(items.size(), 0.0);
+  const int nw = std::max(1, threads);
+  std::vector<Scratch> scratch(nw);
+  std::vector<FastScratch> fscratch(nw);
+  std::vector<Plan> plans(ms.size());
+  std::vector<bool> fast(ms.size(), false);
+  for (size_t t = 0; t < ms.size(); ++t) {
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
+    fast[t] = method == 2 || (method == 0 && mm >= kFastFrom);
+    if (fast[t] && mm >= 1) plans[t] = make_plan(mm);
+  }
+  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nw,
+                         [&](R_xlen_t it, int w) {
+    const Item& I = items[it];
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[I.tau]);
+    const R_xlen_t nb = I.n1 - I.n0;
+    Scratch& sc = scratch[w];
+    if (fast[I.tau]) {
+      // sub-blocks of 4m windows, each on its own local phase
+      double acc = 0;
+      for (R_xlen_t b0 = I.n0; b0 < I.n1; b0 += 4 * mm) {
+        const R_xlen_t nsub = std::min(I.n1 - b0, 4 * mm);
+        const R_xlen_t len = nsub + 3 * mm - (hadamard ? 0 : 1);
+        sc.r.resize(len);
+        allanvar::local_phase(in, b0, len, sc.r.data());
+        if (hadamard) {
+          // frequency, with its least-squares line removed: each window's
+          // own line absorbs it (HTOT ignores a linear frequency term), and
+          // a drift then leaves no large offsets to cancel
+          const R_xlen_t nz = len - 1;
+          for (R_xlen_t i = 0; i < nz; ++i) sc.r[i] = sc.r[i + 1] - sc.r[i];
+          const double mid = 0.5 * static_cast<double>(nz - 1);
+          double s0 = 0, s1 = 0, s2 = 0;
+          for (R_xlen_t i = 0; i < nz; ++i) {
+            const double t = static_cast<double>(i) - mid;
+            s0 += sc.r[i];
+            s1 += t * sc.r[i];
+            s2 += t * t;
+          }
+          const double a = s0 / static_cast<double>(nz), b = s2 > 0 ? s1 / s2 : 0;
+          for (R_xlen_t i = 0; i < nz; ++i)
+            sc.r[i] -= a + b * (static_cast<double>(i) - mid);
+        }
+        acc += block_q_fast(sc.r.data(), nsub, mm, plans[I.tau], fscratch[w]);
+      }
+      part[it] = acc;
+      return;
+    }
+    const R_xlen_t len = nb + 3 * mm - (hadamard ? 0 : 1);
+    sc.r.resize(len);
+    allanvar::local_phase(in, I.n0, len, sc.r.data());
+    sc.s.resize(3 * mm);
+    double acc = 0;
+    for (R_xlen_t n = 0; n < nb; ++n) {
+      const double* r = sc.r.data() + n;
+      if (hadamard) {
+        for (R_xlen_t t = 0; t < 3 * mm; ++t) sc.s[t] = r[t + 1] - r[t];
+      } else {
+        for (R_xlen_t t = 0; t < 3 * mm; ++t) sc.s[t] = r[t];
+      }
+      acc += window_q(sc.s.data(), mm, sc);
+    }
+    part[it] = acc;
+  });
+  Rcpp::NumericVector out(ms.size(), NA_REAL);
+  std::vector<double> tot(ms.size(), 0.0), cor(ms.size(), 0.0);
+  std::vector<bool> any(ms.size(), false);
+  for (size_t it = 0; it < items.size(); ++it) {
+    const size_t t = items[it].tau;
+    double s, e;
+    allanvar::phase_two_sum(tot[t], part[it], s, e);
+    tot[t] = s;
+    cor[t] += e;
+    any[t] = true;
+  }
+  for (size_t t = 0; t < ms.size(); ++t)
+    if (any[t]) out[t] = tot[t] + cor[t];
+  return out;
+}
