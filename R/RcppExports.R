@@ -93,6 +93,14 @@ col_block_avar <- function(x, j, m) {
     .Call(`_allanvar_col_block_avar`, x, j, m)
 }
 
+stamp_steps <- function(t) {
+    .Call(`_allanvar_stamp_steps`, t)
+}
+
+stamp_repeats <- function(t) {
+    .Call(`_allanvar_stamp_repeats`, t)
+}
+
 decode_imu_blobs <- function(blobs, encoding, recv_ns) {
     .Call(`_allanvar_decode_imu_blobs`, blobs, encoding, recv_ns)
 }

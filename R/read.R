@@ -476,7 +476,8 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
     segments <- data.frame(start = 1L, end = nrow(x), n = nrow(x),
                            t_start = 0, duration = nrow(x) * dt)
   } else {
-    t <- (time - time[1L]) * scale
+    # Stamps already relative seconds (the readers' output) are not copied.
+    t <- if (scale == 1 && time[1L] == 0) time else (time - time[1L]) * scale
     if (is.unsorted(t)) {
       back <- sum(diff(t) < 0)
       o <- order(t, method = "radix")
@@ -487,8 +488,9 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
       t <- t[o]
       if (!is.null(rows)) rows <- rows[o]
     }
-    dup <- c(FALSE, diff(t) == 0)
-    if (any(dup)) {
+    rep1 <- stamp_repeats(t)
+    if (rep1[2L] > 0) {
+      dup <- c(FALSE, diff(t) == 0)
       add("duplicate", sum(dup), sprintf("%d duplicated stamp(s) (first at t = %.6g s, %s)",
                                          sum(dup), t[which(dup)[1L]],
                                          where(which(dup)[1L])),
@@ -496,29 +498,29 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
       x <- x[!dup, , drop = FALSE]
       t <- t[!dup]
     }
-    t <- t - t[1L]
-    steps <- diff(t)
-    if (!length(steps)) {
+    if (t[1L] != 0) t <- t - t[1L]
+    # Median step, gaps and jitter in one pass (src/read_text.cpp).
+    st <- stamp_steps(t)
+    if (!st$n) {
       abort("fewer than 2 distinct timestamps in ", source, ".", class = "too_short")
     }
-    dt_med <- stats::median(steps)
+    dt_med <- st$median
     check_stamp_rate(1 / dt_med, time_label, source)
-    is_gap <- steps > 1.5 * dt_med
-    regular <- steps[!is_gap]
-    jitter_rms <- sqrt(mean((regular - dt_med)^2))
+    jitter_rms <- sqrt(st$mean_sq)
     jitter_rel <- jitter_rms / dt_med
     if (jitter_rel > 0.01) {
-      add("jitter", sum(abs(regular - dt_med) > 0.01 * dt_med),
+      add("jitter", st$over,
           sprintf("irregular sampling: RMS step deviation %.3g s (%.1f%% of the %.6g s step)",
                   jitter_rms, 100 * jitter_rel, dt_med),
           "samples used as if regular")
     }
-    gi <- which(is_gap)
-    gaps <- data.frame(after = gi, t = t[gi], length = steps[gi])
+    gi <- as.integer(st$gap_at)
+    steps_gi <- st$gap_len
+    gaps <- data.frame(after = gi, t = t[gi], length = steps_gi)
     if (length(gi)) {
       detail <- sprintf("%d gap(s) longer than 1.5 steps; longest %.6g s at t = %.6g s, %.6g s missing in all",
-                        length(gi), max(steps[gi]), t[gi[which.max(steps[gi])]],
-                        sum(steps[gi] - dt_med))
+                        length(gi), max(steps_gi), t[gi[which.max(steps_gi)]],
+                        sum(steps_gi - dt_med))
       if (gap == "error") {
         abort(source, ": ", detail, ". Use gap = \"segments\" to split the ",
               "record at the gaps (analyze_imu() then uses the longest ",

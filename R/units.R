@@ -238,7 +238,7 @@ check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
   said <- NULL
   if (length(acc) == 3L) {
     u <- unique(units[acc])
-    r <- sqrt(sum(colMeans(x[, acc, drop = FALSE])^2))
+    r <- sqrt(sum(colMeans(x)[acc]^2))   # colMeans(x): no copy of columns
     hit <- names(gravity_units)[abs(r / gravity_units - 1) <= 0.1]
     if (length(u) == 1L && is.finite(r)) {
       evidence[acc] <- sprintf("|mean a| = %.5g %s on 3 axes", r, u)
@@ -299,11 +299,12 @@ check_gyro_noise <- function(x, sensors, units, freq, checks, source,
   k <- n %/% m
   if (k < 10L) return(checks)
   msgs <- character()
+  means <- colMeans(x)
   for (j in gy) {
     av <- col_block_avar(x, j, m)
     N <- sqrt(av * m / freq) * to_dph
     if (!is.finite(N) || N == 0) next
-    mean_rate <- abs(mean(x[, j]))
+    mean_rate <- abs(means[[j]])
     checks$evidence[j] <- sprintf("N ~ %.3g deg/sqrt(h) from ADEV at %.3g s; |mean| %.3g rad/s",
                                   N, m / freq, mean_rate)
     if (N > gyro_noise_range[2L] || N < gyro_noise_range[1L] ||

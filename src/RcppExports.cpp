@@ -297,6 +297,26 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// stamp_steps
+Rcpp::List stamp_steps(const Rcpp::NumericVector& t);
+RcppExport SEXP _allanvar_stamp_steps(SEXP tSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type t(tSEXP);
+    rcpp_result_gen = Rcpp::wrap(stamp_steps(t));
+    return rcpp_result_gen;
+END_RCPP
+}
+// stamp_repeats
+Rcpp::NumericVector stamp_repeats(const Rcpp::NumericVector& t);
+RcppExport SEXP _allanvar_stamp_repeats(SEXP tSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type t(tSEXP);
+    rcpp_result_gen = Rcpp::wrap(stamp_repeats(t));
+    return rcpp_result_gen;
+END_RCPP
+}
 // decode_imu_blobs
 Rcpp::NumericMatrix decode_imu_blobs(const Rcpp::List& blobs, int encoding, const Rcpp::NumericVector& recv_ns);
 RcppExport SEXP _allanvar_decode_imu_blobs(SEXP blobsSEXP, SEXP encodingSEXP, SEXP recv_nsSEXP) {
@@ -469,6 +489,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_int64_to_double", (DL_FUNC) &_allanvar_int64_to_double, 1},
     {"_allanvar_col_first_nonfinite", (DL_FUNC) &_allanvar_col_first_nonfinite, 1},
     {"_allanvar_col_block_avar", (DL_FUNC) &_allanvar_col_block_avar, 3},
+    {"_allanvar_stamp_steps", (DL_FUNC) &_allanvar_stamp_steps, 1},
+    {"_allanvar_stamp_repeats", (DL_FUNC) &_allanvar_stamp_repeats, 1},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},

@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <cmath>
 #include <cstring>
+#include <algorithm>
+#include <vector>
 
 // Lines of a delimited text whose number of fields differs from `expected`
 // (blank lines count as 0 fields). `sep` is one byte, or 0 for runs of white
@@ -116,4 +118,78 @@ double col_block_avar(const Rcpp::NumericMatrix& x, int j, double m) {
     prev = a;
   }
   return k > 1 ? 0.5 * s / static_cast<double>(k - 1) : NA_REAL;
+}
+
+// The steps of sorted, distinct stamps t (seconds) in one pass after the
+// median, for new_imu_record() (R/read.R): the median step (as R's
+// median(): the mean of the two middle values for an even count), gaps
+// (steps > 1.5 median: 1-based index of the step and its length), and the
+// jitter of the other steps: mean((step - median)^2) with R's mean()
+// arithmetic (long double sum, then its correction pass), and how many
+// deviate by more than 1% of the median.
+// [[Rcpp::export(rng = false)]]
+Rcpp::List stamp_steps(const Rcpp::NumericVector& t) {
+  const R_xlen_t n = t.size() - 1;
+  if (n < 1) return Rcpp::List::create(Rcpp::Named("n") = 0);
+  std::vector<double> s(static_cast<size_t>(n));
+  for (R_xlen_t i = 0; i < n; ++i) s[i] = t[i + 1] - t[i];
+  const R_xlen_t half = n / 2;
+  std::nth_element(s.begin(), s.begin() + half, s.end());
+  double med = s[half];
+  if (n % 2 == 0) {
+    const double lo = *std::max_element(s.begin(), s.begin() + half);
+    med = static_cast<double>((static_cast<long double>(lo) + med) / 2.0L);
+  }
+  const double lim = 1.5 * med, tol = 0.01 * med;
+  std::vector<double> gap_at, gap_len;
+  long double sum = 0;
+  R_xlen_t k = 0, over = 0;
+  for (R_xlen_t i = 0; i < n; ++i) {
+    const double st = t[i + 1] - t[i];
+    if (st > lim) {
+      gap_at.push_back(static_cast<double>(i + 1));
+      gap_len.push_back(st);
+      continue;
+    }
+    const double d = st - med;
+    sum += d * d;
+    if (std::fabs(d) > tol) ++over;
+    ++k;
+  }
+  double ms = NA_REAL;
+  if (k > 0) {
+    long double m = sum / k;
+    if (std::isfinite(static_cast<double>(m))) {
+      long double c = 0;
+      for (R_xlen_t i = 0; i < n; ++i) {
+        const double st = t[i + 1] - t[i];
+        if (st > lim) continue;
+        const double d = st - med;
+        c += d * d - m;
+      }
+      m += c / k;
+    }
+    ms = static_cast<double>(m);
+  }
+  return Rcpp::List::create(Rcpp::Named("n") = static_cast<double>(n),
+                            Rcpp::Named("median") = med,
+                            Rcpp::Named("mean_sq") = ms,
+                            Rcpp::Named("over") = static_cast<double>(over),
+                            Rcpp::Named("gap_at") = Rcpp::wrap(gap_at),
+                            Rcpp::Named("gap_len") = Rcpp::wrap(gap_len));
+}
+
+// 1-based index of the first stamp equal to its predecessor (0: none), and
+// how many there are, for sorted t.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector stamp_repeats(const Rcpp::NumericVector& t) {
+  const R_xlen_t n = t.size();
+  double first = 0, count = 0;
+  for (R_xlen_t i = 1; i < n; ++i) {
+    if (t[i] == t[i - 1]) {
+      if (count == 0) first = static_cast<double>(i + 1);
+      ++count;
+    }
+  }
+  return Rcpp::NumericVector::create(first, count);
 }
