@@ -37,6 +37,10 @@ avar_white_cov <- function(m, n, overlapping, threads) {
     .Call(`_allanvar_avar_white_cov`, m, n, overlapping, threads)
 }
 
+bz2_available_cpp <- function() {
+    .Call(`_allanvar_bz2_available_cpp`)
+}
+
 first_nonfinite <- function(x) {
     .Call(`_allanvar_first_nonfinite`, x)
 }
@@ -113,8 +117,8 @@ rosbag_records <- function(buf, start, end) {
     .Call(`_allanvar_rosbag_records`, buf, start, end)
 }
 
-rosbag_chunk_imu <- function(buf, off, len, compression, size, conns) {
-    .Call(`_allanvar_rosbag_chunk_imu`, buf, off, len, compression, size, conns)
+rosbag_imu <- function(buf, off, len, comp, size, conns) {
+    .Call(`_allanvar_rosbag_imu`, buf, off, len, comp, size, conns)
 }
 
 theo1_sums_cpp <- function(v, rate, m, threads) {

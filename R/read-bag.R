@@ -27,13 +27,9 @@ bag_scan <- function(file, buf = NULL) {
   recs <- rosbag_records(buf, nchar(bag_version), length(buf))
   conns <- bag_conn_table(buf, recs, which(recs$op == 7L))
   chunk <- which(recs$op == 5L)
-  chunks <- data.frame(
-    off = recs$data[chunk], len = recs$data_len[chunk],
-    compression = vapply(chunk, function(k) rawToChar(bag_fields(
-      slice(buf, recs$hdr[k], recs$hdr_len[k]))$compression), ""),
-    size = vapply(chunk, function(k) raw_u32(bag_fields(
-      slice(buf, recs$hdr[k], recs$hdr_len[k]))$size, 1L), 0),
-    stringsAsFactors = FALSE)
+  chunks <- data.frame(off = recs$data[chunk], len = recs$data_len[chunk],
+                       compression = recs$compression[chunk],
+                       size = recs$size[chunk], stringsAsFactors = FALSE)
   if (!nrow(conns) && nrow(chunks)) {
     # An unindexed bag: connection records only inside the chunks.
     parts <- lapply(seq_len(nrow(chunks)), function(k) {
@@ -99,22 +95,31 @@ bag_read_imu <- function(file, topic, progress) {
   topic <- select_topic(s$topics, topic, file)
   ids <- as.integer(s$conns$conn[s$conns$topic == topic])
   if (!is.null(progress)) progress("decoding chunks")
-  parts <- vector("list", nrow(s$chunks))
-  bad <- 0
-  for (k in seq_len(nrow(s$chunks))) {
-    ch <- s$chunks[k, ]
-    res <- if (ch$compression == "bz2") {
-      raw <- memDecompress(slice(s$buf, ch$off, ch$len), type = "bzip2")
-      rosbag_chunk_imu(raw, 0, length(raw), "none", ch$size, ids)
-    } else if (ch$compression %in% c("none", "lz4")) {
-      rosbag_chunk_imu(s$buf, ch$off, ch$len, ch$compression, ch$size, ids)
-    } else {
-      abort("\"", basename(file), "\" has chunks compressed with \"",
-            ch$compression, "\"; none, bz2 and lz4 are read.", class = "file_format")
-    }
-    parts[[k]] <- res$imu
-    bad <- bad + res$bad
+  ch <- s$chunks
+  comp <- match(ch$compression, c("none", "lz4", "bz2")) - 1L
+  if (anyNA(comp)) {
+    abort("\"", basename(file), "\" has chunks compressed with \"",
+          ch$compression[is.na(comp)][1L], "\"; none, bz2 and lz4 are read.",
+          class = "file_format")
   }
-  imu <- if (length(parts)) do.call(rbind, parts) else matrix(numeric(), 0, 10)
-  list(imu = imu, bad = bad, topic = topic, format = "rosbag")
+  if (any(comp == 2L) && !bz2_available_cpp()) {
+    # No libbz2 to load: base R decompresses each bz2 chunk.
+    parts <- vector("list", nrow(ch))
+    bad <- 0
+    for (k in seq_len(nrow(ch))) {
+      res <- if (comp[k] == 2L) {
+        raw <- memDecompress(slice(s$buf, ch$off[k], ch$len[k]), type = "bzip2")
+        rosbag_imu(raw, 0, length(raw), 0L, length(raw), ids)
+      } else {
+        rosbag_imu(s$buf, ch$off[k], ch$len[k], comp[k], ch$size[k], ids)
+      }
+      parts[[k]] <- res$imu
+      bad <- bad + res$bad
+    }
+    imu <- if (length(parts)) do.call(rbind, parts) else matrix(numeric(), 0, 10)
+    return(list(imu = imu, bad = bad, topic = topic, format = "rosbag"))
+  }
+  # Every chunk in one C++ call (src/rosbag.cpp): no R work per chunk.
+  res <- rosbag_imu(s$buf, ch$off, ch$len, comp, ch$size, ids)
+  list(imu = res$imu, bad = res$bad, topic = topic, format = "rosbag")
 }

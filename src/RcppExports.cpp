@@ -126,6 +126,15 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// bz2_available_cpp
+bool bz2_available_cpp();
+RcppExport SEXP _allanvar_bz2_available_cpp() {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    rcpp_result_gen = Rcpp::wrap(bz2_available_cpp());
+    return rcpp_result_gen;
+END_RCPP
+}
 // first_nonfinite
 double first_nonfinite(const Rcpp::NumericVector& x);
 RcppExport SEXP _allanvar_first_nonfinite(SEXP xSEXP) {
@@ -353,18 +362,18 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// rosbag_chunk_imu
-Rcpp::List rosbag_chunk_imu(const Rcpp::RawVector& buf, double off, double len, std::string compression, double size, const Rcpp::IntegerVector& conns);
-RcppExport SEXP _allanvar_rosbag_chunk_imu(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP compressionSEXP, SEXP sizeSEXP, SEXP connsSEXP) {
+// rosbag_imu
+Rcpp::List rosbag_imu(const Rcpp::RawVector& buf, const Rcpp::NumericVector& off, const Rcpp::NumericVector& len, const Rcpp::IntegerVector& comp, const Rcpp::NumericVector& size, const Rcpp::IntegerVector& conns);
+RcppExport SEXP _allanvar_rosbag_imu(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP compSEXP, SEXP sizeSEXP, SEXP connsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
-    Rcpp::traits::input_parameter< double >::type off(offSEXP);
-    Rcpp::traits::input_parameter< double >::type len(lenSEXP);
-    Rcpp::traits::input_parameter< std::string >::type compression(compressionSEXP);
-    Rcpp::traits::input_parameter< double >::type size(sizeSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type off(offSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type len(lenSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type comp(compSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type size(sizeSEXP);
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type conns(connsSEXP);
-    rcpp_result_gen = Rcpp::wrap(rosbag_chunk_imu(buf, off, len, compression, size, conns));
+    rcpp_result_gen = Rcpp::wrap(rosbag_imu(buf, off, len, comp, size, conns));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -475,6 +484,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_log_nnls", (DL_FUNC) &_allanvar_avfit_log_nnls, 7},
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
+    {"_allanvar_bz2_available_cpp", (DL_FUNC) &_allanvar_bz2_available_cpp, 0},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
@@ -494,7 +504,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},
-    {"_allanvar_rosbag_chunk_imu", (DL_FUNC) &_allanvar_rosbag_chunk_imu, 6},
+    {"_allanvar_rosbag_imu", (DL_FUNC) &_allanvar_rosbag_imu, 6},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 4},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},

@@ -2,8 +2,9 @@
 // line, records of <header_len u32><header><data_len u32><data>, the header
 // being fields <len u32><name>=<value>. Chunks (op 0x05) hold connection
 // (0x07) and message data (0x02) records, compressed as the chunk's
-// `compression` field says; the R side (R/read-bag.R) decompresses bz2.
+// `compression` field says (none, lz4: src/lz4.cpp, bz2: src/bz2.cpp).
 #include "bytes.h"
+#include "bz2.h"
 #include "lz4.h"
 #include "ros_msgs.h"
 
@@ -113,9 +114,19 @@ Rcpp::List rosbag_records(const Rcpp::RawVector& buf, double start, double end) 
   }
   const R_xlen_t n = recs.size();
   Rcpp::IntegerVector op(n);
-  Rcpp::NumericVector hdr(n), hdr_len(n), data(n), data_len(n);
+  Rcpp::NumericVector hdr(n), hdr_len(n), data(n), data_len(n), size(n, NA_REAL);
+  Rcpp::CharacterVector compression(n, NA_STRING);
+  const unsigned char* p = RAW(buf);
   for (R_xlen_t i = 0; i < n; ++i) {
     op[i] = recs[i].op;
+    if (op[i] == 5) {
+      // Chunk: its compression and uncompressed size, from its header.
+      std::size_t len = 0;
+      const unsigned char* c = find_field(p + recs[i].hdr, recs[i].hdr_len, "compression", &len);
+      if (c) compression[i] = std::string(reinterpret_cast<const char*>(c), len);
+      const unsigned char* z = find_field(p + recs[i].hdr, recs[i].hdr_len, "size", &len);
+      if (z && len == 4) size[i] = rd_u32(z);
+    }
     hdr[i] = recs[i].hdr;
     hdr_len[i] = recs[i].hdr_len;
     data[i] = recs[i].data;
@@ -123,34 +134,50 @@ Rcpp::List rosbag_records(const Rcpp::RawVector& buf, double start, double end) 
   }
   return Rcpp::List::create(Rcpp::Named("op") = op, Rcpp::Named("hdr") = hdr,
                             Rcpp::Named("hdr_len") = hdr_len, Rcpp::Named("data") = data,
-                            Rcpp::Named("data_len") = data_len);
+                            Rcpp::Named("data_len") = data_len,
+                            Rcpp::Named("compression") = compression,
+                            Rcpp::Named("size") = size);
 }
 
-// The sensor_msgs/Imu messages of connections `conns` in the chunk data
-// buf[off, off + len), decompressed here when `compression` is "lz4"
-// (to `size` bytes); "none" is read in place. Returns the decoded table and
-// the number of messages that did not decode.
+// Every chunk of a bag at once: the sensor_msgs/Imu messages of connections
+// `conns` in the chunks at buf[off[k], off[k] + len[k]), of compression
+// `comp[k]` (0 none, read in place; 1 lz4; 2 bz2, through libbz2) and
+// uncompressed size `size[k]`, decoded into one table (one copy at the end,
+// no R call per chunk). Returns the table and the number of messages that did
+// not decode.
 // [[Rcpp::export(rng = false)]]
-Rcpp::List rosbag_chunk_imu(const Rcpp::RawVector& buf, double off, double len,
-                            std::string compression, double size,
-                            const Rcpp::IntegerVector& conns) {
+Rcpp::List rosbag_imu(const Rcpp::RawVector& buf, const Rcpp::NumericVector& off,
+                      const Rcpp::NumericVector& len, const Rcpp::IntegerVector& comp,
+                      const Rcpp::NumericVector& size, const Rcpp::IntegerVector& conns) {
   std::vector<int> cs(conns.begin(), conns.end());
   std::vector<double> out;
   R_xlen_t bad = 0;
+  std::vector<unsigned char> raw;
   try {
-    const unsigned char* p = RAW(buf) + static_cast<std::size_t>(off);
-    const std::size_t n = static_cast<std::size_t>(len);
-    if (compression == "none") {
-      chunk_messages(p, n, cs, out, &bad);
-    } else if (compression == "lz4") {
-      std::vector<unsigned char> raw;
-      allanvar::lz4_frame_decode(p, n, raw, static_cast<std::size_t>(size));
-      if (raw.size() != static_cast<std::size_t>(size)) {
-        throw format_error("bag: an lz4 chunk does not decompress to its stated size");
+    const std::size_t total = buf.size();
+    for (R_xlen_t k = 0; k < off.size(); ++k) {
+      const std::size_t o = static_cast<std::size_t>(off[k]);
+      const std::size_t n = static_cast<std::size_t>(len[k]);
+      if (o > total || n > total - o) throw format_error("bag: a chunk runs past the end of the file");
+      const unsigned char* p = RAW(buf) + o;
+      const std::size_t sz = static_cast<std::size_t>(size[k]);
+      if (comp[k] == 0) {
+        chunk_messages(p, n, cs, out, &bad);
+      } else {
+        raw.clear();
+        if (comp[k] == 1) {
+          allanvar::lz4_frame_decode(p, n, raw, sz);
+          if (raw.size() != sz) {
+            throw format_error("bag: an lz4 chunk does not decompress to its stated size");
+          }
+        } else if (comp[k] == 2) {
+          allanvar::bz2_decode(p, n, sz, raw);
+        } else {
+          throw format_error("bag: unknown chunk compression code");
+        }
+        chunk_messages(raw.data(), raw.size(), cs, out, &bad);
       }
-      chunk_messages(raw.data(), raw.size(), cs, out, &bad);
-    } else {
-      throw format_error("bag: chunk compression \"" + compression + "\" is not handled here");
+      Rcpp::checkUserInterrupt();
     }
   } catch (const format_error& e) {
     Rcpp::stop(e.what());
