@@ -108,7 +108,7 @@ ros_source <- function(got, columns, units) {
   if (!nrow(m)) abort("topic ", got$topic, " has no message.", class = "too_short")
   sec <- m[, 1L]
   nsec <- m[, 2L]
-  if (all(sec == 0 & nsec == 0)) {
+  if (sec[1L] == 0 && nsec[1L] == 0 && all(sec == 0 & nsec == 0)) {
     problems <- add_problem(problems, "stamps", nrow(m), sprintf(
       "every header stamp of %s is zero", got$topic),
       "the recording (receive) times used instead")
