@@ -85,3 +85,33 @@ test_that("long reads report progress through progressr, and only when asked", {
   # no handler: nothing printed
   expect_silent(read_imu(f, topic = "/imu0"))
 })
+
+test_that("bz2 chunks read through libbz2 and, without it, through memDecompress alike", {
+  # The reference: base R's own bzip2 decoder on every chunk of the bag.
+  f <- ros_fixture("imu_bz2.bag")
+  s <- allanvar:::bag_scan(f)
+  expect_true(all(s$chunks$compression == "bz2"))
+  ref <- read_imu(ros_fixture("imu.csv"))
+  got <- read_imu(f, topic = "/imu0")
+  expect_identical(unname(got$data), unname(ref$data))
+  # A chunk whose stated size is wrong is a classed error, not garbage.
+  b <- readBin(f, "raw", file.size(f))
+  k <- which(s$chunks$compression == "bz2")[1L]
+  expect_identical(length(memDecompress(b[s$chunks$off[k] + seq_len(s$chunks$len[k])],
+                                        type = "bzip2")), as.integer(s$chunks$size[k]))
+  if (allanvar:::bz2_available_cpp()) {
+    expect_error(allanvar:::rosbag_imu(b, s$chunks$off[k], s$chunks$len[k], 2L,
+                                       s$chunks$size[k] + 1, 0L),
+                 "stated size")
+  }
+  skip_if_not_installed("callr")
+  skip_if_not(installed_allanvar(), "needs the installed package")
+  res <- callr::r(function(f) {
+    r <- allanvar::read_imu(f, topic = "/imu0")
+    list(avail = allanvar:::bz2_available_cpp(), data = unname(r$data), time = r$time)
+  }, args = list(f = normalizePath(f)),
+  env = c(callr::rcmd_safe_env(), ALLANVAR_DISABLE_BZ2 = "1"), libpath = .libPaths())
+  expect_false(res$avail)
+  expect_identical(res$data, unname(ref$data))
+  expect_identical(res$time, ref$time)
+})
