@@ -128,6 +128,9 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   # (when no seed existed yet): the caller's RNG state is restored.
   restore <- save_rng()
   on.exit(restore(), add = TRUE)
+  # progressr: one step per axis, relayed from future workers; silent unless
+  # the user set handlers (progressr::handlers(), with_progress()).
+  opts$tick <- progressr::progressor(steps = n_jobs)
   results <- future.apply::future_lapply(jobs, analyze_channel, opts = opts,
                                          future.seed = TRUE,
                                          future.scheduling = Inf)
@@ -164,6 +167,7 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
 # arguments and the package's namespace.
 analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
+  if (is.function(opts$tick)) on.exit(opts$tick(job$label), add = TRUE)
   curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
   fit <- NULL
   failure <- NULL

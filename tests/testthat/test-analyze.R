@@ -94,3 +94,29 @@ test_that("analyze_imu() errors are classed and worded", {
   })
   expect_error(analyze_imu(1), class = "allanvar_error_argument")
 })
+
+test_that("analyze_imu reports one progressr step per axis, also from future workers", {
+  set.seed(3)
+  r <- imu_record(cbind(gyro_x = rnorm(4000, sd = 1e-3), accel_x = rnorm(4000, sd = 1e-2)),
+                  freq = 100)
+  old_opt <- options(progressr.enable = TRUE)   # progressr is off when not interactive
+  on.exit(options(old_opt), add = TRUE)
+  got <- function() {
+    steps <- character()
+    withCallingHandlers(
+      progressr::with_progress(
+        suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE)),
+        handlers = progressr::handler_void()),
+      progression = function(p) if (identical(p$type, "update")) steps <<- c(steps, p$message))
+    steps
+  }
+  expect_setequal(got(), c("[1/2] in memory: gyro_x", "[2/2] in memory: accel_x"))
+  skip_if_not_installed("future")
+  skip_if_not(installed_allanvar(), "workers need the installed package")
+  skip_on_cran()
+  old <- future::plan(future::multisession, workers = 2L)
+  on.exit(future::plan(old), add = TRUE)
+  expect_setequal(got(), c("[1/2] in memory: gyro_x", "[2/2] in memory: accel_x"))
+  # No handler: nothing is printed.
+  expect_silent(suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE)))
+})
