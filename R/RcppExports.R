@@ -117,8 +117,8 @@ rosbag_records <- function(buf, start, end) {
     .Call(`_allanvar_rosbag_records`, buf, start, end)
 }
 
-rosbag_imu <- function(buf, off, len, comp, size, conns) {
-    .Call(`_allanvar_rosbag_imu`, buf, off, len, comp, size, conns)
+rosbag_imu <- function(buf, off, len, comp, size, conns, threads = 1L) {
+    .Call(`_allanvar_rosbag_imu`, buf, off, len, comp, size, conns, threads)
 }
 
 theo1_sums_cpp <- function(v, rate, m, threads) {

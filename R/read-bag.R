@@ -120,6 +120,6 @@ bag_read_imu <- function(file, topic, progress) {
     return(list(imu = imu, bad = bad, topic = topic, format = "rosbag"))
   }
   # Every chunk in one C++ call (src/rosbag.cpp): no R work per chunk.
-  res <- rosbag_imu(s$buf, ch$off, ch$len, comp, ch$size, ids)
+  res <- rosbag_imu(s$buf, ch$off, ch$len, comp, ch$size, ids, allanvar_threads())
   list(imu = res$imu, bad = res$bad, topic = topic, format = "rosbag")
 }

@@ -363,8 +363,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // rosbag_imu
-Rcpp::List rosbag_imu(const Rcpp::RawVector& buf, const Rcpp::NumericVector& off, const Rcpp::NumericVector& len, const Rcpp::IntegerVector& comp, const Rcpp::NumericVector& size, const Rcpp::IntegerVector& conns);
-RcppExport SEXP _allanvar_rosbag_imu(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP compSEXP, SEXP sizeSEXP, SEXP connsSEXP) {
+Rcpp::List rosbag_imu(const Rcpp::RawVector& buf, const Rcpp::NumericVector& off, const Rcpp::NumericVector& len, const Rcpp::IntegerVector& comp, const Rcpp::NumericVector& size, const Rcpp::IntegerVector& conns, int threads);
+RcppExport SEXP _allanvar_rosbag_imu(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP compSEXP, SEXP sizeSEXP, SEXP connsSEXP, SEXP threadsSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
@@ -373,7 +373,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type comp(compSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type size(sizeSEXP);
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type conns(connsSEXP);
-    rcpp_result_gen = Rcpp::wrap(rosbag_imu(buf, off, len, comp, size, conns));
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(rosbag_imu(buf, off, len, comp, size, conns, threads));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -504,7 +505,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},
-    {"_allanvar_rosbag_imu", (DL_FUNC) &_allanvar_rosbag_imu, 6},
+    {"_allanvar_rosbag_imu", (DL_FUNC) &_allanvar_rosbag_imu, 7},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 4},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},

@@ -6,6 +6,7 @@
 #include "bytes.h"
 #include "bz2.h"
 #include "lz4.h"
+#include "parallel.h"
 #include "ros_msgs.h"
 
 #include <Rcpp.h>
@@ -143,45 +144,70 @@ Rcpp::List rosbag_records(const Rcpp::RawVector& buf, double start, double end) 
 // `conns` in the chunks at buf[off[k], off[k] + len[k]), of compression
 // `comp[k]` (0 none, read in place; 1 lz4; 2 bz2, through libbz2) and
 // uncompressed size `size[k]`, decoded into one table (one copy at the end,
-// no R call per chunk). Returns the table and the number of messages that did
-// not decode.
+// no R call per chunk). Compressed chunks are decompressed on up to
+// `threads` threads, a batch of a few chunks per thread at a time (bz2 costs
+// about 20 ns a byte, the decoding after it little); messages are decoded
+// in file order on the calling thread. Returns the table and the number of
+// messages that did not decode.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List rosbag_imu(const Rcpp::RawVector& buf, const Rcpp::NumericVector& off,
                       const Rcpp::NumericVector& len, const Rcpp::IntegerVector& comp,
-                      const Rcpp::NumericVector& size, const Rcpp::IntegerVector& conns) {
+                      const Rcpp::NumericVector& size, const Rcpp::IntegerVector& conns,
+                      int threads = 1) {
   std::vector<int> cs(conns.begin(), conns.end());
   std::vector<double> out;
   R_xlen_t bad = 0;
-  std::vector<unsigned char> raw;
+  const R_xlen_t nk = off.size();
+  const unsigned char* base = RAW(buf);
+  const std::size_t total = buf.size();
+  if (threads < 1) threads = 1;
+  allanvar::InterruptScope scope;
   try {
-    const std::size_t total = buf.size();
-    for (R_xlen_t k = 0; k < off.size(); ++k) {
+    for (R_xlen_t k = 0; k < nk; ++k) {
       const std::size_t o = static_cast<std::size_t>(off[k]);
       const std::size_t n = static_cast<std::size_t>(len[k]);
       if (o > total || n > total - o) throw format_error("bag: a chunk runs past the end of the file");
-      const unsigned char* p = RAW(buf) + o;
-      const std::size_t sz = static_cast<std::size_t>(size[k]);
-      if (comp[k] == 0) {
-        chunk_messages(p, n, cs, out, &bad);
-      } else {
+      if (comp[k] < 0 || comp[k] > 2) throw format_error("bag: unknown chunk compression code");
+    }
+    for (R_xlen_t k = 0; k < nk; ++k) {
+      if (comp[k] == 2 && !allanvar::bz2_available()) throw format_error("bz2: libbz2 is not available");
+    }
+    const R_xlen_t batch = 4 * static_cast<R_xlen_t>(threads);
+    std::vector<std::vector<unsigned char>> raws(static_cast<std::size_t>(batch));
+    for (R_xlen_t k0 = 0; k0 < nk; k0 += batch) {
+      const R_xlen_t m = std::min(batch, nk - k0);
+      allanvar::parallel_for(m, threads, [&](R_xlen_t i, int) {
+        const R_xlen_t k = k0 + i;
+        std::vector<unsigned char>& raw = raws[static_cast<std::size_t>(i)];
         raw.clear();
+        if (comp[k] == 0) return;
+        const unsigned char* p = base + static_cast<std::size_t>(off[k]);
+        const std::size_t n = static_cast<std::size_t>(len[k]);
+        const std::size_t sz = static_cast<std::size_t>(size[k]);
         if (comp[k] == 1) {
           allanvar::lz4_frame_decode(p, n, raw, sz);
           if (raw.size() != sz) {
             throw format_error("bag: an lz4 chunk does not decompress to its stated size");
           }
-        } else if (comp[k] == 2) {
-          allanvar::bz2_decode(p, n, sz, raw);
         } else {
-          throw format_error("bag: unknown chunk compression code");
+          allanvar::bz2_decode(p, n, sz, raw);
         }
-        chunk_messages(raw.data(), raw.size(), cs, out, &bad);
+      });
+      for (R_xlen_t i = 0; i < m; ++i) {
+        const R_xlen_t k = k0 + i;
+        if (comp[k] == 0) {
+          chunk_messages(base + static_cast<std::size_t>(off[k]),
+                         static_cast<std::size_t>(len[k]), cs, out, &bad);
+        } else {
+          const std::vector<unsigned char>& raw = raws[static_cast<std::size_t>(i)];
+          chunk_messages(raw.data(), raw.size(), cs, out, &bad);
+        }
       }
-      Rcpp::checkUserInterrupt();
     }
   } catch (const format_error& e) {
     Rcpp::stop(e.what());
   }
+  scope.finish();
   return Rcpp::List::create(Rcpp::Named("imu") = as_matrix(out),
                             Rcpp::Named("bad") = static_cast<double>(bad));
 }
