@@ -94,6 +94,11 @@ for (k in seq_along(bag_files)) {
       timed(read_imu(f, topic = "/imu0")),
       if (same) "record identical to the CSV's" else "RECORD DIFFERS FROM THE CSV")
   if (grepl("bz2", nm)) {
+    # Do the decompression threads pay? The same read on one thread.
+    old <- options(allanvar.threads = 1L)
+    add("  the same on 1 thread (allanvar.threads = 1)", "",
+        timed(read_imu(f, topic = "/imu0"), 1L), "one run")
+    options(old)
     # The yardstick for bz2: base R's memDecompress() on the same chunks
     # (read_imu() decodes them with libbz2 once, at their stated size).
     s <- allanvar:::bag_scan(f)
