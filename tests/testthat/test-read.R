@@ -57,17 +57,22 @@ test_that("other layouts: columns, units and time unit by argument", {
   expect_equal(unname(r$data[, "gyro_y"]), d$gy * pi / 180)
   expect_equal(unname(r$data[, "accel_z"]), d$az * 9.80665e-3)
   # ms picked automatically from the step (10) too
-  expect_message(r2 <- read_imu(f, time = 2, sep = ";", columns = 3:6,
-                                sensors = c("gyro", "gyro", "accel", "accel")),
-                 "no units given")
+  # (rnorm(sd = 1) gyros read as rad/s: the plausibility warning is due)
+  expect_warning(
+    expect_message(r2 <- read_imu(f, time = 2, sep = ";", columns = 3:6,
+                                  sensors = c("gyro", "gyro", "accel", "accel")),
+                   "no units given"),
+    class = "allanvar_warning_gyro_units")
   expect_identical(r2$time_unit, "ms")
   expect_equal(r2$freq, 100)
   # no time column: freq required
   expect_error(read_imu(f, time = FALSE, sep = ";", columns = 3:4,
                         sensors = c("gyro", "gyro")), "freq")
-  expect_message(r3 <- read_imu(f, time = FALSE, sep = ";", columns = 3:4,
-                                sensors = c("gyro", "gyro"), freq = 50),
-                 "assuming rad/s")
+  expect_warning(
+    expect_message(r3 <- read_imu(f, time = FALSE, sep = ";", columns = 3:4,
+                                  sensors = c("gyro", "gyro"), freq = 50),
+                   "assuming rad/s"),
+    class = "allanvar_warning_gyro_units")
   expect_equal(r3$freq, 50)
   expect_error(read_imu(f, time = 2, sep = ";", columns = "nope"), "not found")
   expect_error(read_imu(f, time = 2, sep = ";", columns = "temp"), "sensor type")
