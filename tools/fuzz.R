@@ -71,6 +71,10 @@ fuzz_setup <- function(pkg_path) {
   e$dyn <- dynamic_allan(rnorm(4000), freq = 100, window = 10, step = 5)
   e$hat <- three_cornered_hat(e$m3, freq = 1)
   e$ds <- datasheet(e$ana)
+  rec2 <- e$rec
+  rec2$name <- "second"
+  e$ana2 <- suppressWarnings(analyze_imu(list(e$rec, rec2), refine = FALSE, progress = FALSE))
+  e$ref <- suppressWarnings(avrefine(e$fit, candidates = "gm", max_steps = 1))
   # files
   n <- 1000
   ts <- 1.6e18 + round(seq_len(n) * 1e7)
@@ -115,6 +119,9 @@ fuzz_setup <- function(pkg_path) {
                                   "gyroscope_noise_density: .inf",
                                   "gyroscope_random_walk: 1", "update_rate: 0"))
   e$f_curve_bad <- w("curve.txt", c("tau avar", "1 -1", "2 NaN", "x y"))
+  tau <- 0.01 * 2^(0:8)
+  e$f_avr <- w("avr.csv", apply(cbind(tau, matrix(rep(1e-3 / sqrt(tau), 6), ncol = 6)), 1,
+                                paste, collapse = " "))
   e$f_missing <- file.path(d, "does-not-exist.csv")
   e$outdir <- file.path(d, "out")
   e$outfile <- file.path(d, "out.txt")
@@ -263,9 +270,9 @@ fuzz_cases <- function(quick = FALSE) {
   sub_arg("avdiagnose", q(avdiagnose(x = x, freq = 100)), "x", series)
   sub_arg("avdiagnose", q(avdiagnose(x = x, freq = 100)), c("freq", "alpha"))
   # fit methods
-  for (f in c("predict")) sub_arg(f, q(predict(fit, newdata = c(0.1, 1))), "newdata")
-  add("predict", "tau Inf", q(predict(fit, Inf)))
-  add("predict", "tau 0", q(predict(fit, 0)))
+  sub_arg("predict.avfit", q(predict(fit, newdata = c(0.1, 1))), c("newdata", "type"))
+  add("predict.avfit", "tau Inf", q(predict(fit, Inf)))
+  add("predict.avfit", "tau 0", q(predict(fit, 0)))
   for (f in c("coef", "confint", "fitted", "residuals", "vcov", "logLik", "nobs",
               "summary", "print", "plot")) {
     add(paste0(f, ".avfit"), "valid", S(f, q(fit)))
@@ -281,6 +288,21 @@ fuzz_cases <- function(quick = FALSE) {
   sub_arg("plot.allan_dynamic", q(plot(dyn)), c("what", "at"))
   sub_arg("plotav", q(plotav(avdf = avdf)), "avdf")
   add("plotav", "allan result", q(plotav(av)))
+  # every registered S3 method, called once on a valid object
+  methods <- list(
+    "print.av_curve" = q(as_av_curve(av)), "print.avdiagnose" = q(avdiagnose(x, 100)),
+    "print.avfit_control" = q(avfit_control()), "print.avrefine" = q(ref),
+    "print.imu_analysis_list" = q(ana2), "plot.imu_analysis_list" = q(plot(ana2)),
+    "datasheet.imu_analysis_list" = q(datasheet(ana2)),
+    "datasheet.imu_analysis" = q(datasheet(ana)),
+    "print.imu_datasheet" = q(print(ds)), "print.imu_record" = q(print(rec)),
+    "print.summary.allan" = q(print(summary(av))),
+    "print.summary.allan_dynamic" = q(print(summary(dyn))),
+    "print.summary.allan_sources" = q(print(summary(hat))),
+    "print.summary.avfit" = q(print(summary(fit))),
+    "print.tool_curve" = q(print(read_avr_curve(f_avr))),
+    "predict.avfit" = q(predict(fit, c(0.1, 1))))
+  for (m in names(methods)) add(m, "valid", methods[[m]])
   # IMU workflow
   sub_arg("imu_record", q(imu_record(x = rec$data, freq = 100)), "x", series)
   sub_arg("imu_record", q(imu_record(x = cbind(gyro_x = x), freq = 100)),
