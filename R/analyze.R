@@ -109,6 +109,17 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
       }
       ch <- channels
     }
+    # A dead (constant) axis has no noise to analyse: reported, others go on.
+    dead <- ch[vapply(ch, function(c) isTRUE(all(r$data[, c] == r$data[1L, c])), NA)]
+    if (length(dead)) {
+      if (length(dead) == length(ch)) {
+        abort("`x`: every channel of ", r$name, " is constant (dead or ",
+              "saturated axes); there is no noise to analyse.", class = "argument")
+      }
+      warn(r$name, ": ", paste(dead, collapse = ", "), " constant (a dead or ",
+           "saturated axis): not analysed.", class = "dead_channel")
+      ch <- setdiff(ch, dead)
+    }
     for (chn in ch) {
       jobs[[length(jobs) + 1L]] <- list(
         record = i, name = r$name, channel = chn, sensor = r$sensors[[chn]],

@@ -402,8 +402,9 @@ predict.avfit <- function(object, newdata = NULL, type = "avar",
   type <- check_choice(type, c("avar", "adev"), "type")
   tau <- if (is.null(newdata)) object$data$tau else
     if (is.data.frame(newdata)) newdata$tau else newdata
-  if (!is.numeric(tau) || !length(tau) || anyNA(tau) || any(tau <= 0)) {
-    abort("`newdata` must be positive tau values in seconds (a vector or a ",
+  if (!is.numeric(tau) || !length(tau) || anyNA(tau) || any(tau <= 0) ||
+      any(!is.finite(tau))) {
+    abort("`newdata` must be positive finite tau values in seconds (a vector or a ",
           "data frame with a `tau` column).", class = "argument")
   }
   tau0 <- if (is.null(object$freq)) NULL else 1 / object$freq

@@ -243,6 +243,16 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
   freq <- check_freq(freq)
   x <- check_values(x, min_n = 256L, arg = "x")
   alpha <- check_number(alpha, "alpha", 0, 1, open = TRUE)
+  if (max(x) == min(x)) {
+    abort("`x` is constant (every sample is ", format(x[1L]), "): there is no ",
+          "noise to diagnose.", class = "argument")
+  }
+  if (max(abs(x)) > 1e150) {
+    # sums of squares overflow double precision beyond 1e154
+    abort("`x` holds values up to ", format(max(abs(x)), digits = 3),
+          "; sums of squares overflow above 1e150: rescale `x` (and its units).",
+          class = "argument")
+  }
   n <- length(x)
   xc <- x - mean(x)
   r1 <- sum(xc[-1L] * xc[-n]) / sum(xc^2)

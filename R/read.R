@@ -313,6 +313,7 @@ imu_record <- function(x, freq = NULL, units = NULL, sensors = NULL,
                        gap = c("segments", "error", "ignore"), name = NULL) {
   check_present(missing(x), "x", "a matrix or data frame of samples")
   gap <- choice_arg(gap, c("segments", "error", "ignore"), "gap")
+  if (!is.null(name)) check_string(name, "name")
   if (is.null(freq)) freq <- attr(x, "freq")
   if (!is.null(freq)) freq <- check_freq(freq)
   if (inherits(x, c("Date", "POSIXt", "difftime", "factor")) ||

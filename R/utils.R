@@ -158,3 +158,40 @@ allanvar_threads <- function() {
   if (!is.numeric(n) || length(n) != 1L || is.na(n) || n < 1) n <- 1L
   as.integer(min(n, 64L))
 }
+
+# A single TRUE or FALSE.
+check_flag <- function(x, arg) {
+  if (!is.logical(x) || length(x) != 1L || is.na(x)) {
+    abort("`", arg, "` must be TRUE or FALSE, not ",
+          if (is.logical(x) && length(x) == 1L) "NA" else describe_type(x),
+          if (length(x) != 1L && !is.null(x)) paste0(" of length ", length(x)), ".",
+          class = "argument")
+  }
+  x
+}
+
+# A single non-missing string (optionally non-empty).
+check_string <- function(x, arg, empty_ok = TRUE) {
+  if (!is.character(x) || length(x) != 1L || is.na(x) || (!empty_ok && !nzchar(x))) {
+    abort("`", arg, "` must be a single ", if (!empty_ok) "non-empty ", "string, not ",
+          if (is.character(x) && length(x) == 1L) format_value(x) else describe_type(x),
+          if (!is.null(x) && length(x) != 1L) paste0(" of length ", length(x)), ".",
+          class = "argument")
+  }
+  x
+}
+
+# An output file path: a single non-empty string that is not a directory and
+# whose directory exists.
+check_out_file <- function(file, arg = "file") {
+  check_string(file, arg, empty_ok = FALSE)
+  if (dir.exists(file)) {
+    abort("`", arg, "` must name a file, but \"", file, "\" is a directory.",
+          class = "argument")
+  }
+  if (!dir.exists(dirname(file))) {
+    abort("`", arg, "`: the directory \"", dirname(file), "\" does not exist.",
+          class = "argument")
+  }
+  file
+}
