@@ -375,6 +375,10 @@ confint.avfit <- function(object, parm, level = 0.95, ...) {
   cf <- object$coefficients
   se <- object$se
   if (missing(parm)) parm <- names(cf)
+  if (!(is.character(parm) || is.numeric(parm)) || is.object(parm)) {
+    abort("`parm` must be coefficient names or indices, not ", describe_type(parm),
+          ".", class = "argument")
+  }
   if (is.numeric(parm)) parm <- names(cf)[parm]
   if (!all(parm %in% names(cf))) {
     abort("`parm` must name coefficients of the fit: ",

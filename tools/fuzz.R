@@ -123,6 +123,10 @@ fuzz_setup <- function(pkg_path) {
   e$f_avr <- w("avr.csv", apply(cbind(tau, matrix(rep(1e-3 / sqrt(tau), 6), ncol = 6)), 1,
                                 paste, collapse = " "))
   e$f_missing <- file.path(d, "does-not-exist.csv")
+  e$reported <- function(r, pattern) {
+    if (any(grepl(pattern, r$problems$detail))) return(r)
+    list(unreported_fault = NaN)
+  }
   e$outdir <- file.path(d, "out")
   e$outfile <- file.path(d, "out.txt")
   e$f_dir <- d
@@ -335,6 +339,16 @@ fuzz_cases <- function(quick = FALSE) {
              "f_dup_ts", "f_back_ts", "f_const", "f_noheader", "f_semicolon",
              "f_binary", "f_fakebag", "f_fakemcap", "f_fakedb3", "f_missing", "f_dir")
   for (f in files) add("read_imu", paste("file =", f), S("read_imu", as.name(f)))
+  # a malformed file that is read must report the fault with its line and
+  # column (issue 12 item 2); otherwise the case counts as GARBAGE
+  faults <- c(f_extra = "line 11.*column 8", f_short = "line 11.*column 6",
+              f_inf = "line 11, column accel_z", f_nan = "line 11, column accel_z",
+              f_abc = "line 11, column 7", f_empty_cell = "line 11, column accel_z",
+              f_latin1 = "line 1, column 8", f_dup_ts = "line 12", f_back_ts = "line 12")
+  for (f in names(faults)) {
+    add("read_imu", paste("report of", f),
+        bquote(reported(read_imu(.(as.name(f))), .(faults[[f]]))))
+  }
   sub_arg("read_imu", q(read_imu(file = f_good)),
           c("file", "time", "time_unit", "columns", "units", "sep", "gap", "freq",
             "sensors", "topic", "dec"))
@@ -377,11 +391,21 @@ fuzz_cases <- function(quick = FALSE) {
     for (fl in list(character(), c("--rate", "-1"), c("--out", ""), c("--terms", "X"))) {
       add("inst/bin/allanvar", paste(fl, collapse = " "),
           bquote({
+            args <- shQuote(c(f_good, "--quiet", "--no-refine", "--out",
+                              file.path(dir, "binout"), .(fl)))
             bin <- system.file("bin", "allanvar", package = "allanvar")
-            if (!nzchar(bin)) bin <- file.path(getNamespaceInfo("allanvar", "path"), "inst", "bin", "allanvar")
-            out <- suppressWarnings(system2("Rscript", c(bin, shQuote(c(f_good, "--quiet", "--no-refine",
-                                             "--out", file.path(dir, "binout"), .(fl)))),
-                                            stdout = TRUE, stderr = TRUE))
+            if (pkgload::is_dev_package("allanvar")) {
+              # the working tree is not installed: load it, then run the launcher
+              path <- getNamespaceInfo("allanvar", "path")
+              bin <- file.path(path, "inst", "bin", "allanvar")
+              expr <- sprintf("suppressMessages(pkgload::load_all(%s, quiet = TRUE)); source(%s)",
+                              deparse(path), deparse(bin))
+              out <- suppressWarnings(system2("Rscript", c("-e", shQuote(expr), "--args", args),
+                                              stdout = TRUE, stderr = TRUE))
+            } else {
+              out <- suppressWarnings(system2("Rscript", c(bin, args), stdout = TRUE,
+                                              stderr = TRUE))
+            }
             st <- attr(out, "status")
             if (!is.null(st) && st != 0L) {
               txt <- paste(out, collapse = "\n")
