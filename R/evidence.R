@@ -247,10 +247,12 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
     abort("`x` is constant (every sample is ", format(x[1L]), "): there is no ",
           "noise to diagnose.", class = "argument")
   }
-  if (max(abs(x)) > 1e150) {
-    # sums of squares overflow double precision beyond 1e154
-    abort("`x` holds values up to ", format(max(abs(x)), digits = 3),
-          "; sums of squares overflow above 1e150: rescale `x` (and its units).",
+  big <- max(abs(x))
+  if (big > 1e150 || big < 1e-150) {
+    # sums of squares overflow (underflow) double precision beyond 1e154 (1e-154)
+    abort("`x` holds values up to ", format(big, digits = 3), "; their squares ",
+          if (big > 1) "overflow" else "underflow", " double precision: rescale ",
+          "`x` (and its units) to numbers between 1e-150 and 1e150.",
           class = "argument")
   }
   n <- length(x)
