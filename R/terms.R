@@ -99,7 +99,7 @@ av_model <- function(tau, coef, freq = NULL, by_term = FALSE) {
     abort("`tau` must be a numeric vector of positive averaging times in ",
           "seconds, not ", describe_type(tau), ".", class = "argument")
   }
-  by_term <- check_flag(by_term, "by_term")
+  by_term <- check_true_false(by_term, "by_term")
   lay <- check_coef(coef)
   tau0 <- if (is.null(freq)) NULL else 1 / check_freq(freq)
   comp <- model_components(tau, tau0, lay)

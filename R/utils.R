@@ -163,17 +163,6 @@ allanvar_threads <- function() {
   as.integer(min(n, 64L))
 }
 
-# A single TRUE or FALSE.
-check_flag <- function(x, arg) {
-  if (!is.logical(x) || length(x) != 1L || is.na(x)) {
-    abort("`", arg, "` must be TRUE or FALSE, not ",
-          if (is.logical(x) && length(x) == 1L) "NA" else describe_type(x),
-          if (length(x) != 1L && !is.null(x)) paste0(" of length ", length(x)), ".",
-          class = "argument")
-  }
-  x
-}
-
 # A single non-missing string (optionally non-empty).
 check_string <- function(x, arg, empty_ok = TRUE) {
   if (!is.character(x) || length(x) != 1L || is.na(x) || (!empty_ok && !nzchar(x))) {

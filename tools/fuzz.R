@@ -153,6 +153,14 @@ fuzz_one <- function(expr) {
     }
     if (!is.double(x)) return(NULL)
     if (any(is.nan(x))) return(paste("NaN in", path))
+    # a named coefficient vector: amplitudes, taus and time constants
+    if (!is.null(names(x)) && is.null(dim(x))) {
+      pn <- grepl("^(Q|N|B|K|R)$|\\.(sigma|tc|tau|A|f0|N)$|^tau", names(x))
+      if (any(pn & (is.infinite(x) | x < 0), na.rm = TRUE)) {
+        return(paste0("negative or infinite ", names(x)[which(pn & (is.infinite(x) | x < 0))[1L]],
+                      " in ", path))
+      }
+    }
     if (is.matrix(x) && !is.null(colnames(x))) {
       for (j in seq_len(ncol(x))) {
         r <- garbage(x[, j], paste0(path, "[, \"", colnames(x)[j], "\"]"), depth + 1L)
@@ -232,7 +240,7 @@ fuzz_cases <- function(quick = FALSE) {
     sub_arg(f, S(f, values = q(x), freq = 100), "freq")
   }
   sub_arg("avarn", q(avarn(values = x, freq = 100)), "exact")
-  sub_arg("dynamic_allan", q(dynamic_allan(x = x, freq = 100, window = 10, step = 5)), "x", series)
+  sub_arg("dynamic_allan", q(dynamic_allan(x = x, freq = 100, window = 1, step = 0.5)), "x", series)
   sub_arg("dynamic_allan", q(dynamic_allan(x = x, freq = 100, window = 10, step = 5)),
           c("freq", "window", "step", "taus", "type", "conf", "alpha"))
   for (f in c("three_cornered_hat", "groslambert")) {
