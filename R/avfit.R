@@ -243,8 +243,9 @@ new_avfit <- function(..., class = character()) {
   validate_avfit(x)
 }
 
-validate_avfit <- function(x) {
-  bad <- function(...) abort("Invalid avfit object: ", ..., class = "avfit")
+validate_avfit <- function(x, arg = NULL) {
+  bad <- function(...) abort(if (is.null(arg)) "Invalid avfit object: " else
+    paste0("`", arg, "` is not a valid avfit() result: "), ..., class = "avfit")
   need <- c("coefficients", "se", "vcov", "chi2", "rms", "objective",
             "df.residual", "nobs", "npar", "terms", "layout", "data",
             "components", "type", "edf_source", "steps", "input",

@@ -243,18 +243,7 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
   freq <- check_freq(freq)
   x <- check_values(x, min_n = 256L, arg = "x")
   alpha <- check_number(alpha, "alpha", 0, 1, open = TRUE)
-  if (max(x) == min(x)) {
-    abort("`x` is constant (every sample is ", format(x[1L]), "): there is no ",
-          "noise to diagnose.", class = "argument")
-  }
-  big <- max(abs(x))
-  if (big > 1e150 || big < 1e-150) {
-    # sums of squares overflow (underflow) double precision beyond 1e154 (1e-154)
-    abort("`x` holds values up to ", format(big, digits = 3), "; their squares ",
-          if (big > 1) "overflow" else "underflow", " double precision: rescale ",
-          "`x` (and its units) to numbers between 1e-150 and 1e150.",
-          class = "argument")
-  }
+  check_diagnosable(x, "x")
   n <- length(x)
   xc <- x - mean(x)
   r1 <- sum(xc[-1L] * xc[-n]) / sum(xc^2)

@@ -137,7 +137,7 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
     line("gyroscope_noise_density"),
     line("gyroscope_random_walk"),
     "",
-    sprintf("%-28s %-14s # the IMU ROS topic", "rostopic:", rostopic),
+    sprintf("%-28s %-14s # the IMU ROS topic", "rostopic:", yaml_scalar(rostopic)),
     sprintf("%-28s %-14s # [Hz] sampling rate, used by Kalibr to discretize",
             "update_rate:", format(rate, nsmall = 1))
   )

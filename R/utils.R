@@ -199,3 +199,33 @@ check_imu_freq <- function(freq, arg = "freq") {
   }
   freq
 }
+
+# Samples the diagnostics (avdiagnose(), avrefine(data =)) can work on: not
+# constant, and of a magnitude whose squares neither overflow nor underflow
+# double precision (beyond 1e154 / below 1e-154).
+check_diagnosable <- function(x, arg) {
+  if (max(x) == min(x)) {
+    abort("`", arg, "` is constant (every sample is ", format(x[1L]), "): there ",
+          "is no noise to diagnose.", class = "argument")
+  }
+  big <- max(abs(x))
+  if (big > 1e150 || big < 1e-150) {
+    abort("`", arg, "` holds values up to ", format(big, digits = 3), "; their ",
+          "squares ", if (big > 1) "overflow" else "underflow", " double ",
+          "precision: rescale `", arg, "` (and its units) to numbers between ",
+          "1e-150 and 1e150.", class = "argument")
+  }
+  invisible(x)
+}
+
+# A string as a YAML scalar: plain when it is safe, else double-quoted with
+# escapes (YAML 1.2, section 5.7), so that copied text cannot add keys.
+yaml_scalar <- function(s) {
+  if (grepl("^[A-Za-z0-9_/.~+-]+$", s)) return(s)
+  esc <- c("\\" = "\\\\", "\"" = "\\\"", "\n" = "\\n", "\r" = "\\r",
+           "\t" = "\\t")
+  chars <- strsplit(s, "", fixed = TRUE)[[1L]]
+  hit <- chars %in% names(esc)
+  chars[hit] <- esc[chars[hit]]
+  paste0("\"", paste(chars, collapse = ""), "\"")
+}
