@@ -510,8 +510,11 @@ fuzz_main <- function(args = commandArgs(trailingOnly = TRUE)) {
     funs <- strsplit(args[only + 1L], ",")[[1]]
     cases <- Filter(function(c) c$fun %in% funs, cases)
   }
+  t0 <- Sys.time()
   df <- fuzz_run(cases, pkg_path = pkg_path, verbose = "--verbose" %in% args)
   print(fuzz_table(df))
+  cat(sprintf("\n%d cases in %.0f s (wall, including the child's start).\n", nrow(df),
+              as.numeric(difftime(Sys.time(), t0, units = "secs"))))
   bad <- fuzz_findings(df)
   if (nrow(bad)) {
     cat("\nFindings:\n")
