@@ -442,11 +442,21 @@ fuzz_cases <- function(quick = FALSE) {
   }
   if (quick) {
     # a deterministic subset: every function keeps at least its first cases
-    # a deterministic subset spread over each function's arguments
+    # the faults issue 12 names, plus a deterministic subset spread over
+    # each function's arguments
+    keys <- c("integrated input, freq 1e300", "huge coef", "Inf coef", "tau 1e-300",
+              "tau Inf", "fixed gm1.tc = -1", "tau_B = -1", "negative N",
+              "dup channel names", "constant series", "fit without data",
+              "constant data", "one dead axis", "allan result", "rostopic with newline",
+              "file = f_comma", "file = f_two", "file = f_const", "file = f_dir",
+              "file = f_secs", "file = f_latin1", "report of f_extra",
+              "report of f_inf", "report of f_abc", "good --out=", "good --terms X",
+              "x = huge 1e300", "x = constant")
     funs <- vapply(cases, `[[`, "", "fun")
+    labels <- vapply(cases, `[[`, "", "label")
     keep <- unlist(lapply(split(seq_along(cases), factor(funs, unique(funs))), function(i)
-      i[unique(round(seq(1, length(i), length.out = min(length(i), 14L))))]))
-    cases <- cases[sort(keep)]
+      i[unique(round(seq(1, length(i), length.out = min(length(i), 6L))))]))
+    cases <- cases[sort(unique(c(keep, which(labels %in% keys))))]
   }
   cases
 }
