@@ -139,12 +139,12 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
   start <- check_named(start, "start", lay$name)
   fixed <- check_named(fixed, "fixed", lay$name)
   lay$fixed <- lay$name %in% names(fixed)
-  for (nm in c(names(start), names(fixed))) {
+  for (nm in names(fixed)) {
     # amplitudes >= 0, time constants and frequencies > 0 (as in av_model())
-    v <- c(start, fixed)[[nm]]
+    v <- fixed[[nm]]
     role <- lay$role[lay$name == nm]
     if ((role == "amp" && v < 0) || (role == "nonlinear" && v <= 0)) {
-      abort("`", if (nm %in% names(fixed)) "fixed" else "start", "`: ", nm,
+      abort("`fixed`: ", nm,
             " must be ", if (role == "amp") "non-negative" else "positive",
             ", not ", format(v), ".", class = "argument")
     }
