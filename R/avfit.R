@@ -419,7 +419,7 @@ predict.avfit <- function(object, newdata = NULL, type = "avar",
     if (is.data.frame(newdata)) newdata$tau else newdata
   if (!is.numeric(tau) || !length(tau) || anyNA(tau) || any(tau <= 0) ||
       any(!is.finite(tau))) {
-    abort("`newdata` must be positive finite tau values in seconds (a vector or a ",
+    abort("`newdata` must be positive tau values in seconds (a vector or a ",
           "data frame with a `tau` column).", class = "argument")
   }
   tau0 <- if (is.null(object$freq)) NULL else 1 / object$freq
