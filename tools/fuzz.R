@@ -419,7 +419,8 @@ fuzz_cases <- function(quick = FALSE) {
             args <- shQuote(c(f_good, "--quiet", "--no-refine", "--out",
                               file.path(dir, "binout"), .(fl)))
             bin <- system.file("bin", "allanvar", package = "allanvar")
-            if (pkgload::is_dev_package("allanvar")) {
+            if (requireNamespace("pkgload", quietly = TRUE) &&
+                pkgload::is_dev_package("allanvar")) {
               # the working tree is not installed: load it, then run the launcher
               path <- getNamespaceInfo("allanvar", "path")
               bin <- file.path(path, "inst", "bin", "allanvar")
