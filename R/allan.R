@@ -171,8 +171,8 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   input <- check_choice(input, c("rate", "integrated"), "input")
   conf <- check_number(conf, "conf", 0, 1, open = TRUE)
   gaps <- check_choice(gaps, c("skip", "error"), "gaps")
+  debias <- check_true_false(debias, "debias")
   if (type %in% allan_extra_types) {
-    debias <- check_true_false(debias, "debias")
     return(allan_extra(x, freq, taus, type, input, conf, debias, gaps))
   }
   ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)

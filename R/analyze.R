@@ -92,6 +92,19 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
     abort("`refine_args` must be a named list of avrefine() arguments, not ",
           describe_type(refine_args), ".", class = "argument")
   }
+  if (!(is.character(segment) && length(segment) == 1L &&
+        segment %in% c("longest", "each")) &&
+      !(is.numeric(segment) && !is.object(segment) && length(segment) == 1L &&
+        is.finite(segment) && segment >= 1 && segment == round(segment))) {
+    abort("`segment` must be \"longest\", \"each\" or a segment number, not ",
+          if (length(segment) == 1L && is.atomic(segment)) format_value(segment)
+          else describe_type(segment), ".", class = "argument")
+  }
+  if (!is.null(channels) && (!is.character(channels) || !length(channels) ||
+                             anyNA(channels))) {
+    abort("`channels` must be a character vector of channel names, not ",
+          describe_type(channels), ".", class = "argument")
+  }
   records <- as_record_list(x, read_args)
   records <- split_segments(records, segment)
   single <- length(records) == 1L
@@ -108,6 +121,17 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
               r$name, " (", paste(ch, collapse = ", "), ").", class = "argument")
       }
       ch <- channels
+    }
+    # A dead (constant) axis has no noise to analyse: reported, others go on.
+    dead <- ch[vapply(ch, function(c) isTRUE(all(r$data[, c] == r$data[1L, c])), NA)]
+    if (length(dead)) {
+      if (length(dead) == length(ch)) {
+        abort("`x`: every channel of ", r$name, " is constant (dead or ",
+              "saturated axes); there is no noise to analyse.", class = "argument")
+      }
+      warn(r$name, ": ", paste(dead, collapse = ", "), " constant (a dead or ",
+           "saturated axis): not analysed.", class = "dead_channel")
+      ch <- setdiff(ch, dead)
     }
     for (chn in ch) {
       jobs[[length(jobs) + 1L]] <- list(

@@ -139,6 +139,16 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
   start <- check_named(start, "start", lay$name)
   fixed <- check_named(fixed, "fixed", lay$name)
   lay$fixed <- lay$name %in% names(fixed)
+  for (nm in names(fixed)) {
+    # amplitudes >= 0, time constants and frequencies > 0 (as in av_model())
+    v <- fixed[[nm]]
+    role <- lay$role[lay$name == nm]
+    if ((role == "amp" && v < 0) || (role == "nonlinear" && v <= 0)) {
+      abort("`fixed`: ", nm,
+            " must be ", if (role == "amp") "non-negative" else "positive",
+            ", not ", format(v), ".", class = "argument")
+    }
+  }
   lay$value <- NA_real_
   lay$value[lay$fixed] <- fixed[lay$name[lay$fixed]]
   keep <- rep(TRUE, nrow(curve$data))
@@ -233,8 +243,9 @@ new_avfit <- function(..., class = character()) {
   validate_avfit(x)
 }
 
-validate_avfit <- function(x) {
-  bad <- function(...) abort("Invalid avfit object: ", ..., class = "avfit")
+validate_avfit <- function(x, arg = NULL) {
+  bad <- function(...) abort(if (is.null(arg)) "Invalid avfit object: " else
+    paste0("`", arg, "` is not a valid avfit() result: "), ..., class = "avfit")
   need <- c("coefficients", "se", "vcov", "chi2", "rms", "objective",
             "df.residual", "nobs", "npar", "terms", "layout", "data",
             "components", "type", "edf_source", "steps", "input",
@@ -375,6 +386,10 @@ confint.avfit <- function(object, parm, level = 0.95, ...) {
   cf <- object$coefficients
   se <- object$se
   if (missing(parm)) parm <- names(cf)
+  if (!(is.character(parm) || is.numeric(parm)) || is.object(parm)) {
+    abort("`parm` must be coefficient names or indices, not ", describe_type(parm),
+          ".", class = "argument")
+  }
   if (is.numeric(parm)) parm <- names(cf)[parm]
   if (!all(parm %in% names(cf))) {
     abort("`parm` must name coefficients of the fit: ",
@@ -402,7 +417,8 @@ predict.avfit <- function(object, newdata = NULL, type = "avar",
   type <- check_choice(type, c("avar", "adev"), "type")
   tau <- if (is.null(newdata)) object$data$tau else
     if (is.data.frame(newdata)) newdata$tau else newdata
-  if (!is.numeric(tau) || !length(tau) || anyNA(tau) || any(tau <= 0)) {
+  if (!is.numeric(tau) || !length(tau) || anyNA(tau) || any(tau <= 0) ||
+      any(!is.finite(tau))) {
     abort("`newdata` must be positive tau values in seconds (a vector or a ",
           "data frame with a `tau` column).", class = "argument")
   }

@@ -97,6 +97,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     abort("`fit` must be an avfit() result, not ", describe_type(fit), ".",
           class = "argument")
   }
+  validate_avfit(fit, arg = "fit")
   kinds <- effect_kinds()
   if (!is.character(candidates) || !length(candidates) || anyNA(candidates) ||
       !all(candidates %in% kinds)) {
@@ -128,6 +129,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
             class = "argument")
     }
     data <- check_values(data, min_n = 256L, arg = "data")
+    check_diagnosable(data, "data")
     raw <- avdiagnose(data, freq)
   }
   # The settings every refit uses, explicitly: the fit's own, overridden by

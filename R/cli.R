@@ -52,7 +52,12 @@
 #' allanvar_cli("--help")
 allanvar_cli <- function(args = commandArgs(trailingOnly = TRUE)) {
   # Errors propagate: Rscript then prints "Error: ..." and exits with 1.
-  invisible(cli_run(as.character(args)))
+  if (!is.character(args) || anyNA(args)) {
+    abort("`args` must be a character vector of command-line arguments, not ",
+          if (is.character(args)) "one holding NA" else describe_type(args), ".",
+          class = "argument")
+  }
+  invisible(cli_run(args))
 }
 
 cli_usage <- function() {

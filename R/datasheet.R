@@ -30,7 +30,13 @@
 #' datasheet(a)
 #' datasheet(a, average = TRUE)$gyro
 #' }
-datasheet <- function(x, average = FALSE, ...) UseMethod("datasheet")
+datasheet <- function(x, average = FALSE, ...) {
+  if (!inherits(x, c("imu_analysis", "imu_analysis_list"))) {
+    abort("`x` must be an imu_analysis or imu_analysis_list (from ",
+          "analyze_imu()), not ", describe_type(x), ".", class = "argument")
+  }
+  UseMethod("datasheet")
+}
 
 #' @export
 datasheet.imu_analysis_list <- function(x, average = FALSE, ...) {
@@ -185,6 +191,8 @@ print.imu_datasheet <- function(x, digits = 3, ...) {
 #' read.csv(f)
 #' }
 write_datasheet <- function(x, file, format = "long") {
+  check_present(missing(file), "file", "the path of the CSV file to write")
+  file <- check_out_file(file)
   format <- check_choice(format, c("long", "wide"), "format")
   if (inherits(x, c("imu_analysis", "imu_analysis_list"))) x <- datasheet(x)
   if (!inherits(x, "imu_datasheet")) {

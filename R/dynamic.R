@@ -130,10 +130,17 @@ dynamic_allan <- function(x, freq, window = NULL, step = NULL, taus = "octave",
                           integer = TRUE)
   }
   nt <- dyn_nterms(type, m, Lw)
-  sums <- dynamic_sums_cpp(x, NULL, m, nt, dyn_opts(type, rate, S, nwin))
-  avar <- sweep(sums, 2L, dyn_norm(type, m) * nt, "/") *
-    (if (rate) 1 else freq^2)
+  # Scaled by a power of two (exact) so that squares of data near the
+  # double range neither overflow nor underflow; scaled back, and refused
+  # when the variance itself cannot be represented (as in allan()).
+  ex <- range_exponent(x)
+  sums <- dynamic_sums_cpp(times_pow2(x, -ex), NULL, m, nt,
+                           dyn_opts(type, rate, S, nwin))
+  avar <- sweep(sums, 2L, dyn_norm(type, m) * nt, "/")
   avar[avar < 0] <- 0  # a sum of squares; guards the last bit only
+  pos <- avar > 0
+  avar[] <- times_pow2(if (rate) avar else times_freq2(avar, freq), 2 * ex)
+  check_representable(avar, nonzero = pos)
   start <- (seq_len(nwin) - 1) * S
   e <- dyn_edf(type, m, Lw, avar, alpha, conf)
   dimnames(avar) <- NULL

@@ -243,6 +243,7 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
   freq <- check_freq(freq)
   x <- check_values(x, min_n = 256L, arg = "x")
   alpha <- check_number(alpha, "alpha", 0, 1, open = TRUE)
+  check_diagnosable(x, "x")
   n <- length(x)
   xc <- x - mean(x)
   r1 <- sum(xc[-1L] * xc[-n]) / sum(xc^2)

@@ -40,6 +40,7 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
   check_present(missing(x), "x", "an imu_analysis or the four noise values")
   axis <- check_choice(axis, c("max", "mean"), "axis")
   inflate <- check_number(inflate, "inflate", lo = 1)
+  file <- check_out_file(file)
   if (!is.character(rostopic) || length(rostopic) != 1L) {
     abort("`rostopic` must be a single string.", class = "argument")
   }
@@ -67,6 +68,12 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
         next
       }
       rows <- do.call(rbind, rows)
+      rows <- rows[is.finite(rows$value), , drop = FALSE]
+      if (!nrow(rows)) {
+        abort("`x` has no ", sub("_", " ", role), " reading for any ", sensor,
+              " axis (the record is too short for one), so `", k,
+              "` cannot be written.", class = "argument")
+      }
       if (axis == "max") {
         i <- which.max(rows$value)
         vals[k] <- rows$value[i]
@@ -130,7 +137,7 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
     line("gyroscope_noise_density"),
     line("gyroscope_random_walk"),
     "",
-    sprintf("%-28s %-14s # the IMU ROS topic", "rostopic:", rostopic),
+    sprintf("%-28s %-14s # the IMU ROS topic", "rostopic:", yaml_scalar(rostopic)),
     sprintf("%-28s %-14s # [Hz] sampling rate, used by Kalibr to discretize",
             "update_rate:", format(rate, nsmall = 1))
   )
@@ -179,6 +186,7 @@ filter_params <- function(x, dt = NULL, bias_instability = "gm",
   check_present(missing(x), "x", "an imu_analysis, an avfit or coefficients")
   bias_instability <- check_choice(bias_instability, c("gm", "omit"),
                                    "bias_instability")
+  if (!is.null(tau_B)) tau_B <- check_number(tau_B, "tau_B", lo = 0, open = TRUE)
   if (inherits(x, "imu_analysis")) {
     if (is.null(dt)) dt <- 1 / x$freq
     dt <- check_number(dt, "dt", lo = 0, open = TRUE)

@@ -84,6 +84,12 @@ print.avfit_control <- function(x, ...) {
 check_control <- function(control) {
   if (is.null(control)) return(avfit_control())
   if (is.list(control) && !inherits(control, "avfit_control")) {
+    bad <- setdiff(names(control), names(formals(avfit_control)))
+    if (is.null(names(control)) || length(bad) || is.data.frame(control)) {
+      abort("`control` must be avfit_control() or a named list of its arguments",
+            if (length(bad)) paste0("; unknown: ", paste(bad, collapse = ", ")), ".",
+            class = "argument")
+    }
     return(do.call(avfit_control, control))
   }
   if (!inherits(control, "avfit_control")) {

@@ -27,6 +27,8 @@ plotav <- function(avdf) {
   # graphical parameter; the warning says nothing about the user's data.
   withCallingHandlers(
     gplots::plotCI(x = curve$time, y = adev, uiw = adev * curve$error,
+                   liw = adev * if (is.null(curve$lower_error)) curve$error else
+                     pmin(curve$lower_error, 1 - 1e-9),
                    gap = 0, lty = 1, xaxt = "n", yaxt = "n", col = "blue",
                    log = "xy", lwd = 1, xlab = "", ylab = ""),
     warning = function(w) {
@@ -51,8 +53,11 @@ plotav_columns <- function(avdf) {
           "avari(), not ", describe_type(avdf), ".")
   }
   if (all(c("tau", "avar", "upper", "adev") %in% names(avdf))) {
+    # allan() results: their own (asymmetric) interval, never below zero
     avdf <- list(time = avdf$tau, av = avdf$avar,
-                 error = (avdf$upper - avdf$adev) / avdf$adev)
+                 error = (avdf$upper - avdf$adev) / avdf$adev,
+                 lower_error = if (!is.null(avdf$lower))
+                   (avdf$adev - pmax(avdf$lower, 0)) / avdf$adev)
   }
   missing_cols <- setdiff(c("time", "av", "error"), names(avdf))
   if (length(missing_cols)) {
@@ -75,5 +80,6 @@ plotav_columns <- function(avdf) {
     abort("`avdf` has no row with positive, finite `time` and `av` to plot ",
           "on log axes.")
   }
+  if (!is.null(avdf$lower_error)) cols$lower_error <- avdf$lower_error
   lapply(cols, `[`, ok)
 }

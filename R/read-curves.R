@@ -256,6 +256,12 @@ read_kalibr_yaml <- function(file) {
     v <- suppressWarnings(as.numeric(y[[k]]))
     if (length(v) != 1L) NA_real_ else v
   }, 0)
+  bad <- !is.finite(val) | val < 0
+  if (any(bad)) {
+    k <- have[bad][1L]
+    abort("\"", basename(file), "\": `", k, "` must be a single non-negative ",
+          "finite number, not ", format_value(y[[k]]), ".", class = "file_format")
+  }
   sk <- strsplit(keys[have], ".", fixed = TRUE)
   sensor <- vapply(sk, `[`, "", 1L)
   term <- vapply(sk, `[`, "", 2L)

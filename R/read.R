@@ -159,7 +159,20 @@ read_imu <- function(file, time = NULL,
     abort("`dec` and `sep` must differ; both are \"", sep, "\".",
           class = "argument")
   }
-  if (!is.null(freq)) freq <- check_freq(freq)
+  if (!is.null(freq)) freq <- check_imu_freq(freq)
+  if (!is.null(time) && !isFALSE(time) &&
+      (!(is.character(time) || is.numeric(time)) || is.object(time) ||
+       length(time) != 1L || is.na(time))) {
+    abort("`time` must be NULL (detect), a column name or index, or FALSE ",
+          "(no timestamp column); not ", if (length(time) == 1L && is.atomic(time))
+            format_value(time) else describe_type(time), ".", class = "argument")
+  }
+  if (!is.null(columns) && (!(is.character(columns) || is.numeric(columns)) ||
+                            is.object(columns) || !length(columns) || anyNA(columns))) {
+    abort("`columns` must be NULL or a vector of column names or indices, not ",
+          describe_type(columns), if (length(columns)) " holding NA", ".",
+          class = "argument")
+  }
   if (!is.null(topic) && (!is.character(topic) || length(topic) != 1L ||
                           is.na(topic))) {
     abort("`topic` must be a single topic name, not ", describe_type(topic),
@@ -312,9 +325,14 @@ imu_record <- function(x, freq = NULL, units = NULL, sensors = NULL,
                        time = NULL, time_unit = "s",
                        gap = c("segments", "error", "ignore"), name = NULL) {
   check_present(missing(x), "x", "a matrix or data frame of samples")
+  if (is.null(x) || !length(x)) {
+    abort("`x` must be a matrix or data frame of samples, not ",
+          if (is.null(x)) "NULL" else "an empty object", ".", class = "argument")
+  }
   gap <- choice_arg(gap, c("segments", "error", "ignore"), "gap")
+  if (!is.null(name)) check_string(name, "name")
   if (is.null(freq)) freq <- attr(x, "freq")
-  if (!is.null(freq)) freq <- check_freq(freq)
+  if (!is.null(freq)) freq <- check_imu_freq(freq)
   if (inherits(x, c("Date", "POSIXt", "difftime", "factor")) ||
       (is.data.frame(x) && any(vapply(x, function(v)
         inherits(v, c("Date", "POSIXt", "difftime", "factor")) || !is.numeric(v),

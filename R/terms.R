@@ -99,8 +99,13 @@ av_model <- function(tau, coef, freq = NULL, by_term = FALSE) {
     abort("`tau` must be a numeric vector of positive averaging times in ",
           "seconds, not ", describe_type(tau), ".", class = "argument")
   }
+  by_term <- check_true_false(by_term, "by_term")
   lay <- check_coef(coef)
   tau0 <- if (is.null(freq)) NULL else 1 / check_freq(freq)
   comp <- model_components(tau, tau0, lay)
+  if (!all(is.finite(comp))) {
+    abort("the model overflows: `coef` or `tau` too large or too small to give ",
+          "a finite Allan variance.", class = "argument")
+  }
   if (by_term) comp else rowSums(comp)
 }

@@ -66,8 +66,12 @@ av_units <- function(sensor = NULL, kind = NULL) {
 #' @return `convert_units()`: `x` expressed in `to`.
 #' @export
 convert_units <- function(x, from, to) {
-  if (!is.numeric(x)) {
-    abort("`x` must be numeric, not ", describe_type(x), ".")
+  if (!is.numeric(x) || is.factor(x)) {
+    abort("`x` must be numeric, not ", describe_type(x), ".", class = "argument")
+  }
+  if (any(is.infinite(x) | is.nan(x))) {
+    abort("`x` must hold finite numbers (or NA); found ",
+          format(x[is.infinite(x) | is.nan(x)][1L]), ".", class = "argument")
   }
   f <- lookup_unit(from, "from")
   t <- lookup_unit(to, "to")

@@ -6,6 +6,7 @@
 describe_type <- function(x) {
   if (is.null(x)) return("NULL")
   if (is.factor(x)) return("a factor")
+  if (is_time_like(x)) return(paste("a", class(x)[1L], "object"))
   if (is.data.frame(x)) return("a data frame")
   if (is.matrix(x)) return(paste("a", typeof(x), "matrix"))
   if (is.list(x)) return("a list")
@@ -72,7 +73,7 @@ check_values <- function(values, min_n = 2L, arg = "values") {
     }
     values <- if (is.data.frame(values)) values[[1L]] else values[, 1L]
   }
-  if (is.null(values) || is.factor(values) || is.list(values) ||
+  if (is.null(values) || is.factor(values) || is.list(values) || is_time_like(values) ||
       !(is.double(values) || is.integer(values))) {
     abort("`", arg, "` must be a numeric vector, not ", describe_type(values), ".",
           class = "argument")
@@ -94,10 +95,13 @@ check_values <- function(values, min_n = 2L, arg = "values") {
   values
 }
 
+# Dates and times are stored as doubles but are not samples or settings.
+is_time_like <- function(x) inherits(x, c("Date", "POSIXt", "difftime"))
+
 # `freq`: a single positive finite number (sampling frequency in Hz).
 check_freq <- function(freq, arg = "freq") {
   if (is.null(freq) || !(is.double(freq) || is.integer(freq)) ||
-      is.factor(freq) || length(freq) != 1L || is.na(freq) ||
+      is.factor(freq) || is_time_like(freq) || length(freq) != 1L || is.na(freq) ||
       !is.finite(freq) || freq <= 0) {
     abort("`", arg, "` must be a single positive number (the sampling ",
           "frequency in Hz), not ", describe_freq(freq), ".",
@@ -125,8 +129,8 @@ check_present <- function(missing, arg, what) {
 # A single number in [lo, hi] (or (lo, hi) when open).
 check_number <- function(x, arg, lo = -Inf, hi = Inf, open = FALSE,
                          integer = FALSE) {
-  ok <- (is.double(x) || is.integer(x)) && length(x) == 1L && !is.na(x) &&
-    is.finite(x)
+  ok <- (is.double(x) || is.integer(x)) && !is_time_like(x) && length(x) == 1L &&
+    !is.na(x) && is.finite(x)
   if (ok) ok <- if (open) x > lo && x < hi else x >= lo && x <= hi
   if (ok && integer) ok <- x == round(x)
   if (!ok) {
@@ -157,4 +161,71 @@ allanvar_threads <- function() {
   n <- getOption("allanvar.threads", 2L)
   if (!is.numeric(n) || length(n) != 1L || is.na(n) || n < 1) n <- 1L
   as.integer(min(n, 64L))
+}
+
+# A single non-missing string (optionally non-empty).
+check_string <- function(x, arg, empty_ok = TRUE) {
+  if (!is.character(x) || length(x) != 1L || is.na(x) || (!empty_ok && !nzchar(x))) {
+    abort("`", arg, "` must be a single ", if (!empty_ok) "non-empty ", "string, not ",
+          if (is.character(x) && length(x) == 1L) format_value(x) else describe_type(x),
+          if (!is.null(x) && length(x) != 1L) paste0(" of length ", length(x)), ".",
+          class = "argument")
+  }
+  x
+}
+
+# An output file path: a single non-empty string that is not a directory and
+# whose directory exists.
+check_out_file <- function(file, arg = "file") {
+  check_string(file, arg, empty_ok = FALSE)
+  if (dir.exists(file)) {
+    abort("`", arg, "` must name a file, but \"", file, "\" is a directory.",
+          class = "argument")
+  }
+  if (!dir.exists(dirname(file))) {
+    abort("`", arg, "`: the directory \"", dirname(file), "\" does not exist.",
+          class = "argument")
+  }
+  file
+}
+
+# An IMU sampling rate: check_freq() and at most 1 GHz (beyond that the
+# per-sample arithmetic of the readers loses its integers).
+check_imu_freq <- function(freq, arg = "freq") {
+  freq <- check_freq(freq, arg)
+  if (freq > 1e9) {
+    abort("`", arg, "` = ", format(freq), " Hz is not a plausible IMU sampling ",
+          "rate (at most 1e9 Hz); give the rate in Hz.", class = "argument")
+  }
+  freq
+}
+
+# Samples the diagnostics (avdiagnose(), avrefine(data =)) can work on: not
+# constant, and of a magnitude whose squares neither overflow nor underflow
+# double precision (beyond 1e154 / below 1e-154).
+check_diagnosable <- function(x, arg) {
+  if (max(x) == min(x)) {
+    abort("`", arg, "` is constant (every sample is ", format(x[1L]), "): there ",
+          "is no noise to diagnose.", class = "argument")
+  }
+  big <- max(abs(x))
+  if (big > 1e150 || big < 1e-150) {
+    abort("`", arg, "` holds values up to ", format(big, digits = 3), "; their ",
+          "squares ", if (big > 1) "overflow" else "underflow", " double ",
+          "precision: rescale `", arg, "` (and its units) to numbers between ",
+          "1e-150 and 1e150.", class = "argument")
+  }
+  invisible(x)
+}
+
+# A string as a YAML scalar: plain when it is safe, else double-quoted with
+# escapes (YAML 1.2, section 5.7), so that copied text cannot add keys.
+yaml_scalar <- function(s) {
+  if (grepl("^[A-Za-z0-9_/.~+-]+$", s)) return(s)
+  esc <- c("\\" = "\\\\", "\"" = "\\\"", "\n" = "\\n", "\r" = "\\r",
+           "\t" = "\\t")
+  chars <- strsplit(s, "", fixed = TRUE)[[1L]]
+  hit <- chars %in% names(esc)
+  chars[hit] <- esc[chars[hit]]
+  paste0("\"", paste(chars, collapse = ""), "\"")
 }
