@@ -5,7 +5,11 @@
 #' ([gplots::plotCI()]), the curve, axes at decades, an orange log grid and
 #' the original title. Works on the output of [avar()], [avarn()] and
 #' [avari()] (and on [allan()] results, whose `tau` and `avar` columns are
-#' used, with the half width of the confidence interval as the error).
+#' used, and its confidence limits `lower` and `upper` drawn as the bars).
+#' A bar whose lower end would fall at or below zero (an `error` of 1 or
+#' more) cannot be drawn on log axes: it is drawn down to the lowest
+#' positive end of the other bars (a tenth of the curve's minimum when there
+#' is none).
 #'
 #' Lines can be added afterwards (for example with [graphics::abline()]) in
 #' the plot's log coordinates, as in `demo(allanvar)`. Graphical parameters
@@ -26,7 +30,7 @@ plotav <- function(avdf) {
   # plotCI() hands `log` on to points(), which warns that it is not a
   # graphical parameter; the warning says nothing about the user's data.
   withCallingHandlers(
-    gplots::plotCI(x = curve$time, y = adev, uiw = adev * curve$error,
+    gplots::plotCI(x = curve$time, y = adev, uiw = curve$uiw, liw = curve$liw,
                    gap = 0, lty = 1, xaxt = "n", yaxt = "n", col = "blue",
                    log = "xy", lwd = 1, xlab = "", ylab = ""),
     warning = function(w) {
@@ -50,7 +54,10 @@ plotav_columns <- function(avdf) {
     abort("`avdf` must be the data frame returned by avar(), avarn() or ",
           "avari(), not ", describe_type(avdf), ".")
   }
+  limits <- NULL
   if (all(c("tau", "avar", "upper", "adev") %in% names(avdf))) {
+    # allan(): asymmetric chi-square limits, drawn as they are
+    limits <- list(lower = avdf$lower %||% avdf$adev, upper = avdf$upper)
     avdf <- list(time = avdf$tau, av = avdf$avar,
                  error = (avdf$upper - avdf$adev) / avdf$adev)
   }
@@ -75,5 +82,24 @@ plotav_columns <- function(avdf) {
     abort("`avdf` has no row with positive, finite `time` and `av` to plot ",
           "on log axes.")
   }
-  lapply(cols, `[`, ok)
+  out <- lapply(cols, `[`, ok)
+  adev <- sqrt(out$av)
+  if (is.null(limits)) {
+    out$uiw <- adev * out$error
+    out$liw <- out$uiw
+  } else {
+    out$uiw <- limits$upper[ok] - adev
+    out$liw <- adev - limits$lower[ok]
+  }
+  # NA or negative widths (no confidence interval): no bar
+  out$uiw[!is.finite(out$uiw) | out$uiw < 0] <- 0
+  out$liw[!is.finite(out$liw) | out$liw < 0] <- 0
+  # a lower end at or below zero has no place on a log axis
+  low <- adev - out$liw
+  bad <- low <= 0
+  if (any(bad)) {
+    floor <- if (any(!bad)) min(low[!bad]) else min(adev) / 10
+    out$liw[bad] <- adev[bad] - floor
+  }
+  out
 }
