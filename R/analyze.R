@@ -144,7 +144,15 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
               channels = res, call = match.call())
     class(a) <- "imu_analysis"
     a$datasheet <- datasheet(a)
+    dead <- Filter(function(ch) !is.null(ch$dead), res)
+    if (length(dead)) {
+      warn(r$name, ": ", paste(names(dead), collapse = ", "),
+           if (length(dead) == 1L) " is a dead axis" else " are dead axes",
+           " (constant signal): reported, not analysed; the other axes are.",
+           class = "dead_axis")
+    }
     g <- imu_guidance(a)
+    g <- g[!g$channel %in% names(dead), , drop = FALSE]
     if (nrow(g)) {
       msg <- paste0(r$name, ": the record is short for some readings:\n",
                     paste0("  - ", g$channel, ": ", g$message, collapse = "\n"))
@@ -165,6 +173,16 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
 analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
   curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
+  if (!any(is.finite(curve$adev) & curve$adev > 0)) {
+    # A dead (constant) axis has nothing to fit or read: it is reported,
+    # and the other axes are analysed.
+    reason <- "dead axis: constant signal (Allan variance 0 at every tau), not analysed"
+    return(list(channel = job$channel, sensor = job$sensor, unit = job$unit,
+                freq = job$freq, n = length(job$x), curve = curve, fit = NULL,
+                fit_error = reason, fit_condition = NULL, coef = numeric(),
+                readings = dead_readings(job$sensor, reason), dead = reason,
+                guidance = paste0(reason, ": check the sensor and the column.")))
+  }
   fit <- NULL
   failure <- NULL
   # A fit or refinement that fails is kept in the result (fit_error,

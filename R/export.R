@@ -68,6 +68,17 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
         next
       }
       rows <- do.call(rbind, rows)
+      header <- c(header, sprintf("#   %-28s %s", k, comment_text(paste(sprintf(
+        "%s = %s", rows$axis, ifelse(is.na(rows$value), "NA (dead axis)",
+                                     sprintf("%.4e", rows$value))),
+        collapse = ", "))))
+      # dead axes carry no value and take no part in the max or the mean
+      rows <- rows[is.finite(rows$value), , drop = FALSE]
+      if (!nrow(rows)) {
+        vals[k] <- NA_real_
+        notes[k] <- "every axis dead"
+        next
+      }
       if (axis == "max") {
         i <- which.max(rows$value)
         vals[k] <- rows$value[i]
@@ -79,8 +90,6 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
         bound <- any(rows$is_bound)
       }
       if (bound) notes[k] <- paste0(notes[k], "; UPPER BOUND, +1/2 region not reached")
-      header <- c(header, sprintf("#   %-28s %s", k, comment_text(paste(sprintf(
-        "%s = %.4e", rows$axis, rows$value), collapse = ", "))))
     }
     rate <- x$freq
     src <- sprintf("# Source: %s, %d samples at %.6g Hz (%.3g h), Allan deviation per axis.",
@@ -120,7 +129,9 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
   block <- function(title, sensor, ks) {
     if (all(is.na(vals[ks]))) {
       return(c(paste0("#", title), sprintf(
-        "# (no %s channel in the record: %s not written)", sensor,
+        "# (%s: %s not written)",
+        if (any(notes[ks] == "every axis dead")) paste("every", sensor, "axis is dead")
+        else paste("no", sensor, "channel in the record"),
         paste(ks, collapse = ", "))))
     }
     c(paste0("#", title), vapply(ks, line, ""))
