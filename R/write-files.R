@@ -52,7 +52,7 @@ yaml_quote <- function(x) {
   x <- gsub("\n", "\\n", x, fixed = TRUE)
   x <- gsub("\r", "\\r", x, fixed = TRUE)
   x <- gsub("\t", "\\t", x, fixed = TRUE)
-  ctl <- gregexpr("[\x01-\x1f\x7f]", x, useBytes = TRUE)
+  ctl <- gregexpr("[\x01-\x1f\x7f]", x)
   regmatches(x, ctl) <- lapply(regmatches(x, ctl), function(m)
     sprintf("\\x%02x", vapply(m, function(ch) as.integer(charToRaw(ch)), 0L)))
   paste0("\"", x, "\"")
@@ -64,5 +64,5 @@ comment_text <- function(x) {
   x <- as.character(x)
   x <- gsub("\n", "\\n", x, fixed = TRUE)
   x <- gsub("\r", "\\r", x, fixed = TRUE)
-  gsub("[\x01-\x1f\x7f]", "?", x, useBytes = TRUE)
+  gsub("[\x01-\x1f\x7f]", "?", enc2utf8(x))
 }
