@@ -217,3 +217,22 @@ test_that("filter_params() refuses garbage instead of returning it", {
                (0.664 * 1e-4 / 0.6174)^2 * (1 - phi^2), tolerance = 2e-3)
   expect_true(all(fp$value > 0))
 })
+
+test_that("a gyro-only record writes a valid imu.yaml holding only the gyro", {
+  set.seed(5)
+  m <- cbind(gyro_x = rnorm(1e4) * 1e-3, gyro_y = rnorm(1e4) * 2e-3)
+  r <- imu_record(m, freq = 100, units = c("rad/s", "rad/s"))
+  a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  write_kalibr_yaml(a, f)
+  txt <- readLines(f)
+  expect_false(any(grepl("nan", txt, ignore.case = TRUE)))
+  expect_match(txt, "# (no accelerometer channel in the record", fixed = TRUE,
+               all = FALSE)
+  y <- yaml::read_yaml(f)
+  expect_setequal(names(y), c("gyroscope_noise_density", "gyroscope_random_walk",
+                              "rostopic", "update_rate"))
+  # N of the worst axis: sigma / sqrt(freq) = 2e-3 / 10
+  expect_equal(y$gyroscope_noise_density, 2e-4, tolerance = 0.1)
+})
