@@ -129,3 +129,28 @@ test_that("a fit of a curve alone gets a datasheet, guidance and filter paramete
   expect_error(datasheet(1), "`x` must be an imu_analysis",
                class = "allanvar_error_argument")
 })
+
+test_that("the same recording as CSV, ROS1 bag, ROS2 db3 and MCAP gives identical datasheets", {
+  # fixtures: tools/make-bag-fixtures.R (one recording in every format)
+  files <- c(csv = "imu.csv", bag = "imu_lz4.bag", db3 = "imu.db3",
+             mcap = "imu_lz4.mcap", mcap_ros1 = "imu_ros1.mcap")
+  sheets <- lapply(names(files), function(k) {
+    args <- if (k == "csv") list() else list(topic = "/imu0")
+    r <- do.call(read_imu, c(list(ros_fixture(files[[k]])), args))
+    a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+    ds <- datasheet(a)
+    # the record's name is its file name; everything else must agree
+    ds$long$record <- NULL
+    ds$gyro$record <- ds$accel$record <- NULL
+    ds
+  })
+  names(sheets) <- names(files)
+  expect_setequal(unique(sheets$csv$long$axis),
+                  c("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"))
+  expect_true(all(is.finite(sheets$csv$long$value)))
+  for (k in names(files)[-1]) {
+    expect_identical(sheets[[k]]$long, sheets$csv$long, label = k)
+    expect_identical(sheets[[k]]$gyro, sheets$csv$gyro, label = k)
+    expect_identical(sheets[[k]]$accel, sheets$csv$accel, label = k)
+  }
+})
