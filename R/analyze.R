@@ -43,8 +43,12 @@
 #' @param segment Which gap-free segment to use: `"longest"` (default),
 #'   `"each"` (every segment analysed as its own record) or a number.
 #' @param channels Optional channel names to analyse (default: all).
-#' @param progress Report progress, one message per axis. Default: on in
-#'   interactive sessions unless `options(allanvar.progress = FALSE)`.
+#' @param progress Report progress. In interactive sessions a progress bar
+#'   (through 'progressr', also across 'future' workers; 'cli' draws it
+#'   when installed), elsewhere one message per axis. Default: on in
+#'   interactive sessions unless `options(allanvar.progress = FALSE)`. With
+#'   `progress = FALSE` the steps are still signalled to 'progressr', so
+#'   `progressr::with_progress(analyze_imu(...))` shows them.
 #' @param read_args A list of arguments for [read_imu()] when `x` holds
 #'   file paths.
 #' @param refine_args A list of further arguments for [avrefine()] (for
@@ -128,9 +132,27 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   # (when no seed existed yet): the caller's RNG state is restored.
   restore <- save_rng()
   on.exit(restore(), add = TRUE)
-  results <- future.apply::future_lapply(jobs, analyze_channel, opts = opts,
-                                         future.seed = TRUE,
-                                         future.scheduling = Inf)
+  # Progress goes through progressr: each finished axis signals one step,
+  # from whichever future worker ran it. Interactive sessions with
+  # `progress = TRUE` get a bar (cli when installed); elsewhere
+  # `progress = TRUE` writes one message per axis (for logs), and the
+  # signals reach only a handler the caller set up (progressr::handlers(),
+  # with_progress()), so that the default stays silent.
+  bar <- isTRUE(progress) && interactive()
+  if (bar) opts$progress <- FALSE
+  run <- function() {
+    p <- progressr::progressor(steps = n_jobs)
+    future.apply::future_lapply(jobs, function(job, opts) {
+      res <- analyze_channel(job, opts)
+      p(job$label)
+      res
+    }, opts = opts, future.seed = TRUE, future.scheduling = Inf)
+  }
+  results <- if (bar) {
+    progressr::with_progress(run(), handlers = progress_handlers())
+  } else {
+    run()
+  }
 
   out <- lapply(seq_along(records), function(i) {
     r <- records[[i]]
@@ -166,6 +188,15 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   names(out) <- vapply(out, function(a) a$name, "")
   class(out) <- "imu_analysis_list"
   out
+}
+
+# The user's progressr handlers when set, else cli's bar when installed,
+# else a text bar.
+progress_handlers <- function() {
+  h <- getOption("progressr.handlers")
+  if (length(h)) return(h)
+  if (requireNamespace("cli", quietly = TRUE)) progressr::handler_cli()
+  else progressr::handler_txtprogressbar()
 }
 
 # The work for one axis; runs on a future worker, so it only uses its

@@ -89,7 +89,14 @@ plot_sensor <- function(x, s, units, ...) {
         graphics::lines(rng_x, r$adev * (rng_x / r$tau)^r$slope * k,
                         col = cols[i], lty = 3)
       }
-      graphics::points(r$tau, r$adev * k, pch = pch_of[[r$term]], bg = cols[i],
+      # a flat reading taken from the data's minimum is marked on the data
+      # (the reading's tau is the fitted model's flattest point)
+      tau_mark <- r$tau
+      if (r$slope == 0 && identical(r$source, "slope")) {
+        near <- which.min(abs(log(cv$adev) - log(r$adev)))
+        if (length(near)) tau_mark <- cv$tau[near]
+      }
+      graphics::points(tau_mark, r$adev * k, pch = pch_of[[r$term]], bg = cols[i],
                        cex = 1.4)
     }
   }

@@ -114,11 +114,6 @@ reading_row <- function(e, lay, coef, se, curve, ok, rel, tau_min, sensor) {
     source <- "bound"
   }
   tau_read <- if (is.finite(spec$tau)) spec$tau else tau_min
-  if (source == "slope" && identical(spec$anchor, "min")) {
-    # read at the data's minimum: the marker goes where the value was read
-    ta <- curve$tau[rel]
-    tau_read <- ta[which.min(curve$adev[rel])]
-  }
   data.frame(term = sym, value = value, unit = si_unit(sensor, spec$unit),
              tau = tau_read, method = method, source = source,
              is_bound = source == "bound",

@@ -132,3 +132,14 @@ test_that("a dead (constant) axis is reported and the others analysed", {
   expect_equal(y$gyroscope_noise_density, mean(ds[[n_col]][c(1, 3)]),
                tolerance = 1e-6)
 })
+
+test_that("each analysed axis signals one progressr step, silently by default", {
+  r <- two_records()[[1]]
+  steps <- character()
+  withCallingHandlers(
+    expect_silent(suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))),
+    progression = function(p) {
+      if (identical(p$type, "update")) steps <<- c(steps, p$message)
+    })
+  expect_identical(steps, c("[1/2] rec1: gyro_x", "[2/2] rec1: accel_x"))
+})
