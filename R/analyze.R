@@ -48,7 +48,8 @@
 #'   when installed), elsewhere one message per axis. Default: on in
 #'   interactive sessions unless `options(allanvar.progress = FALSE)`. With
 #'   `progress = FALSE` the steps are still signalled to 'progressr', so
-#'   `progressr::with_progress(analyze_imu(...))` shows them.
+#'   `progressr::with_progress(analyze_imu(...))` shows them (outside
+#'   interactive sessions when `options(progressr.enable = TRUE)`).
 #' @param read_args A list of arguments for [read_imu()] when `x` holds
 #'   file paths.
 #' @param refine_args A list of further arguments for [avrefine()] (for

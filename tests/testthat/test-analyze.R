@@ -136,6 +136,9 @@ test_that("a dead (constant) axis is reported and the others analysed", {
 test_that("each analysed axis signals one progressr step, silently by default", {
   r <- two_records()[[1]]
   steps <- character()
+  # progressr signals outside interactive sessions only when enabled
+  old <- options(progressr.enable = TRUE)
+  on.exit(options(old))
   withCallingHandlers(
     expect_silent(suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))),
     progression = function(p) {
