@@ -52,7 +52,7 @@ plotav <- function(avdf) {
 plotav_columns <- function(avdf) {
   if (!is.data.frame(avdf) && !is.list(avdf)) {
     abort("`avdf` must be the data frame returned by avar(), avarn() or ",
-          "avari(), not ", describe_type(avdf), ".")
+          "avari(), not ", describe_type(avdf), ".", class = "argument")
   }
   limits <- NULL
   if (all(c("tau", "avar", "upper", "adev") %in% names(avdf))) {
@@ -64,23 +64,24 @@ plotav_columns <- function(avdf) {
   missing_cols <- setdiff(c("time", "av", "error"), names(avdf))
   if (length(missing_cols)) {
     abort("`avdf` must have columns `time`, `av` and `error`; it lacks ",
-          paste0("`", missing_cols, "`", collapse = ", "), ".")
+          paste0("`", missing_cols, "`", collapse = ", "), ".", class = "argument")
   }
   cols <- list(time = avdf$time, av = avdf$av, error = avdf$error)
   for (nm in names(cols)) {
     x <- cols[[nm]]
     if (!is.numeric(x) || is.factor(x)) {
-      abort("`avdf$", nm, "` must be numeric, not ", describe_type(x), ".")
+      abort("`avdf$", nm, "` must be numeric, not ", describe_type(x), ".", class = "argument")
     }
   }
   lens <- lengths(cols)
   if (lens[[1L]] < 1L || any(lens != lens[[1L]])) {
-    abort("`avdf` must have at least one row and columns of equal length.")
+    abort("`avdf` must have at least one row and columns of equal length.",
+          class = "argument")
   }
   ok <- is.finite(cols$time) & cols$time > 0 & is.finite(cols$av) & cols$av > 0
   if (!any(ok)) {
     abort("`avdf` has no row with positive, finite `time` and `av` to plot ",
-          "on log axes.")
+          "on log axes.", class = "argument")
   }
   out <- lapply(cols, `[`, ok)
   adev <- sqrt(out$av)

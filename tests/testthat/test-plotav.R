@@ -61,3 +61,10 @@ test_that("plotav() draws allan() results and bars that reach below zero", {
                  min(sqrt(big$av[1:2]) * (1 - big$error[1:2])), tolerance = 0.1)
   })
 })
+
+test_that("plotav() errors are classed", {
+  expect_error(plotav(1:3), class = "allanvar_error_argument")
+  expect_error(plotav(data.frame(time = 1, av = 1)), class = "allanvar_error_argument")
+  expect_error(plotav(data.frame(time = 1, av = 0, error = 1)),
+               class = "allanvar_error_argument")
+})
