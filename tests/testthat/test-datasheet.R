@@ -154,3 +154,27 @@ test_that("the same recording as CSV, ROS1 bag, ROS2 db3 and MCAP gives identica
     expect_identical(sheets[[k]]$accel, sheets$csv$accel, label = k)
   }
 })
+
+test_that("write_datasheet() quotes names copied from the user and writes whole files", {
+  set.seed(41)
+  m <- cbind(gyro_x = rnorm(4000) * 1e-3)
+  nm <- "rec, \"quoted\"\nnext line"
+  a <- suppressWarnings(analyze_imu(imu_record(m, freq = 100, units = "rad/s",
+                                               name = nm),
+                                    refine = FALSE, progress = FALSE))
+  d <- tempfile("ds")
+  dir.create(d)
+  on.exit(unlink(d, recursive = TRUE))
+  f <- file.path(d, "datasheet.csv")
+  for (fmt in c("long", "wide")) {
+    write_datasheet(a, f, format = fmt)
+    back <- utils::read.csv(f, stringsAsFactors = FALSE)
+    expect_identical(unique(back$record), nm)
+    expect_identical(list.files(d, all.files = TRUE, no.. = TRUE), "datasheet.csv")
+  }
+  expect_equal(back[["N..rad.s.sqrt.Hz.."]], datasheet(a)$gyro[["N [rad/s/sqrt(Hz)]"]],
+               tolerance = 1e-12)
+  expect_error(write_datasheet(a, d), class = "allanvar_error_output_path")
+  expect_error(write_datasheet(a, file.path(d, "no", "x.csv")),
+               class = "allanvar_error_output_path")
+})
