@@ -17,7 +17,8 @@
 #' advises inflating the values for real use; `inflate` multiplies all four
 #' (default 1, stated in the file).
 #'
-#' @param x An `imu_analysis` ([analyze_imu()]), or a named list or vector
+#' @param x An `imu_analysis` ([analyze_imu()]), an [avfit()] of a curve of
+#'   known unit and rate, or a named list or vector
 #'   with `gyroscope_noise_density`, `gyroscope_random_walk`,
 #'   `accelerometer_noise_density`, `accelerometer_random_walk` (SI) and
 #'   `update_rate` (Hz).
@@ -45,6 +46,14 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
           ".", class = "argument")
   }
   file <- check_output_path(file)
+  if (inherits(x, "avfit")) {
+    # a fit of a curve alone, read as one axis (in SI when its unit is known)
+    x <- fit_analysis(x)
+    if (is.null(x$freq) || all(is.na(x$channels[[1L]]$sensor))) {
+      abort("`x`: an avfit needs its sampling rate (`freq`) and the unit of ",
+            "its curve to be written as a Kalibr imu.yaml.", class = "argument")
+    }
+  }
   keys <- c("accelerometer_noise_density", "accelerometer_random_walk",
             "gyroscope_noise_density", "gyroscope_random_walk")
   notes <- stats::setNames(rep("", 4L), keys)

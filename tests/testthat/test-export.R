@@ -236,3 +236,19 @@ test_that("a gyro-only record writes a valid imu.yaml holding only the gyro", {
   # N of the worst axis: sigma / sqrt(freq) = 2e-3 / 10
   expect_equal(y$gyroscope_noise_density, 2e-4, tolerance = 0.1)
 })
+
+test_that("write_kalibr_yaml() writes a fit of another tool's curve", {
+  tau <- 10^seq(-1, 2, 0.1)
+  cv <- data.frame(tau = tau, avar = 1e-8 / tau + 1e-12 * tau / 3, unit = "rad/s")
+  fit <- avfit(cv, c("N", "K"), n = 1e6, freq = 200)
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  write_kalibr_yaml(fit, f)
+  y <- yaml::read_yaml(f)
+  expect_equal(y$gyroscope_noise_density, 1e-4, tolerance = 1e-3)
+  expect_equal(y$gyroscope_random_walk, 1e-6, tolerance = 1e-2)
+  expect_null(y$accelerometer_noise_density)
+  expect_equal(y$update_rate, 200)
+  un <- avfit(cv[c("tau", "avar")], "N", n = 1e6, freq = 200)
+  expect_error(write_kalibr_yaml(un, f), "unit", class = "allanvar_error_argument")
+})
