@@ -241,6 +241,11 @@ filter_params <- function(x, dt = NULL, bias_instability = "gm",
       abort("`x` must be an imu_analysis, an avfit or a named numeric vector ",
             "of coefficients, not ", describe_type(x), ".", class = "argument")
     }
+    if (anyDuplicated(names(x))) {
+      abort("`x` names a coefficient twice (",
+            names(x)[anyDuplicated(names(x))], "); give each once.",
+            class = "argument")
+    }
     bad <- which(!is.finite(x) | x < 0)
     if (length(bad)) {
       abort("`x` must hold finite, non-negative coefficients; ",

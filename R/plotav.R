@@ -34,8 +34,12 @@ plotav <- function(avdf) {
                    gap = 0, lty = 1, xaxt = "n", yaxt = "n", col = "blue",
                    log = "xy", lwd = 1, xlab = "", ylab = ""),
     warning = function(w) {
+      # (a row without an interval has a bar of zero length: nothing to draw)
       if (grepl("\"log\" is not a graphical parameter", conditionMessage(w),
-                fixed = TRUE)) invokeRestart("muffleWarning")
+                fixed = TRUE) ||
+          grepl("zero-length arrow", conditionMessage(w), fixed = TRUE)) {
+        invokeRestart("muffleWarning")
+      }
     })
   graphics::lines(curve$time, adev, col = "blue")
   graphics::axis(1, c(0.001, 0.01, 0.1, 0, 1, 10, 100, 1000, 10000))

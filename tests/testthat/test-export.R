@@ -202,6 +202,7 @@ test_that("filter_params() refuses garbage instead of returning it", {
                  "`tau_B`", class = "allanvar_error_argument")
   }
   for (x in list(c(N = -1e-3), c(N = NaN), c(N = Inf), c(N = 1e-3, K = -1),
+                 c(N = 1e-3, N = 2e-3),
                  stats::setNames(1e-3, ""), c(1e-3))) {
     expect_error(filter_params(x, dt = 0.01), class = "allanvar_error_argument")
   }

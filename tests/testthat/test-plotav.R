@@ -68,3 +68,10 @@ test_that("plotav() errors are classed", {
   expect_error(plotav(data.frame(time = 1, av = 0, error = 1)),
                class = "allanvar_error_argument")
 })
+
+test_that("plotav() draws rows without an interval without warnings", {
+  plot_to_file({
+    expect_no_warning(plotav(data.frame(time = 1:3, av = c(1, 0.5, 0.3),
+                                        error = c(0.1, NA, 0))))
+  })
+})
