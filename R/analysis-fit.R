@@ -52,7 +52,7 @@ fit_analysis <- function(fit, unit = NULL, name = NULL) {
   curve <- data.frame(tau = d$tau, m = d$m, avar = adev^2, adev = adev,
                       lower = lo, upper = hi, edf = edf)
   fitted <- data.frame(tau = fit$data$tau, fitted = fit$data$fitted * k^2)
-  label <- name %||% (fit$channel %||% "fit")
+  label <- name %||% (fit$channel %||% (fit$input$channel %||% "fit"))
   readings <- channel_readings(curve, coef, sensor, se = se, fitted = fitted)
   ch <- list(channel = label, sensor = sensor, unit = unit %||% "u",
              freq = fit$freq, n = fit$n, curve = curve, fit = fit,

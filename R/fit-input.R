@@ -168,6 +168,8 @@ as_av_curve <- function(av, n = NULL, freq = NULL, type = NULL, channel = NULL) 
   # datasheet of a curve-only fit (R/analysis-fit.R).
   u <- if (is.data.frame(av) && is.character(av$unit)) unique(av$unit) else NULL
   if (length(u) == 1L && !is.na(u)) out$unit <- u
+  ch <- if (is.data.frame(av) && !is.null(av$channel)) unique(as.character(av$channel))
+  if (length(ch) == 1L && !is.na(ch)) out$channel <- ch
   out
 }
 

@@ -96,6 +96,7 @@ test_that("a fit of a curve alone gets a datasheet, guidance and filter paramete
   expect_s3_class(ds, "imu_datasheet")
   g <- ds$gyro
   expect_identical(nrow(g), 1L)
+  expect_identical(g$axis, "gyro_x")
   # deg/sqrt(s) * 60 = deg/sqrt(h); deg/s * 3600 = deg/h;
   # deg/s/sqrt(s) * 3600 * 60 = deg/h/sqrt(h)
   expect_equal(g[["N [deg/sqrt(h)]"]], N * 60, tolerance = 1e-3)
