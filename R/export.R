@@ -85,7 +85,9 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
       rows <- rows[is.finite(rows$value), , drop = FALSE]
       if (!nrow(rows)) {
         vals[k] <- NA_real_
-        notes[k] <- "every axis dead"
+        dead <- vapply(Filter(function(cc) identical(cc$sensor, sensor), x$channels),
+                       function(cc) !is.null(cc$dead), FALSE)
+        notes[k] <- if (all(dead)) "every axis dead" else "not read on any axis"
         next
       }
       if (axis == "max") {
@@ -99,6 +101,19 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
         bound <- any(rows$is_bound)
       }
       if (bound) notes[k] <- paste0(notes[k], "; UPPER BOUND, +1/2 region not reached")
+    }
+    # A measured sensor needs both of its values: a yaml with one of them
+    # missing (a record too short for any reading) is refused, not written.
+    for (ks in list(keys[1:2], keys[3:4])) {
+      v <- vals[ks]
+      if (anyNA(v) && !all(is.na(v))) {
+        miss <- ks[is.na(v)]
+        abort(paste(miss, collapse = ", "), " could not be read from ",
+              "the analysis (", paste(notes[miss][nzchar(notes[miss])], collapse = "; "),
+              if (any(nzchar(notes[miss]))) "; ",
+              "see imu_guidance(): the record may be too short); nothing written.",
+              class = "argument")
+      }
     }
     rate <- x$freq
     src <- sprintf("# Source: %s, %d samples at %.6g Hz (%.3g h), Allan deviation per axis.",

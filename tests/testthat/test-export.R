@@ -253,3 +253,14 @@ test_that("write_kalibr_yaml() writes a fit of another tool's curve", {
   un <- avfit(cv[c("tau", "avar")], "N", n = 1e6, freq = 200)
   expect_error(write_kalibr_yaml(un, f), "unit", class = "allanvar_error_argument")
 })
+
+test_that("write_kalibr_yaml() refuses a sensor with a value it could not read", {
+  # 3 samples: no -1/2 region, so N is not read; K would be a bound
+  r <- imu_record(cbind(gyro_x = c(0.001, 0.002, 0.0015)), freq = 100,
+                  units = "rad/s")
+  a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+  f <- tempfile(fileext = ".yaml")
+  expect_error(write_kalibr_yaml(a, f), "gyroscope_noise_density could not be read",
+               class = "allanvar_error_argument")
+  expect_false(file.exists(f))
+})
