@@ -43,8 +43,13 @@
 #' @param segment Which gap-free segment to use: `"longest"` (default),
 #'   `"each"` (every segment analysed as its own record) or a number.
 #' @param channels Optional channel names to analyse (default: all).
-#' @param progress Report progress, one message per axis. Default: on in
-#'   interactive sessions unless `options(allanvar.progress = FALSE)`.
+#' @param progress Report progress. In interactive sessions a progress bar
+#'   (through 'progressr', also across 'future' workers; 'cli' draws it
+#'   when installed), elsewhere one message per axis. Default: on in
+#'   interactive sessions unless `options(allanvar.progress = FALSE)`. With
+#'   `progress = FALSE` the steps are still signalled to 'progressr', so
+#'   `progressr::with_progress(analyze_imu(...))` shows them (outside
+#'   interactive sessions when `options(progressr.enable = TRUE)`).
 #' @param read_args A list of arguments for [read_imu()] when `x` holds
 #'   file paths.
 #' @param refine_args A list of further arguments for [avrefine()] (for
@@ -122,16 +127,12 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
       }
       ch <- channels
     }
-    # A dead (constant) axis has no noise to analyse: reported, others go on.
+    # Every axis dead: nothing to analyse. One dead axis among live ones is
+    # reported by analyze_channel() and the others are analysed.
     dead <- ch[vapply(ch, function(c) isTRUE(all(r$data[, c] == r$data[1L, c])), NA)]
-    if (length(dead)) {
-      if (length(dead) == length(ch)) {
-        abort("`x`: every channel of ", r$name, " is constant (dead or ",
-              "saturated axes); there is no noise to analyse.", class = "argument")
-      }
-      warn(r$name, ": ", paste(dead, collapse = ", "), " constant (a dead or ",
-           "saturated axis): not analysed.", class = "dead_channel")
-      ch <- setdiff(ch, dead)
+    if (length(dead) && length(dead) == length(ch)) {
+      abort("`x`: every channel of ", r$name, " is constant (dead or ",
+            "saturated axes); there is no noise to analyse.", class = "argument")
     }
     for (chn in ch) {
       jobs[[length(jobs) + 1L]] <- list(
@@ -152,12 +153,27 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   # (when no seed existed yet): the caller's RNG state is restored.
   restore <- save_rng()
   on.exit(restore(), add = TRUE)
-  # progressr: one step per axis, relayed from future workers; silent unless
-  # the user set handlers (progressr::handlers(), with_progress()).
-  opts$tick <- progressr::progressor(steps = n_jobs)
-  results <- future.apply::future_lapply(jobs, analyze_channel, opts = opts,
-                                         future.seed = TRUE,
-                                         future.scheduling = Inf)
+  # Progress goes through progressr: each finished axis signals one step,
+  # from whichever future worker ran it. Interactive sessions with
+  # `progress = TRUE` get a bar (cli when installed); elsewhere
+  # `progress = TRUE` writes one message per axis (for logs), and the
+  # signals reach only a handler the caller set up (progressr::handlers(),
+  # with_progress()), so that the default stays silent.
+  bar <- isTRUE(progress) && interactive()
+  if (bar) opts$progress <- FALSE
+  run <- function() {
+    p <- progressr::progressor(steps = n_jobs)
+    future.apply::future_lapply(jobs, function(job, opts) {
+      res <- analyze_channel(job, opts)
+      p(job$label)
+      res
+    }, opts = opts, future.seed = TRUE, future.scheduling = Inf)
+  }
+  results <- if (bar) {
+    progressr::with_progress(run(), handlers = progress_handlers())
+  } else {
+    run()
+  }
 
   out <- lapply(seq_along(records), function(i) {
     r <- records[[i]]
@@ -171,7 +187,15 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
               channels = res, call = match.call())
     class(a) <- "imu_analysis"
     a$datasheet <- datasheet(a)
+    dead <- Filter(function(ch) !is.null(ch$dead), res)
+    if (length(dead)) {
+      warn(r$name, ": ", paste(names(dead), collapse = ", "),
+           if (length(dead) == 1L) " is a dead axis" else " are dead axes",
+           " (constant signal): reported, not analysed; the other axes are.",
+           class = "dead_axis")
+    }
     g <- imu_guidance(a)
+    g <- g[!g$channel %in% names(dead), , drop = FALSE]
     if (nrow(g)) {
       msg <- paste0(r$name, ": the record is short for some readings:\n",
                     paste0("  - ", g$channel, ": ", g$message, collapse = "\n"))
@@ -187,12 +211,30 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   out
 }
 
+# The user's progressr handlers when set, else cli's bar when installed,
+# else a text bar.
+progress_handlers <- function() {
+  h <- getOption("progressr.handlers")
+  if (length(h)) return(h)
+  if (requireNamespace("cli", quietly = TRUE)) progressr::handler_cli()
+  else progressr::handler_txtprogressbar()
+}
+
 # The work for one axis; runs on a future worker, so it only uses its
 # arguments and the package's namespace.
 analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
-  if (is.function(opts$tick)) on.exit(opts$tick(job$label), add = TRUE)
   curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
+  if (!any(is.finite(curve$adev) & curve$adev > 0)) {
+    # A dead (constant) axis has nothing to fit or read: it is reported,
+    # and the other axes are analysed.
+    reason <- "dead axis: constant signal (Allan variance 0 at every tau), not analysed"
+    return(list(channel = job$channel, sensor = job$sensor, unit = job$unit,
+                freq = job$freq, n = length(job$x), curve = curve, fit = NULL,
+                fit_error = reason, fit_condition = NULL, coef = numeric(),
+                readings = dead_readings(job$sensor, reason), dead = reason,
+                guidance = paste0(reason, ": check the sensor and the column.")))
+  }
   fit <- NULL
   failure <- NULL
   # A fit or refinement that fails is kept in the result (fit_error,

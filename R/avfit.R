@@ -336,6 +336,8 @@ check_dots_empty <- function(...) {
 #' @param by_term For `predict()`: return each term's contribution.
 #' @param terms For `plot()`: draw each term's curve.
 #' @param residuals For `plot()`: add the residual panel.
+#' @param unit For `plot()`: the rate unit of the curve, for the y axis;
+#'   `NULL` for the unit the curve carried, else "u".
 #' @param ... Further arguments (for `plot()`, passed to the main
 #'   `plot.default()` call).
 #' @return `coef()` a named vector; `vcov()` a matrix; `confint()` a matrix
@@ -452,7 +454,7 @@ print.avfit <- function(x, ...) {
               switch(x$edf_source, input = "the input", model = "the model",
                      previous = "the previous fit's model")))
   tab <- data.frame(estimate = signif(x$coefficients, 4),
-                    se = signif(x$se, 3), unit = x$layout$unit)
+                    se = signif(x$se, 3), unit = unit_label(x$layout$unit, x))
   print(tab)
   cat(sprintf("chi2/dof = %.3g (dof %d), RMS ADEV error = %.3g %%\n",
               x$chi2, x$df.residual, x$rms))
@@ -480,7 +482,8 @@ summary.avfit <- function(object, level = 0.95, ...) {
     p$meaning[p$name == lay$param[i]]
   }, "")
   tab <- data.frame(estimate = object$coefficients, se = object$se,
-                    lower = ci[, 1], upper = ci[, 2], unit = lay$unit,
+                    lower = ci[, 1], upper = ci[, 2],
+                    unit = unit_label(lay$unit, object),
                     meaning = words, fixed = lay$fixed,
                     stringsAsFactors = FALSE)
   rownames(tab) <- lay$name
@@ -489,7 +492,8 @@ summary.avfit <- function(object, level = 0.95, ...) {
                  logLik = logLik(object), AIC = stats::AIC(object),
                  BIC = stats::BIC(object), level = level, steps = object$steps,
                  terms = object$terms, type = object$type,
-                 convergence = object$convergence),
+                 convergence = object$convergence,
+                 rate_unit = fit_unit(object)),
             class = "summary.avfit")
 }
 
@@ -506,7 +510,9 @@ print.summary.avfit <- function(x, ...) {
   rownames(out) <- rownames(tab)
   names(out)[3:4] <- paste0(c("lower ", "upper "), format(100 * x$level), "%")
   print(out, right = FALSE)
-  cat("\n\"u\" is the input's rate unit (e.g. deg/s or m/s^2).\n")
+  if (is.null(x$rate_unit)) {
+    cat("\n\"u\" is the input's rate unit (e.g. deg/s or m/s^2).\n")
+  }
   cat(sprintf("chi2/dof = %.4g on %d dof; RMS relative ADEV error = %.3g %%\n",
               x$chi2, x$df.residual, x$rms))
   cat(sprintf("logLik = %.4g, AIC = %.4g, BIC = %.4g (%d points)\n",
@@ -521,8 +527,9 @@ print.summary.avfit <- function(x, ...) {
 
 #' @rdname avfit-methods
 #' @export
-plot.avfit <- function(x, terms = TRUE, residuals = TRUE, ...) {
+plot.avfit <- function(x, terms = TRUE, residuals = TRUE, unit = NULL, ...) {
   d <- x$data
+  unit <- fit_unit(x, unit)
   op <- graphics::par(no.readonly = TRUE)
   on.exit(graphics::par(op))
   if (residuals) {
@@ -541,26 +548,39 @@ plot.avfit <- function(x, terms = TRUE, residuals = TRUE, ...) {
   yl[1] <- max(min(yl[1], 0.5 * apply(sqrt(comp), 2, max)), yl[2] * 1e-4)
   graphics::plot(d$tau, sqrt(d$avar), log = "xy", ylim = yl, pch = 19,
                  cex = 0.7, xlab = if (residuals) "" else "tau [s]",
-                 ylab = "Allan deviation", xaxt = if (residuals) "n" else "s",
+                 ylab = if (is.null(unit)) "Allan deviation [u]" else
+                   sprintf("Allan deviation [%s]", unit),
+                 xaxt = if (residuals) "n" else "s",
                  main = paste("avfit:", paste(x$terms, collapse = " + ")), ...)
   if (residuals) graphics::axis(1, labels = FALSE)
-  graphics::arrows(d$tau, lo, d$tau, hi, angle = 90, code = 3,
-                   length = 0.02, col = "grey40")
+  # error bars only where they have a length (arrows() warns otherwise)
+  bar <- is.finite(lo) & is.finite(hi) & hi > lo * (1 + 1e-3)
+  if (any(bar)) {
+    graphics::arrows(d$tau[bar], lo[bar], d$tau[bar], hi[bar], angle = 90,
+                     code = 3, length = 0.02, col = "grey40")
+  }
   cols <- grDevices::hcl.colors(max(ncol(comp), 2), "Dark 3")
+  labs <- colnames(comp)
   if (terms) {
     for (k in seq_len(ncol(comp))) {
       v <- sqrt(comp[, k])
+      # an oscillating term (a sinusoid's lobes) is drawn as its upper
+      # envelope: dashes along every lobe would hide the model
+      if (n_peaks(v) > 2L) {
+        v <- rev(cummax(rev(v)))
+        labs[k] <- paste(labs[k], "(envelope)")
+      }
       v[v < yl[1] / 10] <- NA
-      graphics::lines(tt, v, lty = 2, col = cols[k])
+      graphics::lines(tt, v, lty = 2, col = grDevices::adjustcolor(cols[k], 0.8))
     }
   }
   graphics::lines(tt, sqrt(tot), lwd = 2)
-  graphics::legend("topright", bty = "n", cex = 0.8,
-                   legend = c("data", "model", if (terms) colnames(comp)),
-                   lty = c(NA, 1, if (terms) rep(2, ncol(comp))),
-                   pch = c(19, NA, if (terms) rep(NA, ncol(comp))),
-                   lwd = c(NA, 2, if (terms) rep(1, ncol(comp))),
-                   col = c("black", "black", if (terms) cols[seq_len(ncol(comp))]))
+  leg <- list(legend = c("data", "model", if (terms) labs),
+              lty = c(NA, 1, if (terms) rep(2, ncol(comp))),
+              pch = c(19, NA, if (terms) rep(NA, ncol(comp))),
+              lwd = c(NA, 2, if (terms) rep(1, ncol(comp))),
+              col = c("black", "black", if (terms) cols[seq_len(ncol(comp))]))
+  draw_legend(leg, d$tau, sqrt(d$avar), cex = 0.8)
   if (residuals) {
     graphics::par(mar = c(0.5, 4.5, 0.5, 1))
     zr <- max(3, abs(d$z), na.rm = TRUE)

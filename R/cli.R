@@ -173,7 +173,9 @@ cli_speak <- function(expr) {
 cli_terms <- function(v) {
   known <- unique(av_terms()$term)
   terms <- trimws(strsplit(v, ",", fixed = TRUE)[[1L]])
-  up <- ifelse(toupper(terms) %in% c("Q", "N", "B", "K", "R"), toupper(terms), terms)
+  # matched case-insensitively against the catalogue's terms
+  hit <- match(tolower(terms), tolower(known))
+  up <- ifelse(is.na(hit), terms, known[hit])
   bad <- setdiff(up, known)
   if (!length(terms) || length(bad)) {
     abort("--terms: ", if (length(bad)) paste0("unknown term(s) ",
@@ -245,7 +247,8 @@ cli_run <- function(args) {
     }
   }
   units <- c(gyro = opt$`gyro-units`, accel = opt$`accel-units`)
-  terms <- if (is.null(opt$terms)) c("N", "B", "K") else cli_terms(opt$terms)
+  # NULL: avfit()'s default, the catalogue's datasheet model
+  terms <- if (is.null(opt$terms)) NULL else cli_terms(opt$terms)
   axis <- choice(if (is.null(opt$axis)) "max" else opt$axis, c("max", "mean"), "--axis")
   read_args <- list(
     time = if (isTRUE(opt$`no-time`)) FALSE else opt$`time-col`,

@@ -13,8 +13,20 @@
 #' accelerometer N in m/s^2/sqrt(Hz), m/s/sqrt(h) and ug/sqrt(Hz), B in
 #' m/s^2, ug and mg, K in m/s^3/sqrt(Hz) and m/s/h^(3/2).
 #'
-#' @param x An `imu_analysis` or `imu_analysis_list` ([analyze_imu()]).
+#' A fit of a curve alone ([avfit()] of another tool's curve, of an
+#' [allan()] result or of a table) gets the same table, as one axis: its
+#' readings in SI when the unit of the curve is known (`unit`, or the unit a
+#' curve read by [read_avr_curve()] or [read_imu_utils_curve()] carries),
+#' else in the input's unit u (`u*sqrt(s)` for N, ...).
+#'
+#' An axis whose analysis failed (a dead, constant channel) is listed with
+#' `NA` values and the reason in `method`.
+#'
+#' @param x An `imu_analysis` or `imu_analysis_list` ([analyze_imu()]), or
+#'   an `avfit`.
 #' @param average Append the mean of the axes per sensor (logical).
+#' @param unit For an `avfit`: the rate unit of the fitted curve (see
+#'   [av_units()]); `NULL` for the unit the curve carried, if any.
 #' @param ... Unused.
 #' @return An object of class `"imu_datasheet"`: a list with one wide data
 #'   frame per sensor (`gyro`, `accel`; columns named with their units) and
@@ -30,19 +42,27 @@
 #' datasheet(a)
 #' datasheet(a, average = TRUE)$gyro
 #' }
-datasheet <- function(x, average = FALSE, ...) {
-  if (!inherits(x, c("imu_analysis", "imu_analysis_list"))) {
-    abort("`x` must be an imu_analysis or imu_analysis_list (from ",
-          "analyze_imu()), not ", describe_type(x), ".", class = "argument")
-  }
-  UseMethod("datasheet")
+datasheet <- function(x, average = FALSE, ...) UseMethod("datasheet")
+
+#' @export
+datasheet.default <- function(x, average = FALSE, ...) {
+  abort("`x` must be an imu_analysis (analyze_imu()), an imu_analysis_list ",
+        "or an avfit, not ", describe_type(x), ".", class = "argument")
+}
+
+#' @rdname datasheet
+#' @export
+datasheet.avfit <- function(x, average = FALSE, unit = NULL, ...) {
+  check_average(average)
+  datasheet(fit_analysis(x, unit = unit), average = average)
 }
 
 #' @export
 datasheet.imu_analysis_list <- function(x, average = FALSE, ...) {
+  check_average(average)
   parts <- lapply(x, datasheet, average = average)
   out <- list(long = do.call(rbind, lapply(parts, function(p) p$long)))
-  for (s in c("gyro", "accel")) {
+  for (s in datasheet_sensors) {
     tabs <- lapply(parts, function(p) p[[s]])
     tabs <- tabs[!vapply(tabs, is.null, logical(1))]
     if (length(tabs)) out[[s]] <- do.call(rbind, tabs)
@@ -54,21 +74,20 @@ datasheet.imu_analysis_list <- function(x, average = FALSE, ...) {
 
 #' @export
 datasheet.imu_analysis <- function(x, average = FALSE, ...) {
-  if (!is.logical(average) || length(average) != 1L || is.na(average)) {
-    abort("`average` must be TRUE or FALSE, not ", format_value(average), ".",
-          class = "argument")
-  }
+  check_average(average)
   long <- list()
   for (ch in x$channels) {
     rd <- ch$readings
-    eff <- added_effects(ch$fit)
+    eff <- if (is.null(ch$dead)) added_effects(ch$fit) else "none"
     for (j in seq_len(nrow(rd))) {
       r <- rd[j, ]
       si <- r$unit
-      us <- c(si, datasheet_units(ch$sensor)[[r$term]])
+      us <- c(si, datasheet_units(ch$sensor)[[unit_dim(ch$sensor, si)]])
       long[[length(long) + 1L]] <- data.frame(
-        record = x$name, sensor = ch$sensor, axis = ch$channel, term = r$term,
-        value = vapply(us, function(u) convert_units(r$value, si, u), 0),
+        record = x$name, sensor = sensor_label(ch$sensor), axis = ch$channel,
+        term = r$term,
+        value = vapply(us, function(u) if (u == si) r$value else
+          convert_units(r$value, si, u), 0),
         unit = us, tau = r$tau, method = r$method, effects = eff,
         stringsAsFactors = FALSE)
     }
@@ -87,12 +106,33 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
     long <- rbind(long, avg[names(long)])
   }
   out <- list(long = long)
-  for (s in c("gyro", "accel")) {
+  for (s in datasheet_sensors) {
     l <- long[long$sensor == s, ]
     if (nrow(l)) out[[s]] <- wide_table(l)
   }
   class(out) <- "imu_datasheet"
   out
+}
+
+check_average <- function(average) {
+  if (!is.logical(average) || length(average) != 1L || is.na(average)) {
+    abort("`average` must be TRUE or FALSE, not ", format_value(average), ".",
+          class = "argument")
+  }
+  average
+}
+
+# The tables of a datasheet: gyroscopes, accelerometers, and a fit whose
+# sensor is not known (values in the input's unit u).
+datasheet_sensors <- c("gyro", "accel", "unknown")
+sensor_label <- function(sensor) if (is.na(sensor)) "unknown" else sensor
+
+# The dimension ("u*sqrt(s)", ...) of a unit of `sensor`; for an unknown
+# sensor the unit is the dimension.
+unit_dim <- function(sensor, unit) {
+  if (is.na(sensor)) return(unit)
+  tab <- unit_table()
+  tab$dim[tab$sensor == sensor & tab$unit == unit][1L]
 }
 
 # One row per axis; one column per (term, unit), plus the tau of the reading
@@ -156,10 +196,12 @@ as.data.frame.imu_datasheet <- function(x, row.names = NULL, optional = FALSE, .
 
 #' @export
 print.imu_datasheet <- function(x, digits = 3, ...) {
-  for (s in c("gyro", "accel")) {
+  for (s in datasheet_sensors) {
     tab <- x[[s]]
     if (is.null(tab)) next
-    cat(if (s == "gyro") "Gyroscopes" else "Accelerometers", "\n", sep = "")
+    cat(switch(s, gyro = "Gyroscopes", accel = "Accelerometers",
+               "Sensor of unknown unit (u: the rate unit of the input)"),
+        "\n", sep = "")
     show <- tab
     num <- vapply(show, is.numeric, logical(1))
     show[num] <- lapply(show[num], function(v) formatC(v, digits = digits,
@@ -191,27 +233,32 @@ print.imu_datasheet <- function(x, digits = 3, ...) {
 #' read.csv(f)
 #' }
 write_datasheet <- function(x, file, format = "long") {
-  check_present(missing(file), "file", "the path of the CSV file to write")
-  file <- check_out_file(file)
+  check_present(missing(x), "x", "an imu_datasheet or imu_analysis")
+  check_present(missing(file), "file", "the path of the CSV file")
   format <- check_choice(format, c("long", "wide"), "format")
-  if (inherits(x, c("imu_analysis", "imu_analysis_list"))) x <- datasheet(x)
+  file <- check_output_path(file)
+  if (inherits(x, c("imu_analysis", "imu_analysis_list", "avfit"))) x <- datasheet(x)
   if (!inherits(x, "imu_datasheet")) {
     abort("`x` must be an imu_datasheet or imu_analysis, not ",
           describe_type(x), ".", class = "argument")
   }
-  if (format == "long") {
-    utils::write.csv(x$long, file, row.names = FALSE)
-  } else {
-    con <- file(file, "w")
-    on.exit(close(con))
-    first <- TRUE
-    for (s in c("gyro", "accel")) {
-      if (is.null(x[[s]])) next
-      if (!first) writeLines("", con)
-      first <- FALSE
-      tab <- cbind(sensor = s, x[[s]])
-      utils::write.csv(tab, con, row.names = FALSE)
+  # write.csv quotes every text field (record, axis, method names copied
+  # from the user) and doubles embedded quotes (RFC 4180).
+  write_atomic(file, function(path) {
+    if (format == "long") {
+      utils::write.csv(x$long, path, row.names = FALSE)
+    } else {
+      con <- file(path, "w")
+      on.exit(close(con))
+      first <- TRUE
+      for (s in datasheet_sensors) {
+        if (is.null(x[[s]])) next
+        if (!first) writeLines("", con)
+        first <- FALSE
+        tab <- cbind(sensor = s, x[[s]])
+        utils::write.csv(tab, con, row.names = FALSE)
+      }
     }
-  }
+  })
   invisible(file)
 }

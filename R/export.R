@@ -17,7 +17,8 @@
 #' advises inflating the values for real use; `inflate` multiplies all four
 #' (default 1, stated in the file).
 #'
-#' @param x An `imu_analysis` ([analyze_imu()]), or a named list or vector
+#' @param x An `imu_analysis` ([analyze_imu()]), an [avfit()] of a curve of
+#'   known unit and rate, or a named list or vector
 #'   with `gyroscope_noise_density`, `gyroscope_random_walk`,
 #'   `accelerometer_noise_density`, `accelerometer_random_walk` (SI) and
 #'   `update_rate` (Hz).
@@ -40,9 +41,18 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
   check_present(missing(x), "x", "an imu_analysis or the four noise values")
   axis <- check_choice(axis, c("max", "mean"), "axis")
   inflate <- check_number(inflate, "inflate", lo = 1)
-  file <- check_out_file(file)
-  if (!is.character(rostopic) || length(rostopic) != 1L) {
-    abort("`rostopic` must be a single string.", class = "argument")
+  if (!is.character(rostopic) || length(rostopic) != 1L || is.na(rostopic)) {
+    abort("`rostopic` must be a single string, not ", describe_type(rostopic),
+          ".", class = "argument")
+  }
+  file <- check_output_path(file)
+  if (inherits(x, "avfit")) {
+    # a fit of a curve alone, read as one axis (in SI when its unit is known)
+    x <- fit_analysis(x)
+    if (is.null(x$freq) || all(is.na(x$channels[[1L]]$sensor))) {
+      abort("`x`: an avfit needs its sampling rate (`freq`) and the unit of ",
+            "its curve to be written as a Kalibr imu.yaml.", class = "argument")
+    }
   }
   keys <- c("accelerometer_noise_density", "accelerometer_random_walk",
             "gyroscope_noise_density", "gyroscope_random_walk")
@@ -64,15 +74,21 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
                      })
       if (!length(rows)) {
         vals[k] <- NA_real_
-        notes[k] <- paste("no", sensor, "channel in the record")
         next
       }
       rows <- do.call(rbind, rows)
+      header <- c(header, sprintf("#   %-28s %s", k, comment_text(paste(sprintf(
+        "%s = %s", rows$axis, ifelse(is.na(rows$value), "NA (dead axis)",
+                                     sprintf("%.4e", rows$value))),
+        collapse = ", "))))
+      # dead axes carry no value and take no part in the max or the mean
       rows <- rows[is.finite(rows$value), , drop = FALSE]
       if (!nrow(rows)) {
-        abort("`x` has no ", sub("_", " ", role), " reading for any ", sensor,
-              " axis (the record is too short for one), so `", k,
-              "` cannot be written.", class = "argument")
+        vals[k] <- NA_real_
+        dead <- vapply(Filter(function(cc) identical(cc$sensor, sensor), x$channels),
+                       function(cc) !is.null(cc$dead), FALSE)
+        notes[k] <- if (all(dead)) "every axis dead" else "not read on any axis"
+        next
       }
       if (axis == "max") {
         i <- which.max(rows$value)
@@ -85,12 +101,23 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
         bound <- any(rows$is_bound)
       }
       if (bound) notes[k] <- paste0(notes[k], "; UPPER BOUND, +1/2 region not reached")
-      header <- c(header, sprintf("#   %-28s %s", k, paste(sprintf(
-        "%s = %.4e", rows$axis, rows$value), collapse = ", ")))
+    }
+    # A measured sensor needs both of its values: a yaml with one of them
+    # missing (a record too short for any reading) is refused, not written.
+    for (ks in list(keys[1:2], keys[3:4])) {
+      v <- vals[ks]
+      if (anyNA(v) && !all(is.na(v))) {
+        miss <- ks[is.na(v)]
+        abort(paste(miss, collapse = ", "), " could not be read from ",
+              "the analysis (", paste(notes[miss][nzchar(notes[miss])], collapse = "; "),
+              if (any(nzchar(notes[miss]))) "; ",
+              "see imu_guidance(): the record may be too short); nothing written.",
+              class = "argument")
+      }
     }
     rate <- x$freq
     src <- sprintf("# Source: %s, %d samples at %.6g Hz (%.3g h), Allan deviation per axis.",
-                   x$name, x$n, x$freq, x$duration / 3600)
+                   comment_text(x$name), x$n, x$freq, x$duration / 3600)
     header <- c(src, paste0("# Kalibr takes one value per sensor; written: ",
                             if (axis == "max") "the worst (largest) axis."
                             else "the mean of the axes.",
@@ -117,9 +144,21 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
             gyroscope_noise_density = "white noise N, continuous time",
             gyroscope_random_walk = "bias random walk K, continuous time")
   line <- function(k) {
-    v <- if (is.na(vals[[k]])) ".nan" else sprintf("%.6e", vals[[k]])
-    sprintf("%-28s %-14s # [%s] %s%s", paste0(k, ":"), v, units[[k]], what[[k]],
-            if (nzchar(notes[[k]])) paste0("; ", notes[[k]]) else "")
+    sprintf("%-28s %-14s # [%s] %s%s", paste0(k, ":"), sprintf("%.6e", vals[[k]]),
+            units[[k]], what[[k]],
+            if (nzchar(notes[[k]])) paste0("; ", comment_text(notes[[k]])) else "")
+  }
+  # A sensor the record does not hold is left out (with a comment), never
+  # written as .nan: Kalibr and OpenVINS would read that as a number.
+  block <- function(title, sensor, ks) {
+    if (all(is.na(vals[ks]))) {
+      return(c(paste0("#", title), sprintf(
+        "# (%s: %s not written)",
+        if (any(notes[ks] == "every axis dead")) paste("every", sensor, "axis is dead")
+        else paste("no", sensor, "channel in the record"),
+        paste(ks, collapse = ", "))))
+    }
+    c(paste0("#", title), vapply(ks, line, ""))
   }
   out <- c(
     sprintf("# Kalibr IMU noise model, written by allanvar %s on %s.",
@@ -129,19 +168,17 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
     if (inflate != 1) sprintf("# All four values multiplied by inflate = %g.", inflate),
     header,
     "",
-    "#Accelerometers",
-    line("accelerometer_noise_density"),
-    line("accelerometer_random_walk"),
+    block("Accelerometers", "accelerometer",
+          c("accelerometer_noise_density", "accelerometer_random_walk")),
     "",
-    "#Gyroscopes",
-    line("gyroscope_noise_density"),
-    line("gyroscope_random_walk"),
+    block("Gyroscopes", "gyroscope",
+          c("gyroscope_noise_density", "gyroscope_random_walk")),
     "",
-    sprintf("%-28s %-14s # the IMU ROS topic", "rostopic:", yaml_scalar(rostopic)),
+    sprintf("%-28s %-14s # the IMU ROS topic", "rostopic:", yaml_quote(rostopic)),
     sprintf("%-28s %-14s # [Hz] sampling rate, used by Kalibr to discretize",
             "update_rate:", format(rate, nsmall = 1))
   )
-  writeLines(out, file)
+  write_atomic(file, function(path) writeLines(out, path))
   invisible(structure(file, values = c(vals, update_rate = rate)))
 }
 
@@ -182,14 +219,23 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
 #' @examples
 #' filter_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
 filter_params <- function(x, dt = NULL, bias_instability = "gm",
-                          tau_B = NULL) {
+                          tau_B = NULL, unit = NULL) {
   check_present(missing(x), "x", "an imu_analysis, an avfit or coefficients")
   bias_instability <- check_choice(bias_instability, c("gm", "omit"),
                                    "bias_instability")
   if (!is.null(tau_B)) tau_B <- check_number(tau_B, "tau_B", lo = 0, open = TRUE)
+  if (!is.null(dt)) dt <- check_number(dt, "dt", lo = 0, open = TRUE)
+  if (inherits(x, "avfit")) {
+    # A fit (of a curve with or without raw data) is read like one axis of
+    # an analysis: the same readings, in the fit's unit when known.
+    x <- fit_analysis(x, unit = unit)
+    if (is.null(dt) && is.null(x$freq)) {
+      abort("`dt` is missing and the fit has no sampling rate; give the ",
+            "filter step in seconds.", class = "missing_argument")
+    }
+  }
   if (inherits(x, "imu_analysis")) {
     if (is.null(dt)) dt <- 1 / x$freq
-    dt <- check_number(dt, "dt", lo = 0, open = TRUE)
     rows <- lapply(x$channels, function(ch) {
       rd <- ch$readings
       # the readings replace the fitted values; terms folded into a reading
@@ -200,28 +246,34 @@ filter_params <- function(x, dt = NULL, bias_instability = "gm",
       cf <- c(stats::setNames(rd$value, rd$term), cf)
       flat <- reading_of(rd, "flicker")
       discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability,
-                    if (nrow(flat)) flat$tau else NA_real_,
+                    tau_B %||% if (nrow(flat)) flat$tau else NA_real_,
                     bounds = rd$term[rd$is_bound])
     })
     out <- do.call(rbind, rows)
   } else {
-    sensor <- NA_character_
-    if (inherits(x, "avfit")) {
-      if (is.null(dt) && !is.null(x$freq)) dt <- 1 / x$freq
-      if (is.null(tau_B) && !is.null(x$data)) {
-        tau_B <- x$data$tau[which.min(x$data$avar)]
-      }
-      x <- x$coefficients
-    }
-    if (!is.numeric(x) || is.null(names(x))) {
+    if (!is.numeric(x) || is.null(names(x)) || anyNA(names(x)) ||
+        !all(nzchar(names(x)))) {
       abort("`x` must be an imu_analysis, an avfit or a named numeric vector ",
             "of coefficients, not ", describe_type(x), ".", class = "argument")
     }
+    if (anyDuplicated(names(x))) {
+      abort("`x` names a coefficient twice (",
+            names(x)[anyDuplicated(names(x))], "); give each once.",
+            class = "argument")
+    }
+    bad <- which(!is.finite(x) | x < 0)
+    if (length(bad)) {
+      abort("`x` must hold finite, non-negative coefficients; ",
+            names(x)[bad[1L]], " = ", format(x[[bad[1L]]]), ".",
+            class = "argument")
+    }
+    check_coef(x, "x")
     if (is.null(dt)) {
       abort("`dt` is missing; give the filter step in seconds.",
             class = "missing_argument")
     }
-    dt <- check_number(dt, "dt", lo = 0, open = TRUE)
+    sensor <- NA_character_
+    if (!is.null(unit)) sensor <- lookup_unit(unit, "unit", kind = "rate")$sensor
     out <- discrete_rows(x, dt, "x", sensor, bias_instability,
                          if (is.null(tau_B)) NA_real_ else tau_B)
   }
@@ -233,10 +285,8 @@ filter_params <- function(x, dt = NULL, bias_instability = "gm",
 # a discrete-time model, in catalogue order. `bounds`: terms that are upper
 # bounds.
 discrete_rows <- function(cf, dt, channel, sensor, bi, tau_b, bounds = character()) {
-  unit <- function(kind) {
-    if (is.na(sensor)) c(rate = "u", N = "u*sqrt(s)", K = "u/sqrt(s)")[[kind]]
-    else si_unit(sensor, kind)
-  }
+  # for an unknown sensor, u is the input's rate unit
+  unit <- function(kind) si_unit(sensor, kind)
   cf <- cf[is.finite(cf)]
   lay <- if (length(cf)) check_coef(cf) else NULL
   rows <- list()

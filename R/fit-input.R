@@ -160,10 +160,17 @@ as_av_curve <- function(av, n = NULL, freq = NULL, type = NULL, channel = NULL) 
   if (nrow(data) < 1L) {
     abort("`av` has no usable points (positive tau and avar).", class = "curve")
   }
-  new_av_curve(data, freq = freq, n = n,
-               L = if (is.null(L) && !is.null(n)) n + 1 else L, type = type,
-               edf_source = if (is.null(edf)) "model" else "input",
-               source = source)
+  out <- new_av_curve(data, freq = freq, n = n,
+                      L = if (is.null(L) && !is.null(n)) n + 1 else L, type = type,
+                      edf_source = if (is.null(edf)) "model" else "input",
+                      source = source)
+  # The rate unit a curve carries (other tools' curves, in SI), for the
+  # datasheet of a curve-only fit (R/analysis-fit.R).
+  u <- if (is.data.frame(av) && is.character(av$unit)) unique(av$unit) else NULL
+  if (length(u) == 1L && !is.na(u)) out$unit <- u
+  ch <- if (is.data.frame(av) && !is.null(av$channel)) unique(as.character(av$channel))
+  if (length(ch) == 1L && !is.na(ch)) out$channel <- ch
+  out
 }
 
 new_av_curve <- function(data, freq, n, L, type, edf_source, source,

@@ -24,7 +24,13 @@
 #'
 #' [analyze_imu()] runs these checks and warns when any fails.
 #'
-#' @param x An `imu_analysis` ([analyze_imu()]).
+#' @param x An `imu_analysis` ([analyze_imu()]), or an [avfit()] of a curve
+#'   alone (for example another tool's curve, [read_avr_curve()]), read as
+#'   one axis.
+#' @param unit For an `avfit`: the rate unit of the fitted curve (`"rad/s"`,
+#'   `"deg/s"`, `"m/s^2"`, ...; see [av_units()]); `NULL` takes the unit the
+#'   curve carried (curves of other tools are SI), else values stay in the
+#'   input's unit.
 #' @return A data frame with columns `record`, `channel`, `message` (empty
 #'   when every check passes).
 #' @export
@@ -36,7 +42,7 @@
 #'                                   refine = FALSE, progress = FALSE))
 #' imu_guidance(a)
 #' }
-imu_guidance <- function(x) {
+imu_guidance <- function(x, unit = NULL) {
   if (inherits(x, "imu_analysis")) {
     rows <- lapply(x$channels, function(ch) {
       if (!length(ch$guidance)) return(NULL)
@@ -57,22 +63,31 @@ imu_guidance <- function(x) {
     rownames(out) <- NULL
     return(out)
   }
+  if (inherits(x, "avfit")) {
+    return(imu_guidance(fit_analysis(x, unit = unit)))
+  }
   if (is.list(x) && !is.null(x$curve) && !is.null(x$readings)) {
     return(channel_guidance(x))
   }
-  abort("`x` must be an imu_analysis, not ", describe_type(x), ".",
+  abort("`x` must be an imu_analysis or an avfit, not ", describe_type(x), ".",
         class = "argument")
 }
 
 channel_guidance <- function(ch) {
   cv <- ch$curve
-  T <- ch$n / ch$freq
+  # A curve read from another tool may come without its record length.
+  T <- if (length(ch$n) == 1L && length(ch$freq) == 1L) ch$n / ch$freq else NA_real_
   msg <- character()
-  hours <- function(s) if (s >= 3600) sprintf("%.3g h", s / 3600) else
-    sprintf("%.4g s", s)
+  hours <- function(s) {
+    if (!is.finite(s)) "? (the record length is not known)" else if (s >= 3600) sprintf("%.3g h", s / 3600)
+    else sprintf("%.4g s", s)
+  }
   edf <- cv$edf
-  rel <- if (is.null(edf) || all(is.na(edf))) cv$tau <= T / 10 else
+  rel <- if (is.null(edf) || all(is.na(edf))) {
+    if (is.finite(T)) cv$tau <= T / 10 else rep(TRUE, length(cv$tau))
+  } else {
     !is.na(edf) & edf >= 10
+  }
   if (!any(rel)) {
     return(sprintf("no tau has 10 degrees of freedom: the record (%s) is too short for any reading.",
                    hours(T)))

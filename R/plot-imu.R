@@ -89,19 +89,86 @@ plot_sensor <- function(x, s, units, ...) {
         graphics::lines(rng_x, r$adev * (rng_x / r$tau)^r$slope * k,
                         col = cols[i], lty = 3)
       }
-      graphics::points(r$tau, r$adev * k, pch = pch_of[[r$term]], bg = cols[i],
+      # a flat reading taken from the data's minimum is marked on the data
+      # (the reading's tau is the fitted model's flattest point)
+      tau_mark <- r$tau
+      if (r$slope == 0 && identical(r$source, "slope")) {
+        near <- which.min(abs(log(cv$adev) - log(r$adev)))
+        if (length(near)) tau_mark <- cv$tau[near]
+      }
+      graphics::points(tau_mark, r$adev * k, pch = pch_of[[r$term]], bg = cols[i],
                        cex = 1.4)
     }
   }
-  n_read <- length(specs)
-  graphics::legend("topright", bty = "n", cex = 0.75,
-                   legend = c(vapply(chans, function(cc) cc$channel, ""),
-                              "fitted model", "-1/2 and +1/2 lines",
-                              vapply(specs, function(r) r$legend, "")),
-                   col = c(cols, rep("black", 2L + n_read)),
-                   lty = c(rep(1, length(chans)), 2, 3, rep(NA, n_read)),
-                   pch = c(rep(20, length(chans)), NA, NA, unname(pch_of)),
-                   pt.bg = "grey60")
+  # The legend lists only the markers and lines drawn on some axis (K is
+  # not drawn when it is only an upper bound).
+  drawn <- unique(unlist(lapply(chans, function(cc) drawn_readings(cc$readings)$term)))
+  shown <- Filter(function(r) r$symbol %in% drawn, specs)
+  slopes <- vapply(Filter(function(r) r$slope != 0, shown), function(r)
+    if (r$slope > 0) sprintf("+%g", r$slope) else sprintf("%g", r$slope), "")
+  slopes <- gsub("0.5", "1/2", slopes, fixed = TRUE)
+  has_fit <- any(vapply(chans, function(cc) !is.null(cc$fit$data$fitted), FALSE))
+  n_read <- length(shown)
+  line_lab <- if (length(slopes)) paste(paste(slopes, collapse = " and "),
+                                        if (length(slopes) > 1L) "lines" else "line")
+  leg <- list(legend = c(vapply(chans, function(cc) cc$channel, ""),
+                         if (has_fit) "fitted model", line_lab,
+                         vapply(shown, function(r) r$legend, "")),
+              col = c(cols, rep("black", has_fit + length(line_lab) + n_read)),
+              lty = c(rep(1, length(chans)), if (has_fit) 2,
+                      if (length(line_lab)) 3, rep(NA, n_read)),
+              pch = c(rep(20, length(chans)), if (has_fit) NA,
+                      if (length(line_lab)) NA,
+                      vapply(shown, function(r) r$pch, 0)),
+              pt.bg = "grey60")
+  xy <- do.call(rbind, lapply(chans, function(cc) cc$curve[c("tau", "adev")]))
+  pos <- draw_legend(leg, xy$tau, xy$adev * k, cex = 0.75)
+  invisible(list(legend = leg$legend, position = pos))
+}
+
+# Draws a legend in the plot corner that covers the fewest data points
+# (x, y in user coordinates; log axes handled).
+draw_legend <- function(args, x, y, cex = 0.8) {
+  lx <- if (graphics::par("xlog")) log10(x) else x
+  ly <- if (graphics::par("ylog")) log10(y) else y
+  ok <- is.finite(lx) & is.finite(ly)
+  best <- "topright"
+  least <- Inf
+  for (pos in c("topright", "bottomleft", "topleft", "bottomright")) {
+    r <- do.call(graphics::legend, c(list(pos), args,
+                                     list(bty = "n", cex = cex, plot = FALSE)))$rect
+    # (the rect is in user coordinates: log10 units on log axes)
+    x0 <- r$left
+    x1 <- r$left + r$w
+    y1 <- r$top
+    y0 <- r$top - r$h
+    inside <- sum(ok & lx >= x0 & lx <= x1 & ly >= y0 & ly <= y1)
+    if (inside < least) {
+      least <- inside
+      best <- pos
+    }
+    if (least == 0) break
+  }
+  do.call(graphics::legend, c(list(best), args, list(bty = "n", cex = cex)))
+  invisible(best)
+}
+
+# Number of interior local maxima of v (an oscillating curve has many).
+n_peaks <- function(v) {
+  v <- v[is.finite(v)]
+  if (length(v) < 3L) return(0L)
+  d <- diff(v)
+  sum(d[-length(d)] > 0 & d[-1L] <= 0)
+}
+
+# Units of fit coefficients ("u*sqrt(s)", "u", "1", "s") with u replaced by
+# the fit's rate unit when it is known.
+unit_label <- function(units, fit) {
+  u <- fit_unit(fit)
+  if (is.null(u)) return(units)
+  out <- gsub("\\bu\\b", paste0("(", u, ")"), units, perl = TRUE)
+  out[units == "u"] <- u
+  out
 }
 
 #' @export

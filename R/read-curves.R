@@ -245,6 +245,10 @@ read_imu_utils_yaml <- function(file, freq = NULL, curve = NULL, scaled = NULL) 
 read_kalibr_yaml <- function(file) {
   check_present(missing(file), "file", "the path of a Kalibr imu.yaml")
   y <- read_yaml_file(file)
+  # OpenVINS' kalibr_imu_chain.yaml nests the same keys under imu0
+  if (is.list(y) && is.list(y$imu0) && !"gyroscope_noise_density" %in% names(y)) {
+    y <- y$imu0
+  }
   keys <- c(gyroscope_noise_density = "gyro.N", gyroscope_random_walk = "gyro.K",
             accelerometer_noise_density = "accel.N", accelerometer_random_walk = "accel.K")
   have <- names(keys)[names(keys) %in% names(y)]

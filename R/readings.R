@@ -40,6 +40,23 @@ channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL) {
   out
 }
 
+# The readings of a dead axis: one row per reading, no value, `reason` as
+# the method.
+dead_readings <- function(sensor, reason) {
+  rows <- lapply(entries_with("reading"), function(e) {
+    spec <- e$reading
+    data.frame(term = spec$symbol, value = NA_real_,
+               unit = si_unit(sensor, spec$unit),
+               tau = if (is.finite(spec$tau)) spec$tau else NA_real_,
+               method = reason, source = "none", is_bound = FALSE, folded = "",
+               role = spec$role, slope = spec$slope, adev = NA_real_,
+               stringsAsFactors = FALSE)
+  })
+  out <- do.call(rbind, rows)
+  rownames(out) <- NULL
+  out
+}
+
 reading_row <- function(e, lay, coef, se, curve, ok, rel, tau_min, sensor) {
   spec <- e$reading
   sym <- spec$symbol

@@ -46,13 +46,16 @@ av_units <- function(sensor = NULL, kind = NULL) {
     tab <- tab[tab$sensor == sensor, ]
   }
   if (!is.null(kind)) {
-    if (!is.character(kind) || !all(kind %in% unit_kinds)) {
+    kinds <- unit_kinds()
+    if (!is.character(kind) || !length(kind) || anyNA(kind) ||
+        !all(kind %in% kinds)) {
       abort("`kind` must be one or more of ",
-            paste0('"', unit_kinds, '"', collapse = ", "), ", not ",
-            format_value(kind), ".")
+            paste0('"', kinds, '"', collapse = ", "), ", not ",
+            format_value(kind), ".", class = "argument")
     }
     tab <- tab[tab$kind %in% kind, ]
   }
+  tab$dim <- NULL
   rownames(tab) <- NULL
   tab
 }
@@ -78,12 +81,11 @@ convert_units <- function(x, from, to) {
   if (f$sensor != t$sensor || f$kind != t$kind) {
     abort("cannot convert from \"", from, "\" (", f$sensor, " ", f$kind,
           ") to \"", to, "\" (", t$sensor, " ", t$kind, "); both units must ",
-          "measure the same quantity. See av_units().")
+          "measure the same quantity. See av_units().", class = "units")
   }
   x * (f$to_si / t$to_si)
 }
 
-unit_kinds <- c("rate", "N", "K", "Q", "R")
 
 # One row per accepted spelling. Factors are written from their definitions
 # so that each can be checked by hand.
@@ -103,68 +105,98 @@ build_unit_table <- function() {
   }
   rows <- list(
     # gyro rate
-    u("rad/s", "gyro", "rate", 1),
-    u("deg/s", "gyro", "rate", deg),
-    u("deg/h", "gyro", "rate", deg / h),
-    u("rad/h", "gyro", "rate", 1 / h),
-    u("mrad/s", "gyro", "rate", 1e-3),
-    u("rpm", "gyro", "rate", 2 * pi / 60),
-    # gyro N (angle random walk)
-    u("rad/sqrt(s)", "gyro", "N", 1),
-    u("rad/s/sqrt(Hz)", "gyro", "N", 1),
-    u("deg/sqrt(s)", "gyro", "N", deg),
-    u("deg/s/sqrt(Hz)", "gyro", "N", deg),
-    u("deg/sqrt(h)", "gyro", "N", deg / sqrt(h)),
-    u("deg/h/sqrt(Hz)", "gyro", "N", deg / h),
-    # gyro K (rate random walk)
-    u("rad/s/sqrt(s)", "gyro", "K", 1),
-    u("rad/s^2/sqrt(Hz)", "gyro", "K", 1),
-    u("deg/s/sqrt(s)", "gyro", "K", deg),
-    u("deg/h/sqrt(h)", "gyro", "K", deg / h / sqrt(h)),
-    u("deg/h^(3/2)", "gyro", "K", deg / h^1.5),
-    # gyro Q and R
-    u("rad", "gyro", "Q", 1),
-    u("deg", "gyro", "Q", deg),
-    u("arcsec", "gyro", "Q", deg / 3600),
-    u("rad/s^2", "gyro", "R", 1),
-    u("deg/s^2", "gyro", "R", deg),
-    u("deg/h^2", "gyro", "R", deg / h^2),
+    u("rad/s", "gyro", "u", 1),
+    u("deg/s", "gyro", "u", deg),
+    u("deg/h", "gyro", "u", deg / h),
+    u("rad/h", "gyro", "u", 1 / h),
+    u("mrad/s", "gyro", "u", 1e-3),
+    u("rpm", "gyro", "u", 2 * pi / 60),
+    # gyro white noise (angle random walk)
+    u("rad/sqrt(s)", "gyro", "u*sqrt(s)", 1),
+    u("rad/s/sqrt(Hz)", "gyro", "u*sqrt(s)", 1),
+    u("deg/sqrt(s)", "gyro", "u*sqrt(s)", deg),
+    u("deg/s/sqrt(Hz)", "gyro", "u*sqrt(s)", deg),
+    u("deg/sqrt(h)", "gyro", "u*sqrt(s)", deg / sqrt(h)),
+    u("deg/h/sqrt(Hz)", "gyro", "u*sqrt(s)", deg / h),
+    # gyro rate random walk
+    u("rad/s/sqrt(s)", "gyro", "u/sqrt(s)", 1),
+    u("rad/s^2/sqrt(Hz)", "gyro", "u/sqrt(s)", 1),
+    u("deg/s/sqrt(s)", "gyro", "u/sqrt(s)", deg),
+    u("deg/h/sqrt(h)", "gyro", "u/sqrt(s)", deg / h / sqrt(h)),
+    u("deg/h^(3/2)", "gyro", "u/sqrt(s)", deg / h^1.5),
+    # gyro quantization and rate ramp
+    u("rad", "gyro", "u*s", 1),
+    u("deg", "gyro", "u*s", deg),
+    u("arcsec", "gyro", "u*s", deg / 3600),
+    u("rad/s^2", "gyro", "u/s", 1),
+    u("deg/s^2", "gyro", "u/s", deg),
+    u("deg/h^2", "gyro", "u/s", deg / h^2),
     # accel rate
-    u("m/s^2", "accel", "rate", 1),
-    u("g", "accel", "rate", g),
-    u("mg", "accel", "rate", g * 1e-3),
-    u("ug", "accel", "rate", g * 1e-6),
-    u("m/s/h", "accel", "rate", 1 / h),
-    # accel N (velocity random walk)
-    u("m/s/sqrt(s)", "accel", "N", 1),
-    u("m/s^2/sqrt(Hz)", "accel", "N", 1),
-    u("m/s/sqrt(h)", "accel", "N", 1 / sqrt(h)),
-    u("ug/sqrt(Hz)", "accel", "N", g * 1e-6),
-    u("mg/sqrt(Hz)", "accel", "N", g * 1e-3),
-    u("g/sqrt(Hz)", "accel", "N", g),
-    # accel K
-    u("m/s^2/sqrt(s)", "accel", "K", 1),
-    u("m/s^3/sqrt(Hz)", "accel", "K", 1),
-    u("m/s/h^(3/2)", "accel", "K", 1 / h^1.5),
-    u("ug/sqrt(s)", "accel", "K", g * 1e-6),
-    u("mg/sqrt(h)", "accel", "K", g * 1e-3 / sqrt(h)),
-    # accel Q and R
-    u("m/s", "accel", "Q", 1),
-    u("m/s^3", "accel", "R", 1),
-    u("ug/s", "accel", "R", g * 1e-6)
+    u("m/s^2", "accel", "u", 1),
+    u("g", "accel", "u", g),
+    u("mg", "accel", "u", g * 1e-3),
+    u("ug", "accel", "u", g * 1e-6),
+    u("m/s/h", "accel", "u", 1 / h),
+    # accel white noise (velocity random walk)
+    u("m/s/sqrt(s)", "accel", "u*sqrt(s)", 1),
+    u("m/s^2/sqrt(Hz)", "accel", "u*sqrt(s)", 1),
+    u("m/s/sqrt(h)", "accel", "u*sqrt(s)", 1 / sqrt(h)),
+    u("ug/sqrt(Hz)", "accel", "u*sqrt(s)", g * 1e-6),
+    u("mg/sqrt(Hz)", "accel", "u*sqrt(s)", g * 1e-3),
+    u("g/sqrt(Hz)", "accel", "u*sqrt(s)", g),
+    # accel rate random walk
+    u("m/s^2/sqrt(s)", "accel", "u/sqrt(s)", 1),
+    u("m/s^3/sqrt(Hz)", "accel", "u/sqrt(s)", 1),
+    u("m/s/h^(3/2)", "accel", "u/sqrt(s)", 1 / h^1.5),
+    u("ug/sqrt(s)", "accel", "u/sqrt(s)", g * 1e-6),
+    u("mg/sqrt(h)", "accel", "u/sqrt(s)", g * 1e-3 / sqrt(h)),
+    # accel quantization and rate ramp
+    u("m/s", "accel", "u*s", 1),
+    u("m/s^3", "accel", "u/s", 1),
+    u("ug/s", "accel", "u/s", g * 1e-6)
   )
+  dim <- vapply(rows, `[[`, "", "kind")
   tab <- data.frame(
     unit = vapply(rows, `[[`, "", "unit"),
     sensor = vapply(rows, `[[`, "", "sensor"),
-    kind = vapply(rows, `[[`, "", "kind"),
+    kind = vapply(dim, dim_kind, ""),
     to_si = vapply(rows, `[[`, 0, "to_si"), stringsAsFactors = FALSE)
-  si <- c(gyro.rate = "rad/s", gyro.N = "rad/s/sqrt(Hz)",
-          gyro.K = "rad/s^2/sqrt(Hz)", gyro.Q = "rad", gyro.R = "rad/s^2",
-          accel.rate = "m/s^2", accel.N = "m/s^2/sqrt(Hz)",
-          accel.K = "m/s^3/sqrt(Hz)", accel.Q = "m/s", accel.R = "m/s^3")
-  tab$si <- unname(si[paste(tab$sensor, tab$kind, sep = ".")])
+  si <- c("gyro u" = "rad/s", "gyro u*sqrt(s)" = "rad/s/sqrt(Hz)",
+          "gyro u/sqrt(s)" = "rad/s^2/sqrt(Hz)", "gyro u*s" = "rad",
+          "gyro u/s" = "rad/s^2", "accel u" = "m/s^2",
+          "accel u*sqrt(s)" = "m/s^2/sqrt(Hz)", "accel u/sqrt(s)" = "m/s^3/sqrt(Hz)",
+          "accel u*s" = "m/s", "accel u/s" = "m/s^3")
+  tab$si <- unname(si[paste(tab$sensor, dim)])
+  tab$dim <- unname(dim)
   tab
 }
+
+# Dimensions are the catalogue's parameter units, written with u, the rate
+# unit: "u" (rate), "u*sqrt(s)", "u/sqrt(s)", "u*s", "u/s". The `kind` of a
+# dimension is "rate" for u, else the first catalogue entry (in catalogue
+# order) whose amplitude has that unit; a kind's dimension is its amplitude's
+# unit. So units.R names no effect kind.
+dim_kind <- function(dim) {
+  if (identical(dim, "u")) return("rate")
+  for (e in catalogue()) {
+    p <- e$params
+    if (any(p$role == "amp" & p$unit == dim)) return(e$name)
+  }
+  dim
+}
+
+kind_dim <- function(kind) {
+  if (identical(kind, "rate") || grepl("^u", kind)) {
+    return(if (identical(kind, "rate")) "u" else kind)
+  }
+  e <- catalogue()[[kind]]
+  if (is.null(e)) return(NA_character_)
+  u <- e$params$unit[e$params$role == "amp"]
+  if (length(u)) u[1L] else NA_character_
+}
+
+# The kinds av_units() accepts: "rate" and the kinds of the other dimensions.
+unit_kinds <- function() unique(unit_table()$kind)
 
 # Normalise a spelling: no spaces, "s2" -> "s^2", micro sign -> u.
 normalize_unit <- function(x) {
@@ -184,7 +216,7 @@ normalize_unit <- function(x) {
 lookup_unit <- function(unit, arg = "unit", sensor = NULL, kind = NULL) {
   if (!is.character(unit) || length(unit) != 1L || is.na(unit)) {
     abort("`", arg, "` must be a single unit name (see av_units()), not ",
-          describe_type(unit), ".")
+          describe_type(unit), ".", class = "units")
   }
   tab <- unit_table()
   row <- tab[tab$unit == normalize_unit(unit), ]
@@ -197,7 +229,7 @@ lookup_unit <- function(unit, arg = "unit", sensor = NULL, kind = NULL) {
     abort("`", arg, "` = \"", unit, "\" is not a known ",
           if (!is.null(sensor)) paste0(sensor, " "),
           if (!is.null(kind)) paste0(kind, " "), "unit; use one of ",
-          paste0('"', unique(cand), '"', collapse = ", "), ".")
+          paste0('"', unique(cand), '"', collapse = ", "), ".", class = "units")
   }
   as.list(row)
 }
@@ -206,25 +238,32 @@ match_sensor <- function(sensor, arg = "sensor") {
   if (!is.character(sensor) || length(sensor) != 1L ||
       !sensor %in% c("gyro", "accel")) {
     abort("`", arg, "` must be \"gyro\" or \"accel\", not ",
-          format_value(sensor), ".")
+          format_value(sensor), ".", class = "argument")
   }
   sensor
 }
 
-# Datasheet units for each coefficient, by sensor: what datasheet() shows
-# beside SI. More than one per coefficient where the field uses several.
+# Datasheet units of each dimension, by sensor: what datasheet() shows
+# beside SI. More than one where the field uses several.
 datasheet_units <- function(sensor) {
-  if (sensor == "gyro") {
-    list(N = "deg/sqrt(h)", B = "deg/h", K = "deg/h/sqrt(h)")
+  if (identical(sensor, "gyro")) {
+    list("u*sqrt(s)" = "deg/sqrt(h)", "u" = "deg/h", "u/sqrt(s)" = "deg/h/sqrt(h)")
+  } else if (identical(sensor, "accel")) {
+    list("u*sqrt(s)" = c("m/s/sqrt(h)", "ug/sqrt(Hz)"), "u" = c("ug", "mg"),
+         "u/sqrt(s)" = "m/s/h^(3/2)")
   } else {
-    list(N = c("m/s/sqrt(h)", "ug/sqrt(Hz)"), B = c("ug", "mg"),
-         K = "m/s/h^(3/2)")
+    list()
   }
 }
 
+# The SI unit of `kind` ("rate", a catalogue kind or a dimension such as
+# "u*sqrt(s)") for `sensor`; for an unknown sensor (NA) the dimension itself,
+# with u the input's rate unit.
 si_unit <- function(sensor, kind) {
+  dim <- kind_dim(kind)
+  if (is.na(sensor)) return(dim)
   tab <- unit_table()
-  tab$si[tab$sensor == sensor & tab$kind == kind][1L]
+  tab$si[tab$sensor == sensor & tab$dim == dim][1L]
 }
 
 # Units checked on the data (read_imu(), imu_record()). Accelerometers: a

@@ -8,8 +8,10 @@ freq <- frequency(gyroz)
 guide_lines <- function(av) {
   abline(1.0 + log(av$time[1]), -1/2, col = "green", lwd = 4, lty = 10)
   abline(1.0 + log(av$time[1]), 1/2, col = "green", lwd = 4, lty = 10)
-  legend(0.11, 1e-03, "Random Walk")
-  legend(2, 1e-03, "Rate Random Walk")
+  # (the original placed these at fixed coordinates, past the right edge of
+  # short records; the corners keep them inside the plot)
+  legend("bottomleft", "Random Walk", inset = 0.02, cex = 0.9)
+  legend("bottomright", "Rate Random Walk", inset = 0.02, cex = 0.9)
 }
 
 # Non-overlapping Allan variance at octave cluster sizes.
@@ -38,5 +40,5 @@ axis(2, c(0.00001, 0.0001, 0.001, 0.01, 0.1, 0, 1, 10, 100, 1000, 10000))
 grid(equilogs = TRUE, lwd = 1, col = "orange")
 title(main = "Allan variance Analysis Comparison", xlab = "Cluster Times (Sec)",
       ylab = "Allan Standard Deviation (rad/s)")
-legend(1, 1e-03, c("GyroZ (avar)", "GyroZ (avarn)", "GyroZ (avari)"),
-       fill = c("blue", "green", "red"))
+legend("topright", c("GyroZ (avar)", "GyroZ (avarn)", "GyroZ (avari)"),
+       fill = c("blue", "green", "red"), inset = 0.02, cex = 0.9)

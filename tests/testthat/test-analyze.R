@@ -120,3 +120,55 @@ test_that("analyze_imu reports one progressr step per axis, also from future wor
   # No handler: nothing is printed.
   expect_silent(suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE)))
 })
+
+test_that("a dead (constant) axis is reported and the others analysed", {
+  set.seed(11)
+  m <- cbind(gyro_x = rnorm(4000) * 1e-3, gyro_y = rep(0.01, 4000),
+             gyro_z = rnorm(4000) * 2e-3)
+  r <- imu_record(m, freq = 100, units = rep("rad/s", 3))
+  expect_warning(
+    a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE),
+                          classes = "allanvar_guidance"),
+    "gyro_y is a dead axis", class = "allanvar_warning_dead_axis")
+  expect_identical(a$channels$gyro_y$dead,
+                   "dead axis: constant signal (Allan variance 0 at every tau), not analysed")
+  expect_null(a$channels$gyro_y$fit)
+  # the live axes: white noise N = sigma / sqrt(f), read to within 10%
+  ds <- datasheet(a)$gyro
+  n_col <- "N [rad/s/sqrt(Hz)]"
+  expect_equal(ds[[n_col]][ds$axis == "gyro_x"], 1e-3 / 10, tolerance = 0.1)
+  expect_equal(ds[[n_col]][ds$axis == "gyro_z"], 2e-3 / 10, tolerance = 0.1)
+  expect_true(is.na(ds[[n_col]][ds$axis == "gyro_y"]))
+  expect_match(ds$method[ds$axis == "gyro_y"], "dead axis")
+  g <- imu_guidance(a)
+  expect_match(g$message[g$channel == "gyro_y"], "dead axis")
+  fp <- filter_params(a)
+  expect_false("gyro_y" %in% fp$channel)
+  expect_true(all(is.finite(fp$value)))
+  # Kalibr: the worst live axis, the dead one listed in the comment
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  for (ax in c("max", "mean")) {
+    write_kalibr_yaml(a, f, axis = ax)
+    y <- yaml::read_yaml(f)
+    expect_true(is.numeric(y$gyroscope_noise_density) &&
+                  is.finite(y$gyroscope_noise_density))
+    expect_match(readLines(f), "gyro_y = NA (dead axis)", fixed = TRUE, all = FALSE)
+  }
+  expect_equal(y$gyroscope_noise_density, mean(ds[[n_col]][c(1, 3)]),
+               tolerance = 1e-6)
+})
+
+test_that("each analysed axis signals one progressr step, silently by default", {
+  r <- two_records()[[1]]
+  steps <- character()
+  # progressr signals outside interactive sessions only when enabled
+  old <- options(progressr.enable = TRUE)
+  on.exit(options(old))
+  withCallingHandlers(
+    expect_silent(suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))),
+    progression = function(p) {
+      if (identical(p$type, "update")) steps <<- c(steps, p$message)
+    })
+  expect_identical(steps, c("[1/2] rec1: gyro_x", "[2/2] rec1: accel_x"))
+})

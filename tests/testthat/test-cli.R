@@ -236,3 +236,23 @@ test_that("--width/--height size the PNG; --topic reads a bag", {
   expect_length(res$files, 4L)
   expect_equal(res$analyses[[1]]$freq, 200, tolerance = 1e-9)
 })
+
+test_that("a gyro-only CSV gives a valid imu.yaml holding only the gyro", {
+  skip_if_not_installed("yaml")
+  set.seed(5)
+  m <- matrix(rnorm(3e4) * 1e-3, ncol = 3)
+  csv <- write_kalibr_csv(m, tempfile(fileext = ".csv"),
+                          header = c("timestamp", "omega_x", "omega_y", "omega_z"))
+  out <- tempfile("cli")
+  on.exit(unlink(c(csv, out), recursive = TRUE))
+  expect_output(allanvar_cli(c(csv, "--out", out, "--quiet", "--no-refine")),
+                "Gyroscopes")
+  txt <- readLines(file.path(out, "imu.yaml"))
+  expect_false(any(grepl("nan", txt, ignore.case = TRUE)))
+  expect_match(txt, "no accelerometer channel in the record", fixed = TRUE, all = FALSE)
+  y <- yaml::read_yaml(file.path(out, "imu.yaml"))
+  expect_setequal(names(y), c("gyroscope_noise_density", "gyroscope_random_walk",
+                              "rostopic", "update_rate"))
+  # sigma = 1e-3 rad/s at 100 Hz: N = 1e-4 rad/s/sqrt(Hz)
+  expect_equal(y$gyroscope_noise_density, 1e-4, tolerance = 0.1)
+})

@@ -131,3 +131,136 @@ test_that("write_kalibr_yaml() and filter_params() errors are classed and worded
   })
   expect_error(filter_params(c(N = 1)), class = "allanvar_error_missing_argument")
 })
+
+test_that("YAML output quotes what it copies from the user", {
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  vals <- list(gyroscope_noise_density = 1.7e-4, gyroscope_random_walk = 2e-5,
+               accelerometer_noise_density = 2e-3,
+               accelerometer_random_walk = 3e-3, update_rate = 200)
+  evil <- c("a\nb: evil", "x\" # y", "back\\slash", "tab\there: 1", "'single'",
+            "- item", "{a: 1}", "\u00b5s")
+  for (topic in evil) {
+    write_kalibr_yaml(vals, f, rostopic = topic)
+    y <- yaml::read_yaml(f)
+    # the topic comes back as it was given, and no key was added
+    expect_identical(y$rostopic, topic)
+    expect_setequal(names(y), c("accelerometer_noise_density",
+                                "accelerometer_random_walk",
+                                "gyroscope_noise_density",
+                                "gyroscope_random_walk", "rostopic",
+                                "update_rate"))
+  }
+  # a record name with a line break stays inside its comment line
+  set.seed(2)
+  m <- cbind(gyro_x = rnorm(3000) * 1e-3, accel_x = rnorm(3000) * 1e-2)
+  r <- imu_record(m, freq = 100, units = c("rad/s", "m/s^2"),
+                  name = "rec\nbad_key: 1")
+  a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+  write_kalibr_yaml(a, f)
+  y <- yaml::read_yaml(f)
+  expect_null(y$bad_key)
+  expect_length(grep("^bad_key", readLines(f)), 0)
+})
+
+test_that("writers refuse bad output paths and leave no half file", {
+  vals <- list(gyroscope_noise_density = 1.7e-4, gyroscope_random_walk = 2e-5,
+               accelerometer_noise_density = 2e-3,
+               accelerometer_random_walk = 3e-3, update_rate = 200)
+  d <- tempfile("outdir")
+  dir.create(d)
+  on.exit(unlink(d, recursive = TRUE))
+  for (bad in list(d, "", "   ", file.path(d, "no", "such", "x.yaml"), NA_character_,
+                   c("a", "b"), 1)) {
+    expect_error(write_kalibr_yaml(vals, bad),
+                 class = "allanvar_error_output_path")
+  }
+  expect_snapshot(error = TRUE, {
+    write_kalibr_yaml(vals, "")
+    write_kalibr_yaml(vals, 1)
+  })
+  # a failure while writing leaves the old file as it was and no temporary
+  f <- file.path(d, "imu.yaml")
+  writeLines("old", f)
+  expect_error(write_atomic(f, function(path) {
+    writeLines("half", path)
+    stop("disk full")
+  }), "disk full")
+  expect_identical(readLines(f), "old")
+  expect_identical(list.files(d, all.files = TRUE, no.. = TRUE), "imu.yaml")
+  # a success replaces it whole
+  write_kalibr_yaml(vals, f)
+  expect_identical(yaml::read_yaml(f)$update_rate, 200)
+  expect_identical(list.files(d, all.files = TRUE, no.. = TRUE), "imu.yaml")
+})
+
+test_that("filter_params() refuses garbage instead of returning it", {
+  # tau_B = -1 gave q_d < 0 and phi > 1; "a" silently dropped the B row
+  cf <- c(N = 1e-3, B = 1e-4, K = 1e-5)
+  for (tb in list(-1, 0, "a", NA_real_, Inf, c(1, 2))) {
+    expect_error(filter_params(cf, dt = 0.01, tau_B = tb),
+                 "`tau_B`", class = "allanvar_error_argument")
+  }
+  for (x in list(c(N = -1e-3), c(N = NaN), c(N = Inf), c(N = 1e-3, K = -1),
+                 c(N = 1e-3, N = 2e-3),
+                 stats::setNames(1e-3, ""), c(1e-3))) {
+    expect_error(filter_params(x, dt = 0.01), class = "allanvar_error_argument")
+  }
+  expect_error(filter_params(cf, dt = 0), "`dt`", class = "allanvar_error_argument")
+  expect_error(filter_params(cf, dt = 0.01, unit = "furlong"),
+               class = "allanvar_error_units")
+  # a valid tau_B: phi = exp(-dt / Tc) with Tc = tau_B / 1.893, in (0, 1),
+  # and q_d = sigma^2 (1 - phi^2) > 0 with sigma = 0.664 B / 0.6174
+  fp <- filter_params(cf, dt = 0.01, tau_B = 20)
+  phi <- fp$value[fp$parameter == "phi"]
+  expect_equal(phi, exp(-0.01 / (20 / 1.893)))
+  expect_equal(fp$value[fp$parameter == "q_d"],
+               (0.664 * 1e-4 / 0.6174)^2 * (1 - phi^2), tolerance = 2e-3)
+  expect_true(all(fp$value > 0))
+})
+
+test_that("a gyro-only record writes a valid imu.yaml holding only the gyro", {
+  set.seed(5)
+  m <- cbind(gyro_x = rnorm(1e4) * 1e-3, gyro_y = rnorm(1e4) * 2e-3)
+  r <- imu_record(m, freq = 100, units = c("rad/s", "rad/s"))
+  a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  write_kalibr_yaml(a, f)
+  txt <- readLines(f)
+  expect_false(any(grepl("nan", txt, ignore.case = TRUE)))
+  expect_match(txt, "# (no accelerometer channel in the record", fixed = TRUE,
+               all = FALSE)
+  y <- yaml::read_yaml(f)
+  expect_setequal(names(y), c("gyroscope_noise_density", "gyroscope_random_walk",
+                              "rostopic", "update_rate"))
+  # N of the worst axis: sigma / sqrt(freq) = 2e-3 / 10
+  expect_equal(y$gyroscope_noise_density, 2e-4, tolerance = 0.1)
+})
+
+test_that("write_kalibr_yaml() writes a fit of another tool's curve", {
+  tau <- 10^seq(-1, 2, 0.1)
+  cv <- data.frame(tau = tau, avar = 1e-8 / tau + 1e-12 * tau / 3, unit = "rad/s")
+  fit <- avfit(cv, c("N", "K"), n = 1e6, freq = 200)
+  f <- tempfile(fileext = ".yaml")
+  on.exit(unlink(f))
+  write_kalibr_yaml(fit, f)
+  y <- yaml::read_yaml(f)
+  expect_equal(y$gyroscope_noise_density, 1e-4, tolerance = 1e-3)
+  expect_equal(y$gyroscope_random_walk, 1e-6, tolerance = 1e-2)
+  expect_null(y$accelerometer_noise_density)
+  expect_equal(y$update_rate, 200)
+  un <- avfit(cv[c("tau", "avar")], "N", n = 1e6, freq = 200)
+  expect_error(write_kalibr_yaml(un, f), "unit", class = "allanvar_error_argument")
+})
+
+test_that("write_kalibr_yaml() refuses a sensor with a value it could not read", {
+  # 3 samples: no -1/2 region, so N is not read; K would be a bound
+  r <- imu_record(cbind(gyro_x = c(0.001, 0.002, 0.0015)), freq = 100,
+                  units = "rad/s")
+  a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+  f <- tempfile(fileext = ".yaml")
+  expect_error(write_kalibr_yaml(a, f), "gyroscope_noise_density could not be read",
+               class = "allanvar_error_argument")
+  expect_false(file.exists(f))
+})

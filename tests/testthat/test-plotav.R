@@ -37,3 +37,41 @@ test_that("plotav() rejects what it cannot plot, naming `avdf`", {
   expect_error(plotav(data.frame(time = 1, av = 0, error = 1)),
                "no row with positive, finite")
 })
+
+test_that("plotav() draws allan() results and bars that reach below zero", {
+  set.seed(3)
+  x <- rnorm(500)
+  a <- allan(x, 10)
+  # the symmetric half width of the last points exceeds the deviation:
+  # adev - (upper - adev) < 0 cannot be drawn on a log axis
+  expect_true(any(2 * a$adev - a$upper <= 0, na.rm = TRUE))
+  plot_to_file({
+    expect_invisible(out <- expect_no_warning(plotav(a)))
+    expect_identical(out, a)
+    expect_true(graphics::par("ylog"))
+    # the y range holds the chi-square limits, not a clipped symmetric bar
+    usr <- 10^graphics::par("usr")[3:4]
+    expect_lte(usr[1], min(a$lower, na.rm = TRUE))
+    expect_gte(usr[2], max(a$upper, na.rm = TRUE))
+    big <- data.frame(time = c(1, 2, 4), av = c(1, 0.5, 0.25),
+                      error = c(0.1, 0.5, 1.5))
+    expect_no_warning(plotav(big))
+    # the third bar is cut at the lowest positive end of the others
+    expect_equal(10^graphics::par("usr")[3],
+                 min(sqrt(big$av[1:2]) * (1 - big$error[1:2])), tolerance = 0.1)
+  })
+})
+
+test_that("plotav() errors are classed", {
+  expect_error(plotav(1:3), class = "allanvar_error_argument")
+  expect_error(plotav(data.frame(time = 1, av = 1)), class = "allanvar_error_argument")
+  expect_error(plotav(data.frame(time = 1, av = 0, error = 1)),
+               class = "allanvar_error_argument")
+})
+
+test_that("plotav() draws rows without an interval without warnings", {
+  plot_to_file({
+    expect_no_warning(plotav(data.frame(time = 1:3, av = c(1, 0.5, 0.3),
+                                        error = c(0.1, NA, 0))))
+  })
+})
