@@ -91,7 +91,7 @@
 #' ref$steps[, c("effect", "params", "chi2_before", "chi2_after")]
 avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
                      max_steps = 5, criterion = "BIC", min_gain = 10,
-                     level = 3.5, ...) {
+                     level = 3.5, remove = character(), ...) {
   check_present(missing(fit), "fit", "an avfit() result")
   if (!inherits(fit, "avfit")) {
     abort("`fit` must be an avfit() result, not ", describe_type(fit), ".",
@@ -115,7 +115,12 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   min_gain <- check_number(min_gain, "min_gain", 0)
   level <- check_number(level, "level", 0, open = TRUE)
   freq <- fit$freq
+  remove <- check_remove(remove)
+  if (length(remove) && is.null(data)) {
+    abort("`remove` needs the raw series: give `data`.", class = "argument")
+  }
   raw <- NULL
+  ser <- NULL
   if (!is.null(data)) {
     if (stats::is.ts(data) && !is.null(freq) &&
         abs(stats::frequency(data) - freq) > 1e-6 * freq) {
@@ -128,8 +133,27 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
             class = "argument")
     }
     data <- check_values(data, min_n = 256L, arg = "data")
+    # Non-stationary effects (steps, warm-up, spikes) are read from the
+    # series first (R/series.R, when present); what the user asks to remove
+    # is taken out of the data the loop then sees.
+    ser <- if (exists("series_effects", mode = "function"))
+      series_effects(data, freq, remove = remove) else NULL
+    if (!is.null(ser) && length(ser$removed)) data <- ser$x
     raw <- avdiagnose(data, freq)
   }
+  # The series the raw-data checks of an effect see: the data with the
+  # significant periodogram lines taken out (a sinusoid disturbs the ACF
+  # that confirms a Gauss-Markov process; the line checks read the
+  # periodogram, not this series). Computed once, when first needed.
+  clean <- NULL
+  evidence_series <- function(effect) {
+    if (is.null(data)) return(NULL)
+    if (is.null(clean)) {
+      clean <<- if (nrow(raw$lines)) remove_lines(data, freq, raw$lines$f0) else data
+    }
+    clean
+  }
+  rejected <- new_rejected()
   # The settings every refit uses, explicitly: the fit's own, overridden by
   # the arguments in `...`.
   settings <- utils::modifyList(
@@ -147,7 +171,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     tau <- current$data$tau
     z <- stats::residuals(current)
     sig <- residual_signatures(tau, z, level = level)
-    if (!nrow(sig)) break
+    # No residual threshold gates the search: with no signature every
+    # candidate is still asked, and only the criterion decides (two GMs a
+    # decade apart leave no run reaching `level` for the second one).
     traced <- trace_candidates(tau, current$data$avar, current$data$fitted, sig,
                                present = current$terms, candidates = candidates,
                                raw = raw)
@@ -159,6 +185,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     # the winner is then refitted with everything free. The criterion of a
     # screened fit is put on the all-free scale by charging the held ones.
     nl_now <- stats::coef(current)[current$layout$role == "nonlinear"]
+    nl_now <- nl_now[!names(nl_now) %in% names(settings$fixed)]
     pen <- if (criterion == "BIC") log(current$nobs) else 2
     crit_s <- function(f) crit(f) + pen * length(hold_now)
     best <- NULL
@@ -166,7 +193,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     # all nonlinear parameters free (slower, but catches effects that only
     # pay once the others may move). Traced candidates first; the others
     # only when none of those pays.
-    holds <- if (length(nl_now)) list(nl_now, numeric(0)) else list(numeric(0))
+    # (Without any residual signature, only the screening pass is run.)
+    holds <- if (length(nl_now) && nrow(sig)) list(nl_now, numeric(0))
+      else if (length(nl_now)) list(nl_now) else list(numeric(0))
     passes <- list()
     for (h in holds) {
       passes[[length(passes) + 1L]] <- list(hold = h, tier = which(trials$traced))
@@ -176,8 +205,11 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       hold_now <- pass$hold
       for (i in pass$tier) {
         tr <- trials[i, ]
-        new <- refit_with(current, c(current$terms, tr$effect), tr$effect,
-                          tr$init[[1L]], settings, hold = hold_now,
+        # Parameters the raw data measure better than the curve (a line's
+        # frequency from the periodogram) are pinned there.
+        pin <- pin_values(current$terms, tr$effect, tr$pin[[1L]])
+        new <- refit_with(current, model_terms(current$terms, tr$effect), tr$effect,
+                          tr$init[[1L]], settings, hold = c(hold_now, pin),
                           good_enough = function(f) crit_s(f) < c0 - min_gain,
                           record = function(cnd, stage) {
                             failures <<- add_failure(failures, cnd, step,
@@ -193,18 +225,32 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         # artefact, not an effect.
         if (max_share(new, lab) < 0.02) next
         par <- instance_params(stats::coef(new), new$layout, lab)
-        ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
-        # Raw-data support or contradiction weighs min_gain criterion units;
-        # an effect the raw data contradict must pay twice the margin.
-        adj <- c1 - min_gain * (isTRUE(ev$support) - isFALSE(ev$support))
-        if (isFALSE(ev$support) && !(adj < c0 - min_gain)) next
+        # An instance that is not a valid instance of its effect on this
+        # curve (a sub-sample GM, a sinusoid the curve cannot see) is never
+        # accepted, however well it bends the curve.
+        why <- inadmissible(tr$effect, par, tau, freq)
+        if (!is.null(why)) {
+          rejected <- add_rejected(rejected, step, tr$effect, par, why)
+          next
+        }
+        ev <- raw_evidence(tr$effect, as.list(par), raw,
+                           evidence_series(tr$effect), freq)
+        # An effect the raw data contradict is never accepted; support
+        # weighs min_gain criterion units in the comparison.
+        if (isFALSE(ev$support)) {
+          rejected <- add_rejected(rejected, step, tr$effect, par,
+                                   paste("contradicted by the raw data:", ev$text))
+          next
+        }
+        adj <- c1 - min_gain * isTRUE(ev$support)
         cand <- list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
-                     params = par, ev = ev)
+                     params = par, ev = ev, pin = pin)
         if (is.null(best) || adj < best$adj) best <- cand
       }
       if (!is.null(best)) break
     }
     if (is.null(best)) break
+    if (length(best$pin)) settings$fixed <- c(settings$fixed, best$pin)
     # Refit the winner with the held nonlinear parameters free again (the new
     # one starts where screening put it).
     if (length(hold_now)) {
@@ -240,11 +286,48 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     current <- best$fit
   }
   all_steps <- Reduce(bind_steps, steps, fit$steps)
+  # What is left: residual structure no catalogue effect explained.
+  sig <- residual_signatures(current$data$tau, stats::residuals(current), level = level)
+  unexplained <- unexplained_table(sig, current)
+  # Short tau cannot hijack the fit: when the model still cannot describe a
+  # run of first points, they are left out of the fit (an automatic tau
+  # range, with a message) so that they do not drive N to 0 or bend the
+  # long-tau terms; the run stays listed as unexplained.
+  tau_range <- NULL
+  short <- unexplained[unexplained$kind == "short_end", , drop = FALSE]
+  if (nrow(short)) {
+    tau_all <- current$data$tau
+    keep_from <- min(tau_all[tau_all > short$tau_to[1L]], Inf)
+    if (sum(tau_all >= keep_from) >= length(current$coefficients) + 3L) {
+      args <- refit_args(current, current$terms, settings,
+                         start = stats::coef(current)[current$layout$role == "nonlinear"])
+      args$tau_range <- c(keep_from, Inf)
+      trimmed <- try_refit(args, function(cnd, stage) {
+        failures <<- add_failure(failures, cnd, length(steps) + 1L, "tau_range", stage)
+      }, "refit without the first points")
+      if (!is.null(trimmed)) {
+        tau_range <- c(keep_from, max(tau_all))
+        message(sprintf(paste(
+          "avrefine(): no catalogue effect describes the first points (tau %s-%s s);",
+          "the model is fitted from tau = %s s on (see $unexplained)."),
+          format_num(short$tau_from[1L]), format_num(short$tau_to[1L]),
+          format_num(keep_from)))
+        current <- trimmed
+      }
+    }
+  }
   current$steps <- all_steps
+  current$unexplained <- unexplained
+  # Curve only: the accepted effects the raw data could not confirm.
+  new_steps_df <- all_steps[seq_len(nrow(all_steps)) > NROW(fit$steps), , drop = FALSE]
+  unconfirmed <- if (is.null(data)) new_steps_df$label else character()
+  current$series <- ser
   current$refine <- list(candidates = candidates, criterion = criterion,
                          min_gain = min_gain, level = level, diagnostics = raw,
                          remaining = sig, start_terms = fit$terms,
-                         failures = failures)
+                         failures = failures, rejected = rejected,
+                         unconfirmed = unconfirmed, tau_range = tau_range,
+                         removed = if (is.null(ser)) character() else ser$removed)
   class(current) <- unique(c("avrefine", class(current)))
   validate_avfit(current)
 }
@@ -254,6 +337,40 @@ print.avrefine <- function(x, ...) {
   NextMethod()
   cat("\n")
   print_steps(x)
+  print_refine_notes(x)
+  invisible(x)
+}
+
+# The loop's notes after the steps: what could not be confirmed, what is
+# left unexplained, the automatic tau range, the series effects.
+print_refine_notes <- function(x) {
+  r <- x$refine
+  if (length(r$unconfirmed)) {
+    cat("Without raw data these effects could not be confirmed: ",
+        paste(r$unconfirmed, collapse = ", "), ".\n", sep = "")
+  }
+  nr <- NROW(r$rejected)
+  if (nr) {
+    cat(nr, " candidate(s) rejected (contradicted by the raw data or not a valid ",
+        "instance); see $refine$rejected.\n", sep = "")
+  }
+  u <- x$unexplained
+  if (NROW(u)) {
+    cat("Unexplained by any catalogue effect:\n")
+    cat(sprintf("  tau %s-%s s: %s (ADEV off by up to %.1f%%)\n",
+                format_num(u$tau_from), format_num(u$tau_to), u$description,
+                u$size), sep = "")
+  }
+  if (!is.null(r$tau_range)) {
+    cat(sprintf("Fitted from tau = %s s on: the first points are not described by any catalogue effect.\n",
+                format_num(r$tau_range[1L])))
+  }
+  if (!is.null(x$series)) {
+    nt <- NROW(x$series$table)
+    cat(sprintf("Series effects (steps, warm-up, spikes): %d found%s.\n", nt,
+                if (length(x$series$removed)) paste0(", removed: ",
+                  paste(x$series$removed, collapse = ", ")) else ", none removed"))
+  }
   invisible(x)
 }
 
@@ -270,6 +387,13 @@ refit_args <- function(fit, terms, settings, start = NULL, hold = NULL) {
   st <- c(st, prev)
   args$start <- if (length(st)) st else NULL
   if (length(hold)) args$fixed <- c(settings$fixed, hold)
+  if (length(args$fixed)) {
+    args$fixed <- args$fixed[!duplicated(names(args$fixed))]
+    if (length(args$start)) {
+      args$start <- args$start[!names(args$start) %in% names(args$fixed)]
+      if (!length(args$start)) args$start <- NULL
+    }
+  }
   args
 }
 
@@ -322,6 +446,88 @@ refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
   best
 }
 
+# ---- rules ------------------------------------------------------------------
+
+# A trial's pinned values (named by parameter) as coefficients of the term
+# `effect` would get next to `terms`.
+pin_values <- function(terms, effect, pin) {
+  if (!length(pin)) return(NULL)
+  sp <- split_term(effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  lab <- new_label(terms, effect)
+  pin <- unlist(pin)
+  j <- match(names(pin), e$params$name)
+  out <- pin[!is.na(j)]
+  names(out) <- coef_names(e, lab)[j[!is.na(j)]]
+  out
+}
+
+# The model after adding `effect`: the kinds the effect's entry replaces
+# (the filter replaces N) leave.
+model_terms <- function(terms, effect) {
+  sp <- split_term(effect)
+  gone <- effect_entry(sp$kind, sp$variant)$replaces
+  c(terms[!split_term(terms)$kind %in% gone], effect)
+}
+
+# Kinds that may still be added next to `present`: repeatable ones or those
+# absent, and never one that a present term replaced.
+addable_kind <- function(kind, present) {
+  pk <- split_term(present)$kind
+  replaced <- unlist(lapply(unique(pk), function(k) effect_entry(k)$replaces))
+  e <- effect_entry(kind)
+  !kind %in% replaced && (e$repeatable || !kind %in% pk)
+}
+
+# NULL when a fitted instance is valid on this curve, else the reason.
+inadmissible <- function(effect, par, tau, freq) {
+  sp <- split_term(effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  if (is.null(e$admissible)) return(NULL)
+  e$admissible(as.list(par), tau, freq)
+}
+
+new_rejected <- function() {
+  data.frame(step = integer(), effect = character(), params = character(),
+             reason = character(), stringsAsFactors = FALSE)
+}
+
+add_rejected <- function(rejected, step, effect, par, reason) {
+  rbind(rejected, data.frame(step = as.integer(step), effect = effect,
+                             params = format_params(par, effect),
+                             reason = reason, stringsAsFactors = FALSE))
+}
+
+# The residual structure left after the loop, as a table: kind, tau range,
+# strength (sigma) and size (largest relative ADEV error inside, percent).
+unexplained_table <- function(sig, fit) {
+  s <- sig[sig$kind != "oscillation", , drop = FALSE]
+  tau <- fit$data$tau
+  err <- 100 * abs(sqrt(fit$data$avar / fit$data$fitted) - 1)
+  size <- vapply(seq_len(nrow(s)), function(i) {
+    inr <- tau >= s$tau_from[i] & tau <= s$tau_to[i]
+    if (any(inr)) max(err[inr]) else NA_real_
+  }, 0)
+  data.frame(kind = s$kind, tau_from = s$tau_from, tau_to = s$tau_to,
+             strength = abs(s$strength), size = size,
+             description = s$description, stringsAsFactors = FALSE)
+}
+
+# `remove`: the series kinds to take out of the data (the catalogue's
+# "series" components when it has them).
+check_remove <- function(remove) {
+  kinds <- effect_kinds("series")
+  if (!is.character(remove) || anyNA(remove) ||
+      (length(kinds) && !all(remove %in% kinds))) {
+    abort("`remove` must name series effects",
+          if (length(kinds)) paste0(" among ", paste0("\"", kinds, "\"", collapse = ", ")),
+          ", not ", if (is.character(remove))
+            paste(encodeString(setdiff(remove, kinds), quote = '"'), collapse = ", ")
+          else describe_type(remove), ".", class = "argument")
+  }
+  unique(remove)
+}
+
 # ---- failures ---------------------------------------------------------------
 
 new_failures <- function() {
@@ -356,12 +562,11 @@ add_failure <- function(failures, cnd, step, effect, stage) {
 # with nonlinear parameters), or a generic start when no signature points
 # at that kind (the refit then decides).
 candidate_trials <- function(traced, present, candidates, sig) {
-  pk <- split_term(present)$kind
-  kinds <- candidates[vapply(candidates, function(k) {
-    effect_entry(k)$repeatable || !k %in% pk
-  }, logical(1))]
+  kinds <- candidates[vapply(candidates, addable_kind, logical(1), present = present)]
   rows <- list()
-  strongest <- sig[which.max(abs(sig$strength)), ]
+  strongest <- if (nrow(sig)) sig[which.max(abs(sig$strength)), ] else
+    data.frame(tau_from = NA_real_, tau_to = NA_real_,
+               description = "no residual signature", stringsAsFactors = FALSE)
   for (k in kinds) {
     t <- traced[traced$effect == k, , drop = FALSE]
     if (nrow(t)) {
@@ -375,14 +580,15 @@ candidate_trials <- function(traced, present, candidates, sig) {
         signature = paste0(strongest$description, " (no signature specific to ", k, ")"),
         score = 0, traced = FALSE, stringsAsFactors = FALSE)
       r$init <- list(list())
+      r$pin <- list(NULL)
       rows[[length(rows) + 1L]] <- r[, c("effect", "tau_from", "tau_to", "signature",
-                                         "score", "init", "traced")]
+                                         "score", "init", "pin", "traced")]
     }
   }
   if (!length(rows)) return(data.frame())
   do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
                                                 "signature", "score", "init",
-                                                "traced")]))
+                                                "pin", "traced")]))
 }
 
 # The residual signature that matches an accepted term: the one whose tau

@@ -124,6 +124,15 @@ effect_gauss_markov <- function() {
            score = if (ctx$kind == "bump") 2 else 1)
     },
     evidence = evidence_gm,
+    # Correlated over fewer than 2 samples, an AR(1) is the sensor's own
+    # averaging (the filter term), not a slow process.
+    admissible = function(par, tau, freq) {
+      tc <- par[["tc"]]
+      if (!is.null(freq) && is.finite(tc) && tc * freq < 2) {
+        sprintf("Tc = %s s is below 2 samples: that is the sensor's filter, not a Gauss-Markov process",
+                format_num(tc))
+      }
+    },
     peak_tau = function(par) gm_peak_ratio * par[["tc"]],
     # Tc well below 1 s: white noise at every tau >= 1 s, AV -> 2 sigma^2 Tc / tau.
     fold = list(into = "white", when = function(par) is.finite(par[["tc"]]) && par[["tc"]] < 0.1,
