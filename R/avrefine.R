@@ -208,6 +208,10 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         # Parameters the raw data measure better than the curve (a line's
         # frequency from the periodogram) are pinned there.
         pin <- pin_values(current$terms, tr$effect, tr$pin[[1L]])
+        # a value already pinned in the model (that line is in it) is not
+        # proposed twice
+        if (length(pin) && any(vapply(pin, function(v) any(abs(settings$fixed - v) <=
+              1e-9 * abs(v)), logical(1)))) next
         new <- refit_with(current, model_terms(current$terms, tr$effect), tr$effect,
                           tr$init[[1L]], settings, hold = c(hold_now, pin),
                           good_enough = function(f) crit_s(f) < c0 - min_gain,
@@ -572,6 +576,10 @@ candidate_trials <- function(traced, present, candidates, sig) {
     if (nrow(t)) {
       nonlinear <- any(effect_entry(k)$params$role == "nonlinear")
       take <- if (nonlinear) seq_len(min(2L, nrow(t))) else 1L
+      # every raw-data proposal that pins a value (each periodogram line)
+      # is tried, not only the two best-scoring starts
+      pinned <- which(lengths(t$pin) > 0L)
+      take <- union(take, pinned)
       t$traced <- rep(TRUE, nrow(t))
       rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
     } else {

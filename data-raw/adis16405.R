@@ -22,6 +22,44 @@ stopifnot(dir.exists(shared))
 options(allanvar.threads = 1L)
 
 units <- c(gyro = "deg/s", accel = "g")
+check_rows <- list()
+
+# Issue 9's Done-when checks for one axis: contradicted steps, the filter
+# term (present where the lag-1 ACF is positive; its noise-equivalent
+# bandwidth), the 0.55 Hz line, chi2/dof, and N against the white level
+# read where the ADEV slope is -1/2 (local slope within 0.1 of it, tau
+# 0.04-10 s: beyond the filter's bend), as the median of adev * sqrt(tau).
+check_axis <- function(x, freq, av, dg, ref) {
+  tau <- av$tau; adev <- av$adev
+  sl <- c(NA, diff(log(adev)) / diff(log(tau)))
+  ok <- is.finite(sl) & abs(sl + 0.5) < 0.1 & tau >= 0.04 & tau <= 10
+  n_ref <- if (any(ok)) stats::median(adev[ok] * sqrt(tau[ok])) else NA_real_
+  cf <- coef(ref)
+  has_filter <- any(grepl("^filter", ref$terms))
+  n_fit <- if ("N" %in% names(cf)) cf[["N"]] else if (has_filter)
+    cf[[grep("Nf$", names(cf), value = TRUE)[1]]] else NA_real_
+  enbw <- NA_real_
+  if (has_filter) {
+    L <- cf[grep("\\.L$", names(cf), value = TRUE)[1]]
+    if (length(L) && is.finite(L)) {
+      enbw <- filter_bandwidth(list(family = "ma", L = max(1, L)), 1 / freq)$enbw
+    }
+  }
+  f0 <- cf[grepl("\\.f0$", names(cf))]
+  st <- ref$steps
+  data.frame(acf1 = dg$acf1, filter = has_filter, enbw = enbw,
+             line_055 = any(f0 > 0.5 & f0 < 0.6),
+             sinusoids = paste(signif(sort(f0), 3), collapse = " "),
+             contradicted = sum(st$confirmed %in% FALSE),
+             chi2 = ref$chi2, n_fit = n_fit, n_ref = n_ref,
+             n_err = 100 * (n_fit / n_ref - 1),
+             converged = isTRUE(ref$convergence$converged),
+             unexplained = NROW(ref$unexplained),
+             tau_from = if (is.null(ref$refine$tau_range)) min(ref$data$tau)
+               else ref$refine$tau_range[1],
+             effects = if (nrow(st)) paste(st$effect, collapse = ",") else "",
+             stringsAsFactors = FALSE)
+}
 av_rows <- list(); diag_rows <- list(); line_rows <- list()
 coef_rows <- list(); step_rows <- list(); fit_rows <- list(); noise_rows <- list()
 fits <- list()
@@ -75,6 +113,7 @@ for (k in 1:3) {
       failed_refits = NROW(ref$refine$failures),
       stringsAsFactors = FALSE))
     fits[[id]] <- list(datasheet = fit0, refined = ref)
+    check_rows[[id]] <- cbind(key, check_axis(x, freq, av, dg, ref))
     cat(sprintf("%-14s chi2 %8.1f -> %7.2f  rms %5.1f%% -> %5.1f%%  [%s]  %.0f s\n", id,
                 fit0$chi2, ref$chi2, fit0$rms, ref$rms,
                 fit_rows[[id]]$effects, as.numeric(Sys.time() - t0, units = "secs")))
@@ -82,6 +121,17 @@ for (k in 1:3) {
 }
 
 bind <- function(l) { out <- do.call(rbind, l); rownames(out) <- NULL; out }
+check <- bind(check_rows)
+writeLines(capture.output({
+  cat("Issue 9 Done-when checks on the 18 ADIS16405 axes (from N, B, K, raw data given)\n\n")
+  print(transform(check, acf1 = round(acf1, 3), enbw = round(enbw, 1),
+                  chi2 = round(chi2, 2), n_fit = signif(n_fit, 4),
+                  n_ref = signif(n_ref, 4), n_err = round(n_err, 1)),
+        row.names = FALSE)
+  bw <- tapply(check$enbw, check$sensor, function(v) diff(range(v, na.rm = TRUE)) /
+                 mean(v, na.rm = TRUE) * 100)
+  cat("\nENBW spread per sensor type (range / mean, %):\n"); print(round(bw, 1))
+}), "data-raw/adis16405-check.txt")
 adis16405_av <- list(
   av = bind(av_rows), diagnostics = bind(diag_rows), lines = bind(line_rows),
   noise_id = bind(noise_rows), fits = bind(fit_rows), coef = bind(coef_rows),
