@@ -25,6 +25,34 @@
 #'    least 10 percent;
 #' 4. repeats until nothing pays or `max_steps` effects were added.
 #'
+#' The rules of acceptance (issue 9):
+#' * Candidates are compared by the criterion, not gated by a residual
+#'   threshold: with no residual signature left, every candidate is still
+#'   tried (screening pass only).
+#' * An effect the raw data contradict is never accepted, nor an instance
+#'   the catalogue declares not valid on this curve (a Gauss-Markov process
+#'   with \eqn{T_c} below 2 samples is the sensor's filter; a sinusoid outside
+#'   the band the curve can see, \eqn{1/\tau_{max}} to
+#'   \eqn{1/(2\tau_{min})}, or above Nyquist). Both are listed in
+#'   `$refine$rejected`.
+#' * An effect may replace a term (the catalogue's `replaces`): the filter
+#'   term replaces `N`, whose value it carries as its DC level.
+#' * A sinusoid proposed by a periodogram line keeps the line's frequency
+#'   (the periodogram measures it far better than the curve) and is matched
+#'   to lines within the periodogram's resolution. Raw-data checks of the
+#'   other effects see the series with the significant lines removed.
+#' * What no catalogue effect explains is reported in `$unexplained`, not
+#'   papered over. When a run at the short-tau end stays unexplained, the
+#'   model is refitted from the first tau after it (a message says so and
+#'   `$refine$tau_range` records it), so that points the model cannot
+#'   describe do not drive `N` to 0 or bend the long-tau terms.
+#' * Without raw data, `$refine$unconfirmed` lists the accepted effects that
+#'   could not be confirmed.
+#' * With raw data, the series' non-stationary effects (steps, warm-up,
+#'   spikes) are read first by `series_effects()` when the package has it,
+#'   kept in `$series`, and removed from the data only when named in
+#'   `remove`.
+#'
 #' For speed, candidates are first screened with the nonlinear parameters
 #' already in the model (`tc`, `f0`) held at their current values, and the
 #' winner is refitted with all of them free; only when screening finds
@@ -45,11 +73,9 @@
 #' the evidence. Candidates traced from a signature (or proposed by the raw
 #' data) are tried first, the others only when none of those pays. Among
 #' the candidates that pay, the one with the lowest criterion wins, where
-#' raw-data support counts as a gain of `min_gain` and a contradiction as a
-#' loss of `min_gain` (so an effect the raw data contradict must lower the
-#' criterion by twice `min_gain`). An accepted effect that the raw data
-#' contradict is kept (it pays on the curve) but flagged
-#' `confirmed = FALSE`.
+#' raw-data support counts as a gain of `min_gain`. A candidate the raw data
+#' contradict is not accepted (see `$refine$rejected`), so `confirmed` is
+#' never `FALSE` for a step of this loop.
 #'
 #' @param fit An [avfit()] result.
 #' @param data Optional raw rate series (numeric vector or `ts`) at the
@@ -64,6 +90,8 @@
 #'   not trusted).
 #' @param level Strength, in standard deviations, a residual run must reach
 #'   to count as structure.
+#' @param remove Series effects to take out of `data` before the loop (kinds
+#'   of the catalogue's series components); never done unless asked.
 #' @param ... Passed to [avfit()] on each refit.
 #' @return The refined `avfit` object. Its `steps` data frame has one row
 #'   per accepted step with columns `effect` (as named in [avsim()]),
@@ -78,7 +106,12 @@
 #'   arguments, the raw-data diagnostics ([avdiagnose()]) and the
 #'   signatures left when the loop stopped and `failures` (a data frame
 #'   `step`, `effect`, `stage`, `message`, with the conditions in the list
-#'   column `condition`). The object keeps class `avfit`
+#'   column `condition`), `rejected` (step, effect, params, reason),
+#'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range) and
+#'   `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,
+#'   strength in sigma, size = largest ADEV error inside in percent,
+#'   description) and `series` the series pass (or NULL). The object keeps
+#'   class `avfit`
 #'   (with `avrefine` in front, whose print method lists the steps), so
 #'   every avfit method applies.
 #' @seealso [avfit()], [avdiagnose()], [avsim()]
