@@ -173,6 +173,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       series_effects(data, freq, remove = remove) else NULL
     if (!is.null(ser) && length(ser$removed)) data <- ser$x
     raw <- avdiagnose(data, freq)
+    # Bins of a broad band (a resonance) are not lines: they are not
+    # proposed or matched as sinusoids.
+    raw$lines <- lines_outside_bands(raw$lines, find_bands(data, freq))
   }
   # The series the raw-data checks of an effect see: the data with the
   # significant periodogram lines taken out (a sinusoid disturbs the ACF
