@@ -24,42 +24,9 @@ options(allanvar.threads = 1L)
 units <- c(gyro = "deg/s", accel = "g")
 check_rows <- list()
 
-# Issue 9's Done-when checks for one axis: contradicted steps, the filter
-# term (present where the lag-1 ACF is positive; its noise-equivalent
-# bandwidth), the 0.55 Hz line, chi2/dof, and N against the white level
-# read where the ADEV slope is -1/2 (local slope within 0.1 of it, tau
-# 0.04-10 s: beyond the filter's bend), as the median of adev * sqrt(tau).
-check_axis <- function(x, freq, av, dg, ref) {
-  tau <- av$tau; adev <- av$adev
-  sl <- c(NA, diff(log(adev)) / diff(log(tau)))
-  ok <- is.finite(sl) & abs(sl + 0.5) < 0.1 & tau >= 0.04 & tau <= 10
-  n_ref <- if (any(ok)) stats::median(adev[ok] * sqrt(tau[ok])) else NA_real_
-  cf <- coef(ref)
-  has_filter <- any(grepl("^filter", ref$terms))
-  n_fit <- if ("N" %in% names(cf)) cf[["N"]] else if (has_filter)
-    cf[[grep("Nf$", names(cf), value = TRUE)[1]]] else NA_real_
-  enbw <- NA_real_
-  if (has_filter) {
-    L <- cf[grep("\\.L$", names(cf), value = TRUE)[1]]
-    if (length(L) && is.finite(L)) {
-      enbw <- filter_bandwidth(list(family = "ma", L = max(1, L)), 1 / freq)$enbw
-    }
-  }
-  f0 <- cf[grepl("\\.f0$", names(cf))]
-  st <- ref$steps
-  data.frame(acf1 = dg$acf1, filter = has_filter, enbw = enbw,
-             line_055 = any(f0 > 0.5 & f0 < 0.6),
-             sinusoids = paste(signif(sort(f0), 3), collapse = " "),
-             contradicted = sum(st$confirmed %in% FALSE),
-             chi2 = ref$chi2, n_fit = n_fit, n_ref = n_ref,
-             n_err = 100 * (n_fit / n_ref - 1),
-             converged = isTRUE(ref$convergence$converged),
-             unexplained = NROW(ref$unexplained),
-             tau_from = if (is.null(ref$refine$tau_range)) min(ref$data$tau)
-               else ref$refine$tau_range[1],
-             effects = if (nrow(st)) paste(st$effect, collapse = ",") else "",
-             stringsAsFactors = FALSE)
-}
+# check_axis(): issue 9's Done-when checks for one axis.
+adis_check_define_only <- TRUE
+source("data-raw/adis16405-check.R")
 av_rows <- list(); diag_rows <- list(); line_rows <- list()
 coef_rows <- list(); step_rows <- list(); fit_rows <- list(); noise_rows <- list()
 fits <- list()
