@@ -264,22 +264,44 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         # An added term that explains (almost) nothing anywhere is a refit
         # artefact, not an effect.
         if (max_share(new, lab) < 0.02) next
-        par <- instance_params(stats::coef(new), new$layout, lab)
         # An instance that is not a valid instance of its effect on this
         # curve (a sub-sample GM, a sinusoid the curve cannot see) is never
-        # accepted, however well it bends the curve.
-        why <- inadmissible(tr$effect, par, tau, freq)
-        if (!is.null(why)) {
-          rejected <- add_rejected(rejected, step, tr$effect, par, why)
-          next
+        # accepted, however well it bends the curve; nor one the raw data
+        # contradict. A screened instance (others held) that fails is
+        # refitted once with everything free before it is rejected: held
+        # at the one-term compromise, a second GM lands at the wrong Tc.
+        judge <- function(f) {
+          par <- instance_params(stats::coef(f), f$layout, lab)
+          why <- inadmissible(tr$effect, par, tau, freq)
+          ev <- if (is.null(why)) raw_evidence(tr$effect, as.list(par), raw,
+                                               evidence_series(tr$effect), freq)
+          if (is.null(why) && isFALSE(ev$support)) {
+            why <- paste("contradicted by the raw data:", ev$text)
+          }
+          list(par = par, why = why, ev = ev)
         }
-        ev <- raw_evidence(tr$effect, as.list(par), raw,
-                           evidence_series(tr$effect), freq)
-        # An effect the raw data contradict is never accepted; support
-        # weighs min_gain criterion units in the comparison.
-        if (isFALSE(ev$support)) {
-          rejected <- add_rejected(rejected, step, tr$effect, par,
-                                   paste("contradicted by the raw data:", ev$text))
+        jd <- judge(new)
+        if (!is.null(jd$why) && length(hold_now)) {
+          args <- refit_args(current, new$terms, settings,
+                             start = stats::coef(new)[new$layout$role == "nonlinear"],
+                             hold = pin)
+          free <- try_refit(args, function(cnd, stage) {
+            failures <<- add_failure(failures, cnd, step, tr$effect, stage)
+          }, "free refit of a rejected screen")
+          if (!is.null(free) && is.finite(crit(free)) && crit(free) < c0 - min_gain &&
+              free$chi2 < 0.9 * current$chi2) {
+            jf <- judge(free)
+            if (is.null(jf$why)) {
+              new <- free
+              c1 <- crit(free)
+              jd <- jf
+            }
+          }
+        }
+        par <- jd$par
+        ev <- jd$ev
+        if (!is.null(jd$why)) {
+          rejected <- add_rejected(rejected, step, tr$effect, par, jd$why)
           next
         }
         adj <- c1 - min_gain * isTRUE(ev$support)
