@@ -213,8 +213,10 @@ fit_search <- function(pr, start, prev, control) {
           count <- count + o$counts[["function"]]
           gain <- v0 - o$value
           if (o$value <= v0) lognl <- o$par
+          # (a restart too short to move the simplex proves nothing)
           if (o$convergence == 0L ||
-              (restart > 1L && gain <= control$reltol * (abs(v0) + control$reltol))) {
+              (restart > 1L && o$counts[["function"]] >= 20L * length(lognl) &&
+               gain <= control$reltol * (abs(v0) + control$reltol))) {
             conv <- 0L
             break
           }
