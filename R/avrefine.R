@@ -323,9 +323,18 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         failures <<- add_failure(failures, cnd, step, best$trial$effect, stage)
       }, "refit of the winner")
       if (!is.null(full) && crit(full) <= best$crit + 1e-6) {
-        best$fit <- full
-        best$crit <- crit(full)
-        best$params <- instance_params(stats::coef(full), full$layout, best$label)
+        # the evidence is read again at the values the free refit gives;
+        # a refit the raw data contradict is not taken
+        p2 <- instance_params(stats::coef(full), full$layout, best$label)
+        ev2 <- raw_evidence(best$trial$effect, as.list(p2), raw,
+                            evidence_series(best$trial$effect), freq)
+        if (!isFALSE(ev2$support) &&
+            is.null(inadmissible(best$trial$effect, p2, tau, freq))) {
+          best$fit <- full
+          best$crit <- crit(full)
+          best$params <- p2
+          best$ev <- ev2
+        }
       }
     }
     tr <- best$trial
