@@ -25,6 +25,34 @@
 #'    least 10 percent;
 #' 4. repeats until nothing pays or `max_steps` effects were added.
 #'
+#' The rules of acceptance (issue 9):
+#' * Candidates are compared by the criterion, not gated by a residual
+#'   threshold: with no residual signature left, every candidate is still
+#'   tried (screening pass only).
+#' * An effect the raw data contradict is never accepted, nor an instance
+#'   the catalogue declares not valid on this curve (a Gauss-Markov process
+#'   with \eqn{T_c} below 2 samples is the sensor's filter; a sinusoid outside
+#'   the band the curve can see, \eqn{1/\tau_{max}} to
+#'   \eqn{1/(2\tau_{min})}, or above Nyquist). Both are listed in
+#'   `$refine$rejected`.
+#' * An effect may replace a term (the catalogue's `replaces`): the filter
+#'   term replaces `N`, whose value it carries as its DC level.
+#' * A sinusoid proposed by a periodogram line keeps the line's frequency
+#'   (the periodogram measures it far better than the curve) and is matched
+#'   to lines within the periodogram's resolution. Raw-data checks of the
+#'   other effects see the series with the significant lines removed.
+#' * What no catalogue effect explains is reported in `$unexplained`, not
+#'   papered over. When a run at the short-tau end stays unexplained, the
+#'   model is refitted from the first tau after it (a message says so and
+#'   `$refine$tau_range` records it), so that points the model cannot
+#'   describe do not drive `N` to 0 or bend the long-tau terms.
+#' * Without raw data, `$refine$unconfirmed` lists the accepted effects that
+#'   could not be confirmed.
+#' * With raw data, the series' non-stationary effects (steps, warm-up,
+#'   spikes) are read first by `series_effects()` when the package has it,
+#'   kept in `$series`, and removed from the data only when named in
+#'   `remove`.
+#'
 #' For speed, candidates are first screened with the nonlinear parameters
 #' already in the model (`tc`, `f0`) held at their current values, and the
 #' winner is refitted with all of them free; only when screening finds
@@ -45,11 +73,9 @@
 #' the evidence. Candidates traced from a signature (or proposed by the raw
 #' data) are tried first, the others only when none of those pays. Among
 #' the candidates that pay, the one with the lowest criterion wins, where
-#' raw-data support counts as a gain of `min_gain` and a contradiction as a
-#' loss of `min_gain` (so an effect the raw data contradict must lower the
-#' criterion by twice `min_gain`). An accepted effect that the raw data
-#' contradict is kept (it pays on the curve) but flagged
-#' `confirmed = FALSE`.
+#' raw-data support counts as a gain of `min_gain`. A candidate the raw data
+#' contradict is not accepted (see `$refine$rejected`), so `confirmed` is
+#' never `FALSE` for a step of this loop.
 #'
 #' @param fit An [avfit()] result.
 #' @param data Optional raw rate series (numeric vector or `ts`) at the
@@ -64,6 +90,8 @@
 #'   not trusted).
 #' @param level Strength, in standard deviations, a residual run must reach
 #'   to count as structure.
+#' @param remove Series effects to take out of `data` before the loop (kinds
+#'   of the catalogue's series components); never done unless asked.
 #' @param ... Passed to [avfit()] on each refit.
 #' @return The refined `avfit` object. Its `steps` data frame has one row
 #'   per accepted step with columns `effect` (as named in [avsim()]),
@@ -78,7 +106,12 @@
 #'   arguments, the raw-data diagnostics ([avdiagnose()]) and the
 #'   signatures left when the loop stopped and `failures` (a data frame
 #'   `step`, `effect`, `stage`, `message`, with the conditions in the list
-#'   column `condition`). The object keeps class `avfit`
+#'   column `condition`), `rejected` (step, effect, params, reason),
+#'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range) and
+#'   `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,
+#'   strength in sigma, size = largest ADEV error inside in percent,
+#'   description) and `series` the series pass (or NULL). The object keeps
+#'   class `avfit`
 #'   (with `avrefine` in front, whose print method lists the steps), so
 #'   every avfit method applies.
 #' @seealso [avfit()], [avdiagnose()], [avsim()]
@@ -91,7 +124,7 @@
 #' ref$steps[, c("effect", "params", "chi2_before", "chi2_after")]
 avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
                      max_steps = 5, criterion = "BIC", min_gain = 10,
-                     level = 3.5, ...) {
+                     level = 3.5, remove = character(), ...) {
   check_present(missing(fit), "fit", "an avfit() result")
   if (!inherits(fit, "avfit")) {
     abort("`fit` must be an avfit() result, not ", describe_type(fit), ".",
@@ -116,7 +149,12 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   min_gain <- check_number(min_gain, "min_gain", 0)
   level <- check_number(level, "level", 0, open = TRUE)
   freq <- fit$freq
+  remove <- check_remove(remove)
+  if (length(remove) && is.null(data)) {
+    abort("`remove` needs the raw series: give `data`.", class = "argument")
+  }
   raw <- NULL
+  ser <- NULL
   if (!is.null(data)) {
     if (stats::is.ts(data) && !is.null(freq) &&
         abs(stats::frequency(data) - freq) > 1e-6 * freq) {
@@ -130,8 +168,30 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     }
     data <- check_values(data, min_n = 256L, arg = "data")
     check_diagnosable(data, "data")
+    # Non-stationary effects (steps, warm-up, spikes) are read from the
+    # series first (R/series.R, when present); what the user asks to remove
+    # is taken out of the data the loop then sees.
+    ser <- if (exists("series_effects", mode = "function"))
+      series_effects(data, freq, remove = remove) else NULL
+    if (!is.null(ser) && length(ser$removed)) data <- ser$x
     raw <- avdiagnose(data, freq)
+    # Bins of a broad band (a resonance) are not lines: they are not
+    # proposed or matched as sinusoids.
+    raw$lines <- lines_outside_bands(raw$lines, find_bands(data, freq))
   }
+  # The series the raw-data checks of an effect see: the data with the
+  # significant periodogram lines taken out (a sinusoid disturbs the ACF
+  # that confirms a Gauss-Markov process; the line checks read the
+  # periodogram, not this series). Computed once, when first needed.
+  clean <- NULL
+  evidence_series <- function(effect) {
+    if (is.null(data)) return(NULL)
+    if (is.null(clean)) {
+      clean <<- if (nrow(raw$lines)) remove_lines(data, freq, raw$lines$f0) else data
+    }
+    clean
+  }
+  rejected <- new_rejected()
   # The settings every refit uses, explicitly: the fit's own, overridden by
   # the arguments in `...`.
   settings <- utils::modifyList(
@@ -149,7 +209,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     tau <- current$data$tau
     z <- stats::residuals(current)
     sig <- residual_signatures(tau, z, level = level)
-    if (!nrow(sig)) break
+    # No residual threshold gates the search: with no signature every
+    # candidate is still asked, and only the criterion decides (two GMs a
+    # decade apart leave no run reaching `level` for the second one).
     traced <- trace_candidates(tau, current$data$avar, current$data$fitted, sig,
                                present = current$terms, candidates = candidates,
                                raw = raw)
@@ -161,6 +223,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     # the winner is then refitted with everything free. The criterion of a
     # screened fit is put on the all-free scale by charging the held ones.
     nl_now <- stats::coef(current)[current$layout$role == "nonlinear"]
+    nl_now <- nl_now[!names(nl_now) %in% names(settings$fixed)]
     pen <- if (criterion == "BIC") log(current$nobs) else 2
     crit_s <- function(f) crit(f) + pen * length(hold_now)
     best <- NULL
@@ -168,7 +231,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     # all nonlinear parameters free (slower, but catches effects that only
     # pay once the others may move). Traced candidates first; the others
     # only when none of those pays.
-    holds <- if (length(nl_now)) list(nl_now, numeric(0)) else list(numeric(0))
+    # (Without any residual signature, only the screening pass is run.)
+    holds <- if (length(nl_now) && nrow(sig)) list(nl_now, numeric(0))
+      else if (length(nl_now)) list(nl_now) else list(numeric(0))
     passes <- list()
     for (h in holds) {
       passes[[length(passes) + 1L]] <- list(hold = h, tier = which(trials$traced))
@@ -178,8 +243,15 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       hold_now <- pass$hold
       for (i in pass$tier) {
         tr <- trials[i, ]
-        new <- refit_with(current, c(current$terms, tr$effect), tr$effect,
-                          tr$init[[1L]], settings, hold = hold_now,
+        # Parameters the raw data measure better than the curve (a line's
+        # frequency from the periodogram) are pinned there.
+        pin <- pin_values(current$terms, tr$effect, tr$pin[[1L]])
+        # a value already pinned in the model (that line is in it) is not
+        # proposed twice
+        if (length(pin) && any(vapply(pin, function(v) any(abs(settings$fixed - v) <=
+              1e-9 * abs(v)), logical(1)))) next
+        new <- refit_with(current, model_terms(current$terms, tr$effect), tr$effect,
+                          tr$init[[1L]], settings, hold = c(hold_now, pin),
                           good_enough = function(f) crit_s(f) < c0 - min_gain,
                           record = function(cnd, stage) {
                             failures <<- add_failure(failures, cnd, step,
@@ -194,19 +266,55 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         # An added term that explains (almost) nothing anywhere is a refit
         # artefact, not an effect.
         if (max_share(new, lab) < 0.02) next
-        par <- instance_params(stats::coef(new), new$layout, lab)
-        ev <- raw_evidence(tr$effect, as.list(par), raw, data, freq)
-        # Raw-data support or contradiction weighs min_gain criterion units;
-        # an effect the raw data contradict must pay twice the margin.
-        adj <- c1 - min_gain * (isTRUE(ev$support) - isFALSE(ev$support))
-        if (isFALSE(ev$support) && !(adj < c0 - min_gain)) next
+        # An instance that is not a valid instance of its effect on this
+        # curve (a sub-sample GM, a sinusoid the curve cannot see) is never
+        # accepted, however well it bends the curve; nor one the raw data
+        # contradict. A screened instance (others held) that fails is
+        # refitted once with everything free before it is rejected: held
+        # at the one-term compromise, a second GM lands at the wrong Tc.
+        judge <- function(f) {
+          par <- instance_params(stats::coef(f), f$layout, lab)
+          why <- inadmissible(tr$effect, par, tau, freq)
+          ev <- if (is.null(why)) raw_evidence(tr$effect, as.list(par), raw,
+                                               evidence_series(tr$effect), freq)
+          if (is.null(why) && isFALSE(ev$support)) {
+            why <- paste("contradicted by the raw data:", ev$text)
+          }
+          list(par = par, why = why, ev = ev)
+        }
+        jd <- judge(new)
+        if (!is.null(jd$why) && length(hold_now)) {
+          args <- refit_args(current, new$terms, settings,
+                             start = stats::coef(new)[new$layout$role == "nonlinear"],
+                             hold = pin)
+          free <- try_refit(args, function(cnd, stage) {
+            failures <<- add_failure(failures, cnd, step, tr$effect, stage)
+          }, "free refit of a rejected screen")
+          if (!is.null(free) && is.finite(crit(free)) && crit(free) < c0 - min_gain &&
+              free$chi2 < 0.9 * current$chi2) {
+            jf <- judge(free)
+            if (is.null(jf$why)) {
+              new <- free
+              c1 <- crit(free)
+              jd <- jf
+            }
+          }
+        }
+        par <- jd$par
+        ev <- jd$ev
+        if (!is.null(jd$why)) {
+          rejected <- add_rejected(rejected, step, tr$effect, par, jd$why)
+          next
+        }
+        adj <- c1 - min_gain * isTRUE(ev$support)
         cand <- list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
-                     params = par, ev = ev)
+                     params = par, ev = ev, pin = pin)
         if (is.null(best) || adj < best$adj) best <- cand
       }
       if (!is.null(best)) break
     }
     if (is.null(best)) break
+    if (length(best$pin)) settings$fixed <- c(settings$fixed, best$pin)
     # Refit the winner with the held nonlinear parameters free again (the new
     # one starts where screening put it).
     if (length(hold_now)) {
@@ -217,9 +325,18 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         failures <<- add_failure(failures, cnd, step, best$trial$effect, stage)
       }, "refit of the winner")
       if (!is.null(full) && crit(full) <= best$crit + 1e-6) {
-        best$fit <- full
-        best$crit <- crit(full)
-        best$params <- instance_params(stats::coef(full), full$layout, best$label)
+        # the evidence is read again at the values the free refit gives;
+        # a refit the raw data contradict is not taken
+        p2 <- instance_params(stats::coef(full), full$layout, best$label)
+        ev2 <- raw_evidence(best$trial$effect, as.list(p2), raw,
+                            evidence_series(best$trial$effect), freq)
+        if (!isFALSE(ev2$support) &&
+            is.null(inadmissible(best$trial$effect, p2, tau, freq))) {
+          best$fit <- full
+          best$crit <- crit(full)
+          best$params <- p2
+          best$ev <- ev2
+        }
       }
     }
     tr <- best$trial
@@ -242,11 +359,48 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     current <- best$fit
   }
   all_steps <- Reduce(bind_steps, steps, fit$steps)
+  # What is left: residual structure no catalogue effect explained.
+  sig <- residual_signatures(current$data$tau, stats::residuals(current), level = level)
+  unexplained <- unexplained_table(sig, current)
+  # Short tau cannot hijack the fit: when the model still cannot describe a
+  # run of first points, they are left out of the fit (an automatic tau
+  # range, with a message) so that they do not drive N to 0 or bend the
+  # long-tau terms; the run stays listed as unexplained.
+  tau_range <- NULL
+  short <- unexplained[unexplained$kind == "short_end", , drop = FALSE]
+  if (nrow(short)) {
+    tau_all <- current$data$tau
+    keep_from <- min(tau_all[tau_all > short$tau_to[1L]], Inf)
+    if (sum(tau_all >= keep_from) >= length(current$coefficients) + 3L) {
+      args <- refit_args(current, current$terms, settings,
+                         start = stats::coef(current)[current$layout$role == "nonlinear"])
+      args$tau_range <- c(keep_from, Inf)
+      trimmed <- try_refit(args, function(cnd, stage) {
+        failures <<- add_failure(failures, cnd, length(steps) + 1L, "tau_range", stage)
+      }, "refit without the first points")
+      if (!is.null(trimmed)) {
+        tau_range <- c(keep_from, max(tau_all))
+        message(sprintf(paste(
+          "avrefine(): no catalogue effect describes the first points (tau %s-%s s);",
+          "the model is fitted from tau = %s s on (see $unexplained)."),
+          format_num(short$tau_from[1L]), format_num(short$tau_to[1L]),
+          format_num(keep_from)))
+        current <- trimmed
+      }
+    }
+  }
   current$steps <- all_steps
+  current$unexplained <- unexplained
+  # Curve only: the accepted effects the raw data could not confirm.
+  new_steps_df <- all_steps[seq_len(nrow(all_steps)) > NROW(fit$steps), , drop = FALSE]
+  unconfirmed <- if (is.null(data)) new_steps_df$label else character()
+  current$series <- ser
   current$refine <- list(candidates = candidates, criterion = criterion,
                          min_gain = min_gain, level = level, diagnostics = raw,
                          remaining = sig, start_terms = fit$terms,
-                         failures = failures)
+                         failures = failures, rejected = rejected,
+                         unconfirmed = unconfirmed, tau_range = tau_range,
+                         removed = if (is.null(ser)) character() else ser$removed)
   class(current) <- unique(c("avrefine", class(current)))
   validate_avfit(current)
 }
@@ -256,6 +410,40 @@ print.avrefine <- function(x, ...) {
   NextMethod()
   cat("\n")
   print_steps(x)
+  print_refine_notes(x)
+  invisible(x)
+}
+
+# The loop's notes after the steps: what could not be confirmed, what is
+# left unexplained, the automatic tau range, the series effects.
+print_refine_notes <- function(x) {
+  r <- x$refine
+  if (length(r$unconfirmed)) {
+    cat("Without raw data these effects could not be confirmed: ",
+        paste(r$unconfirmed, collapse = ", "), ".\n", sep = "")
+  }
+  nr <- NROW(r$rejected)
+  if (nr) {
+    cat(nr, " candidate(s) rejected (contradicted by the raw data or not a valid ",
+        "instance); see $refine$rejected.\n", sep = "")
+  }
+  u <- x$unexplained
+  if (NROW(u)) {
+    cat("Unexplained by any catalogue effect:\n")
+    cat(sprintf("  tau %s-%s s: %s (ADEV off by up to %.1f%%)\n",
+                format_num(u$tau_from), format_num(u$tau_to), u$description,
+                u$size), sep = "")
+  }
+  if (!is.null(r$tau_range)) {
+    cat(sprintf("Fitted from tau = %s s on: the first points are not described by any catalogue effect.\n",
+                format_num(r$tau_range[1L])))
+  }
+  if (!is.null(x$series)) {
+    nt <- NROW(x$series$table)
+    cat(sprintf("Series effects (steps, warm-up, spikes): %d found%s.\n", nt,
+                if (length(x$series$removed)) paste0(", removed: ",
+                  paste(x$series$removed, collapse = ", ")) else ", none removed"))
+  }
   invisible(x)
 }
 
@@ -272,6 +460,13 @@ refit_args <- function(fit, terms, settings, start = NULL, hold = NULL) {
   st <- c(st, prev)
   args$start <- if (length(st)) st else NULL
   if (length(hold)) args$fixed <- c(settings$fixed, hold)
+  if (length(args$fixed)) {
+    args$fixed <- args$fixed[!duplicated(names(args$fixed))]
+    if (length(args$start)) {
+      args$start <- args$start[!names(args$start) %in% names(args$fixed)]
+      if (!length(args$start)) args$start <- NULL
+    }
+  }
   args
 }
 
@@ -324,6 +519,88 @@ refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
   best
 }
 
+# ---- rules ------------------------------------------------------------------
+
+# A trial's pinned values (named by parameter) as coefficients of the term
+# `effect` would get next to `terms`.
+pin_values <- function(terms, effect, pin) {
+  if (!length(pin)) return(NULL)
+  sp <- split_term(effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  lab <- new_label(terms, effect)
+  pin <- unlist(pin)
+  j <- match(names(pin), e$params$name)
+  out <- pin[!is.na(j)]
+  names(out) <- coef_names(e, lab)[j[!is.na(j)]]
+  out
+}
+
+# The model after adding `effect`: the kinds the effect's entry replaces
+# (the filter replaces N) leave.
+model_terms <- function(terms, effect) {
+  sp <- split_term(effect)
+  gone <- effect_entry(sp$kind, sp$variant)$replaces
+  c(terms[!split_term(terms)$kind %in% gone], effect)
+}
+
+# Kinds that may still be added next to `present`: repeatable ones or those
+# absent, and never one that a present term replaced.
+addable_kind <- function(kind, present) {
+  pk <- split_term(present)$kind
+  replaced <- unlist(lapply(unique(pk), function(k) effect_entry(k)$replaces))
+  e <- effect_entry(kind)
+  !kind %in% replaced && (e$repeatable || !kind %in% pk)
+}
+
+# NULL when a fitted instance is valid on this curve, else the reason.
+inadmissible <- function(effect, par, tau, freq) {
+  sp <- split_term(effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  if (is.null(e$admissible)) return(NULL)
+  e$admissible(as.list(par), tau, freq)
+}
+
+new_rejected <- function() {
+  data.frame(step = integer(), effect = character(), params = character(),
+             reason = character(), stringsAsFactors = FALSE)
+}
+
+add_rejected <- function(rejected, step, effect, par, reason) {
+  rbind(rejected, data.frame(step = as.integer(step), effect = effect,
+                             params = format_params(par, effect),
+                             reason = reason, stringsAsFactors = FALSE))
+}
+
+# The residual structure left after the loop, as a table: kind, tau range,
+# strength (sigma) and size (largest relative ADEV error inside, percent).
+unexplained_table <- function(sig, fit) {
+  s <- sig[sig$kind != "oscillation", , drop = FALSE]
+  tau <- fit$data$tau
+  err <- 100 * abs(sqrt(fit$data$avar / fit$data$fitted) - 1)
+  size <- vapply(seq_len(nrow(s)), function(i) {
+    inr <- tau >= s$tau_from[i] & tau <= s$tau_to[i]
+    if (any(inr)) max(err[inr]) else NA_real_
+  }, 0)
+  data.frame(kind = s$kind, tau_from = s$tau_from, tau_to = s$tau_to,
+             strength = abs(s$strength), size = size,
+             description = s$description, stringsAsFactors = FALSE)
+}
+
+# `remove`: the series kinds to take out of the data (the catalogue's
+# "series" components when it has them).
+check_remove <- function(remove) {
+  kinds <- effect_kinds("series")
+  if (!is.character(remove) || anyNA(remove) ||
+      (length(kinds) && !all(remove %in% kinds))) {
+    abort("`remove` must name series effects",
+          if (length(kinds)) paste0(" among ", paste0("\"", kinds, "\"", collapse = ", ")),
+          ", not ", if (is.character(remove))
+            paste(encodeString(setdiff(remove, kinds), quote = '"'), collapse = ", ")
+          else describe_type(remove), ".", class = "argument")
+  }
+  unique(remove)
+}
+
 # ---- failures ---------------------------------------------------------------
 
 new_failures <- function() {
@@ -358,17 +635,20 @@ add_failure <- function(failures, cnd, step, effect, stage) {
 # with nonlinear parameters), or a generic start when no signature points
 # at that kind (the refit then decides).
 candidate_trials <- function(traced, present, candidates, sig) {
-  pk <- split_term(present)$kind
-  kinds <- candidates[vapply(candidates, function(k) {
-    effect_entry(k)$repeatable || !k %in% pk
-  }, logical(1))]
+  kinds <- candidates[vapply(candidates, addable_kind, logical(1), present = present)]
   rows <- list()
-  strongest <- sig[which.max(abs(sig$strength)), ]
+  strongest <- if (nrow(sig)) sig[which.max(abs(sig$strength)), ] else
+    data.frame(tau_from = NA_real_, tau_to = NA_real_,
+               description = "no residual signature", stringsAsFactors = FALSE)
   for (k in kinds) {
     t <- traced[traced$effect == k, , drop = FALSE]
     if (nrow(t)) {
       nonlinear <- any(effect_entry(k)$params$role == "nonlinear")
       take <- if (nonlinear) seq_len(min(2L, nrow(t))) else 1L
+      # every raw-data proposal that pins a value (each periodogram line)
+      # is tried, not only the two best-scoring starts
+      pinned <- which(lengths(t$pin) > 0L)
+      take <- union(take, pinned)
       t$traced <- rep(TRUE, nrow(t))
       rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
     } else {
@@ -377,14 +657,15 @@ candidate_trials <- function(traced, present, candidates, sig) {
         signature = paste0(strongest$description, " (no signature specific to ", k, ")"),
         score = 0, traced = FALSE, stringsAsFactors = FALSE)
       r$init <- list(list())
+      r$pin <- list(NULL)
       rows[[length(rows) + 1L]] <- r[, c("effect", "tau_from", "tau_to", "signature",
-                                         "score", "init", "traced")]
+                                         "score", "init", "pin", "traced")]
     }
   }
   if (!length(rows)) return(data.frame())
   do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
                                                 "signature", "score", "init",
-                                                "traced")]))
+                                                "pin", "traced")]))
 }
 
 # The residual signature that matches an accepted term: the one whose tau

@@ -38,6 +38,7 @@
 #   trace(ctx)  from a residual signature (see trace.R) to list(init =
 #                 start values, score = how well it matches), or NULL
 #   propose(raw, tau, sig)  candidates read from the raw-data diagnostics
+#                 (each may `pin` parameters the raw data measure better)
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
 #                 the raw series says about a fitted instance
@@ -54,6 +55,12 @@
 #   describe(values)  datasheet text for the instances of this kind added by
 #                 the loop (values: data frame, one row per instance)
 #   detect(x, freq), remove(x, freq, par)  for "series" components
+#   replaces    kinds this entry takes the place of when the loop adds it
+#                 (the filter replaces N: its DC level is the white level)
+#   admissible(par, tau, freq)  NULL when a fitted instance is a valid
+#                 instance of this effect on this curve, else the reason it
+#                 is not (a sub-sample GM is a filter; a sinusoid outside
+#                 the band the curve can see)
 
 .catalogue <- new.env(parent = emptyenv())
 
@@ -122,7 +129,8 @@ new_effect <- function(name, title, params, component = "av",
                        trace = NULL, propose = NULL, evidence = NULL,
                        peak_tau = NULL, reading = NULL, fold = NULL,
                        discrete = NULL, describe = NULL, detect = NULL,
-                       remove = NULL) {
+                       remove = NULL, replaces = character(),
+                       admissible = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -130,7 +138,8 @@ new_effect <- function(name, title, params, component = "av",
        edf_alpha = edf_alpha, nl_range = nl_range, trace = trace,
        propose = propose, evidence = evidence, peak_tau = peak_tau,
        reading = reading, fold = fold, discrete = discrete,
-       describe = describe, detect = detect, remove = remove)
+       describe = describe, detect = detect, remove = remove,
+       replaces = replaces, admissible = admissible)
 }
 
 validate_effect <- function(e) {
@@ -163,7 +172,7 @@ validate_effect <- function(e) {
   fun_ok <- function(f) is.null(f) || is.function(f)
   for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
               "nl_range", "trace", "propose", "evidence", "peak_tau",
-              "discrete", "describe", "detect", "remove")) {
+              "discrete", "describe", "detect", "remove", "admissible")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
   if (!is.null(e$variants) && !is.function(e$variants)) {
@@ -194,6 +203,10 @@ validate_effect <- function(e) {
   }
   if (!is.null(e$fold) && !all(c("into", "when", "amount") %in% names(e$fold))) {
     bad("`fold` needs into, when and amount.")
+  }
+  if (is.null(e$replaces)) e$replaces <- character()
+  if (!is.character(e$replaces) || anyNA(e$replaces)) {
+    bad("`replaces` must name effect kinds.")
   }
   if (is.null(e$describe)) e$describe <- function(values) e$name
   # Coefficients are written bare ("N") when the entry is a single

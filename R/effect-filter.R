@@ -91,7 +91,9 @@ effect_filter <- function() {
     fold = list(into = "white", when = function(par) TRUE,
                 amount = function(par) par[["Nf"]]^2,
                 note = "white level of the filtered term"),
-    describe = function(values) "filter (the sensor's averaging)"
+    describe = function(values) "filter (the sensor's averaging)",
+    # the filtered white term carries the white level itself (N^2 = S(0))
+    replaces = "N"
   )
   e
 }

@@ -78,7 +78,10 @@ evidence_gm <- function(par, raw, x, freq) {
   if (is.finite(a$tc) && a$z > 5) {
     list(text = sprintf("exponential ACF of %s-sample means, Tc = %s s (z = %.1f)",
                         a$m, format_num(a$tc), a$z),
-         support = a$tc > tc / 2 && a$tc < tc * 2)
+         # within a factor 2: support; beyond 3: contradiction; between,
+         # undecided (a one-GM compromise over two processes sits there)
+         support = if (a$tc > tc / 2 && a$tc < tc * 2) TRUE
+           else if (a$tc < tc / 3 || a$tc > tc * 3) FALSE else NA)
   } else {
     list(text = sprintf("no exponential ACF near Tc = %s s (z = %.1f)",
                         format_num(tc), a$z), support = FALSE)
@@ -124,6 +127,15 @@ effect_gauss_markov <- function() {
            score = if (ctx$kind == "bump") 2 else 1)
     },
     evidence = evidence_gm,
+    # Correlated over fewer than 2 samples, an AR(1) is the sensor's own
+    # averaging (the filter term), not a slow process.
+    admissible = function(par, tau, freq) {
+      tc <- par[["tc"]]
+      if (!is.null(freq) && is.finite(tc) && tc * freq < 2) {
+        sprintf("Tc = %s s is below 2 samples: that is the sensor's filter, not a Gauss-Markov process",
+                format_num(tc))
+      }
+    },
     peak_tau = function(par) gm_peak_ratio * par[["tc"]],
     # Tc well below 1 s: white noise at every tau >= 1 s, AV -> 2 sigma^2 Tc / tau.
     fold = list(into = "white", when = function(par) is.finite(par[["tc"]]) && par[["tc"]] < 0.1,

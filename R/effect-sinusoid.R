@@ -11,7 +11,8 @@ evidence_sinusoid <- function(par, raw, x, freq) {
   f0 <- par[["f0"]] %||% NA_real_
   res <- attr(l, "resolution") %||% 0
   if (nrow(l) && is.finite(f0)) {
-    near <- which(abs(l$f0 - f0) <= max(0.25 * f0, 2 * res))
+    # within the periodogram's resolution (issue 9), not a fraction of f0
+    near <- which(abs(l$f0 - f0) <= 1.5 * res)
     j <- near[which.max(l$ratio[near])]
     if (length(near)) {
       return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)",
@@ -67,9 +68,19 @@ effect_sinusoid <- function() {
     },
     # deterministic: treated as adding no estimation variance
     edf_alpha = function(tau, tau0, nl) rep(NA_real_, length(tau)),
+    # searched only where the curve can see a line (visible_band())
     nl_range = function(tau, freq) {
-      hi <- if (is.null(freq)) 2 / min(tau) else 0.499 * freq
-      list(f0 = c(min(0.2 / max(tau), hi / 10), hi))
+      b <- visible_band(min(tau), max(tau), freq)
+      hi <- if (is.null(freq)) b[["hi"]] else min(b[["hi"]], 0.499 * freq)
+      list(f0 = c(min(b[["lo"]], hi / 10), hi))
+    },
+    admissible = function(par, tau, freq) {
+      f0 <- par[["f0"]]
+      b <- visible_band(min(tau), max(tau), freq)
+      if (!is.finite(f0) || f0 < b[["lo"]] * (1 - 1e-6) || f0 > b[["hi"]] * (1 + 1e-6)) {
+        sprintf("f0 = %s Hz is outside the band the curve can see (%s-%s Hz)",
+                format_num(f0), format_num(b[["lo"]]), format_num(b[["hi"]]))
+      }
     },
     trace = function(ctx) {
       if (ctx$sign <= 0 || !is.finite(ctx$emax) ||
@@ -84,14 +95,26 @@ effect_sinusoid <- function() {
       lines <- raw$lines
       out <- list()
       if (is.null(lines) || !nrow(lines)) return(out)
-      for (j in seq_len(min(nrow(lines), 3L))) {
+      # only lines the curve can see; harmonics of one source say so
+      b <- visible_band(min(tau), max(tau), raw$freq)
+      lines <- harmonic_sets(lines)
+      for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
+        if (f0 < b[["lo"]] || f0 > b[["hi"]]) next
         t1 <- sin_peak_ratio / f0
-        if (t1 < min(tau) / 2 || t1 > max(tau)) next
+        h <- lines$harmonic[j]
+        src <- if (lines$pattern[j] != "single") {
+          sprintf(" (harmonic %d of the %s Hz source, %s harmonics)", h,
+                  format_num(f0 / h, 4), lines$pattern[j])
+        } else ""
         out[[length(out) + 1L]] <- list(
           init = list(f0 = f0, amp = lines$amp[j]), tau_from = t1 / 2,
           tau_to = 2 / f0, score = 2,
-          note = sprintf("proposed by a periodogram line at %s Hz", format_num(f0)))
+          # the periodogram measures f0 far better than the curve does
+          pin = list(f0 = f0),
+          note = sprintf("proposed by a periodogram line at %s Hz%s",
+                         format_num(f0, 4), src))
+        if (length(out) >= 5L) break
       }
       out
     },

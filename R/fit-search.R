@@ -204,11 +204,31 @@ fit_search <- function(pr, start, prev, control) {
       }
       nm <- NULL
       if (length(nlrows) > 1L) {
-        o <- stats::optim(lognl, obj, method = "Nelder-Mead",
-                          control = list(reltol = control$reltol,
-                                         maxit = control$maxit))
-        nm <- list(convergence = o$convergence, count = o$counts[["function"]])
-        if (o$value <= obj(lognl)) lognl <- o$par
+        # Nelder-Mead restarted from its own result (a fresh simplex) until
+        # it stops on its tolerance or a restart no longer improves: a
+        # simplex that collapsed along a curved valley otherwise spends
+        # maxit crawling. A restart that gains less than reltol (relative)
+        # means the search sits at the optimum.
+        v0 <- obj(lognl)
+        count <- 0L
+        conv <- 1L
+        for (restart in seq_len(4L)) {
+          o <- stats::optim(lognl, obj, method = "Nelder-Mead",
+                            control = list(reltol = control$reltol,
+                                           maxit = control$maxit))
+          count <- count + o$counts[["function"]]
+          gain <- v0 - o$value
+          if (o$value <= v0) lognl <- o$par
+          # (a restart too short to move the simplex proves nothing)
+          if (o$convergence == 0L ||
+              (restart > 1L && o$counts[["function"]] >= 20L * length(lognl) &&
+               gain <= control$reltol * (abs(v0) + control$reltol))) {
+            conv <- 0L
+            break
+          }
+          v0 <- min(v0, o$value)
+        }
+        nm <- list(convergence = conv, count = count)
       }
       list(lognl = lognl, value = obj(lognl), nm = nm)
     }

@@ -48,13 +48,13 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
   excess <- avar - fitted
   present_kinds <- split_term(present)$kind
   usable <- Filter(function(e) {
-    e$name %in% candidates && (e$repeatable || !e$name %in% present_kinds)
+    e$name %in% candidates && addable_kind(e$name, present)
   }, catalogue()[effect_kinds()])
   out <- list()
-  add <- function(effect, from, to, init, signature, score) {
+  add <- function(effect, from, to, init, signature, score, pin = NULL) {
     out[[length(out) + 1L]] <<- list(effect = effect, tau_from = from, tau_to = to,
                                      init = init, signature = signature,
-                                     score = score)
+                                     score = score, pin = pin)
   }
   for (i in seq_len(nrow(sig))) {
     ctx <- trace_context(sig[i, ], tau, excess)
@@ -71,7 +71,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
       for (p in e$propose(raw, tau, sig)) {
         add(e$name, p$tau_from, p$tau_to, p$init,
             paste0(overlapping_signature(sig, p$tau_from, p$tau_to), "; ", p$note),
-            p$score)
+            p$score, p$pin)
       }
     }
   }
@@ -87,6 +87,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
                    score = vapply(out, `[[`, 0, "score"),
                    stringsAsFactors = FALSE)
   df$init <- lapply(out, `[[`, "init")
+  df$pin <- lapply(out, function(o) o$pin)
   df[order(-df$score), , drop = FALSE]
 }
 

@@ -22,6 +22,11 @@ stopifnot(dir.exists(shared))
 options(allanvar.threads = 1L)
 
 units <- c(gyro = "deg/s", accel = "g")
+check_rows <- list()
+
+# check_axis(): issue 9's Done-when checks for one axis.
+adis_check_define_only <- TRUE
+source("data-raw/adis16405-check.R")
 av_rows <- list(); diag_rows <- list(); line_rows <- list()
 coef_rows <- list(); step_rows <- list(); fit_rows <- list(); noise_rows <- list()
 fits <- list()
@@ -75,6 +80,7 @@ for (k in 1:3) {
       failed_refits = NROW(ref$refine$failures),
       stringsAsFactors = FALSE))
     fits[[id]] <- list(datasheet = fit0, refined = ref)
+    check_rows[[id]] <- cbind(key, check_axis(x, freq, av, dg, ref))
     cat(sprintf("%-14s chi2 %8.1f -> %7.2f  rms %5.1f%% -> %5.1f%%  [%s]  %.0f s\n", id,
                 fit0$chi2, ref$chi2, fit0$rms, ref$rms,
                 fit_rows[[id]]$effects, as.numeric(Sys.time() - t0, units = "secs")))
@@ -82,6 +88,17 @@ for (k in 1:3) {
 }
 
 bind <- function(l) { out <- do.call(rbind, l); rownames(out) <- NULL; out }
+check <- bind(check_rows)
+writeLines(capture.output({
+  cat("Issue 9 Done-when checks on the 18 ADIS16405 axes (from N, B, K, raw data given)\n\n")
+  print(transform(check, acf1 = round(acf1, 3), enbw = round(enbw, 1),
+                  chi2 = round(chi2, 2), n_fit = signif(n_fit, 4),
+                  n_ref = signif(n_ref, 4), n_err = round(n_err, 1)),
+        row.names = FALSE)
+  bw <- tapply(check$enbw, check$sensor, function(v) diff(range(v, na.rm = TRUE)) /
+                 mean(v, na.rm = TRUE) * 100)
+  cat("\nENBW spread per sensor type (range / mean, %):\n"); print(round(bw, 1))
+}), "data-raw/adis16405-check.txt")
 adis16405_av <- list(
   av = bind(av_rows), diagnostics = bind(diag_rows), lines = bind(line_rows),
   noise_id = bind(noise_rows), fits = bind(fit_rows), coef = bind(coef_rows),

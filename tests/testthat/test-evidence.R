@@ -11,8 +11,12 @@ test_that("a periodogram line is found at f0 with its amplitude and significance
   expect_equal(d$lines$f0[1], 0.5, tolerance = 0.01)
   expect_equal(d$lines$amp[1], 0.02, tolerance = 0.1)
   expect_lt(d$lines$p_value[1], 1e-10)
-  ev <- raw_evidence("sinusoid", list(f0 = 0.52), d, x, 100)
+  # matched within the periodogram's resolution (issue 9), no longer 25%
+  res <- attr(d$lines, "resolution")
+  ev <- raw_evidence("sinusoid", list(f0 = 0.5 + res), d, x, 100)
   expect_true(ev$support)
+  ev <- raw_evidence("sinusoid", list(f0 = 0.52), d, x, 100)
+  expect_false(ev$support)
   ev <- raw_evidence("sinusoid", list(f0 = 2), d, x, 100)
   expect_false(ev$support)
   # White noise: no line in most seeds at the 1e-3 family-wise level.

@@ -1,0 +1,164 @@
+# The rules of the closed loop (issue 9, items 4-5) on series generated
+# here (stats::filter, rnorm; not the package's simulator). References: the
+# generating parameters and the issue's tolerances.
+
+gen_white <- function(n, freq, N) rnorm(n, sd = N * sqrt(freq))
+gen_ma <- function(n, freq, N, L) {
+  w <- gen_white(n + L - 1, freq, N)
+  as.numeric(stats::filter(w, rep(1 / L, L), sides = 1))[-seq_len(L - 1)]
+}
+gen_rrw <- function(n, freq, K) cumsum(rnorm(n, sd = K / sqrt(freq)))
+gen_gm <- function(n, freq, sigma, tc) {
+  phi <- exp(-1 / (freq * tc))
+  w <- rnorm(n, sd = sigma * sqrt(1 - phi^2))
+  w[1] <- rnorm(1, sd = sigma)
+  as.numeric(stats::filter(w, phi, method = "recursive"))
+}
+gen_sin <- function(n, freq, amp, f0) {
+  amp * sin(2 * pi * f0 * seq_len(n) / freq + runif(1, 0, 2 * pi))
+}
+
+test_that("a 4-tap average through the loop: the filter replaces N, no sub-sample GM", {
+  set.seed(301)
+  freq <- 100
+  n <- 3e5
+  x <- gen_ma(n, freq, 0.01, 4) + gen_rrw(n, freq, 1e-4)
+  fit <- avfit(allan(x, freq, taus = 10), terms = c("N", "B", "K"))
+  ref <- suppressMessages(avrefine(fit, data = x))
+  expect_true("filter" %in% ref$steps$effect)
+  expect_false("N" %in% ref$terms)            # replaced, not doubled
+  cf <- coef(ref)
+  expect_equal(cf[["filter.Nf"]], 0.01, tolerance = 0.1)
+  expect_equal(cf[["filter.L"]], 4, tolerance = 0.1)
+  # no accepted step the raw data contradict, no GM faster than 2 samples
+  expect_false(any(ref$steps$confirmed %in% FALSE))
+  tc <- cf[grepl("^gm[0-9]+\\.tc$", names(cf))]
+  expect_true(all(tc * freq >= 2))
+  expect_lte(ref$chi2, 2)
+})
+
+test_that("two Gauss-Markov processes a decade apart are both found (Tc within 30%)", {
+  set.seed(302)
+  freq <- 100
+  n <- 4e5
+  x <- gen_white(n, freq, 0.005) + gen_gm(n, freq, 0.01, 0.2) +
+    gen_gm(n, freq, 0.007, 5)
+  fit <- avfit(allan(x, freq, taus = 10), terms = "N")
+  ref <- suppressMessages(avrefine(fit, data = x, candidates = c("gm", "K")))
+  cf <- coef(ref)
+  tc <- sort(unname(cf[grepl("^gm[0-9]+\\.tc$", names(cf))]))
+  expect_length(tc, 2)
+  expect_equal(tc[1], 0.2, tolerance = 0.3)
+  expect_equal(tc[2], 5, tolerance = 0.3)
+  expect_false(any(ref$steps$confirmed %in% FALSE))
+})
+
+test_that("a GM beside a sinusoid: both found and both confirmed by the raw data", {
+  set.seed(303)
+  freq <- 100
+  n <- 4e5
+  x <- gen_white(n, freq, 0.005) + gen_gm(n, freq, 0.01, 5) +
+    gen_sin(n, freq, 0.01, 1)
+  fit <- avfit(allan(x, freq, taus = 10), terms = "N")
+  ref <- suppressMessages(avrefine(fit, data = x, candidates = c("gm", "sinusoid")))
+  st <- ref$steps
+  expect_setequal(st$effect, c("gm", "sinusoid"))
+  expect_true(all(st$confirmed))
+  cf <- coef(ref)
+  expect_equal(cf[["gm1.tc"]], 5, tolerance = 0.3)
+  expect_equal(cf[["sinusoid1.f0"]], 1, tolerance = 0.01)
+})
+
+test_that("a square wave: lines at f, 3f, 5f, each within the periodogram's resolution", {
+  set.seed(304)
+  freq <- 100
+  n <- 4e5
+  f <- 0.25
+  t <- seq_len(n) / freq
+  sq <- 0.02 * sign(sin(2 * pi * f * t + 0.3))
+  x <- gen_white(n, freq, 0.005) + sq
+  fit <- avfit(allan(x, freq, taus = 10), terms = "N")
+  ref <- suppressMessages(avrefine(fit, data = x, candidates = "sinusoid",
+                                   max_steps = 4))
+  cf <- coef(ref)
+  f0 <- sort(unname(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]))
+  res <- attr(ref$refine$diagnostics$lines, "resolution")
+  expect_gte(length(f0), 3)
+  for (h in c(1, 3, 5)) expect_lte(min(abs(f0 - h * f)), 1.5 * res)
+  expect_true(all(ref$steps$confirmed))
+})
+
+test_that("a contradicted candidate is rejected, and controls gain at most 1 false addition in 10 seeds", {
+  freq <- 100
+  n <- 1e5
+  false <- 0
+  for (seed in 1:10) {
+    set.seed(400 + seed)
+    x <- gen_white(n, freq, 0.01) + gen_rrw(n, freq, 1e-4)
+    fit <- avfit(allan(x, freq, taus = 5), terms = c("N", "K"))
+    ref <- suppressMessages(avrefine(fit, data = x, max_steps = 2))
+    false <- false + nrow(ref$steps)
+    expect_false(any(ref$steps$confirmed %in% FALSE))
+  }
+  expect_lte(false, 1)
+})
+
+test_that("curve only: a 400 Hz 4-tap curve gives N within 10% and no sinusoid outside the visible band", {
+  set.seed(305)
+  freq <- 400
+  n <- 1e6
+  x <- gen_ma(n, freq, 0.01, 4) + gen_rrw(n, freq, 1e-4)
+  a <- allan(x, freq)
+  fit <- avfit(a, terms = c("N", "B", "K"))
+  ref <- suppressMessages(avrefine(fit))
+  cf <- coef(ref)
+  Nhat <- if ("N" %in% names(cf)) cf[["N"]] else cf[["filter.Nf"]]
+  expect_equal(Nhat, 0.01, tolerance = 0.1)
+  f0 <- cf[grepl("\\.f0$", names(cf))]
+  band <- visible_band(min(a$tau), max(a$tau), freq)
+  expect_true(all(f0 >= band[["lo"]] & f0 <= band[["hi"]]))
+  # without raw data the result says what could not be confirmed
+  expect_setequal(ref$refine$unconfirmed, ref$steps$label)
+  if (nrow(ref$steps)) {
+    expect_output(print(ref), "could not be confirmed")
+  }
+})
+
+test_that("short tau cannot hijack the fit: first points no term describes are left out, N stays", {
+  set.seed(306)
+  freq <- 400
+  n <- 1e6
+  x <- gen_ma(n, freq, 0.01, 4) + gen_rrw(n, freq, 1e-4)
+  a <- allan(x, freq)
+  fit <- avfit(a, terms = c("N", "K"))
+  # the filter is not offered: nothing in the candidates describes the
+  # first points
+  expect_message(ref <- avrefine(fit, candidates = c("K", "B")),
+                 "no catalogue effect describes the first points")
+  expect_false(is.null(ref$refine$tau_range))
+  expect_true("short_end" %in% ref$unexplained$kind)
+  expect_equal(coef(ref)[["N"]], 0.01, tolerance = 0.1)
+  expect_output(print(ref), "Unexplained by any catalogue effect")
+})
+
+test_that("admissibility rules: a sub-sample GM and an invisible sinusoid are refused", {
+  tau <- 10^seq(-2, 3, by = 0.1)
+  expect_match(inadmissible("gm", c(sigma = 1, tc = 0.01), tau, 100),
+               "below 2 samples")
+  expect_null(inadmissible("gm", c(sigma = 1, tc = 1), tau, 100))
+  expect_match(inadmissible("sinusoid", c(amp = 1, f0 = 60), tau, 100),
+               "outside the band")
+  expect_match(inadmissible("sinusoid", c(amp = 1, f0 = 1e-4), tau, 100),
+               "outside the band")
+  expect_null(inadmissible("sinusoid", c(amp = 1, f0 = 1), tau, 100))
+  expect_equal(model_terms(c("N", "B", "K"), "filter"), c("B", "K", "filter"))
+  expect_false(addable_kind("N", c("filter", "K")))
+  expect_true(addable_kind("gm", c("gm", "K")))
+})
+
+test_that("remove is validated", {
+  x <- rnorm(1e4)
+  fit <- avfit(allan(x, 100, taus = 5), terms = "N")
+  expect_error(avrefine(fit, remove = 1), class = "allanvar_error_argument")
+  expect_error(avrefine(fit, remove = "steps"), class = "allanvar_error_argument")
+})
