@@ -151,7 +151,7 @@ remove_series <- function(x, freq, table) {
 series_adev <- function(x, freq, table) {
   a <- allan(x, freq)
   one <- function(tab) {
-    b <- if (nrow(tab)) allan(remove_series(x, freq, tab), freq, taus = a$tau)$adev
+    b <- if (nrow(tab)) allan(remove_series(x, freq, tab), freq, taus = I(a$tau))$adev
          else a$adev
     data.frame(tau = a$tau, before = a$adev, after = b, change = a$adev / b - 1)
   }
