@@ -164,3 +164,33 @@ test_that("avrefine() reports the series effects and removes those asked for", {
   expect_equal(tb$time[tb$kind == "steps"], 600, tolerance = 0.01 * n / freq / 600)
   expect_identical(ref$series$removed, c("spikes", "steps"))
 })
+
+test_that("analyze_imu(remove =) and the CLI's --remove take the effects out before the curve", {
+  set.seed(111)
+  n <- 6000
+  d <- data.frame(time = (0:(n - 1)) / 50, gx = rnorm(n, sd = 0.05),
+                  ax = rnorm(n, sd = 2))
+  spikes <- c(700, 2500, 4100)
+  d$gx[spikes] <- d$gx[spikes] + 1.5
+  f <- tempfile(fileext = ".csv")
+  out <- tempfile("cli")
+  on.exit(unlink(c(f, out), recursive = TRUE))
+  utils::write.csv(d, f, row.names = FALSE)
+  r <- read_imu(f, time_unit = "s", columns = c("gx", "ax"),
+                sensors = c("gyro", "accel"))
+  a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE,
+                                    remove = "spikes"))
+  s <- a$channels$gyro_x$series
+  expect_identical(s$table$index, as.integer(spikes))
+  expect_identical(s$removed, "spikes")
+  keep <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+  expect_null(keep$channels$gyro_x$series)
+  expect_lt(a$channels$gyro_x$curve$adev[1], 0.97 * keep$channels$gyro_x$curve$adev[1])
+  capture.output(res <- suppressMessages(suppressWarnings(allanvar_cli(c(
+    f, "--out", out, "--gyro-cols", "gx", "--accel-cols", "ax", "--time-unit", "s",
+    "--no-refine", "--quiet", "--remove", "spikes,steps")))))
+  expect_equal(res$analyses[[1]]$channels$gyro_x$curve$adev,
+               a$channels$gyro_x$curve$adev)
+  expect_error(analyze_imu(r, refine = FALSE, progress = FALSE, remove = "bumps"),
+               class = "allanvar_error_argument")
+})
