@@ -112,9 +112,11 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     best <- list(z = 0)
     for (j in seq_along(ws)) {
       d <- allan_differences(r, ws[j])
-      z <- d / scale[j]
-      z[excluded[ws[j]:(nb - ws[j])]] <- 0
-      i <- which.max(abs(z))
+      d[excluded[ws[j]:(nb - ws[j])]] <- 0
+      # a noiseless series (scale 0): any difference at all is a step, at
+      # the largest difference
+      z <- if (scale[j] > 0) d / scale[j] else ifelse(d == 0, 0, sign(d) * Inf)
+      i <- which.max(abs(d))
       if (abs(z[i]) > abs(best$z)) best <- list(z = z[i], d = d[i], i = i + ws[j] - 1L, j = j)
     }
     if (abs(best$z) < zc) break

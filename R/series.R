@@ -153,7 +153,10 @@ series_adev <- function(x, freq, table) {
   one <- function(tab) {
     b <- if (nrow(tab)) allan(remove_series(x, freq, tab), freq, taus = I(a$tau))$adev
          else a$adev
-    data.frame(tau = a$tau, before = a$adev, after = b, change = a$adev / b - 1)
+    # a noiseless series: no change where both are 0, unknown where only
+    # the corrected one is
+    change <- ifelse(b > 0, a$adev / b - 1, ifelse(a$adev > 0, NA_real_, 0))
+    data.frame(tau = a$tau, before = a$adev, after = b, change = change)
   }
   kinds <- unique(table$kind)
   per <- lapply(kinds, function(k) {
@@ -180,10 +183,11 @@ print.series_effects <- function(x, ...) {
     rows <- tab[tab$kind == k, , drop = FALSE]
     ch <- x$adev_kinds[x$adev_kinds$kind == k, , drop = FALSE]
     j <- which.max(abs(ch$change))
-    cat(sprintf("  %s%s; ADEV %+.1f%% at tau = %s s when left in\n",
-                effect_entry(k)$describe(rows),
+    cat(sprintf("  %s%s%s\n", effect_entry(k)$describe(rows),
                 if (all(rows$removed)) " [removed]" else "",
-                100 * ch$change[j], format_num(ch$tau[j])))
+                if (length(j)) sprintf("; ADEV %+.1f%% at tau = %s s when left in",
+                                       100 * ch$change[j], format_num(ch$tau[j]))
+                else "; nothing left without it"))
   }
   cat(if (length(x$removed)) paste0("  removed: ", paste(x$removed, collapse = ", "))
       else "  nothing removed (see `remove`)", "\n", sep = "")

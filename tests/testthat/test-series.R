@@ -194,3 +194,16 @@ test_that("analyze_imu(remove =) and the CLI's --remove take the effects out bef
   expect_error(analyze_imu(r, refine = FALSE, progress = FALSE, remove = "bumps"),
                class = "allanvar_error_argument")
 })
+
+test_that("degenerate series: a constant has nothing, a noiseless step is one step", {
+  s <- series_effects(rep(1, 5000), 100)
+  expect_equal(nrow(s$table), 0L)
+  expect_true(all(s$adev$change == 0))
+  x <- c(rep(0, 3000), rep(1, 3000))
+  s <- series_effects(x, 100, remove = "all")
+  expect_identical(s$table$kind, "steps")
+  expect_identical(s$table$index, 3001L)
+  expect_equal(s$table$size, 1)
+  expect_equal(s$x, rep(0, 6000))
+  expect_output(print(s), "bias step of 1 at 30 s \\[removed\\]")
+})
