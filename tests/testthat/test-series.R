@@ -207,3 +207,25 @@ test_that("degenerate series: a constant has nothing, a noiseless step is one st
   expect_equal(s$x, rep(0, 6000))
   expect_output(print(s), "bias step of 1 at 30 s \\[removed\\]")
 })
+
+test_that("a transient whose return is weak is paired, and a bias step stays a step", {
+  found <- 0L
+  for (seed in 1:6) {
+    set.seed(seed)
+    x <- rnorm(2e4, sd = 0.1)
+    x[5001:7000] <- x[5001:7000] + 0.05        # 20 s at 50 s
+    tb <- series_effects(x, 100, kinds = c("steps", "transients"))$table
+    expect_false("steps" %in% tb$kind)
+    if (identical(tb$kind, "transients")) {
+      found <- found + 1L
+      expect_lt(abs(tb$time - 50), 1)
+      expect_equal(tb$duration, 20, tolerance = 0.1)
+    }
+    set.seed(seed + 100)
+    y <- rnorm(2e4, sd = 0.1)
+    y[12001:2e4] <- y[12001:2e4] + 0.08
+    expect_identical(series_effects(y, 100, kinds = c("steps", "transients"))$table$kind,
+                     "steps")
+  }
+  expect_gte(found, 5L)
+})
