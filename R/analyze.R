@@ -54,6 +54,10 @@
 #'   file paths.
 #' @param refine_args A list of further arguments for [avrefine()] (for
 #'   example `candidates` or `max_steps`).
+#' @param remove Non-stationary effects to take out of each axis before its
+#'   Allan deviation is computed (see [series_effects()]): e.g.
+#'   `c("spikes", "steps")`, or `"all"`; none by default. What was found
+#'   and removed is kept in each channel's `series`.
 #' @param ... Further arguments passed to [avfit()].
 #' @return For one recording, an object of class `"imu_analysis"`: a list
 #'   with `name`, `freq`, `n` (samples used), `duration` (s), `record` (the
@@ -83,8 +87,10 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
                         segment = "longest", channels = NULL,
                         progress = interactive() &&
                           isTRUE(getOption("allanvar.progress", TRUE)),
-                        read_args = list(), refine_args = list(), ...) {
+                        read_args = list(), refine_args = list(),
+                        remove = character(), ...) {
   check_present(missing(x), "x", "an imu_record, a list of them or file paths")
+  remove <- check_series_kinds(remove, "remove", c(effect_kinds("series"), "all"))
   if (!is.logical(refine) || length(refine) != 1L || is.na(refine)) {
     abort("`refine` must be TRUE or FALSE, not ", format_value(refine), ".",
           class = "argument")
@@ -146,7 +152,7 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
                                                         jobs[[k]]$channel)
   opts <- list(taus = taus, type = type, terms = terms, refine = refine,
                progress = progress, fit_args = list(...),
-               refine_args = refine_args)
+               refine_args = refine_args, remove = remove)
   # One future per axis: axes differ in cost (the refinement), so this
   # balances the workers, and progress arrives as each axis finishes.
   # future.seed = TRUE can leave the caller's RNG kind at L'Ecuyer-CMRG
@@ -224,6 +230,9 @@ progress_handlers <- function() {
 # arguments and the package's namespace.
 analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
+  # Effects the user asked to remove go before the curve (R/series.R).
+  series <- if (length(opts$remove)) series_effects(job$x, job$freq, remove = opts$remove)
+  if (!is.null(series)) job$x <- series$x
   curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
   if (!any(is.finite(curve$adev) & curve$adev > 0)) {
     # A dead (constant) axis has nothing to fit or read: it is reported,
@@ -262,7 +271,7 @@ analyze_channel <- function(job, opts) {
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = failure$message, fit_condition = failure$condition,
-              coef = coef, readings = readings)
+              coef = coef, readings = readings, series = series)
   res$guidance <- imu_guidance(res)
   res
 }

@@ -590,10 +590,12 @@ unexplained_table <- function(sig, fit) {
 # "series" components when it has them).
 check_remove <- function(remove) {
   kinds <- effect_kinds("series")
+  if (is.character(remove) && identical(remove, "all")) return(kinds)
   if (!is.character(remove) || anyNA(remove) ||
       (length(kinds) && !all(remove %in% kinds))) {
     abort("`remove` must name series effects",
-          if (length(kinds)) paste0(" among ", paste0("\"", kinds, "\"", collapse = ", ")),
+          if (length(kinds)) paste0(" among ", paste0("\"", kinds, "\"", collapse = ", "),
+                                    " (or \"all\")"),
           ", not ", if (is.character(remove))
             paste(encodeString(setdiff(remove, kinds), quote = '"'), collapse = ", ")
           else describe_type(remove), ".", class = "argument")

@@ -76,7 +76,9 @@ catalogue <- function() {
 builtin_effects <- function() {
   list(effect_quantization(), effect_white(), effect_flicker(),
        effect_random_walk(), effect_ramp(), effect_gauss_markov(),
-       effect_sinusoid(), effect_filter(), effect_resonance())
+       effect_sinusoid(), effect_filter(), effect_resonance(),
+       # series effects, in the order series_effects() detects them
+       effect_spike(), effect_warmup(), effect_bias_step(), effect_transient())
 }
 
 #' Register an effect in the catalogue (internal)

@@ -35,6 +35,8 @@
 #' * `--gap segments|error|ignore` what to do with time gaps;
 #' * `--terms N,B,K` terms to fit (of [av_terms()]: Q, N, B, K, R, gm,
 #'   sinusoid); `--no-refine` skip [avrefine()];
+#' * `--remove spikes,steps` non-stationary effects to take out of each
+#'   axis first (see [series_effects()]; `all` for every kind);
 #' * `--width PX`, `--height PX` size of the PNG (default 700 per sensor
 #'   by 600);
 #' * `--axis max|mean` which value goes into imu.yaml; `--average` adds the
@@ -82,6 +84,7 @@ cli_usage <- function() {
     "  --gap G                segments (default), error or ignore",
     "  --terms N,B,K          noise terms to fit (default N,B,K; also Q, R, gm, sinusoid)",
     "  --no-refine            do not add missing effects (avrefine)",
+    "  --remove K1,K2         take effects out first: spikes, warmup, steps, transients, all",
     "  --axis max|mean        value written to imu.yaml (default max: worst axis)",
     "  --average              add the mean of the axes to the datasheet",
     "  --width PX             PNG width (default 700 per sensor)",
@@ -95,7 +98,7 @@ cli_usage <- function() {
 cli_flags <- c("--no-time", "--no-refine", "--average", "--quiet", "--help")
 cli_valued <- c("--out", "--rate", "--time-col", "--time-unit", "--gyro-cols",
                 "--accel-cols", "--gyro-units", "--accel-units", "--sep", "--dec",
-                "--topic", "--gap", "--terms", "--axis", "--workers", "--width",
+                "--topic", "--gap", "--terms", "--remove", "--axis", "--workers", "--width",
                 "--height")
 
 cli_parse <- function(args) {
@@ -286,7 +289,9 @@ cli_run <- function(args) {
     if (progress) print(rec)
     # The guidance is printed below; no need to repeat it as a warning.
     a <- withCallingHandlers(cli_speak(analyze_imu(
-      rec, terms = terms, refine = !isTRUE(opt$`no-refine`), progress = progress)),
+      rec, terms = terms, refine = !isTRUE(opt$`no-refine`), progress = progress,
+      remove = if (is.null(opt$remove)) character()
+               else trimws(strsplit(opt$remove, ",", fixed = TRUE)[[1L]]))),
       allanvar_guidance = function(w) invokeRestart("muffleWarning"))
     prefix <- if (several) paste0(sub("\\.[^.]*$", "", basename(f)), "_") else ""
     names_out <- paste0(prefix, c("allan_deviation.png", "datasheet.csv",

@@ -112,9 +112,11 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     best <- list(z = 0)
     for (j in seq_along(ws)) {
       d <- allan_differences(r, ws[j])
-      z <- d / scale[j]
-      z[excluded[ws[j]:(nb - ws[j])]] <- 0
-      i <- which.max(abs(z))
+      d[excluded[ws[j]:(nb - ws[j])]] <- 0
+      # a noiseless series (scale 0): any difference at all is a step, at
+      # the largest difference
+      z <- if (scale[j] > 0) d / scale[j] else ifelse(d == 0, 0, sign(d) * Inf)
+      i <- which.max(abs(d))
       if (abs(z[i]) > abs(best$z)) best <- list(z = z[i], d = d[i], i = i + ws[j] - 1L, j = j)
     }
     if (abs(best$z) < zc) break
@@ -174,6 +176,20 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
                se = se, z = zs[k], window = W * tau0)
   })
   out <- do.call(rbind, rows)
+  # A transient whose return (or onset) is too weak for the record-wide
+  # threshold: look for the opposite step within pulse_gap of each step,
+  # at the Bonferroni level of that stretch alone.
+  ret <- lapply(seq_len(nrow(out)), function(k) {
+    step_return(x, out, k, round(pulse_gap * freq), alpha, tau0)
+  })
+  ret <- do.call(rbind, ret)
+  out$extra <- rep(FALSE, nrow(out))
+  if (!is.null(ret) && nrow(ret)) {
+    ret <- ret[!duplicated(ret$index) & !ret$index %in% out$index, , drop = FALSE]
+    ret$extra <- rep(TRUE, nrow(ret))
+    out <- rbind(out, ret)
+    out <- out[order(out$index), , drop = FALSE]
+  }
   # opposite-sign pairs close together are transients
   pulse <- rep(FALSE, nrow(out))
   prow <- list()
@@ -183,6 +199,7 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     c2 <- out[k + 1L, ]
     ratio <- abs(c2$size / a$size)
     if (sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
+        !(a$extra && c2$extra) &&
         ratio > 1 / 3 && ratio < 3) {
       pulse[c(k, k + 1L)] <- TRUE
       prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,
@@ -192,11 +209,50 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
       k <- k + 1L
     }
   }
-  steps <- out[!pulse, , drop = FALSE]
+  # a return found below the record-wide threshold counts only as the end
+  # of a transient
+  steps <- out[!pulse & !out$extra, setdiff(names(out), "extra"), drop = FALSE]
   rownames(steps) <- NULL
   attr(steps, "pulses") <- if (length(prow)) do.call(rbind, prow) else attr(empty, "pulses")
   attr(steps, "rejected") <- rejected
   steps
+}
+
+# The step of opposite sign within `gap` samples after (or before) step k
+# of `steps`, the other steps removed: at windows from the step's own up to
+# gap / 4 (octaves), the split maximising the opposite difference of means
+# over the window on each side, never reaching across step k; kept when its
+# z (the step's standard error scaled as white noise to the window) exceeds
+# the Bonferroni threshold over that stretch and those windows (at least
+# 3). NULL when there is none.
+step_return <- function(x, steps, k, gap, alpha, tau0) {
+  n <- length(x)
+  at <- steps$index[k]
+  if (!is.finite(steps$se[k]) || steps$se[k] <= 0) return(NULL)
+  W0 <- max(1L, as.integer(round(steps$window[k] / tau0)))
+  Ws <- unique(pmin(W0 * 2L^(0:8), max(W0, gap %/% 4L)))
+  xs <- remove_steps(x, steps[-k, c("index", "size"), drop = FALSE])
+  cs <- c(0, cumsum(xs))
+  best <- NULL
+  M <- 0
+  for (W in Ws) {
+    cand <- c(max(1L, at - gap):(at - W), (at + W):min(n, at + gap))
+    cand <- cand[cand >= W + 1L & cand <= n - W + 1L & abs(cand - at) >= W]
+    if (!length(cand)) next
+    M <- M + length(cand) / W
+    d <- (cs[cand + W] - 2 * cs[cand] + cs[cand - W]) / W
+    se <- steps$se[k] * sqrt(W0 / W)
+    z <- -sign(steps$size[k]) * d / se
+    j <- which.max(z)
+    if (length(j) && is.finite(z[j]) && (is.null(best) || z[j] > best$zo)) {
+      best <- list(zo = z[j], i = cand[j], d = d[j], se = se, W = W)
+    }
+  }
+  if (is.null(best)) return(NULL)
+  zc <- max(3, stats::qnorm(1 - alpha / (2 * max(1, M))))
+  if (!is.finite(best$se) || best$se <= 0 || best$zo < zc) return(NULL)
+  data.frame(index = best$i, time = (best$i - 1) * tau0, size = best$d,
+             se = best$se, z = best$d / best$se, window = best$W * tau0)
 }
 
 # The series with the steps removed: each step's size subtracted from every

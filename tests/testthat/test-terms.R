@@ -106,8 +106,11 @@ test_that("terms add in variance; by_term gives the parts", {
 
 test_that("catalogue listing and argument checks", {
   tt <- av_terms()
-  expect_setequal(unique(tt$term), c("Q", "N", "B", "K", "R", "gm", "sinusoid",
-                                     "filter", "resonance"))
+  expect_setequal(unique(tt$term[tt$component == "av"]),
+                  c("Q", "N", "B", "K", "R", "gm", "sinusoid", "filter", "resonance"))
+  expect_setequal(unique(tt$term[tt$component == "series"]),
+                  c("spikes", "warmup", "steps", "transients"))
+  expect_setequal(unique(tt$component), c("av", "series"))
   expect_equal(tt$unit[tt$parameter == "N"], "u*sqrt(s)")
   expect_equal(tt$slope[tt$term == "K"], 0.5)
   expect_error(av_model(-1, c(N = 1)), "`tau`")

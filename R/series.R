@@ -1,0 +1,195 @@
+# The non-stationary effects of a raw series through one pass: every
+# "series" entry of the catalogue detects its instances, the Allan deviation
+# is computed with and without them, and the series is corrected only for
+# the kinds the user names. series.R names no effect: the entries, their
+# order and their columns come from the catalogue (R/effect-series.R).
+
+#' Non-stationary effects of a rate series: find, measure, remove on request
+#'
+#' Runs the detectors of the catalogue's series effects ([av_terms()] rows
+#' with `component == "series"`) over a raw rate series, in catalogue
+#' order: isolated spikes (residual from a 7-sample running median against
+#' its robust scale), an exponential warm-up, bias steps (multi-scale
+#' changepoints of the Allan differences, standardised by the series' own
+#' Allan variance so that red noise is not read as steps) and transients
+#' (two steps of opposite sign and similar size less than 120 s apart).
+#' Each detector sees the series with the instances found before it taken
+#' out (a spike does not disturb the step search). Thresholds are
+#' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
+#' steps) standard deviations.
+#'
+#' The Allan deviation of the series as given is compared with that of the
+#' series with every effect found taken out, on the octave grid of
+#' [allan()]: the error the uncorrected effects make at each tau. The
+#' series is corrected only for the kinds named in `remove`, never
+#' silently; what was removed is listed.
+#'
+#' @param x Rate series: numeric vector or `ts`.
+#' @param freq Sampling frequency in Hz (taken from `x` when it is a `ts`
+#'   and `freq` is missing).
+#' @param remove The kinds of effect to take out of the series: none (the
+#'   default: report only), kinds among `kinds`, e.g. `c("spikes",
+#'   "steps")`, or `"all"` (every kind found).
+#' @param ... Must be empty.
+#' @param kinds The kinds to look for; default every series effect of the
+#'   catalogue (`"spikes"`, `"warmup"`, `"steps"`, `"transients"`). Kinds
+#'   named in `remove` are always looked for.
+#' @return An object of class `series_effects`: a list with
+#'   * `table`: one row per instance found, columns `kind`, `index` (first
+#'     sample affected), `time` (s from the first sample), `size` (rate
+#'     unit: the spike's excess over its neighbours, the step's level after
+#'     minus before, the warm-up's offset at the first sample, the
+#'     transient's offset while it lasts), `tc` (s, time constant of a
+#'     warm-up), `duration` (s, of a transient), `z` (detection statistic in
+#'     noise standard deviations), `removed` (logical) and `evidence` (text);
+#'     `NA` where a kind has no such quantity;
+#'   * `adev`: columns `tau`, `before` (Allan deviation of `x` as given),
+#'     `after` (with every effect found taken out) and `change` (`before /
+#'     after - 1`, the error the uncorrected effects make);
+#'   * `adev_kinds`: the same per kind found (columns `kind`, `tau`,
+#'     `before`, `after`, `change`: only that kind taken out);
+#'   * `x`: the series with the `removed` kinds taken out (the input
+#'     unchanged when nothing was removed; a `ts` when `x` was);
+#'   * `removed`: the kinds removed; `kinds`, `freq` and `n`.
+#' @seealso [avrefine()] (its `remove` argument), [avdiagnose()]
+#' @export
+#' @examples
+#' set.seed(1)
+#' x <- rnorm(1e5, sd = 0.1) + cumsum(rnorm(1e5, sd = 1e-4))
+#' x[60001:1e5] <- x[60001:1e5] + 0.05        # a bias step at 600 s
+#' x[c(1000, 42000)] <- x[c(1000, 42000)] + 2  # two spikes
+#' se <- series_effects(x, 100, remove = "spikes")
+#' se
+#' se$table[, c("kind", "time", "size", "z", "removed")]
+series_effects <- function(x, freq, remove = character(), ..., kinds = NULL) {
+  check_dots_empty(...)
+  check_present(missing(x), "x", "a rate series")
+  was_ts <- stats::is.ts(x)
+  if (missing(freq)) {
+    if (!was_ts) check_present(TRUE, "freq", "the sampling frequency in Hz")
+    freq <- stats::frequency(x)
+  }
+  freq <- check_freq(freq)
+  if (was_ts && abs(stats::frequency(x) - freq) > 1e-6 * freq) {
+    abort("`x` is a ts at ", format(stats::frequency(x)), " Hz but `freq` is ",
+          format(freq), " Hz.", class = "argument")
+  }
+  start <- if (was_ts) stats::start(x) else NULL
+  x <- check_values(x, min_n = 256L, arg = "x")
+  all_kinds <- effect_kinds("series")
+  kinds <- if (is.null(kinds)) all_kinds else check_series_kinds(kinds, "kinds", all_kinds)
+  remove <- check_series_kinds(remove, "remove", c(all_kinds, "all"))
+  if ("all" %in% remove) remove <- all_kinds
+  kinds <- intersect(all_kinds, c(kinds, remove))
+  table <- detect_series(x, freq, kinds)
+  table$removed <- table$kind %in% remove
+  removed <- intersect(all_kinds, unique(table$kind[table$removed]))
+  y <- remove_series(x, freq, table[table$removed, , drop = FALSE])
+  if (was_ts) y <- stats::ts(y, start = start, frequency = freq)
+  adev <- series_adev(x, freq, table)
+  structure(list(table = table, adev = adev$all, adev_kinds = adev$kinds,
+                 x = y, removed = removed, kinds = kinds, freq = freq,
+                 n = length(x)),
+            class = "series_effects")
+}
+
+# `x`: a character vector of kinds among `allowed` (character() allowed).
+check_series_kinds <- function(x, arg, allowed) {
+  if (is.null(x)) x <- character()
+  if (!is.character(x) || anyNA(x) || !all(x %in% allowed)) {
+    abort("`", arg, "` must name series effects among ",
+          paste0("\"", allowed, "\"", collapse = ", "), "; not ",
+          if (is.character(x) && !anyNA(x))
+            paste(encodeString(setdiff(x, allowed), quote = '"'), collapse = ", ")
+          else describe_type(x), ".", class = "argument")
+  }
+  unique(x)
+}
+
+# The columns of the table, whatever was found.
+series_columns <- c("kind", "index", "time", "size", "tc", "duration", "z",
+                    "removed", "evidence")
+
+# Every kind's instances, in catalogue order, each detector seeing the
+# series with the instances found before it removed.
+detect_series <- function(x, freq, kinds) {
+  work <- x
+  parts <- list()
+  for (k in intersect(effect_kinds("series"), kinds)) {
+    e <- effect_entry(k)
+    d <- e$detect(work, freq)
+    if (!NROW(d)) next
+    work <- e$remove(work, freq, d)
+    d$kind <- rep(k, nrow(d))
+    for (cl in setdiff(series_columns, names(d))) d[[cl]] <- NA
+    parts[[k]] <- d[series_columns]
+  }
+  out <- if (length(parts)) do.call(rbind, parts) else
+    data.frame(kind = character(), index = integer(), time = numeric(),
+               size = numeric(), tc = numeric(), duration = numeric(),
+               z = numeric(), removed = logical(), evidence = character(),
+               stringsAsFactors = FALSE)
+  out$kind <- as.character(out$kind)
+  out$index <- as.integer(out$index)
+  for (cl in c("time", "size", "tc", "duration", "z")) out[[cl]] <- as.double(out[[cl]])
+  out$removed <- rep(FALSE, nrow(out))
+  out$evidence <- as.character(out$evidence)
+  rownames(out) <- NULL
+  out
+}
+
+# The series with the instances in `table` removed, in catalogue order.
+remove_series <- function(x, freq, table) {
+  for (k in intersect(effect_kinds("series"), unique(table$kind))) {
+    x <- effect_entry(k)$remove(x, freq, table[table$kind == k, , drop = FALSE])
+  }
+  x
+}
+
+# Allan deviation before and after taking out every instance found, and
+# per kind, on allan()'s octave grid.
+series_adev <- function(x, freq, table) {
+  a <- allan(x, freq)
+  one <- function(tab) {
+    b <- if (nrow(tab)) allan(remove_series(x, freq, tab), freq, taus = I(a$tau))$adev
+         else a$adev
+    # a noiseless series: no change where both are 0, unknown where only
+    # the corrected one is
+    change <- ifelse(b > 0, a$adev / b - 1, ifelse(a$adev > 0, NA_real_, 0))
+    data.frame(tau = a$tau, before = a$adev, after = b, change = change)
+  }
+  kinds <- unique(table$kind)
+  per <- lapply(kinds, function(k) {
+    cbind(kind = k, one(table[table$kind == k, , drop = FALSE]),
+          stringsAsFactors = FALSE)
+  })
+  list(all = one(table),
+       kinds = if (length(per)) do.call(rbind, per) else
+         data.frame(kind = character(), tau = numeric(), before = numeric(),
+                    after = numeric(), change = numeric(),
+                    stringsAsFactors = FALSE))
+}
+
+#' @export
+print.series_effects <- function(x, ...) {
+  tab <- x$table
+  cat(sprintf("Series effects in %d samples at %s Hz (looked for: %s)\n", x$n,
+              format(x$freq), paste(x$kinds, collapse = ", ")))
+  if (!nrow(tab)) {
+    cat("  none found\n")
+    return(invisible(x))
+  }
+  for (k in unique(tab$kind)) {
+    rows <- tab[tab$kind == k, , drop = FALSE]
+    ch <- x$adev_kinds[x$adev_kinds$kind == k, , drop = FALSE]
+    j <- which.max(abs(ch$change))
+    cat(sprintf("  %s%s%s\n", effect_entry(k)$describe(rows),
+                if (all(rows$removed)) " [removed]" else "",
+                if (length(j)) sprintf("; ADEV %+.1f%% at tau = %s s when left in",
+                                       100 * ch$change[j], format_num(ch$tau[j]))
+                else "; nothing left without it"))
+  }
+  cat(if (length(x$removed)) paste0("  removed: ", paste(x$removed, collapse = ", "))
+      else "  nothing removed (see `remove`)", "\n", sep = "")
+  invisible(x)
+}

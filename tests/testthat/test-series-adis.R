@@ -1,0 +1,39 @@
+# series_effects() on the measured ADIS16405 recordings (../shared/data;
+# skipped without them). data-raw/adis16405-study.md: the gyros y carry one
+# spike of 2.05 deg/s; unit 1's accelerometers show transients (a knock, a
+# tilt that returns) at 2154, 6817 and 7027 s on all three axes; no gyro has
+# a bias step.
+
+test_that("ADIS16405 unit 1 gyros: the 2.05 deg/s spike, no bias step", {
+  skip_if_no_shared()
+  m <- readRDS(shared_file("adis16405_unit1.rds"))
+  freq <- attr(m, "freq")
+  for (axis in c("gyro_x", "gyro_y", "gyro_z")) {
+    se <- series_effects(m[, axis], freq)
+    expect_false(any(se$table$kind %in% c("steps", "warmup")), label = axis)
+    if (axis == "gyro_y") {
+      big <- se$table[se$table$kind == "spikes" & abs(se$table$size) > 1, ]
+      expect_equal(nrow(big), 1L)
+      expect_equal(big$size, 2.05, tolerance = 0.01)
+    }
+  }
+})
+
+test_that("ADIS16405 unit 1 accel_z: the transient at 2154 s", {
+  skip_if_no_shared()
+  m <- readRDS(shared_file("adis16405_unit1.rds"))
+  se <- series_effects(m[, "accel_z"], attr(m, "freq"), remove = "spikes")
+  tr <- se$table[se$table$kind == "transients", ]
+  expect_gte(nrow(tr), 1L)
+  expect_true(any(abs(tr$time - 2154) < 10))
+  expect_true(all(abs(tr$size) > 0.001 & abs(tr$size) < 0.005))
+  # spikes of about 10 LSB (0.0033 g each): many, typically 7-10 LSB, none
+  # as large as a tenth of a g
+  sp <- se$table[se$table$kind == "spikes", ]
+  expect_gt(nrow(sp), 10L)
+  expect_true(all(abs(sp$size) < 0.1))
+  expect_gt(stats::median(abs(sp$size)), 6 * 0.00333)
+  expect_lt(stats::median(abs(sp$size)), 12 * 0.00333)
+  expect_true(all(sp$removed))
+  expect_false(any(se$table$kind %in% c("steps", "warmup")))
+})

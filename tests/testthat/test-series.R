@@ -1,0 +1,231 @@
+# series_effects(): the catalogue's series entries in one pass. Series built
+# here with base R (white noise, a random walk by cumsum, a Gauss-Markov by
+# stats::filter) plus the deterministic effect, never with avsim().
+
+gen_series <- function(n, white = 0.1, rw = 5e-5, seed) {
+  set.seed(seed)
+  rnorm(n, sd = white) + cumsum(rnorm(n, sd = rw))
+}
+
+test_that("a bias step: time within 1% of the record, size within 20%; removed on request", {
+  n <- 2e5
+  freq <- 100
+  for (seed in 1:2) {
+    x <- gen_series(n, seed = 10 + seed)
+    at <- 123457
+    x[at:n] <- x[at:n] + 0.03
+    se <- series_effects(x, freq)
+    st <- se$table[se$table$kind == "steps", ]
+    expect_identical(se$table$kind, "steps")
+    expect_lt(abs(st$time - (at - 1) / freq), 0.01 * n / freq)
+    expect_equal(st$size, 0.03, tolerance = 0.2)
+    # reported, not removed: x is the input
+    expect_false(st$removed)
+    expect_identical(se$x, x)
+    expect_identical(se$removed, character())
+    # the step raises the long-tau ADEV; taking it out lowers it
+    big <- se$adev$tau >= 40 & se$adev$tau <= 400
+    expect_true(all(se$adev$before[big] > se$adev$after[big]))
+    expect_true(all(abs(se$adev$change[se$adev$tau <= 0.1]) < 1e-3))
+    # removed when asked: nothing left to find
+    rm <- series_effects(x, freq, remove = "steps")
+    expect_true(rm$table$removed)
+    expect_identical(rm$removed, "steps")
+    expect_equal(nrow(series_effects(rm$x, freq)$table), 0L)
+    expect_lt(abs(mean(rm$x[(at - 5000):(at - 1)]) - mean(rm$x[at:(at + 4999)])), 0.01)
+  }
+})
+
+test_that("an exponential warm-up: time constant within 30%", {
+  n <- 2e5
+  freq <- 100
+  t <- (seq_len(n) - 1) / freq
+  for (seed in 1:2) {
+    for (tc in c(30, 120)) {
+      x <- gen_series(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / tc)
+      se <- series_effects(x, freq, remove = "warmup")
+      w <- se$table[se$table$kind == "warmup", ]
+      expect_equal(nrow(w), 1L)
+      expect_equal(w$tc, tc, tolerance = 0.3)
+      expect_equal(w$size, 0.1, tolerance = 0.3)
+      expect_identical(se$table$kind, "warmup")
+      # the corrected start is level with the rest
+      expect_lt(abs(mean(se$x[1:500]) - mean(se$x[(5 * tc * freq):(6 * tc * freq)])), 0.02)
+    }
+  }
+})
+
+test_that("spikes: all found, none invented; removal restores the short-tau ADEV", {
+  n <- 1e5
+  freq <- 100
+  for (seed in 1:3) {
+    clean <- gen_series(n, seed = 30 + seed)
+    set.seed(300 + seed)
+    at <- sort(sample(10:(n - 10), 12))
+    size <- sample(c(-1, 1), 12, replace = TRUE) * runif(12, 1, 3)  # 10-30 sd
+    x <- clean
+    x[at] <- x[at] + size
+    se <- series_effects(x, freq, remove = "spikes")
+    sp <- se$table[se$table$kind == "spikes", ]
+    expect_identical(sp$index, as.integer(at))
+    expect_equal(sp$size, size, tolerance = 0.1)
+    expect_identical(unique(se$table$kind), "spikes")
+    # without the spikes the ADEV at tau0 is the clean series' within 1%
+    a0 <- allan(clean, freq, taus = I(1 / freq))$adev
+    expect_equal(allan(se$x, freq, taus = I(1 / freq))$adev, a0, tolerance = 0.01)
+    expect_gt(se$adev$before[1], 1.01 * a0)
+  }
+})
+
+test_that("controls: red noise, a slow Gauss-Markov and a sinusoid add nothing (<= 1 in 10 seeds)", {
+  n <- 1e5
+  freq <- 100
+  t <- seq_len(n) / freq
+  phi <- exp(-1 / (freq * 30))
+  added <- 0L
+  for (seed in 1:10) {
+    set.seed(500 + seed)
+    gm <- as.numeric(stats::filter(rnorm(n, sd = 0.05 * sqrt(1 - phi^2)), phi,
+                                   method = "recursive"))
+    x <- rnorm(n, sd = 0.1) + cumsum(rnorm(n, sd = 5e-4)) + gm +
+      0.05 * sin(2 * pi * 0.01 * t + seed)
+    added <- added + nrow(series_effects(x, freq)$table)
+  }
+  expect_lte(added, 1L)
+})
+
+test_that("the effects together: each kind found once, `all` removes every one", {
+  n <- 2e5
+  freq <- 100
+  t <- (seq_len(n) - 1) / freq
+  x <- gen_series(n, rw = 2e-5, seed = 61) + 0.1 * exp(-t / 50)
+  x[150001:n] <- x[150001:n] - 0.04
+  x[c(20000, 90000)] <- x[c(20000, 90000)] + c(2, -2.5)
+  se <- series_effects(x, freq, remove = "all")
+  expect_setequal(se$table$kind, c("spikes", "warmup", "steps"))
+  expect_equal(sum(se$table$kind == "spikes"), 2L)
+  expect_equal(se$table$time[se$table$kind == "steps"], 1500, tolerance = 0.01 * n / freq / 1500)
+  expect_true(all(se$table$removed))
+  expect_identical(se$removed, c("spikes", "warmup", "steps"))
+  expect_setequal(se$adev_kinds$kind, c("spikes", "warmup", "steps"))
+  # looking only for spikes leaves the rest alone
+  only <- series_effects(x, freq, kinds = "spikes")
+  expect_identical(unique(only$table$kind), "spikes")
+  expect_identical(only$kinds, "spikes")
+})
+
+test_that("a ts comes back as a ts; freq is taken from it", {
+  x <- stats::ts(gen_series(5000, seed = 71), start = 3, frequency = 50)
+  x[1000] <- x[1000] + 2
+  se <- series_effects(x, remove = "spikes")
+  expect_true(stats::is.ts(se$x))
+  expect_equal(stats::tsp(se$x), stats::tsp(x))
+  expect_equal(se$freq, 50)
+  expect_equal(se$table$index, 1000L)
+})
+
+test_that("series_effects() prints what it found and what it removed", {
+  x <- gen_series(2e4, seed = 81)
+  x[5000] <- x[5000] + 2
+  x[12001:2e4] <- x[12001:2e4] + 0.08
+  expect_snapshot({
+    print(series_effects(x, 100, remove = "spikes"))
+    print(series_effects(gen_series(2e4, seed = 82), 100))
+  })
+})
+
+test_that("series_effects() errors are classed and worded", {
+  x <- gen_series(1000, seed = 91)
+  expect_snapshot(error = TRUE, {
+    series_effects()
+    series_effects(x)
+    series_effects(x, 100, remove = "bumps")
+    series_effects(x, 100, remove = TRUE)
+    series_effects(x, 100, kinds = 1)
+    series_effects(x, 100, 1)
+    series_effects(stats::ts(x, frequency = 10), 100)
+    series_effects(x[1:100], 100)
+  })
+  expect_error(series_effects(x, 100, remove = "x"),
+               class = "allanvar_error_argument")
+})
+
+test_that("avrefine() reports the series effects and removes those asked for", {
+  skip_if_not("remove" %in% names(formals(avrefine)))
+  n <- 1e5
+  freq <- 100
+  x <- gen_series(n, rw = 1e-5, seed = 101)
+  x[60001:n] <- x[60001:n] + 0.03
+  x[c(7000, 33000)] <- x[c(7000, 33000)] + 2
+  fit <- avfit(allan(x, freq), terms = c("N", "K"))
+  ref <- avrefine(fit, data = x, remove = c("spikes", "steps"), max_steps = 1)
+  tb <- ref$series$table
+  expect_identical(sort(unique(tb$kind)), c("spikes", "steps"))
+  expect_equal(tb$time[tb$kind == "steps"], 600, tolerance = 0.01 * n / freq / 600)
+  expect_identical(ref$series$removed, c("spikes", "steps"))
+})
+
+test_that("analyze_imu(remove =) and the CLI's --remove take the effects out before the curve", {
+  set.seed(111)
+  n <- 6000
+  d <- data.frame(time = (0:(n - 1)) / 50, gx = rnorm(n, sd = 0.05),
+                  ax = rnorm(n, sd = 2))
+  spikes <- c(700, 2500, 4100)
+  d$gx[spikes] <- d$gx[spikes] + 1.5
+  f <- tempfile(fileext = ".csv")
+  out <- tempfile("cli")
+  on.exit(unlink(c(f, out), recursive = TRUE))
+  utils::write.csv(d, f, row.names = FALSE)
+  r <- read_imu(f, time_unit = "s", columns = c("gx", "ax"),
+                sensors = c("gyro", "accel"))
+  a <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE,
+                                    remove = "spikes"))
+  s <- a$channels$gyro_x$series
+  expect_identical(s$table$index, as.integer(spikes))
+  expect_identical(s$removed, "spikes")
+  keep <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
+  expect_null(keep$channels$gyro_x$series)
+  expect_lt(a$channels$gyro_x$curve$adev[1], 0.97 * keep$channels$gyro_x$curve$adev[1])
+  capture.output(res <- suppressMessages(suppressWarnings(allanvar_cli(c(
+    f, "--out", out, "--gyro-cols", "gx", "--accel-cols", "ax", "--time-unit", "s",
+    "--no-refine", "--quiet", "--remove", "spikes,steps")))))
+  expect_equal(res$analyses[[1]]$channels$gyro_x$curve$adev,
+               a$channels$gyro_x$curve$adev)
+  expect_error(analyze_imu(r, refine = FALSE, progress = FALSE, remove = "bumps"),
+               class = "allanvar_error_argument")
+})
+
+test_that("degenerate series: a constant has nothing, a noiseless step is one step", {
+  s <- series_effects(rep(1, 5000), 100)
+  expect_equal(nrow(s$table), 0L)
+  expect_true(all(s$adev$change == 0))
+  x <- c(rep(0, 3000), rep(1, 3000))
+  s <- series_effects(x, 100, remove = "all")
+  expect_identical(s$table$kind, "steps")
+  expect_identical(s$table$index, 3001L)
+  expect_equal(s$table$size, 1)
+  expect_equal(s$x, rep(0, 6000))
+  expect_output(print(s), "bias step of 1 at 30 s \\[removed\\]")
+})
+
+test_that("a transient whose return is weak is paired, and a bias step stays a step", {
+  found <- 0L
+  for (seed in 1:6) {
+    set.seed(seed)
+    x <- rnorm(2e4, sd = 0.1)
+    x[5001:7000] <- x[5001:7000] + 0.05        # 20 s at 50 s
+    tb <- series_effects(x, 100, kinds = c("steps", "transients"))$table
+    expect_false("steps" %in% tb$kind)
+    if (identical(tb$kind, "transients")) {
+      found <- found + 1L
+      expect_lt(abs(tb$time - 50), 1)
+      expect_equal(tb$duration, 20, tolerance = 0.1)
+    }
+    set.seed(seed + 100)
+    y <- rnorm(2e4, sd = 0.1)
+    y[12001:2e4] <- y[12001:2e4] + 0.08
+    expect_identical(series_effects(y, 100, kinds = c("steps", "transients"))$table$kind,
+                     "steps")
+  }
+  expect_gte(found, 5L)
+})
