@@ -303,7 +303,12 @@ cli_run <- function(args) {
     tryCatch(plot(a), finally = grDevices::dev.off())
     ds <- datasheet(a, average = isTRUE(opt$average))
     write_datasheet(ds, path(2))
-    write_kalibr_yaml(a, path(3), axis = axis)
+    tryCatch(write_kalibr_yaml(a, path(3), axis = axis),
+             allanvar_error = function(e) {
+               abort("\"", f, "\": imu.yaml cannot be written: ",
+                     sub("^`x`: ", "", conditionMessage(e)),
+                     class = "record_too_short")
+             })
     utils::write.csv(filter_params(a), path(4), row.names = FALSE)
     cat("\n", a$name, "\n", sep = "")
     print(ds)

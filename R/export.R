@@ -108,7 +108,7 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
       v <- vals[ks]
       if (anyNA(v) && !all(is.na(v))) {
         miss <- ks[is.na(v)]
-        abort(paste(miss, collapse = ", "), " could not be read from ",
+        abort("`x`: ", paste(miss, collapse = ", "), " could not be read from ",
               "the analysis (", paste(notes[miss][nzchar(notes[miss])], collapse = "; "),
               if (any(nzchar(notes[miss]))) "; ",
               "see imu_guidance(): the record may be too short); nothing written.",

@@ -198,8 +198,13 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     a <- out[k, ]
     c2 <- out[k + 1L, ]
     ratio <- abs(c2$size / a$size)
+    # a weak partner found only near a strong step must bring the level
+    # back: the two sizes cancel within their errors (else a noise dip
+    # before a real step would turn the step into a transient)
+    cancels <- !(a$extra || c2$extra) ||
+      abs(a$size + c2$size) <= 3 * sqrt(a$se^2 + c2$se^2)
     if (sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
-        !(a$extra && c2$extra) &&
+        !(a$extra && c2$extra) && cancels &&
         ratio > 1 / 3 && ratio < 3) {
       pulse[c(k, k + 1L)] <- TRUE
       prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,

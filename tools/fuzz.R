@@ -342,6 +342,19 @@ fuzz_cases <- function(quick = FALSE) {
   sub_arg("write_datasheet", q(write_datasheet(x = ana, file = file.path(dir, "ds.csv"))),
           c("x", "file", "format"))
   add("write_datasheet", "file is a directory", q(write_datasheet(ana, dir)))
+  # other tools' conventions, curve-only readings, series effects
+  sub_arg("tool_params", q(tool_params(x = ana, tool = "imu_utils")),
+          c("x", "tool", "axis", "freq", "noise_type"))
+  add("tool_params", "an avfit without freq", q(tool_params(fit, "matlab")))
+  sub_arg("write_tool_params", q(write_tool_params(x = ana, tool = "openvins",
+                                                   file = file.path(dir, "kalibr_imu_chain.yaml"))),
+          c("x", "tool", "file", "axis", "noise_type", "rostopic"))
+  add("write_tool_params", "file is a directory", q(write_tool_params(ana, "imu_utils", dir)))
+  sub_arg("datasheet.avfit", q(datasheet(x = fit)), c("average", "unit"))
+  add("datasheet.default", "a number", q(datasheet(1)))
+  sub_arg("series_effects", q(series_effects(x = x, freq = 100)), c("x"), series)
+  sub_arg("series_effects", q(series_effects(x = x, freq = 100)), c("freq", "remove", "kinds"))
+  add("print.series_effects", "valid", q(print(series_effects(x, 100))))
   sub_arg("write_kalibr_yaml", q(write_kalibr_yaml(x = ana, file = file.path(dir, "imu.yaml"))),
           c("x", "file", "axis", "rostopic", "inflate"))
   # what is copied from the user must come back as written (issue 12 item 3)
