@@ -323,6 +323,12 @@ test_that("Ctrl-C stops a long allan() within a second", {
                        "allan(x, 100, taus = 'all', type = 'total')")
   expect_false(is.na(d))
   expect_lt(d, 1)
+  # a further type (src/totals.cpp): minutes of work, most of it in the
+  # O(m) plans built before the parallel loop; before: no poll there
+  d <- interrupt_delay("x <- rnorm(1e5)",
+                       "allan(x, 1, taus = 'all', type = 'mtotdev')", wait = 2)
+  expect_false(is.na(d))
+  expect_lt(d, 1)
 })
 
 test_that("running out of memory in a worker thread is an R error, and R goes on", {
