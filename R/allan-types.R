@@ -365,10 +365,15 @@ allan_extra <- function(x, freq, taus, type, input, conf, debias,
   rate <- input == "rate"
   ch <- allan_channels(x, min_n = if (rate) 2L else 3L)
   if (gaps == "skip" && anyNA(ch$values)) {
+    # TDEV is tau/sqrt(3) MDEV: the modified gap rule (R/allan.R) carries
+    # over. The others are not defined with gaps: MTIE/TIE and the Theo
+    # family need every phase point of their spans, the Total family
+    # reflects each window (a gap would be copied to its far end).
+    if (type == "tdev") return(allan_tdev_gaps(x, freq, taus, input, conf))
     abort("`gaps = \"skip\"` is not defined for type \"", type, "\" (",
           "missing values in `x`); use one of \"standard\", \"overlapping\", ",
-          "\"modified\", \"hadamard\" or \"ohadamard\", or fill the gaps.",
-          class = "gaps")
+          "\"modified\", \"hadamard\", \"ohadamard\" or \"tdev\", or fill ",
+          "the gaps.", class = "gaps")
   }
   N <- ch$N
   L <- if (rate) N + 1 else N
@@ -418,6 +423,20 @@ allan_extra <- function(x, freq, taus, type, input, conf, debias,
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf,
             debias = if (allan_type_prop(type, "debias")) isTRUE(debias))
+}
+
+# TDEV with gaps: the modified variance with gaps (same taus, kept terms,
+# EDF and noise type), times tau^2/3.
+allan_tdev_gaps <- function(x, freq, taus, input, conf) {
+  a <- allan(x, freq, taus = taus, type = "modified", input = input,
+             conf = conf, gaps = "skip")
+  k <- a$tau^2 / 3
+  a$avar <- a$avar * k
+  a$adev <- a$adev * sqrt(k)
+  a$lower <- a$lower * sqrt(k)
+  a$upper <- a$upper * sqrt(k)
+  attr(a, "type") <- "tdev"
+  a
 }
 
 # One channel of a further type: the columns of the result (alpha as

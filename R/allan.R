@@ -89,9 +89,13 @@
 #' number of missing values per channel (print shows the total). Cluster
 #' sizes with no complete term are left out with a warning. The noise type
 #' is identified on the longest run without a gap (`NA` where that run is
-#' too short), and the EDF uses the kept terms and the present points. The
-#' total type is not defined with gaps (its reflection would carry a gap to
-#' the far end) and is refused.
+#' too short), and the EDF uses the kept terms and the present points.
+#' `"tdev"` (\eqn{\tau/\sqrt3} MDEV) follows the modified rule. The other
+#' types are not defined with gaps and are refused (an error of class
+#' `allanvar_error_gaps`): `"total"`, `"mtotdev"`, `"ttotdev"` and
+#' `"htotdev"` (their reflection would carry a gap to the far end of the
+#' extended window), `"theo1"`, `"theobr"`, `"theoh"`, `"mtie"`, `"tierms"`
+#' and `"pdev"` (no published gap rule; fill the gaps first).
 #'
 #' @section Methods:
 #' `print()` shows a header line and the table (`digits`, default 4);

@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <memory>
 #include <vector>
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -286,10 +287,14 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
   R_xlen_t K = 0;
   for (size_t j = 0; j < nt; ++j) K = std::max(K, nterms[j]);
   const R_xlen_t nchunks = (K + kChunk - 1) / kChunk;
-  std::vector<double> part(static_cast<size_t>(nchunks) * nt, 0.0);
+  // nchunks x nt partial sums: gigabytes for taus = "all" at 1e7, so left
+  // uninitialised here (a zero fill took 5-30 s with no interrupt poll) and
+  // zeroed row by row inside the items, which poll
+  std::unique_ptr<double[]> part(new double[static_cast<size_t>(nchunks) * nt]);
   run_items(nchunks, threads, main, [&](R_xlen_t c) {
     const R_xlen_t c0 = c * kChunk, c1 = std::min(K, c0 + kChunk);
-    double* p = part.data() + c * nt;
+    double* p = part.get() + c * nt;
+    std::fill(p, p + nt, 0.0);
     for (R_xlen_t b0 = c0; b0 < c1; b0 += kBlock) {
       const R_xlen_t b1 = std::min(c1, b0 + kBlock);
       for (size_t j = 0; j < nt; ++j) {
@@ -301,7 +306,9 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
       }
     }
   });
+  if (allanvar::interrupt_state().stop.load()) return;  // rows not all set
   for (size_t j = 0; j < nt; ++j) {
+    if ((j & 4095) == 4095 && allanvar::interrupted()) return;
     Acc a;
     for (R_xlen_t c = 0; c < nchunks; ++c) a.add(part[c * nt + j]);
     out[j] = a.value();
@@ -468,7 +475,12 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
   L.pl = pl;
   L.acc.add(s);
   if (L.keep) {
-    for (R_xlen_t k = 0; k < n; ++k) L.z.push_back(h[k] + l[k]);
+    // one resize and a plain loop (per-element push_back cost 8% of an
+    // octave call at 1e7; the capacity is reserved by the caller)
+    const size_t o = L.z.size();
+    L.z.resize(o + static_cast<size_t>(n));
+    double* z = L.z.data() + o;
+    for (R_xlen_t k = 0; k < n; ++k) z[k] = h[k] + l[k];
   }
   if (!pair) return 0;
   const R_xlen_t n2 = n / 2;

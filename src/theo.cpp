@@ -138,6 +138,7 @@ struct PhaseProducts {
 Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
                                   double kmax_d,
                                   const Rcpp::NumericVector& need) {
+  const allanvar::InterruptScope scope;
   const allanvar::PhaseInput in{v.begin(), v.size(), rate};
   allanvar::SplitPhase X;
   allanvar::split_phase(in, X);
@@ -180,8 +181,9 @@ Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
       triT(kmax + 1);
   R_xlen_t k = 0;  // arrays describe this k
   for (R_xlen_t kn = 1; kn <= kmax; ++kn) {
-    if ((kn & 15) == 0 && allanvar::interrupt_pending())
-      throw Rcpp::internal::InterruptedException();
+    // each step costs O(N) (two full lags): ask every step (interrupted()
+    // asks R at most every 20 ms)
+    if (allanvar::interrupted()) scope.finish();
     // advance k -> kn = k + 1
     if (k == 0) r[0] = C1[N];
     r[2 * k + 1] = full(2 * k + 1);

@@ -47,6 +47,7 @@ struct Total {
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector mtie_cpp(const Rcpp::NumericVector& v, bool rate,
                              const Rcpp::NumericVector& m) {
+  const allanvar::InterruptScope scope;
   const allanvar::PhaseInput in{v.begin(), v.size(), rate};
   allanvar::SplitPhase X;
   allanvar::split_phase(in, X);
@@ -61,9 +62,10 @@ Rcpp::NumericVector mtie_cpp(const Rcpp::NumericVector& v, bool rate,
   for (R_xlen_t t = 0; t < nt; ++t) {
     const R_xlen_t w = static_cast<R_xlen_t>(m[t]) + 1;  // window points
     if (w < 2 || w > L) continue;
+    // each tau is one O(L) pass
+    if (allanvar::interrupted()) scope.finish();
     while ((static_cast<R_xlen_t>(2) << level) <= w) {
-      if (allanvar::interrupt_pending())
-        throw Rcpp::internal::InterruptedException();
+      if (allanvar::interrupted()) scope.finish();
       const R_xlen_t h = static_cast<R_xlen_t>(1) << level;
       const R_xlen_t end = L - 2 * h + 1;  // windows of 2h points
       double* px = mx.data();

@@ -334,6 +334,7 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
 Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
                                    const Rcpp::NumericVector& m, bool hadamard,
                                    int threads, int method = 0) {
+  const allanvar::InterruptScope scope;
   const allanvar::PhaseInput in{v.begin(), v.size(), rate};
   const R_xlen_t L = in.length();
   const std::vector<double> ms(m.begin(), m.end());
@@ -359,6 +360,8 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   for (size_t t = 0; t < ms.size(); ++t) {
     const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
     fast[t] = method == 2 || (method == 0 && mm >= kFastFrom);
+    // a plan costs O(m): with taus = "all" the plans alone take minutes
+    if (allanvar::interrupted()) scope.finish();
     if (fast[t] && mm >= 1) plans[t] = make_plan(mm);
   }
   allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nw,

@@ -5,6 +5,8 @@
 #
 #   bash tools/sanitize.sh            # prints the suite's summary, then the
 #                                     # sanitizer findings (none: "clean")
+#   ALLANVAR_SANITIZE_FILTER='^(allan|types|edf)$' bash tools/sanitize.sh
+#                                     # only those test files
 #
 # How: a private Makevars (R_MAKEVARS_USER) adds
 # -fsanitize=address,undefined -fno-omit-frame-pointer to the C/C++ flags
@@ -37,12 +39,19 @@ R_MAKEVARS_USER="$work/Makevars" R CMD INSTALL --preclean --no-test-load \
 asan=$(gcc -print-file-name=libasan.so)
 ubsan=$(gcc -print-file-name=libubsan.so)
 log="$work/tests.log"
+# the whole suite, or only the test files matching ALLANVAR_SANITIZE_FILTER
+runner=(tools/run-tests.R)
+if [ -n "${ALLANVAR_SANITIZE_FILTER:-}" ]; then
+  runner=(-e "Sys.setenv(NOT_CRAN = 'true'); options(allanvar.threads = 2L)
+r <- as.data.frame(testthat::test_dir('tests/testthat', filter = Sys.getenv('ALLANVAR_SANITIZE_FILTER'), package = 'allanvar', load_package = 'installed', stop_on_failure = FALSE))
+cat(sprintf('%d passed, %d failed, %d skipped\\n', sum(r\$nb) - sum(r\$failed) - sum(r\$skipped), sum(r\$failed) + sum(r\$error), sum(r\$skipped)))")
+fi
 echo "sanitize: running the test suite (log: ${ALLANVAR_SANITIZE_LOG:-not kept})"
 LD_PRELOAD="$asan $ubsan" \
 ASAN_OPTIONS="detect_leaks=0:halt_on_error=0:abort_on_error=0" \
 UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=0" \
 ALLANVAR_SANITIZE=1 R_LIBS="$work/lib${R_LIBS:+:$R_LIBS}" \
-  Rscript --vanilla tools/run-tests.R >"$log" 2>&1
+  Rscript --vanilla "${runner[@]}" >"$log" 2>&1
 status=$?
 tail -n 1 "$log"
 if [ -n "${ALLANVAR_SANITIZE_LOG:-}" ]; then cp "$log" "$ALLANVAR_SANITIZE_LOG"; fi

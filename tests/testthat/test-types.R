@@ -306,3 +306,40 @@ test_that("PDEV keeps its digits on long random-walk records", {
     expect_lt(max(abs(p$avar / ref - 1)), 1e-10)
   }
 })
+
+test_that("tdev with gaps keeps the modified terms without a gap (by hand)", {
+  set.seed(3)
+  x <- cumsum(rnorm(200))
+  x[c(17, 90, 91)] <- NA
+  a <- allan(x, 2, taus = c(0.5, 1, 2.5, 5), type = "tdev",
+             input = "integrated")
+  # TVAR = mean over complete terms of (second difference of m-point
+  # phase means)^2 / 6; a term uses x[k .. k + 3m - 1]
+  hand <- vapply(a$m, function(m) {
+    t <- vapply(seq_len(200 - 3 * m + 1), function(k) {
+      j <- k:(k + m - 1)
+      sum(x[j + 2 * m] - 2 * x[j + m] + x[j]) / m
+    }, 0)
+    t <- t[!is.na(t)]
+    c(length(t), mean(t^2) / 6)
+  }, c(0, 0))
+  expect_equal(a$n, as.integer(hand[1, ]), ignore_attr = TRUE)
+  expect_equal(a$avar, hand[2, ], tolerance = 1e-12)
+  expect_equal(attr(a, "type"), "tdev")
+  expect_equal(unname(attr(a, "missing")), 3L)
+  # one gap-free stretch: the same as without gaps
+  b <- allan(x[18:89], 2, taus = c(0.5, 1), type = "tdev",
+             input = "integrated")
+  y <- c(x[18:89], NA)
+  expect_equal(allan(y, 2, taus = c(0.5, 1), type = "tdev",
+                     input = "integrated")$avar, b$avar, tolerance = 1e-12)
+})
+
+test_that("types without a gap rule refuse NA with a classed error", {
+  x <- c(cumsum(rnorm(300)), NA, cumsum(rnorm(99)))
+  for (type in c("mtotdev", "ttotdev", "htotdev", "theo1", "theobr",
+                 "theoh", "mtie", "tierms", "pdev", "total")) {
+    expect_error(allan(x, 1, type = type, input = "integrated"),
+                 class = "allanvar_error_gaps")
+  }
+})
