@@ -211,6 +211,8 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
 #' @param bias_instability `"gm"` (default) or `"omit"`, see above.
 #' @param tau_B For a vector or `avfit`: the tau (s) of the flat minimum,
 #'   used by `bias_instability = "gm"`.
+#' @param unit For an `avfit`: the rate unit of the fitted curve (see
+#'   [av_units()]); `NULL` for the unit the curve carried, if any.
 #' @return A data frame with one row per parameter: `channel`, `sensor`,
 #'   `term`, `parameter`, `value`, `unit`, `continuous` (the coefficient it
 #'   comes from), `continuous_unit`, `dt` and `convention`; rows in the

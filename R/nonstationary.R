@@ -302,6 +302,8 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 5000L,
   none <- list(present = FALSE, amplitude = 0, tc = NA_real_, z = 0,
                level = mean(x))
   if (max_tc <= min_tc || nb < 32L) return(none)
+  # a constant series has no warm-up (and no noise to judge one by)
+  if (max(x) == min(x)) return(none)
   fit_at <- function(tc, span) {
     k <- seq_len(min(nb, max(8L, ceiling(span / dt))))
     X <- cbind(1, exp(-t[k] / tc))

@@ -22,8 +22,7 @@ test_that("the quick fuzz battery finds no unclear error, garbage or crash", {
   sys.source(script, envir = env)
   ns <- asNamespace("allanvar")
   # the working tree when the tests run under load_all(), else the installed package
-  dev <- requireNamespace("pkgload", quietly = TRUE) &&
-    pkgload::is_dev_package("allanvar")
+  dev <- !installed_allanvar()
   pkg <- if (dev) getNamespaceInfo(ns, "path") else ""
   df <- env$fuzz_run(env$fuzz_cases(quick = TRUE), pkg_path = pkg, timeout = 60)
   bad <- env$fuzz_findings(df)
