@@ -16,6 +16,7 @@
 // (|lo| <= q/2) carries the remainder. The running sums are kept as a pair
 // (sum, compensation), so a quiet window after a loud stretch keeps its
 // digits.
+#include "buffer.h"
 #include "opts-dynamic.h"
 #include "parallel.h"
 #include "types.h"
@@ -28,6 +29,8 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
+
+using allanvar::Buffer;
 
 namespace {
 
@@ -60,41 +63,9 @@ inline double pair_diff(const Pair& a, const Pair& b) {
   return s + ((a.c - b.c) + e);
 }
 
-// An uninitialised double array. On Linux, large ones are 2 MiB aligned and
-// marked for transparent huge pages: a fresh 8 MB array otherwise costs
-// thousands of page faults, more than the pass that fills it.
-class Array {
- public:
-  Array() {}
-  Array(const Array&) = delete;
-  Array& operator=(const Array&) = delete;
-  ~Array() { std::free(p_); }
-  void resize(R_xlen_t n) {
-    std::free(p_);
-    p_ = nullptr;
-    const size_t bytes = static_cast<size_t>(n > 0 ? n : 1) * sizeof(double);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    const size_t align = static_cast<size_t>(1) << 21;
-    if (bytes >= align) {
-      void* q = nullptr;
-      if (posix_memalign(&q, align, bytes) == 0) {
-        madvise(q, bytes, MADV_HUGEPAGE);
-        p_ = static_cast<double*>(q);
-      }
-    }
-#endif
-    if (!p_) p_ = static_cast<double*>(std::malloc(bytes));
-    if (!p_) throw std::bad_alloc();
-  }
-  double* data() const { return p_; }
-
- private:
-  double* p_ = nullptr;
-};
-
 // A sequence on the grid described above.
 struct Grid {
-  Array hi, lo;
+  Buffer hi, lo;
 };
 
 // Grid step: the power of two q with bound <= 2^50 q.
@@ -108,7 +79,7 @@ double grid_step(double bound) {
 // Stores s + e (|s| <= 2^50 q) on the grid of step q: hi the nearest
 // multiple of q, lo the rest. Adding and removing 1.5 * 2^52 rounds s / q to
 // an integer (std::nearbyint saves and restores the FP environment).
-inline void put(const Grid& g, R_xlen_t i, double s, double e, double q) {
+inline void put(Grid& g, R_xlen_t i, double s, double e, double q) {
   const double big = 6755399441055744.0;
   const double h = ((s / q + big) - big) * q;
   g.hi.data()[i] = h;
