@@ -494,6 +494,12 @@ summary.allan <- function(object, ...) {
 
 #' @export
 print.summary.allan <- function(x, digits = 4, ...) {
+  print_summary_table(x, digits, ...)
+}
+
+# The summaries of allan(), dynamic_allan() and three_cornered_hat(): a
+# header line, then the table with its real numbers to `digits`.
+print_summary_table <- function(x, digits, ...) {
   cat(attr(x, "header"), "\n", sep = "")
   d <- x
   attr(d, "header") <- NULL

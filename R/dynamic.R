@@ -358,14 +358,7 @@ summary.allan_dynamic <- function(object, ...) {
 
 #' @export
 print.summary.allan_dynamic <- function(x, digits = 4, ...) {
-  cat(attr(x, "header"), "\n", sep = "")
-  d <- x
-  attr(d, "header") <- NULL
-  class(d) <- "data.frame"
-  num <- vapply(d, is.double, TRUE) & names(d) != "n"
-  d[num] <- lapply(d[num], signif, digits = digits)
-  print(d, row.names = FALSE, ...)
-  invisible(x)
+  print_summary_table(x, digits, ...)
 }
 
 #' @export
