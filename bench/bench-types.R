@@ -13,17 +13,11 @@
 #                        unpacked in /tmp/allantools); timed with python3 and
 #                        numpy, each call under `timeout` (BENCH_PY_TIMEOUT,
 #                        default 120 s).
-# Prints one table: median elapsed seconds (3 runs after a warm-up for
+# Prints one table: median elapsed seconds (3 or 9 runs after a first for
 # calls under 5 s, else one run), ratio to sum(x), allantools' time.
 
-lib <- tempfile("allanlib")
-dir.create(lib)
-status <- system2(file.path(R.home("bin"), "R"),
-                  c("CMD", "INSTALL", "--preclean", "--no-test-load",
-                    paste0("--library=", lib), "."),
-                  stdout = FALSE, stderr = FALSE)
-if (status != 0) stop("R CMD INSTALL failed")
-library(allanvar, lib.loc = lib)
+source(file.path("bench", "common.R"))
+lib <- bench_install()
 
 env_num <- function(name, default) {
   v <- Sys.getenv(name)
@@ -33,7 +27,7 @@ sizes <- env_num("BENCH_TYPES_N", c(1e4, 1e5, 1e6))
 cap <- env_num("BENCH_TYPES_CAP", 30)
 py_timeout <- env_num("BENCH_PY_TIMEOUT", 120)
 
-timed <- function(expr) {
+timed_adaptive <- function(expr) {
   f <- substitute(expr)
   e <- parent.frame()
   t1 <- system.time(eval(f, e))[["elapsed"]]
@@ -100,7 +94,7 @@ for (N in sizes) {
                                               allantools = NA)
       next
     }
-    t <- timed(allan(y, 1, type = ty))
+    t <- timed_adaptive(allan(y, 1, type = ty))
     py <- if (have_py && ty %in% names(py_name) && !ty %in% py_stopped) {
       py_time(py_name[[ty]], f)
     } else {
