@@ -8,8 +8,7 @@ welch_psd <- function(x, freq, seg = NULL) {
   n <- length(x)
   if (is.null(seg)) seg <- 2^floor(log2(max(n / 8, 64)))
   seg <- min(seg, 2^floor(log2(n)))
-  t <- seq_len(n)
-  x <- stats::residuals(stats::lm.fit(cbind(1, t), x))
+  x <- detrend_linear(x)
   w <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
   U <- sum(w^2)
   starts <- seq(1, n - seg + 1, by = seg / 2)
@@ -88,11 +87,20 @@ spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 5L) {
   lines
 }
 
-# Autocorrelation of x (mean removed) at lags 0..max_lag via FFT.
+# x minus its least-squares line on 1..n (the residuals of
+# lm.fit(cbind(1, t), x) in closed form: centred t is orthogonal to 1).
+detrend_linear <- function(x) {
+  t <- seq_along(x) - (length(x) + 1) / 2
+  x - mean(x) - t * (sum(t * x) / sum(t^2))
+}
+
+# Autocorrelation of x (mean removed) at lags 0..max_lag via FFT. Zero
+# padding to n + max_lag (not 2n) is enough for lags up to max_lag: the
+# circular products never wrap into them.
 acf_fft <- function(x, max_lag) {
   n <- length(x)
   x <- x - mean(x)
-  nfft <- 2^ceiling(log2(2 * n))
+  nfft <- stats::nextn(n + max_lag + 1L)
   f <- stats::fft(c(x, numeric(nfft - n)))
   a <- Re(stats::fft(Mod(f)^2, inverse = TRUE))[seq_len(max_lag + 1L)] / nfft
   a / a[1L]
@@ -113,8 +121,7 @@ acf_exponential <- function(x, freq, tc) {
   b <- block_means(x, m)
   nb <- length(b)
   if (nb < 40L) return(list(tc = NA_real_, r1 = NA_real_, z = NA_real_, m = m))
-  t <- seq_len(nb)
-  b <- stats::residuals(stats::lm.fit(cbind(1, t), b))
+  b <- detrend_linear(b)
   max_lag <- min(nb - 2L, 48L)
   r <- acf_fft(b, max_lag)[-1L]
   lag <- seq_len(max_lag)
@@ -172,8 +179,7 @@ linear_trend <- function(x, freq, blocks = 100L) {
 lag1_noise_id <- function(x, m = 1L) {
   b <- block_means(x, m)
   if (length(b) < 30L) return(NA_real_)
-  t <- seq_along(b)
-  b <- stats::residuals(stats::lm.fit(cbind(1, t), b))
+  b <- detrend_linear(b)
   d <- 0L
   repeat {
     bc <- b - mean(b)
