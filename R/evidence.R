@@ -205,7 +205,11 @@ acf_exponential <- function(x, freq, tc) {
 # fraction of samples lying on that grid.
 quantization_grid <- function(x) {
   n <- length(x)
-  u <- sort(unique(x))
+  # sort(unique(x)) without the hash table: the distinct values of the
+  # sorted series
+  xs <- sort(x)
+  u <- xs[c(TRUE, xs[-1L] != xs[-n])]
+  rm(xs)
   if (length(u) < 2L) {
     return(list(step = NA_real_, levels = length(u), on_grid = 1,
                 quantized = FALSE, sd_lsb = NA_real_))
