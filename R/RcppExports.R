@@ -57,6 +57,10 @@ edf_interpolate_cpp <- function(m, sub, es, alpha) {
     .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
 }
 
+acf_sums <- function(x, max_lag) {
+    .Call(`_allanvar_acf_sums`, x, max_lag)
+}
+
 lz4_decompress_cpp <- function(x, expected) {
     .Call(`_allanvar_lz4_decompress_cpp`, x, expected)
 }

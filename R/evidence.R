@@ -154,12 +154,17 @@ growing_medians <- function(e) {
   out
 }
 
-# Autocorrelation of x (mean removed) at lags 0..max_lag via FFT. Zero
-# padding to n + max_lag (not 2n) is enough for lags up to max_lag: the
-# circular products never wrap into them.
+# Autocorrelation of x (mean removed) at lags 0..max_lag: direct sums
+# (C++, src/evidence.cpp) for a few dozen lags, otherwise an FFT zero-padded
+# to n + max_lag (enough for lags up to max_lag: the circular products
+# never wrap into them).
 acf_fft <- function(x, max_lag) {
   n <- length(x)
   x <- x - mean(x)
+  if (max_lag <= 64L) {
+    a <- acf_sums(x, as.integer(max_lag))
+    return(a / a[1L])
+  }
   nfft <- stats::nextn(n + max_lag + 1L)
   f <- stats::fft(c(x, numeric(nfft - n)))
   a <- Re(stats::fft(Mod(f)^2, inverse = TRUE))[seq_len(max_lag + 1L)] / nfft

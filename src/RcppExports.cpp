@@ -187,6 +187,17 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// acf_sums
+Rcpp::NumericVector acf_sums(const Rcpp::NumericVector& x, int max_lag);
+RcppExport SEXP _allanvar_acf_sums(SEXP xSEXP, SEXP max_lagSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< int >::type max_lag(max_lagSEXP);
+    rcpp_result_gen = Rcpp::wrap(acf_sums(x, max_lag));
+    return rcpp_result_gen;
+END_RCPP
+}
 // lz4_decompress_cpp
 Rcpp::RawVector lz4_decompress_cpp(const Rcpp::RawVector& x, double expected);
 RcppExport SEXP _allanvar_lz4_decompress_cpp(SEXP xSEXP, SEXP expectedSEXP) {
@@ -490,6 +501,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
+    {"_allanvar_acf_sums", (DL_FUNC) &_allanvar_acf_sums, 2},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
     {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
     {"_allanvar_mcap_chunk_raw", (DL_FUNC) &_allanvar_mcap_chunk_raw, 3},
