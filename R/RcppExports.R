@@ -61,6 +61,10 @@ acf_sums <- function(x, max_lag) {
     .Call(`_allanvar_acf_sums`, x, max_lag)
 }
 
+line_sums <- function(y, f, freq) {
+    .Call(`_allanvar_line_sums`, y, f, freq)
+}
+
 lz4_decompress_cpp <- function(x, expected) {
     .Call(`_allanvar_lz4_decompress_cpp`, x, expected)
 }
