@@ -252,7 +252,8 @@ lag1_noise_id <- function(x, m = 1L) {
   d <- 0L
   repeat {
     bc <- b - mean(b)
-    r1 <- sum(bc[-1L] * bc[-length(bc)]) / sum(bc^2)
+    a <- acf_sums(bc, 1L)
+    r1 <- a[2L] / a[1L]
     delta <- r1 / (1 + r1)
     if (delta < 0.25 || d >= 2L) break
     b <- diff(b)
@@ -326,8 +327,8 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
   alpha <- check_number(alpha, "alpha", 0, 1, open = TRUE)
   check_diagnosable(x, "x")
   n <- length(x)
-  xc <- x - mean(x)
-  r1 <- sum(xc[-1L] * xc[-n]) / sum(xc^2)
+  a1 <- acf_sums(x - mean(x), 1L)
+  r1 <- a1[2L] / a1[1L]
   ms <- 10^(0:floor(log10(n / 30)))
   alphas <- vapply(ms, function(m) lag1_noise_id(x, m), 0)
   structure(list(
