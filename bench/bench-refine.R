@@ -37,7 +37,9 @@ cases <- list(
   "detect_spikes" = function(x) ns_fun("detect_spikes")(x, freq),
   "detect_steps" = function(x) ns_fun("detect_steps")(x, freq),
   "detect_warmup" = function(x) ns_fun("detect_warmup")(x, freq),
-  "old spectral_lines (runmed per octave)" = function(x) ns_fun("spectral_lines")(x, freq),
+  "spectral_lines (avdiagnose's lines)" = function(x) ns_fun("spectral_lines")(x, freq),
+  "remove_lines (one line)" = function(x) ns_fun("remove_lines")(x, freq, 1.3),
+  "acf_exponential (Tc = 0.05 s)" = function(x) ns_fun("acf_exponential")(x, freq, 0.05),
   "avdiagnose (today)" = function(x) avdiagnose(x, freq),
   "avrefine(fit, data = x) (today's loop)" = function(x) {
     fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
