@@ -61,6 +61,10 @@ acf_sums <- function(x, max_lag) {
     .Call(`_allanvar_acf_sums`, x, max_lag)
 }
 
+detrend_line <- function(x) {
+    .Call(`_allanvar_detrend_line`, x)
+}
+
 line_sums <- function(y, f, freq) {
     .Call(`_allanvar_line_sums`, y, f, freq)
 }

@@ -90,11 +90,9 @@ spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 5L) {
 }
 
 # x minus its least-squares line on 1..n (the residuals of
-# lm.fit(cbind(1, t), x) in closed form: centred t is orthogonal to 1).
-detrend_linear <- function(x) {
-  t <- seq_along(x) - (length(x) + 1) / 2
-  x - mean(x) - t * (sum(t * x) / sum(t^2))
-}
+# lm.fit(cbind(1, t), x) in closed form: centred t is orthogonal to 1), in
+# two passes over x in C++ (src/evidence.cpp) instead of five vectors of n.
+detrend_linear <- function(x) detrend_line(as.double(x))
 
 # stats::smoothEnds(y, k) (Tukey's end-point rule, the runmed() end rule
 # "median") at the chosen ends, in O(k log k) instead of O(k^2): the medians
@@ -175,7 +173,8 @@ block_means <- function(x, m) {
   m <- as.integer(m)
   nb <- length(x) %/% m
   if (m <= 1L) return(x)
-  colMeans(matrix(x[seq_len(nb * m)], nrow = m))
+  # .colMeans reads the first nb * m values in place (no copy, no matrix)
+  .colMeans(x, m, nb)
 }
 
 # Exponential ACF (a Gauss-Markov process) near a correlation time `tc` (s):

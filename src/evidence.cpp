@@ -33,3 +33,31 @@ Rcpp::NumericVector acf_sums(const Rcpp::NumericVector& x, int max_lag) {
   }
   return Rcpp::NumericVector(acc.begin(), acc.end());
 }
+
+// x minus its least-squares line on t = 1..n: with t centred, the slope is
+// sum(t x) / sum(t^2) and the intercept the mean (long double sums, as R's
+// sum() and mean()).
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector detrend_line(const Rcpp::NumericVector& x) {
+  const R_xlen_t n = x.size();
+  Rcpp::NumericVector out(n);
+  if (n == 0) return out;
+  const double* v = x.begin();
+  long double s = 0;
+  for (R_xlen_t j = 0; j < n; ++j) s += v[j];
+  const double mean = static_cast<double>(s / n);
+  const double c = (static_cast<double>(n) + 1.0) / 2.0;
+  long double stx = 0, stt = 0;
+  for (R_xlen_t j = 0; j < n; ++j) {
+    const double t = static_cast<double>(j + 1) - c;
+    stx += static_cast<long double>(t) * v[j];
+    stt += static_cast<long double>(t) * t;
+    if ((j & 0x3FFFFF) == 0) Rcpp::checkUserInterrupt();
+  }
+  const double slope = stt > 0 ? static_cast<double>(stx / stt) : 0.0;
+  for (R_xlen_t j = 0; j < n; ++j) {
+    const double t = static_cast<double>(j + 1) - c;
+    out[j] = v[j] - mean - t * slope;
+  }
+  return out;
+}
