@@ -50,8 +50,10 @@ rows <- list()
 for (n in ns) {
   x <- gen(n)
   r <- if (n >= 4e6) 1L else reps
-  # sum(x) is too quick for one timing: 20 in a row, divided
-  base <- time_med(function() for (i in 1:20) sum(x), 3L) / 20
+  # sum(x) is too quick for one timing: enough in a row for about 2e8
+  # additions (system.time() resolves 1 ms), divided
+  k <- max(20L, ceiling(2e8 / n))
+  base <- time_med(function() for (i in seq_len(k)) sum(x), 3L) / k
   for (nm in names(cases)) {
     f <- cases[[nm]]
     sec <- time_med(function() f(x), r)
