@@ -57,6 +57,18 @@ edf_interpolate_cpp <- function(m, sub, es, alpha) {
     .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
 }
 
+acf_sums <- function(x, max_lag) {
+    .Call(`_allanvar_acf_sums`, x, max_lag)
+}
+
+detrend_line <- function(x) {
+    .Call(`_allanvar_detrend_line`, x)
+}
+
+line_sums <- function(y, f, freq) {
+    .Call(`_allanvar_line_sums`, y, f, freq)
+}
+
 lz4_decompress_cpp <- function(x, expected) {
     .Call(`_allanvar_lz4_decompress_cpp`, x, expected)
 }
