@@ -106,6 +106,12 @@ struct PlanItem {
 struct Plan {
   double tt = 0;  // coefficient of T^2
   std::vector<PlanItem> items;
+  // the TS items merged: sum over them of coef T (sum of S_k, k in [a, b])
+  // = T (sum_o ts_w[o] ZZ(n + ts_off[o]) - ts_c1 Z(n) - ts_c2 beta); their
+  // dozens of ranges share six end points
+  std::vector<R_xlen_t> ts_off;
+  std::vector<double> ts_w;
+  double ts_c1 = 0, ts_c2 = 0;
 };
 
 inline double qk(R_xlen_t k) { return 0.5 * static_cast<double>(k) * (k + 1); }
@@ -181,6 +187,20 @@ Plan make_plan(R_xlen_t m) {
   for (PlanItem& it : P.items) {
     if (it.kind == ITEM_TS) {
       for (R_xlen_t k = it.a; k <= it.b; ++k) it.q1 += qk(k);
+      P.ts_c1 += it.coef * static_cast<double>(it.b - it.a + 1);
+      P.ts_c2 += it.coef * it.q1;
+      // W(n + a + 1, n + b + 1) = ZZ(n + b + 2) - ZZ(n + a + 1)
+      for (int z = 0; z < 2; ++z) {
+        const R_xlen_t o = z == 0 ? it.b + 2 : it.a + 1;
+        const double wv = z == 0 ? it.coef : -it.coef;
+        size_t k = 0;
+        while (k < P.ts_off.size() && P.ts_off[k] != o) ++k;
+        if (k == P.ts_off.size()) {
+          P.ts_off.push_back(o);
+          P.ts_w.push_back(0.0);
+        }
+        P.ts_w[k] += wv;
+      }
     } else if (it.kind == ITEM_SAME) {
       for (R_xlen_t t = it.a; t <= it.b; ++t) {
         it.q1 += qk(t);
@@ -195,11 +215,26 @@ Plan make_plan(R_xlen_t m) {
       }
     }
   }
+  std::vector<PlanItem> rest;
+  for (const PlanItem& it : P.items)
+    if (it.kind != ITEM_TS) rest.push_back(it);
+  P.items.swap(rest);
+  // offsets whose weights cancelled exactly (integers) are dropped
+  std::vector<R_xlen_t> off;
+  std::vector<double> wt;
+  for (size_t k = 0; k < P.ts_off.size(); ++k) {
+    if (P.ts_w[k] != 0) {
+      off.push_back(P.ts_off[k]);
+      wt.push_back(P.ts_w[k]);
+    }
+  }
+  P.ts_off.swap(off);
+  P.ts_w.swap(wt);
   return P;
 }
 
 struct FastScratch {
-  std::vector<double> Z, ZZ, M1, M2, PE, zn, beta, T;
+  std::vector<double> Z, ZZ, M1, M2, PE, zn, beta;
   std::vector<std::vector<double> > LP;  // lags 0, m, 2m
 };
 
@@ -249,8 +284,10 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
   // (a pass per window over all items would touch ~250 scattered places)
   w.zn.resize(nb);
   w.beta.resize(nb);
-  w.T.resize(nb);
   double total = 0;
+  const size_t nts = P.ts_off.size();
+  const R_xlen_t* tso = P.ts_off.data();
+  const double* tsw = P.ts_w.data();
   for (R_xlen_t n = 0; n < nb; ++n) {
     const double zn = Z[n];
     const double beta =
@@ -258,22 +295,17 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
     const double T = (Z[n + n3] - zn) - beta * qk(n3 - 1);
     w.zn[n] = zn;
     w.beta[n] = beta;
-    w.T[n] = T;
-    total += P.tt * T * T;
+    double v = 0;
+    for (size_t k = 0; k < nts; ++k) v += tsw[k] * ZZ[n + tso[k]];
+    total += T * (P.tt * T + (v - P.ts_c1 * zn - P.ts_c2 * beta));
   }
   const double* zv = w.zn.data();
   const double* bv = w.beta.data();
-  const double* Tv = w.T.data();
   for (const PlanItem& it : P.items) {
     const R_xlen_t a = it.a, b = it.b;
     const double cnt = static_cast<double>(b - a + 1);
     double acc = 0;
-    if (it.kind == ITEM_TS) {
-      for (R_xlen_t n = 0; n < nb; ++n) {
-        const double sumS = W(n + a + 1, n + b + 1) - cnt * zv[n] - bv[n] * it.q1;
-        acc += Tv[n] * sumS;
-      }
-    } else if (it.kind == ITEM_SAME) {
+    if (it.kind == ITEM_SAME) {
       const R_xlen_t c = it.c;
       const double* L = w.LP[c / m].data();
       for (R_xlen_t n = 0; n < nb; ++n) {
