@@ -75,7 +75,9 @@
 #'
 #' **Cost**: MTIE builds a table of window extremes level by level
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
-#' \eqn{O(L)} per tau; the Total family \eqn{O(L m)} per tau; Theo1
+#' \eqn{O(L)} per tau; the Total family \eqn{O(L)} per tau (each
+#' window's quadratic form in closed form, from prefix sums over blocks of
+#' \eqn{4m} windows; directly, \eqn{O(L m)}, below \eqn{m = 8}); Theo1
 #' \eqn{O(L m)} per tau, and TheoBR's factor \eqn{O(L^2)} once (Lewis's
 #' recurrence, evaluated in double-double arithmetic).
 #' @param debias For `"mtotdev"`, `"ttotdev"`, `"htotdev"` and `"theo1"`:

@@ -14,6 +14,7 @@
 // normalises (MTOT: / (12 m^5 n tau^2/m^2), HTOT: / (36 m^3 n)).
 // O(m) per window; windows are processed in blocks of local phase
 // (src/local-phase.h; both statistics ignore a linear phase term).
+#include "dd.h"
 #include "local-phase.h"
 #include "parallel.h"
 #include <algorithm>
@@ -160,6 +161,41 @@ struct Plan {
 
 inline double qk(R_xlen_t k) { return 0.5 * static_cast<double>(k) * (k + 1); }
 
+// a b exactly, as a double-double
+inline allanvar::DD dd_prod(double a, double b) {
+  double p, e;
+  allanvar::dd_two_prod(a, b, p, e);
+  return allanvar::DD(p, e);
+}
+
+// sum over t in [a, b] of the polynomial f of degree <= d (d <= 4) in
+// O(d^2) instead of O(b - a): Newton's forward differences at a times
+// binomial coefficients, sum_j Delta^j f(a) C(b - a + 1, j + 1), in
+// double-double (f's values are integers below 2^100, so the differences
+// are exact and the result is the correctly rounded sum but for ~1e-30)
+template <class F>
+double poly_sum(R_xlen_t a, R_xlen_t b, int d, F f) {
+  using allanvar::DD;
+  if (b < a) return 0.0;
+  const double n = static_cast<double>(b - a + 1);
+  DD v[5];
+  for (int i = 0; i <= d; ++i) v[i] = f(a + i);
+  for (int j = 1; j <= d; ++j)
+    for (int i = d; i >= j; --i) v[i] = v[i] - v[i - 1];
+  DD tot, ff(1.0);
+  double fact = 1;
+  for (int j = 0; j <= d; ++j) {
+    ff = ff * (n - j);      // n (n - 1) ... (n - j), exact below 2^106
+    fact *= (j + 1);        // (j + 1)!
+    DD t = v[j] * ff;
+    // t / fact to double-double accuracy
+    const double q1 = t.hi / fact;
+    const DD r = t - dd_prod(q1, fact);
+    tot = tot + (DD(q1) + DD(r.hi / fact));
+  }
+  return tot.value();
+}
+
 // index state: 0 below 0 (S = 0), 1 inside [0, 3m-1], 2 above (S = T)
 inline int state(R_xlen_t i, R_xlen_t n3) { return i < 0 ? 0 : (i < n3 ? 1 : 2); }
 
@@ -230,7 +266,7 @@ Plan make_plan(R_xlen_t m) {
   }
   for (PlanItem& it : P.items) {
     if (it.kind == ITEM_TS) {
-      for (R_xlen_t k = it.a; k <= it.b; ++k) it.q1 += qk(k);
+      it.q1 = poly_sum(it.a, it.b, 2, [](R_xlen_t k) { return allanvar::DD(qk(k)); });
       P.ts_c1 += it.coef * static_cast<double>(it.b - it.a + 1);
       P.ts_c2 += it.coef * it.q1;
       // W(n + a + 1, n + b + 1) = ZZ(n + b + 2) - ZZ(n + a + 1)
@@ -246,17 +282,15 @@ Plan make_plan(R_xlen_t m) {
         P.ts_w[k] += wv;
       }
     } else if (it.kind == ITEM_SAME) {
-      for (R_xlen_t t = it.a; t <= it.b; ++t) {
-        it.q1 += qk(t);
-        it.q2 += qk(t - it.c);
-        it.qq += qk(t) * qk(t - it.c);
-      }
+      const R_xlen_t c = it.c;
+      it.q1 = poly_sum(it.a, it.b, 2, [](R_xlen_t t) { return allanvar::DD(qk(t)); });
+      it.q2 = poly_sum(it.a, it.b, 2, [c](R_xlen_t t) { return allanvar::DD(qk(t - c)); });
+      it.qq = poly_sum(it.a, it.b, 4, [c](R_xlen_t t) { return dd_prod(qk(t), qk(t - c)); });
     } else {
-      for (R_xlen_t t = it.a; t <= it.b; ++t) {
-        it.q1 += qk(t);
-        it.q2 += qk(it.c - t);
-        it.qq += qk(t) * qk(it.c - t);
-      }
+      const R_xlen_t c = it.c;
+      it.q1 = poly_sum(it.a, it.b, 2, [](R_xlen_t t) { return allanvar::DD(qk(t)); });
+      it.q2 = poly_sum(it.a, it.b, 2, [c](R_xlen_t t) { return allanvar::DD(qk(c - t)); });
+      it.qq = poly_sum(it.a, it.b, 4, [c](R_xlen_t t) { return dd_prod(qk(t), qk(c - t)); });
     }
   }
   std::vector<PlanItem> rest;

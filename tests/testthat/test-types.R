@@ -343,3 +343,25 @@ test_that("types without a gap rule refuse NA with a classed error", {
                  class = "allanvar_error_gaps")
   }
 })
+
+test_that("PDEV's global kernel equals its blocked kernel and a plain sum", {
+  set.seed(17)
+  N <- 4000
+  sets <- list(wpm = rnorm(N), wfm = cumsum(rnorm(N)),
+               rwfm = cumsum(cumsum(rnorm(N))),
+               drift = 1e6 + 1e3 * (1:N) + 0.01 * (1:N)^2 + cumsum(rnorm(N)))
+  m <- c(2, 3, 8, 31, 100, 257, 1000, 1999)
+  for (nm in names(sets)) {
+    x <- sets[[nm]]
+    blocked <- pdev_sums_cpp(x, FALSE, m, 2L, 1L)
+    global <- pdev_sums_cpp(x, FALSE, m, 2L, 2L)
+    chosen <- pdev_sums_cpp(x, FALSE, m, 1L, 0L)
+    expect_lt(max(abs(global / blocked - 1)), 1e-11, label = nm)
+    expect_lt(max(abs(chosen / blocked - 1)), 1e-11, label = nm)
+  }
+  # white PM: the plain sum of the definition has no cancellation to fear
+  x <- sets$wpm
+  mm <- c(2, 7, 500, 1999)
+  ref <- vapply(mm, function(k) ref_pvar(x, k) * (N - 2 * k) * k^6 / 18, 0)
+  expect_lt(max(abs(pdev_sums_cpp(x, FALSE, mm, 2L, 2L) / ref - 1)), 1e-13)
+})
