@@ -552,12 +552,12 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   u <- sort(unique(mm))
   mx <- max(abs(v))
   if (length(u) <= 200L && mx > 1e-100 && mx < 1e100) {
-    # the kernel's noise identification alone (no term counts, so no sums):
-    # what allan() would report, without the cost of the base type's sums.
+    # the kernel's noise identification, as allan() calls it (the term
+    # counts are part of the identification), without allan()'s limits:
     # allan() identifies every row itself up to 200 rows and rescales only
     # data whose sums over- or underflow, kept out by the range above.
     res <- allan_call_kernel(
-      allan_sums_cpp(v, length(v), u, rep(0, length(u)), u,
+      allan_sums_cpp(v, length(v), u, allan_nterms(base, u, L), u,
                      allan_opts(base, input == "rate")),
       length(v), 1L)
     tab <- allan_type_table()

@@ -9,6 +9,7 @@
 // drift or length of the record.
 #include "buffer.h"
 #include "checks.h"
+#include "local-phase.h"
 #include "noise_id.h"
 #include "opts-allan.h"
 #include "parallel.h"
@@ -178,12 +179,8 @@ void build_split(const double* v, R_xlen_t n, double c, double bound,
 // for k in [k0, k1): two terms per vector (GCC/Clang vector extensions,
 // plain SSE2 on x86-64), two independent accumulators.
 #if defined(__GNUC__)
-typedef double v2d __attribute__((vector_size(16)));
-inline v2d ld2(const double* p) {
-  v2d v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
+using allanvar::v2d;
+using allanvar::ld2;
 #endif
 
 template <int D>

@@ -14,7 +14,6 @@
 #include "parallel.h"
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <vector>
 
 namespace {
@@ -33,15 +32,6 @@ struct Item {
 // difference, whose product Dekker's split makes exact too. Only lo
 // (|lo| <= q/2) is rounded: an error of at most about 12 m eps q per term,
 // checked against the size of the terms after the sum (pdev_sums_cpp).
-#if defined(__GNUC__)
-typedef double v2d __attribute__((vector_size(16)));
-inline v2d ld2(const double* p) {
-  v2d v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-#endif
-
 struct Grid {
   std::vector<double> hi, lo;
   double q = 0;
@@ -87,6 +77,31 @@ void build_pp(const allanvar::SplitPhase& X, Grid& G) {
   }
 }
 
+// 2 S_j from the grid, for one term (V = double, Ld reads one value) or two
+// (V = v2d, Ld reads two): the same arithmetic either way.
+template <class V, class Ld>
+inline V grid_term(const double* h, const double* l, R_xlen_t j, R_xlen_t m,
+                   V k1, Ld ld) {
+  const double* a = h + j;
+  const double* b = h + j + m;
+  const double* c = h + j + 2 * m;
+  const V A = 2.0 * ((ld(b) + ld(b + 1)) - (ld(a + 1) + ld(c)));  // exact
+  const V D = (ld(c + 1) - ld(c)) - (ld(a + 1) - ld(a));          // exact
+  // D k1 = p + e exactly (k1 has at most 26 bits; Veltkamp's split of D)
+  const V p = D * k1;
+  const V sp = 134217729.0 * D;
+  const V dh = sp - (sp - D);
+  const V e = (dh * k1 - p) + (D - dh) * k1;
+  // A + p rounds by at most eps |A + p| (exactly when they cancel)
+  const V s = A + p;
+  const double* la = l + j;
+  const double* lb = l + j + m;
+  const double* lc = l + j + 2 * m;
+  const V lo = 2.0 * ((ld(lb) + ld(lb + 1)) - (ld(la + 1) + ld(lc))) +
+               k1 * ((ld(lc + 1) - ld(lc)) - (ld(la + 1) - ld(la)));
+  return s + (e + lo);
+}
+
 // Sum of (2 S_i)^2 for i in [i0, i1) from the grid (m >= 2, m - 1 < 2^26).
 double global_terms(const Grid& G, R_xlen_t m, R_xlen_t i0, R_xlen_t i1) {
   const double* h = G.hi.data();
@@ -94,67 +109,29 @@ double global_terms(const Grid& G, R_xlen_t m, R_xlen_t i0, R_xlen_t i1) {
   const double k1 = static_cast<double>(m - 1);
   double s0 = 0, s1 = 0;
   R_xlen_t i = i0;
-  auto term = [&](R_xlen_t j) {
-    const double* a = h + j;
-    const double* b = h + j + m;
-    const double* c = h + j + 2 * m;
-    const double A = 2.0 * ((b[0] + b[1]) - (a[1] + c[0]));  // exact
-    const double D = (c[1] - c[0]) - (a[1] - a[0]);          // exact
-    // D k1 = p + e exactly (k1 has at most 26 bits)
-    const double p = D * k1;
-    const double sp = 134217729.0 * D;
-    const double dh = sp - (sp - D);
-    const double e = (dh * k1 - p) + (D - dh) * k1;
-    const double s = A + p;
-    const double bb = s - A;
-    const double te = (A - (s - bb)) + (p - bb);
-    const double* la = l + j;
-    const double* lb = l + j + m;
-    const double* lc = l + j + 2 * m;
-    const double lo = 2.0 * ((lb[0] + lb[1]) - (la[1] + lc[0])) +
-                      k1 * ((lc[1] - lc[0]) - (la[1] - la[0]));
-    return s + ((te + e) + lo);
-  };
 #if defined(__GNUC__)
-  // the same arithmetic on two terms per SSE2 vector
+  using allanvar::v2d;
   v2d a0 = {0, 0}, a1 = {0, 0};
   const v2d k1v = {k1, k1};
-  const v2d splitv = {134217729.0, 134217729.0};
-  auto vterm = [&](R_xlen_t j) {
-    const double* a = h + j;
-    const double* b = h + j + m;
-    const double* c = h + j + 2 * m;
-    const v2d A = 2.0 * ((ld2(b) + ld2(b + 1)) - (ld2(a + 1) + ld2(c)));
-    const v2d D = (ld2(c + 1) - ld2(c)) - (ld2(a + 1) - ld2(a));
-    const v2d p = D * k1v;
-    const v2d sp = splitv * D;
-    const v2d dh = sp - (sp - D);
-    const v2d e = (dh * k1v - p) + (D - dh) * k1v;
-    const v2d s = A + p;
-    const v2d bb = s - A;
-    const v2d te = (A - (s - bb)) + (p - bb);
-    const double* la = l + j;
-    const double* lb = l + j + m;
-    const double* lc = l + j + 2 * m;
-    const v2d lo = 2.0 * ((ld2(lb) + ld2(lb + 1)) - (ld2(la + 1) + ld2(lc))) +
-                   k1v * ((ld2(lc + 1) - ld2(lc)) - (ld2(la + 1) - ld2(la)));
-    return s + ((te + e) + lo);
-  };
+  auto ld2 = [](const double* p) { return allanvar::ld2(p); };
   for (; i + 4 <= i1; i += 4) {
-    const v2d d0 = vterm(i), d1 = vterm(i + 2);
+    const v2d d0 = grid_term(h, l, i, m, k1v, ld2);
+    const v2d d1 = grid_term(h, l, i + 2, m, k1v, ld2);
     a0 += d0 * d0;
     a1 += d1 * d1;
   }
   s0 = a0[0] + a1[0];
   s1 = a0[1] + a1[1];
 #endif
+  auto ld1 = [](const double* p) { return *p; };
   for (; i + 2 <= i1; i += 2) {
-    const double d0 = term(i), d1 = term(i + 1);
+    const double d0 = grid_term(h, l, i, m, k1, ld1);
+    const double d1 = grid_term(h, l, i + 1, m, k1, ld1);
     s0 += d0 * d0;
     s1 += d1 * d1;
   }
   for (; i < i1; ++i) {
-    const double d = term(i);
+    const double d = grid_term(h, l, i, m, k1, ld1);
     s0 += d * d;
   }
   return s0 + s1;
@@ -263,14 +240,9 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     if (allanvar::interrupted()) scope.finish();
     for (size_t t = 0; t < nt; ++t) {
       if (!glob[t]) continue;
-      double tot = 0, cor = 0;
-      for (R_xlen_t c = 0; c < nchunks; ++c) {
-        double s, e;
-        allanvar::phase_two_sum(tot, part[c * nt + t], s, e);
-        tot = s;
-        cor += e;
-      }
-      res[t] = tot + cor;
+      allanvar::TauSums one(1);
+      for (R_xlen_t c = 0; c < nchunks; ++c) one.add(0, part[c * nt + t]);
+      res[t] = one.value(0);
       // each term's error is below (8 + 4 k1) eps q (the lo part, the
       // final additions); the sum of squares then errs by at most twice
       // that over the rms term, relatively (Cauchy-Schwarz)
@@ -310,19 +282,11 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     part[it] = local_terms(hx, lx, mm, a, nb, pbuf[w], ppbuf[w], fbuf[w]);
   });
   if (allanvar::interrupted()) scope.finish();
-  std::vector<double> tot(nt, 0.0), cor(nt, 0.0);
-  std::vector<bool> any(nt, false);
-  for (size_t it = 0; it < items.size(); ++it) {
-    const size_t t = items[it].tau;
-    double s, e;
-    allanvar::phase_two_sum(tot[t], part[it], s, e);
-    tot[t] = s;
-    cor[t] += e;
-    any[t] = true;
-  }
+  allanvar::TauSums sums(nt);
+  for (size_t it = 0; it < items.size(); ++it) sums.add(items[it].tau, part[it]);
   for (size_t t = 0; t < nt; ++t) {
-    if (any[t]) {
-      out[t] = tot[t] + cor[t];
+    if (sums.any(t)) {
+      out[t] = sums.value(t);
     } else if (glob[t]) {
       out[t] = res[t];
     }

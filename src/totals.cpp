@@ -522,17 +522,9 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     part[it] = acc;
   });
   Rcpp::NumericVector out(ms.size(), NA_REAL);
-  std::vector<double> tot(ms.size(), 0.0), cor(ms.size(), 0.0);
-  std::vector<bool> any(ms.size(), false);
-  for (size_t it = 0; it < items.size(); ++it) {
-    const size_t t = items[it].tau;
-    double s, e;
-    allanvar::phase_two_sum(tot[t], part[it], s, e);
-    tot[t] = s;
-    cor[t] += e;
-    any[t] = true;
-  }
+  allanvar::TauSums sums(ms.size());
+  for (size_t it = 0; it < items.size(); ++it) sums.add(items[it].tau, part[it]);
   for (size_t t = 0; t < ms.size(); ++t)
-    if (any[t]) out[t] = tot[t] + cor[t];
+    if (sums.any(t)) out[t] = sums.value(t);
   return out;
 }

@@ -278,12 +278,18 @@ test_that("print says the statistic and the unit; plot labels the axis", {
   }
 })
 
+# White PM, white FM, random-walk FM and a large offset with drift (the
+# cancellation cases of the closed-form kernels), N points each.
+four_noises <- function(N) {
+  list(wpm = rnorm(N), wfm = cumsum(rnorm(N)),
+       rwfm = cumsum(cumsum(rnorm(N))),
+       drift = 1e6 + 1e3 * (1:N) + 0.01 * (1:N)^2 + cumsum(rnorm(N)))
+}
+
 test_that("the Total family's closed form equals its direct evaluation", {
   set.seed(15)
   N <- 4000
-  sets <- list(wpm = rnorm(N), wfm = cumsum(rnorm(N)),
-               rwfm = cumsum(cumsum(rnorm(N))),
-               drift = 1e6 + 1e3 * (1:N) + 0.01 * (1:N)^2 + cumsum(rnorm(N)))
+  sets <- four_noises(N)
   m <- c(8, 9, 16, 31, 100, 257, 1000, 1333)
   for (nm in names(sets)) {
     x <- sets[[nm]]
@@ -347,9 +353,7 @@ test_that("types without a gap rule refuse NA with a classed error", {
 test_that("PDEV's global kernel equals its blocked kernel and a plain sum", {
   set.seed(17)
   N <- 4000
-  sets <- list(wpm = rnorm(N), wfm = cumsum(rnorm(N)),
-               rwfm = cumsum(cumsum(rnorm(N))),
-               drift = 1e6 + 1e3 * (1:N) + 0.01 * (1:N)^2 + cumsum(rnorm(N)))
+  sets <- four_noises(N)
   m <- c(2, 3, 8, 31, 100, 257, 1000, 1999)
   for (nm in names(sets)) {
     x <- sets[[nm]]
