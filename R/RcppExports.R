@@ -85,8 +85,8 @@ mcap_imu <- function(buf, op, off, len, ids, enc) {
     .Call(`_allanvar_mcap_imu`, buf, op, off, len, ids, enc)
 }
 
-pdev_sums_cpp <- function(v, rate, m, threads) {
-    .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads)
+pdev_sums_cpp <- function(v, rate, m, threads, method = 0L) {
+    .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads, method)
 }
 
 csv_field_faults <- function(bytes, sep, expected) {

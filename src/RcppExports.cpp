@@ -271,15 +271,16 @@ BEGIN_RCPP
 END_RCPP
 }
 // pdev_sums_cpp
-Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
-RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
+RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
     Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(pdev_sums_cpp(v, rate, m, threads));
+    Rcpp::traits::input_parameter< int >::type method(methodSEXP);
+    rcpp_result_gen = Rcpp::wrap(pdev_sums_cpp(v, rate, m, threads, method));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -530,7 +531,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
     {"_allanvar_mcap_chunk_raw", (DL_FUNC) &_allanvar_mcap_chunk_raw, 3},
     {"_allanvar_mcap_imu", (DL_FUNC) &_allanvar_mcap_imu, 6},
-    {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 4},
+    {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 5},
     {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
     {"_allanvar_int64_rel_seconds", (DL_FUNC) &_allanvar_int64_rel_seconds, 3},
     {"_allanvar_int64_to_double", (DL_FUNC) &_allanvar_int64_to_double, 1},
