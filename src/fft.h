@@ -43,11 +43,14 @@ class FFTPlan {
       const size_t half = len / 2, step = n / len;
       for (size_t i = 0; i < n; i += len) {
         for (size_t j = 0; j < half; ++j) {
-          cplx w = w_[j * step];
-          if (inverse) w = std::conj(w);
-          const cplx u = a[i + j], v = a[i + j + half] * w;
-          a[i + j] = u + v;
-          a[i + j + half] = u - v;
+          // written out: std::complex's operator* checks for NaN (slow)
+          const double wr = w_[j * step].real();
+          const double wi = inverse ? -w_[j * step].imag() : w_[j * step].imag();
+          const double br = a[i + j + half].real(), bi = a[i + j + half].imag();
+          const double vr = br * wr - bi * wi, vi = br * wi + bi * wr;
+          const double ur = a[i + j].real(), ui = a[i + j].imag();
+          a[i + j] = cplx(ur + vr, ui + vi);
+          a[i + j + half] = cplx(ur - vr, ui - vi);
         }
       }
     }
@@ -95,8 +98,10 @@ inline void real_correlation(const double* a, size_t na, const double* b,
   C.resize(n);
   for (size_t f = 0; f < n; ++f) {
     const cplx z = buf[f], zr = std::conj(buf[(n - f) & (n - 1)]);
-    const cplx A = 0.5 * (z + zr), B = cplx(0, -0.5) * (z - zr);
-    C[f] = std::conj(A) * B;
+    // A = (z + zr) / 2, B = -i (z - zr) / 2, C = conj(A) B
+    const double ar = 0.5 * (z.real() + zr.real()), ai = 0.5 * (z.imag() + zr.imag());
+    const double br = 0.5 * (z.imag() - zr.imag()), bi = -0.5 * (z.real() - zr.real());
+    C[f] = cplx(ar * br + ai * bi, ar * bi - ai * br);
   }
   P.run(C.data(), true);
   const double s = 1.0 / static_cast<double>(n);
