@@ -6,10 +6,15 @@
 //   T_k = sum_{i < N-m} sum_{L=1..k} (1/L) (x(i) - x(i+L) + x(i+m) - x(i+m-L))^2
 // (L = m/2 - delta of SP 1065's inner index).
 //
-// Two evaluations:
-//  * theo1_sums_cpp: T_k at the requested m, straight from the definition:
-//    for each L one pass of a four-point stencil over the phase split hi +
-//    lo (src/local-phase.h), exact on the hi grid. O(N k) per m.
+// Three evaluations:
+//  * theo1_sums_cpp: T_k at the requested m, per m the cheaper of
+//    - the definition: for each L one pass of a four-point stencil over the
+//      phase split hi + lo (src/local-phase.h), exact on the hi grid;
+//      O(N k) per m;
+//    - the blocked expansion (theo_block below): FFT correlations of
+//      locally detrended blocks of 6k to 12k points plus two triangle sums
+//      by divide and conquer; O(N log^2 k) per m, within about 1e-12 of
+//      the definition whatever the noise type.
 //  * theo1_all_cpp: T_k for every k = 1..kmax in O(N kmax + kmax^2), the
 //    complexity of the all-tau Allan variance, by the recurrence idea of
 //    B. Lewis, "A fast algorithm for calculation of Theo1" (IEEE TUFFC
