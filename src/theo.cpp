@@ -60,7 +60,7 @@ using allanvar::DD;
 struct FastScratch {
   allanvar::FFTPlans plans;
   std::vector<allanvar::cplx> buf, buf2;
-  std::vector<double> z, zr, s, c, p2;
+  std::vector<double> z, zr, s, c, c2, p2;
 };
 
 // sum over p + d < n (p, d >= 0) of z[p0 + p] z[p0 + p + 2 (d0 + d)] / (k - d0 - d)
@@ -119,22 +119,21 @@ double theo_block(const double* z, R_xlen_t W, R_xlen_t k, FastScratch& S) {
   S.p2.resize(W + 1);
   S.p2[0] = 0;
   for (R_xlen_t j = 0; j < W; ++j) S.p2[j + 1] = S.p2[j] + z[j] * z[j];
-  // sum_t g(t) sum_i s_i z_{i+t}, t in [1, m)
+  // sum_t g(t) sum_i s_i z_{i+t}, t in [1, m), and the autocorrelation of
+  // z at lags 2d < m, from one pair of transforms
   S.c.resize(m);
-  allanvar::real_correlation(S.s.data(), Mb, z, W, m, S.c.data(), S.plans,
-                             S.buf, S.buf2);
+  S.c2.resize(m - 1);
+  allanvar::real_correlation2(S.s.data(), Mb, z, W, m, S.c.data(), m - 1,
+                              S.c2.data(), S.plans, S.buf, S.buf2);
   double cross = 0, sq = 0;
   for (R_xlen_t t = 1; t < m; ++t) {
     cross += g(t) * S.c[t];
     sq += g(t) * (S.p2[t + Mb] - S.p2[t]);
   }
   // sum_d w(d) P(d)
-  S.c.resize(m - 1);
-  allanvar::real_correlation(z, W, z, W, m - 1, S.c.data(), S.plans, S.buf,
-                             S.buf2);
   double pd = 0;
   for (R_xlen_t d = 0; d < k; ++d)
-    pd += S.c[2 * d] / static_cast<double>(k - d);
+    pd += S.c2[2 * d] / static_cast<double>(k - d);
   pd -= theo_triangle(z, k, 0, 0, k, S);
   S.zr.assign(z, z + W);
   std::reverse(S.zr.begin(), S.zr.end());
@@ -161,7 +160,7 @@ double theo_fast_cost(R_xlen_t N, R_xlen_t k) {
   const double n = static_cast<double>(allanvar::fft_size(B + 4 * k));
   const double lk = std::log2(static_cast<double>(k) + 2);
   // calibrated against the direct stencil (one thread, N = 2^17)
-  return nb * (5.0 * n * std::log2(n) + 8.0 * k * lk * lk);
+  return nb * (3.0 * n * std::log2(n) + 8.0 * k * lk * lk);
 }
 
 struct Item {
@@ -177,6 +176,7 @@ struct Item {
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
                                    const Rcpp::NumericVector& m, int threads,
                                    int method = 0) {
+  const allanvar::InterruptScope scope;
   const allanvar::PhaseInput in{v.begin(), v.size(), rate};
   allanvar::SplitPhase X;
   allanvar::split_phase(in, X);
