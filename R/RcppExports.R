@@ -133,8 +133,8 @@ rosbag_imu <- function(buf, off, len, comp, size, conns, threads = 1L) {
     .Call(`_allanvar_rosbag_imu`, buf, off, len, comp, size, conns, threads)
 }
 
-theo1_sums_cpp <- function(v, rate, m, threads) {
-    .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads)
+theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
+    .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }
 
 theo1_all_cpp <- function(v, rate, kmax_d, need) {

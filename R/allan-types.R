@@ -77,9 +77,13 @@
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
 #' \eqn{O(L)} per tau; the Total family \eqn{O(L)} per tau (each
 #' window's quadratic form in closed form, from prefix sums over blocks of
-#' \eqn{4m} windows; directly, \eqn{O(L m)}, below \eqn{m = 8}); Theo1
-#' \eqn{O(L m)} per tau, and TheoBR's factor \eqn{O(L^2)} once (Lewis's
-#' recurrence, evaluated in double-double arithmetic).
+#' \eqn{4m} windows; directly, \eqn{O(L m)}, below \eqn{m = 8}); Theo1 per
+#' tau the cheaper of its definition (\eqn{O(L m)}) and an expansion into
+#' FFT correlations over blocks of the phase (\eqn{O(L \log^2 m)}, agreeing
+#' with the definition to about \eqn{10^{-12}}), and TheoBR's factor
+#' \eqn{O(L^2)} once (Lewis's recurrence, evaluated in double-double
+#' arithmetic), so `"theobr"` and `"theoh"` stay slow beyond about
+#' \eqn{10^5} samples.
 #' @param debias For `"mtotdev"`, `"ttotdev"`, `"htotdev"` and `"theo1"`:
 #'   apply NIST SP 1065's noise-dependent bias correction (default `TRUE`);
 #'   see "Further statistics". Ignored by the other types.

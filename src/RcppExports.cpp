@@ -413,15 +413,16 @@ BEGIN_RCPP
 END_RCPP
 }
 // theo1_sums_cpp
-Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
-RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
+RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
     Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(theo1_sums_cpp(v, rate, m, threads));
+    Rcpp::traits::input_parameter< int >::type method(methodSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_sums_cpp(v, rate, m, threads, method));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -543,7 +544,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},
     {"_allanvar_rosbag_imu", (DL_FUNC) &_allanvar_rosbag_imu, 7},
-    {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 4},
+    {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
     {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
