@@ -68,11 +68,13 @@ py_time <- function(fun, file) {
   v <- suppressWarnings(as.numeric(utils::tail(out, 1)))
   if (length(v) != 1L || is.na(v)) NA_real_ else v
 }
-py_name <- c(overlapping = "oadev", modified = "mdev", tdev = "tdev",
+py_name <- c(standard = "adev", overlapping = "oadev", modified = "mdev",
+             hadamard = "hdev", ohadamard = "ohdev", total = "totdev", tdev = "tdev",
              mtotdev = "mtotdev", ttotdev = "ttotdev", htotdev = "htotdev",
              theo1 = "theo1", mtie = "mtie", tierms = "tierms", pdev = "pdev")
 
-types <- c("overlapping", "modified", "tdev", "tierms", "mtie", "pdev",
+types <- c("standard", "overlapping", "modified", "hadamard", "ohadamard",
+           "total", "tdev", "tierms", "mtie", "pdev",
            "mtotdev", "ttotdev", "htotdev", "theo1", "theobr", "theoh")
 options(allanvar.threads = 2)
 set.seed(1)
@@ -108,9 +110,9 @@ for (N in sizes) {
                                             allantools = signif(py, 3))
     message(sprintf("%-12s %8.0e %10.4g s  %8.1f x sum  allantools %s", ty, N,
                     t[1], t[1] / s, format(signif(py, 3))))
-    # not run at the next size when it would take over 10 caps (the Theo
-    # family is O(N^2) at octave taus, the others about O(N log N))
-    p <- if (ty %in% c("theo1", "theobr", "theoh")) 2 else 1.1
+    # not run at the next size when it would take over 10 caps (TheoBR's
+    # factor, so TheoBR and TheoH, is O(N^2); the others about O(N log N))
+    p <- if (ty %in% c("theobr", "theoh")) 2 else 1.1
     if (t[1] > cap || t[1] * 10^p > 10 * cap) stopped <- c(stopped, ty)
   }
   rows[[length(rows) + 1L]] <- data.frame(type = "sum(x)", N = N,
