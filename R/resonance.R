@@ -167,3 +167,30 @@ resonance_raw_support <- function(sigma, fr, tc, bands) {
                  100 * bands$share[j], pr)
   list(text = txt, support = near && pr > 1 / 3 && pr < 3)
 }
+
+# The series with each broad band of find_bands() brought down to its
+# background: the FFT bins of the band (widened by half its width on each
+# side, for the Lorentzian's shoulders) are scaled so that their mean power
+# equals that of the bins just beside it. Phases are kept, so the white
+# noise and the filter's roll-off under the band stay; only the band's
+# excess goes. Used for the raw-data checks of the other effects (the
+# filter's short-lag ACF, a Gauss-Markov ACF), which a resonance disturbs.
+remove_bands <- function(x, freq, bands) {
+  if (is.null(bands) || !nrow(bands)) return(x)
+  n <- length(x)
+  m <- mean(x)
+  X <- stats::fft(x - m)
+  f <- (seq_len(n) - 1) * freq / n
+  fa <- pmin(f, freq - f)
+  for (k in seq_len(nrow(bands))) {
+    w <- max(bands$f_to[k] - bands$f_from[k], 2 * freq / n)
+    lo <- bands$f_from[k] - w / 2
+    hi <- bands$f_to[k] + w / 2
+    inb <- fa >= lo & fa <= hi
+    side <- (fa >= lo - w & fa < lo) | (fa > hi & fa <= hi + w)
+    if (!any(inb) || !any(side)) next
+    g <- sqrt(mean(Mod(X[side])^2) / mean(Mod(X[inb])^2))
+    if (is.finite(g) && g < 1) X[inb] <- X[inb] * g
+  }
+  Re(stats::fft(X, inverse = TRUE)) / n + m
+}

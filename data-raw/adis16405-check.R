@@ -23,9 +23,14 @@ check_axis <- function(x, freq, av, dg, ref) {
     cf[[grep("Nf$", names(cf), value = TRUE)[1]]] else NA_real_
   enbw <- NA_real_
   if (has_filter) {
-    L <- cf[grep("\\.L$", names(cf), value = TRUE)[1]]
-    if (length(L) && is.finite(L)) {
-      enbw <- filter_bandwidth(list(family = "ma", L = max(1, L)), 1 / freq)$enbw
+    # the family the loop chose: "filter" (moving average) or "filter:lp1/lp2"
+    v <- split_term(grep("^filter", ref$terms, value = TRUE)[1])$variant
+    if (!nzchar(v)) v <- "ma"
+    p <- if (v == "ma") "L" else "fc"
+    val <- unname(cf[grep(paste0("\\.", p, "$"), names(cf), value = TRUE)[1]])
+    if (length(val) && is.finite(val)) {
+      nl <- stats::setNames(list(val), p)
+      enbw <- filter_bandwidth(filter_spec_of(v, nl, 1 / freq), 1 / freq)$enbw
     }
   }
   f0 <- cf[grepl("\\.f0$", names(cf))]
