@@ -91,6 +91,10 @@ if (!exists("adis_check_define_only")) {
     row <- check_axis(x, freq, av, dg, ref)
     row$seconds <- as.numeric(Sys.time() - t0, units = "secs")
     row$commit <- commit[1]
+    # ADIS_SAVE=dir keeps each refined fit for inspection (outside the tree)
+    if (nzchar(Sys.getenv("ADIS_SAVE"))) {
+      saveRDS(ref, file.path(Sys.getenv("ADIS_SAVE"), sprintf("ref_%d_%s.rds", k, axis)))
+    }
     row <- cbind(data.frame(unit = k, axis = axis), row)
     fmt <- function(v) if (is.numeric(v)) format(signif(v, 4)) else as.character(v)
     cat(paste(vapply(row[cols], fmt, ""), collapse = "\t"), "\n", sep = "",
