@@ -93,7 +93,8 @@ if (!exists("adis_check_define_only")) {
     row$commit <- commit[1]
     # ADIS_SAVE=dir keeps each refined fit for inspection (outside the tree)
     if (nzchar(Sys.getenv("ADIS_SAVE"))) {
-      saveRDS(ref, file.path(Sys.getenv("ADIS_SAVE"), sprintf("ref_%d_%s.rds", k, axis)))
+      saveRDS(list(datasheet = fit0, refined = ref),
+              file.path(Sys.getenv("ADIS_SAVE"), sprintf("fits_%d_%s.rds", k, axis)))
     }
     row <- cbind(data.frame(unit = k, axis = axis), row)
     fmt <- function(v) if (is.numeric(v)) format(signif(v, 4)) else as.character(v)
