@@ -31,7 +31,7 @@ adis_check_define_only <- TRUE
 source("data-raw/adis16405-check.R")
 av_rows <- list(); diag_rows <- list(); line_rows <- list()
 coef_rows <- list(); step_rows <- list(); fit_rows <- list(); noise_rows <- list()
-fits <- list()
+fits <- list(); unexpl_rows <- list()
 
 for (k in 1:3) {
   m <- readRDS(file.path(shared, sprintf("adis16405_unit%d.rds", k)))
@@ -90,6 +90,8 @@ for (k in 1:3) {
       converged = fit0$convergence$converged && ref$convergence$converged,
       failed_refits = NROW(ref$refine$failures),
       stringsAsFactors = FALSE))
+    un <- ref$unexplained
+    if (NROW(un)) unexpl_rows[[id]] <- cbind(key[rep(1, nrow(un)), ], un, row.names = NULL)
     fits[[id]] <- list(datasheet = fit0, refined = ref)
     check_rows[[id]] <- cbind(key, check_axis(x, freq, av, dg, ref))
     cat(sprintf("%-14s chi2 %8.1f -> %7.2f  rms %5.1f%% -> %5.1f%%  [%s]  %.0f s\n", id,
@@ -113,7 +115,7 @@ writeLines(capture.output({
 adis16405_av <- list(
   av = bind(av_rows), diagnostics = bind(diag_rows), lines = bind(line_rows),
   noise_id = bind(noise_rows), fits = bind(fit_rows), coef = bind(coef_rows),
-  steps = bind(step_rows),
+  steps = bind(step_rows), unexplained = bind(unexpl_rows), check = check,
   source = paste("ADIS16405 static recordings, 3 units x 6 axes, 100 Hz, 1e6",
                  "samples each. Department of Geomatics Engineering, University",
                  "of Calgary, via the imudata R package; CC BY-NC-SA 4.0."))
