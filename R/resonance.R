@@ -169,28 +169,33 @@ resonance_raw_support <- function(sigma, fr, tc, bands) {
 }
 
 # The series with each broad band of find_bands() brought down to its
-# background: the FFT bins of the band (widened by half its width on each
-# side, for the Lorentzian's shoulders) are scaled so that their mean power
-# equals that of the bins just beside it. Phases are kept, so the white
-# noise and the filter's roll-off under the band stay; only the band's
-# excess goes. Used for the raw-data checks of the other effects (the
-# filter's short-lag ACF, a Gauss-Markov ACF), which a resonance disturbs.
+# background: every FFT bin is scaled by sqrt(bg / (bg + M(f))), where M is
+# the band's fitted Lorentzian (one-sided PSD) and bg the background PSD
+# read 3-6 band widths away (M taken off), so that the expected power of
+# each bin becomes the background's. Phases are kept, so the white noise
+# and the filter's roll-off under the band stay; only the band's excess
+# goes. Used for the raw-data checks of the other effects (the filter's
+# short-lag ACF, a Gauss-Markov ACF), which a resonance disturbs.
 remove_bands <- function(x, freq, bands) {
   if (is.null(bands) || !nrow(bands)) return(x)
   n <- length(x)
   m <- mean(x)
+  tau0 <- 1 / freq
   X <- stats::fft(x - m)
   f <- (seq_len(n) - 1) * freq / n
   fa <- pmin(f, freq - f)
+  P <- 2 * Mod(X)^2 / (n * freq)
   for (k in seq_len(nrow(bands))) {
-    w <- max(bands$f_to[k] - bands$f_from[k], 2 * freq / n)
-    lo <- bands$f_from[k] - w / 2
-    hi <- bands$f_to[k] + w / 2
-    inb <- fa >= lo & fa <= hi
-    side <- (fa >= lo - w & fa < lo) | (fa > hi & fa <= hi + w)
-    if (!any(inb) || !any(side)) next
-    g <- sqrt(mean(Mod(X[side])^2) / mean(Mod(X[inb])^2))
-    if (is.finite(g) && g < 1) X[inb] <- X[inb] * g
+    b <- bands[k, ]
+    M <- 2 * resonance_psd(fa, tau0, sqrt(b$power), b$f_center, b$tc)
+    w <- max(b$width, b$f_to - b$f_from)
+    d <- abs(fa - b$f_center)
+    near <- d > 3 * w & d < 6 * w
+    bg <- mean(P[near] - M[near])
+    if (!is.finite(bg) || bg <= 0) next
+    g <- sqrt(bg / (bg + M))
+    X <- X * g
+    P <- P * g^2
   }
   Re(stats::fft(X, inverse = TRUE)) / n + m
 }
