@@ -69,3 +69,19 @@ test_that("a filtered sensor with a resonance: the low-pass family, the band's c
   expect_false(any(st$confirmed %in% FALSE))
   expect_false("sinusoid" %in% st$effect)
 })
+
+test_that("with raw data, a sinusoid within 4 periodogram bins of DC is not taken", {
+  set.seed(5)
+  n <- 1e5
+  freq <- 100
+  x <- cumsum(stats::rnorm(n, sd = 0.01)) + stats::rnorm(n)
+  raw <- avdiagnose(x, freq)
+  res <- attr(raw$lines, "resolution")
+  ev <- evidence_sinusoid(list(amp = 1, f0 = 2 * res), raw, x, freq)
+  expect_false(ev$support)
+  expect_match(ev$text, "within 4 bins")
+  # a real line well above DC is still confirmed
+  y <- x + 0.5 * sin(2 * pi * 3 * (seq_len(n) - 1) / freq)
+  raw2 <- avdiagnose(y, freq)
+  expect_true(evidence_sinusoid(list(amp = 0.5, f0 = 3), raw2, y, freq)$support)
+})
