@@ -150,9 +150,12 @@ effect_resonance <- function() {
       resonance_raw_support(par[["sigma"]], par[["fr"]], par[["tc"]],
                             raw$bands %||% find_bands(x, freq))
     },
-    # A broad band of the periodogram proposes a resonance, its centre
-    # pinned where find_bands() measures it (the curve alone places fr
-    # poorly: it sees the band only through the AV's sinc filter).
+    # A broad band of the periodogram proposes a resonance twice: its
+    # centre pinned where find_bands() measures it (the curve alone may
+    # place fr poorly: it sees the band only through the AV's sinc filter),
+    # and free from there (a band that is not quite Lorentzian puts its
+    # AV-equivalent centre elsewhere). The criterion chooses; the raw-data
+    # check still asks for the band within half its width of fr.
     propose = function(raw, tau, sig) {
       b <- raw$bands
       out <- list()
@@ -162,12 +165,13 @@ effect_resonance <- function() {
       b <- b[order(-b$power), , drop = FALSE]
       for (j in seq_len(min(2L, nrow(b)))) {
         st <- resonance_start(b[j, ])
-        out[[j]] <- list(
-          init = st, tau_from = 0.371 / st$fr / 2, tau_to = 2 / st$fr, score = 2,
-          pin = list(fr = b$f_center[j]),
-          note = sprintf("proposed by a spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance)",
-                         format_num(b$f_center[j], 4), format(signif(b$width[j], 2)),
-                         100 * b$share[j]))
+        note <- sprintf("proposed by a spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance)",
+                        format_num(b$f_center[j], 4), format(signif(b$width[j], 2)),
+                        100 * b$share[j])
+        one <- list(init = st, tau_from = 0.371 / st$fr / 2, tau_to = 2 / st$fr,
+                    score = 2, note = note)
+        out[[length(out) + 1L]] <- c(one, list(pin = list(fr = b$f_center[j])))
+        out[[length(out) + 1L]] <- one
       }
       out
     },
