@@ -208,6 +208,19 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   steps <- list()
   current <- fit
   sig <- NULL
+  # A refit that frees the parameters of the effects accepted earlier must
+  # leave each of them valid and not contradicted by the raw data (a
+  # resonance whose tc runs off to a pure tone no longer matches its band).
+  earlier_hold <- function(f) {
+    for (st in steps) {
+      if (!any(startsWith(names(stats::coef(f)), paste0(st$label, ".")))) next
+      par <- instance_params(stats::coef(f), f$layout, st$label)
+      if (!is.null(inadmissible(st$effect, par, f$data$tau, freq))) return(FALSE)
+      ev <- raw_evidence(st$effect, as.list(par), raw, evidence_series(st$effect), freq)
+      if (isFALSE(ev$support)) return(FALSE)
+    }
+    TRUE
+  }
   for (step in seq_len(max_steps)) {
     tau <- current$data$tau
     z <- stats::residuals(current)
@@ -283,6 +296,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
           if (is.null(why) && isFALSE(ev$support)) {
             why <- paste("contradicted by the raw data:", ev$text)
           }
+          if (is.null(why) && !earlier_hold(f)) {
+            why <- "moves an effect accepted earlier to values the raw data contradict"
+          }
           list(par = par, why = why, ev = ev)
         }
         jd <- judge(new)
@@ -334,7 +350,8 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         ev2 <- raw_evidence(best$trial$effect, as.list(p2), raw,
                             evidence_series(best$trial$effect), freq)
         if (!isFALSE(ev2$support) &&
-            is.null(inadmissible(best$trial$effect, p2, tau, freq))) {
+            is.null(inadmissible(best$trial$effect, p2, tau, freq)) &&
+            earlier_hold(full)) {
           best$fit <- full
           best$crit <- crit(full)
           best$params <- p2
@@ -381,7 +398,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       trimmed <- try_refit(args, function(cnd, stage) {
         failures <<- add_failure(failures, cnd, length(steps) + 1L, "tau_range", stage)
       }, "refit without the first points")
-      if (!is.null(trimmed)) {
+      if (!is.null(trimmed) && earlier_hold(trimmed)) {
         tau_range <- c(keep_from, max(tau_all))
         message(sprintf(paste(
           "avrefine(): no catalogue effect describes the first points (tau %s-%s s);",
