@@ -150,7 +150,7 @@ resonance_start <- function(band) {
 # What the raw data say about a fitted resonance: a band of find_bands()
 # whose centre lies within half its width (or 2 resolution bins) of f_r is
 # support; its power within a factor 3 of sigma^2 as well; no band at all
-# near f_r contradicts it.
+# near f_r contradicts it, as does a width 1/(pi tc) more than 3x off the band's.
 resonance_raw_support <- function(sigma, fr, tc, bands) {
   if (!nrow(bands)) {
     return(list(text = sprintf("no spectral band near %s Hz", format(signif(fr, 3))),
@@ -162,10 +162,13 @@ resonance_raw_support <- function(sigma, fr, tc, bands) {
   j <- which.min(d)
   near <- d[j] <= max(0.5 * bands$width[j], 2 * res)
   pr <- bands$power[j] / sigma^2
-  txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x the fitted)",
+  # a resonance is a band, not a tone: its width 1/(pi tc) must match the
+  # band's within a factor 3 (both at least the resolution)
+  wr <- max(bands$width[j], res) / max(1 / (pi * tc), res)
+  txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x and width %.2g x the fitted)",
                  format(signif(bands$f_center[j], 4)), format(signif(bands$width[j], 2)),
-                 100 * bands$share[j], pr)
-  list(text = txt, support = near && pr > 1 / 3 && pr < 3)
+                 100 * bands$share[j], pr, wr)
+  list(text = txt, support = near && pr > 1 / 3 && pr < 3 && wr > 1 / 3 && wr < 3)
 }
 
 # The series with each broad band of find_bands() brought down to its
