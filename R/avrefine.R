@@ -49,7 +49,7 @@
 #' * Without raw data, `$refine$unconfirmed` lists the accepted effects that
 #'   could not be confirmed.
 #' * With raw data, the series' non-stationary effects (steps, warm-up,
-#'   spikes) are read first by `series_effects()` when the package has it,
+#'   spikes) are read first by [series_effects()],
 #'   kept in `$series`, and removed from the data only when named in
 #'   `remove`.
 #'
@@ -169,11 +169,10 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     data <- check_values(data, min_n = 256L, arg = "data")
     check_diagnosable(data, "data")
     # Non-stationary effects (steps, warm-up, spikes) are read from the
-    # series first (R/series.R, when present); what the user asks to remove
-    # is taken out of the data the loop then sees.
-    ser <- if (exists("series_effects", mode = "function"))
-      series_effects(data, freq, remove = remove) else NULL
-    if (!is.null(ser) && length(ser$removed)) data <- ser$x
+    # series first (R/series.R); what the user asks to remove is taken out
+    # of the data the loop then sees.
+    ser <- series_effects(data, freq, remove = remove)
+    if (length(ser$removed)) data <- ser$x
     raw <- avdiagnose(data, freq)
     # Bins of a broad band (a resonance) are not lines: they are not
     # proposed or matched as sinusoids. The bands themselves propose and
