@@ -81,33 +81,6 @@ class FFTPlans {
   std::vector<FFTPlan> plans_;
 };
 
-// c[t] = sum_j a[j] b[j + t] for t in [0, nt), with b zero beyond nb.
-// Exact (no wrap) when the transform size n >= nb and n >= na + nt - 1:
-// then j + t < n for every needed term (no wrap) and b fits.
-inline void real_correlation(const double* a, size_t na, const double* b,
-                             size_t nb, size_t nt, double* c, FFTPlans& plans,
-                             std::vector<cplx>& buf, std::vector<cplx>& C) {
-  size_t need = std::max(nb, na + nt - 1);
-  const FFTPlan& P = plans.get(fft_size(need));
-  const size_t n = P.size();
-  buf.assign(n, cplx(0, 0));
-  for (size_t j = 0; j < na; ++j) buf[j].real(a[j]);
-  for (size_t j = 0; j < nb; ++j) buf[j].imag(b[j]);
-  P.run(buf.data(), false);
-  // A = FFT(a), B = FFT(b) from the packed transform; C = conj(A) B
-  C.resize(n);
-  for (size_t f = 0; f < n; ++f) {
-    const cplx z = buf[f], zr = std::conj(buf[(n - f) & (n - 1)]);
-    // A = (z + zr) / 2, B = -i (z - zr) / 2, C = conj(A) B
-    const double ar = 0.5 * (z.real() + zr.real()), ai = 0.5 * (z.imag() + zr.imag());
-    const double br = 0.5 * (z.imag() - zr.imag()), bi = -0.5 * (z.real() - zr.real());
-    C[f] = cplx(ar * br + ai * bi, ar * bi - ai * br);
-  }
-  P.run(C.data(), true);
-  const double s = 1.0 / static_cast<double>(n);
-  for (size_t t = 0; t < nt; ++t) c[t] = C[t].real() * s;
-}
-
 // Both c1[t] = sum_j a[j] b[j + t] (t < nt1) and c2[t] = sum_j b[j] b[j + t]
 // (t < nt2) from one forward and one inverse transform: the two products
 // are spectra of real sequences, so the inverse of c1's spectrum plus i
@@ -116,7 +89,8 @@ inline void real_correlation2(const double* a, size_t na, const double* b,
                               size_t nb, size_t nt1, double* c1, size_t nt2,
                               double* c2, FFTPlans& plans,
                               std::vector<cplx>& buf, std::vector<cplx>& C) {
-  size_t need = std::max(nb, std::max(na + nt1 - 1, nb + nt2 - 1));
+  size_t need = std::max(nb, na + nt1 - 1);
+  if (nt2 > 0) need = std::max(need, nb + nt2 - 1);
   const FFTPlan& P = plans.get(fft_size(need));
   const size_t n = P.size();
   buf.assign(n, cplx(0, 0));
@@ -128,13 +102,25 @@ inline void real_correlation2(const double* a, size_t na, const double* b,
     const cplx z = buf[f], zr = std::conj(buf[(n - f) & (n - 1)]);
     const double ar = 0.5 * (z.real() + zr.real()), ai = 0.5 * (z.imag() + zr.imag());
     const double br = 0.5 * (z.imag() - zr.imag()), bi = -0.5 * (z.real() - zr.real());
-    // conj(A) B + i |B|^2
-    C[f] = cplx(ar * br + ai * bi, ar * bi - ai * br + (br * br + bi * bi));
+    // conj(A) B (+ i |B|^2 when c2 is wanted)
+    const double b2 = c2 ? br * br + bi * bi : 0.0;
+    C[f] = cplx(ar * br + ai * bi, ar * bi - ai * br + b2);
   }
   P.run(C.data(), true);
   const double s = 1.0 / static_cast<double>(n);
   for (size_t t = 0; t < nt1; ++t) c1[t] = C[t].real() * s;
-  for (size_t t = 0; t < nt2; ++t) c2[t] = C[t].imag() * s;
+  if (c2) {
+    for (size_t t = 0; t < nt2; ++t) c2[t] = C[t].imag() * s;
+  }
+}
+
+// c[t] = sum_j a[j] b[j + t] for t in [0, nt), with b zero beyond nb.
+// Exact (no wrap) when the transform size n >= nb and n >= na + nt - 1:
+// then j + t < n for every needed term (no wrap) and b fits.
+inline void real_correlation(const double* a, size_t na, const double* b,
+                             size_t nb, size_t nt, double* c, FFTPlans& plans,
+                             std::vector<cplx>& buf, std::vector<cplx>& C) {
+  real_correlation2(a, na, b, nb, nt, c, 0, nullptr, plans, buf, C);
 }
 
 }  // namespace allanvar

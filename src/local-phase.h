@@ -53,6 +53,7 @@ inline v2d ld2(const double* p) {
   std::memcpy(&v, p, sizeof v);
   return v;
 }
+inline void st2(double* p, v2d v) { std::memcpy(p, &v, sizeof v); }
 #endif
 
 // The input as a phase sequence: rate samples y (x(0) = 0, x(j) = y(0) +
