@@ -65,6 +65,14 @@ detrend_line <- function(x) {
     .Call(`_allanvar_detrend_line`, x)
 }
 
+welch_segments <- function(x, starts, win) {
+    .Call(`_allanvar_welch_segments`, x, starts, win)
+}
+
+welch_accumulate <- function(z, half, acc) {
+    .Call(`_allanvar_welch_accumulate`, z, half, acc)
+}
+
 line_sums <- function(y, f, freq) {
     .Call(`_allanvar_line_sums`, y, f, freq)
 }

@@ -438,7 +438,10 @@ filter_evidence <- function(x, freq, max_lag = 16L, base_lags = 24:48,
 
 # Welch periodogram (Hann, 50% overlap, segments demeaned), one-sided PSD in
 # u^2/Hz, in O(n log seg): the segments are the columns of one matrix and
-# mvfft transforms them together.
+# mvfft transforms them together. The matrix is built and the squared
+# moduli summed in C++ (src/evidence.cpp), one pass each, with R's own
+# rounding (colMeans, Mod, rowSums), so the PSD is the same to the bit as
+# the R expression in the comments.
 welch_psd_lin <- function(x, freq, seg) {
   n <- length(x)
   seg <- as.integer(min(seg, 2^floor(log2(n))))
@@ -448,14 +451,16 @@ welch_psd_lin <- function(x, freq, seg) {
   U <- sum(win^2)
   half <- seg %/% 2L + 1L
   acc <- numeric(half)
+  x <- as.double(x)
   # Chunks of columns keep the memory bounded for long records.
   chunk <- max(1L, (2^22) %/% seg)
   for (c0 in seq.int(1L, length(starts), by = chunk)) {
     st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
-    idx <- outer(seq_len(seg) - 1L, st, `+`)
-    X <- matrix(x[idx], nrow = seg)
-    X <- (X - rep(colMeans(X), each = seg)) * win
-    acc <- acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
+    # X <- matrix(x[outer(seq_len(seg) - 1L, st, `+`)], nrow = seg)
+    # X <- (X - rep(colMeans(X), each = seg)) * win
+    X <- welch_segments(x, as.integer(st), win)
+    # acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
+    acc <- welch_accumulate(stats::mvfft(X), half, acc)
   }
   k <- length(starts)
   p <- acc / k / (freq * U)

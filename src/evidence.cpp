@@ -4,6 +4,7 @@
 // n points) and exact to rounding.
 #include <Rcpp.h>
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 // sum_j x[j] x[j + k] for k = 0..max_lag, x already centred by the caller.
@@ -67,5 +68,57 @@ Rcpp::NumericVector detrend_line(const Rcpp::NumericVector& x) {
     const double t = static_cast<double>(j + 1) - c;
     out[j] = v[j] - mean - t * slope;
   }
+  return out;
+}
+
+// Welch periodogram (R/filter-noise.R, welch_psd_lin()) without R's many
+// passes over a seg x k index matrix: the segments x[s .. s + seg - 1]
+// (1-based starts) as the columns of one matrix, each minus its mean and
+// times the window, in one pass. The mean is a long double sum divided by
+// seg, as R's colMeans(), so the FFT input is the same to the bit.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericMatrix welch_segments(const Rcpp::NumericVector& x,
+                                   const Rcpp::IntegerVector& starts,
+                                   const Rcpp::NumericVector& win) {
+  const R_xlen_t seg = win.size();
+  const R_xlen_t k = starts.size();
+  Rcpp::NumericMatrix out(seg, k);
+  const double* v = x.begin();
+  const double* w = win.begin();
+  double* o = out.begin();
+  for (R_xlen_t j = 0; j < k; ++j) {
+    const double* s = v + (static_cast<R_xlen_t>(starts[j]) - 1);
+    long double sum = 0;
+    for (R_xlen_t i = 0; i < seg; ++i) sum += s[i];
+    sum /= static_cast<long double>(seg);
+    const double m = static_cast<double>(sum);
+    double* col = o + j * seg;
+    for (R_xlen_t i = 0; i < seg; ++i) col[i] = (s[i] - m) * w[i];
+    if ((j & 0xFFF) == 0) Rcpp::checkUserInterrupt();
+  }
+  return out;
+}
+
+// acc + the row sums of |Z[1:half, ]|^2 for the transformed segments Z:
+// |z| by hypot() (R's Mod()), squared, summed over the columns in long
+// double (R's rowSums()) and then added to acc in double, as
+// acc + rowSums(Mod(Z[seq_len(half), ])^2) does.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector welch_accumulate(const Rcpp::ComplexMatrix& z, int half,
+                                     const Rcpp::NumericVector& acc) {
+  const R_xlen_t seg = z.nrow();
+  const R_xlen_t k = z.ncol();
+  const R_xlen_t h = half;
+  std::vector<long double> rs(h, 0.0L);
+  const Rcomplex* p = z.begin();
+  for (R_xlen_t j = 0; j < k; ++j) {
+    const Rcomplex* col = p + j * seg;
+    for (R_xlen_t i = 0; i < h; ++i) {
+      const double m = std::hypot(col[i].r, col[i].i);
+      rs[i] += m * m;
+    }
+  }
+  Rcpp::NumericVector out(h);
+  for (R_xlen_t i = 0; i < h; ++i) out[i] = acc[i] + static_cast<double>(rs[i]);
   return out;
 }

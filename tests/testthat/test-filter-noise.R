@@ -195,3 +195,36 @@ test_that("the raw data support a fitted filter, and contradict one on white noi
                               filter_evidence(rnorm(n, sd = 0.05), 100), 0.05^2, 100)
   expect_false(wrong$support)
 })
+
+test_that("the C++ Welch periodogram is R's matrix expression to the bit", {
+  # The reference: the all-R form welch_psd_lin() had before its segments
+  # and sums moved to C++ (same FFT, same rounding of each step).
+  ref <- function(x, freq, seg) {
+    n <- length(x)
+    seg <- as.integer(min(seg, 2^floor(log2(n))))
+    starts <- seq.int(1L, n - seg + 1L, by = seg %/% 2L)
+    win <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
+    half <- seg %/% 2L + 1L
+    acc <- numeric(half)
+    chunk <- max(1L, (2^22) %/% seg)
+    for (c0 in seq.int(1L, length(starts), by = chunk)) {
+      st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
+      X <- matrix(x[outer(seq_len(seg) - 1L, st, `+`)], nrow = seg)
+      X <- (X - rep(colMeans(X), each = seg)) * win
+      acc <- acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
+    }
+    p <- acc / length(starts) / (freq * sum(win^2))
+    p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
+    p
+  }
+  set.seed(7)
+  for (n in c(300, 20011)) {
+    x <- 3 + cumsum(rnorm(n)) * 1e-2 + rnorm(n)
+    for (seg in c(64L, 512L)) {
+      expect_identical(welch_psd_lin(x, 50, seg)$psd, ref(x, 50, seg))
+    }
+  }
+  # more than one chunk of columns (2^22 / seg columns, 2^21 samples each)
+  x <- rnorm(2.2e6)
+  expect_identical(welch_psd_lin(x, 10, 4096L)$psd, ref(x, 10, 4096L))
+})
