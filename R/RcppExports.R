@@ -73,6 +73,10 @@ welch_accumulate <- function(z, half, acc) {
     .Call(`_allanvar_welch_accumulate`, z, half, acc)
 }
 
+grid_stats <- function(xs, x) {
+    .Call(`_allanvar_grid_stats`, xs, x)
+}
+
 line_sums <- function(y, f, freq) {
     .Call(`_allanvar_line_sums`, y, f, freq)
 }

@@ -218,27 +218,24 @@ acf_exponential <- function(x, freq, tc) {
 }
 
 # Quantization grid: the step between adjacent distinct values and the
-# fraction of samples lying on that grid.
+# fraction of samples lying on that grid. After R's sort, the distinct
+# values, gaps, medians and the on-grid count come from one C++ pass
+# (src/evidence.cpp, grid_stats()) with R's rounding; the R form was
+#   u <- unique(sort(x)); d <- diff(u); step <- median(d[d > 0])
+#   small <- d[d < 1.5 * step]; if (length(small)) step <- median(small)
+#   off <- (x - u[1]) / step; on <- mean(abs(off - round(off)) < 1e-3)
 quantization_grid <- function(x) {
   n <- length(x)
-  # sort(unique(x)) without the hash table: the distinct values of the
-  # sorted series
-  xs <- sort(x)
-  u <- xs[c(TRUE, xs[-1L] != xs[-n])]
-  rm(xs)
-  if (length(u) < 2L) {
-    return(list(step = NA_real_, levels = length(u), on_grid = 1,
+  g <- grid_stats(sort(x), as.double(x))
+  levels <- as.integer(g[1L])
+  if (levels < 2L) {
+    return(list(step = NA_real_, levels = levels, on_grid = 1,
                 quantized = FALSE, sd_lsb = NA_real_))
   }
-  d <- diff(u)
-  step <- stats::median(d[d > 0])
-  # The smallest gap that is a common divisor: take the small-gap mode.
-  small <- d[d < 1.5 * step]
-  if (length(small)) step <- stats::median(small)
-  off <- (x - u[1L]) / step
-  on <- mean(abs(off - round(off)) < 1e-3)
-  quantized <- length(u) < n / 10 && on > 0.99
-  list(step = step, levels = length(u), on_grid = on, quantized = quantized,
+  step <- g[2L]
+  on <- g[3L]
+  quantized <- levels < n / 10 && on > 0.99
+  list(step = step, levels = levels, on_grid = on, quantized = quantized,
        sd_lsb = stats::sd(x) / step)
 }
 

@@ -122,3 +122,70 @@ Rcpp::NumericVector welch_accumulate(const Rcpp::ComplexMatrix& z, int half,
   for (R_xlen_t i = 0; i < h; ++i) out[i] = acc[i] + static_cast<double>(rs[i]);
   return out;
 }
+
+// Median as R's median() computes it: the middle value, or for an even count
+// the mean of the two middle values (R's mean(): long double sum / 2 plus
+// the long double correction pass). Reorders v.
+static double median_r(std::vector<double>& v) {
+  const size_t n = v.size();
+  const size_t h = (n + 1) / 2;  // R's half, 1-based
+  std::nth_element(v.begin(), v.begin() + (h - 1), v.end());
+  const double a = v[h - 1];
+  if (n % 2 == 1) return a;
+  const double b = *std::min_element(v.begin() + h, v.end());
+  long double s = (static_cast<long double>(a) + b) / 2.0L;
+  long double t = ((a - s) + (b - s)) / 2.0L;
+  return static_cast<double>(s + t);
+}
+
+// The quantization grid of R/evidence.R's quantization_grid() from the
+// sorted series xs and the series x, in two passes and without R's
+// temporaries: the distinct values u, the step (median gap, then the median
+// of the gaps below 1.5 times it) and the fraction of samples within 1e-3
+// steps of the grid u[1] + k step. Returns c(levels, step, on_grid); step
+// is NA with fewer than two levels.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector grid_stats(const Rcpp::NumericVector& xs,
+                               const Rcpp::NumericVector& x) {
+  const R_xlen_t n = xs.size();
+  std::vector<double> d;
+  R_xlen_t levels = n ? 1 : 0;
+  for (R_xlen_t i = 1; i < n; ++i) {
+    if (xs[i] != xs[i - 1]) {
+      // gaps between distinct values: u[levels] - u[levels - 1]
+      d.push_back(0.0);
+      ++levels;
+    }
+  }
+  if (levels < 2) {
+    return Rcpp::NumericVector::create(static_cast<double>(levels), NA_REAL, NA_REAL);
+  }
+  // second pass: the gaps themselves (the count first keeps one allocation)
+  {
+    R_xlen_t j = 0;
+    double prev = xs[0];
+    for (R_xlen_t i = 1; i < n; ++i) {
+      if (xs[i] != xs[i - 1]) {
+        d[j++] = xs[i] - prev;
+        prev = xs[i];
+      }
+    }
+  }
+  std::vector<double> pos;
+  pos.reserve(d.size());
+  for (double g : d) if (g > 0) pos.push_back(g);
+  double step = median_r(pos);
+  std::vector<double> small;
+  for (double g : d) if (g < 1.5 * step) small.push_back(g);
+  if (!small.empty()) step = median_r(small);
+  const double u1 = xs[0];
+  R_xlen_t on = 0;
+  for (R_xlen_t i = 0; i < n; ++i) {
+    const double off = (x[i] - u1) / step;
+    if (std::fabs(off - std::nearbyint(off)) < 1e-3) ++on;
+  }
+  // mean() of a logical: a long double quotient rounded once
+  const long double frac = static_cast<long double>(on) / static_cast<long double>(n);
+  return Rcpp::NumericVector::create(static_cast<double>(levels), step,
+                                     static_cast<double>(frac));
+}

@@ -27,6 +27,33 @@ test_that("a periodogram line is found at f0 with its amplitude and significance
   expect_lte(sum(fa > 0), 1)
 })
 
+test_that("the quantization grid's C++ pass is the R expression to the bit", {
+  # The reference: the all-R form quantization_grid() had before its gaps,
+  # medians and on-grid count moved to C++.
+  ref <- function(x) {
+    xs <- sort(x)
+    u <- xs[c(TRUE, xs[-1L] != xs[-length(x)])]
+    if (length(u) < 2L) return(list(step = NA_real_, levels = length(u), on_grid = 1))
+    d <- diff(u)
+    step <- stats::median(d[d > 0])
+    small <- d[d < 1.5 * step]
+    if (length(small)) step <- stats::median(small)
+    off <- (x - u[1L]) / step
+    list(step = step, levels = length(u), on_grid = mean(abs(off - round(off)) < 1e-3))
+  }
+  set.seed(31)
+  cases <- list(rnorm(2e4), round(rnorm(2e4) / 0.05) * 0.05,
+                round(rnorm(10001) / 0.05) * 0.05 + rnorm(10001, sd = 1e-6),
+                rep(1, 300), c(rep(0, 100), rep(1, 200)),
+                round(rnorm(5e3) * 3) * 0.1 + 0.05,
+                sample(c(0, 0.3, 0.7, 1.1), 1000, TRUE),
+                c(1, 2, 4, 8, 16, 32)[sample(6, 999, TRUE)])
+  for (x in cases) {
+    g <- quantization_grid(x)
+    expect_identical(g[c("step", "levels", "on_grid")], ref(x))
+  }
+})
+
 test_that("the quantization grid and the -1/2 lag-1 ACF are recognised", {
   set.seed(3)
   xq <- round(rnorm(1e5) / 0.05) * 0.05
