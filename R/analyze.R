@@ -256,9 +256,14 @@ analyze_channel <- function(job, opts) {
       NULL
     })
   if (!is.null(fit) && opts$refine) {
+    # The series pass run above is handed on, not run again on its output.
+    refine_args <- opts$refine_args
+    if (!is.null(series) && is.null(refine_args$remove) && is.null(refine_args$series)) {
+      refine_args$series <- series
+    }
     # The raw series lets avrefine() confirm an effect in the data itself.
     fit <- tryCatch(
-      do.call(avrefine, c(list(fit, data = job$x), opts$refine_args)),
+      do.call(avrefine, c(list(fit, data = job$x), refine_args)),
       error = function(e) {
         failure <<- list(message = paste("avrefine():", conditionMessage(e)),
                          condition = e)

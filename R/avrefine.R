@@ -92,6 +92,11 @@
 #'   to count as structure.
 #' @param remove Series effects to take out of `data` before the loop (kinds
 #'   of the catalogue's series components); never done unless asked.
+#' @param series `NULL`, or the [series_effects()] result that produced
+#'   `data` (its cleaned series `series$x`), when that pass has already been
+#'   run (as [analyze_imu()] does when asked to `remove` effects before the
+#'   curve): it is kept in `$series` instead of running the pass again.
+#'   Give `remove` or `series`, not both.
 #' @param ... Passed to [avfit()] on each refit.
 #' @return The refined `avfit` object. Its `steps` data frame has one row
 #'   per accepted step with columns `effect` (as named in [avsim()]),
@@ -124,7 +129,7 @@
 #' ref$steps[, c("effect", "params", "chi2_before", "chi2_after")]
 avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
                      max_steps = 5, criterion = "BIC", min_gain = 10,
-                     level = 3.5, remove = character(), ...) {
+                     level = 3.5, remove = character(), series = NULL, ...) {
   check_present(missing(fit), "fit", "an avfit() result")
   if (!inherits(fit, "avfit")) {
     abort("`fit` must be an avfit() result, not ", describe_type(fit), ".",
@@ -153,6 +158,20 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   if (length(remove) && is.null(data)) {
     abort("`remove` needs the raw series: give `data`.", class = "argument")
   }
+  if (!is.null(series)) {
+    if (!inherits(series, "series_effects")) {
+      abort("`series` must be a series_effects() result or NULL, not ",
+            describe_type(series), ".", class = "argument")
+    }
+    if (is.null(data)) {
+      abort("`series` needs the series it produced: give `data = series$x`.",
+            class = "argument")
+    }
+    if (length(remove)) {
+      abort("Give `remove` or `series`, not both: `series` has already removed ",
+            "what it was asked to.", class = "argument")
+    }
+  }
   raw <- NULL
   ser <- NULL
   if (!is.null(data)) {
@@ -171,8 +190,18 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     # Non-stationary effects (steps, warm-up, spikes) are read from the
     # series first (R/series.R); what the user asks to remove is taken out
     # of the data the loop then sees.
-    ser <- series_effects(data, freq, remove = remove)
-    if (length(ser$removed)) data <- ser$x
+    if (is.null(series)) {
+      ser <- series_effects(data, freq, remove = remove)
+      if (length(ser$removed)) data <- ser$x
+    } else {
+      # the caller's pass: `data` must be the series it left
+      if (!isTRUE(all.equal(series$freq, freq)) ||
+          !identical(as.numeric(series$x), data)) {
+        abort("`data` must be `series$x` at the fit's sampling frequency: the ",
+              "series the given series_effects() pass left.", class = "argument")
+      }
+      ser <- series
+    }
     raw <- avdiagnose(data, freq)
     # Bins of a broad band (a resonance) are not lines: they are not
     # proposed or matched as sinusoids. The bands themselves propose and
@@ -191,6 +220,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     clean <- if (nrow(raw$lines)) remove_lines(data, freq, raw$lines$f0) else data
     clean <- remove_bands(clean, freq, raw$bands)
     raw$filter <- filter_evidence(clean, freq)
+    # Statistics of `clean` that the checks of many candidates share (the
+    # block-mean ACF of each block size), computed once per call.
+    raw$cache <- new.env(parent = emptyenv())
   }
   evidence_series <- function(effect) clean
   rejected <- new_rejected()
@@ -414,6 +446,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   new_steps_df <- all_steps[seq_len(nrow(all_steps)) > NROW(fit$steps), , drop = FALSE]
   unconfirmed <- if (is.null(data)) new_steps_df$label else character()
   current$series <- ser
+  if (!is.null(raw)) raw$cache <- NULL
   current$refine <- list(candidates = candidates, criterion = criterion,
                          min_gain = min_gain, level = level, diagnostics = raw,
                          remaining = sig, start_terms = fit$terms,

@@ -74,7 +74,8 @@ evidence_gm <- function(par, raw, x, freq) {
   if (!is.finite(tc) || tc * freq * 40 / 8 > length(x)) {
     return(list(text = "record too short for an ACF check", support = NA))
   }
-  a <- acf_exponential(x, freq, tc)
+  # raw$cache: avrefine()'s per-call store (NULL elsewhere)
+  a <- acf_exponential(x, freq, tc, cache = raw$cache)
   if (is.finite(a$tc) && a$z > 5) {
     list(text = sprintf("exponential ACF of %s-sample means, Tc = %s s (z = %.1f)",
                         a$m, format_num(a$tc), a$z),

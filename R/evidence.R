@@ -192,14 +192,28 @@ block_means <- function(x, m) {
 # Exponential ACF (a Gauss-Markov process) near a correlation time `tc` (s):
 # block-average so that white noise shrinks and the GM stays, detrend, and
 # fit log ACF on lag. Returns tc estimate, the lag-1 ACF and its z-score.
-acf_exponential <- function(x, freq, tc) {
+# `cache`: NULL or an environment (avrefine()'s, one per call and series)
+# in which the ACF of the block means is kept by block size m, so that the
+# checks of many candidate Tc that share m read the series once.
+acf_exponential <- function(x, freq, tc, cache = NULL) {
   m <- max(1L, floor(tc * freq / 8))
-  b <- block_means(x, m)
-  nb <- length(b)
+  key <- paste0("acf_exponential.", m)
+  hit <- if (!is.null(cache)) cache[[key]]
+  if (is.null(hit)) {
+    b <- block_means(x, m)
+    nb <- length(b)
+    r <- NULL
+    if (nb >= 40L) {
+      b <- detrend_linear(b)
+      r <- acf_fft(b, min(nb - 2L, 48L))[-1L]
+    }
+    hit <- list(nb = nb, r = r)
+    if (!is.null(cache)) cache[[key]] <- hit
+  }
+  nb <- hit$nb
   if (nb < 40L) return(list(tc = NA_real_, r1 = NA_real_, z = NA_real_, m = m))
-  b <- detrend_linear(b)
-  max_lag <- min(nb - 2L, 48L)
-  r <- acf_fft(b, max_lag)[-1L]
+  r <- hit$r
+  max_lag <- length(r)
   lag <- seq_len(max_lag)
   # ACF = a exp(-lag m tau0 / Tc) + (c + d lag): the linear part absorbs the
   # slowly falling ACF of flicker and random walk over a few Tc. Tc is

@@ -160,6 +160,30 @@ test_that("avrefine() reports the series effects and removes those asked for", {
   expect_identical(ref$series$removed, c("spikes", "steps"))
 })
 
+test_that("avrefine(series =) takes an earlier pass instead of running it again", {
+  n <- 5e4
+  freq <- 100
+  x <- gen_white_walk(n, rw = 1e-5, seed = 102)
+  x[c(7000, 33000)] <- x[c(7000, 33000)] + 2
+  se <- series_effects(x, freq, remove = "spikes")
+  fit <- avfit(allan(se$x, freq), terms = c("N", "K"))
+  again <- avrefine(fit, data = se$x, max_steps = 1)
+  given <- avrefine(fit, data = se$x, series = se, max_steps = 1)
+  # the loop itself is the same; the series pass kept is the caller's
+  expect_identical(coef(given), coef(again))
+  expect_identical(given$steps, again$steps)
+  expect_identical(given$series, se)
+  expect_identical(given$refine$removed, "spikes")
+  expect_identical(again$refine$removed, character())
+  expect_error(avrefine(fit, data = se$x, series = list()),
+               class = "allanvar_error_argument")
+  expect_error(avrefine(fit, series = se), class = "allanvar_error_argument")
+  expect_error(avrefine(fit, data = se$x, series = se, remove = "spikes"),
+               class = "allanvar_error_argument")
+  # data that is not the pass's series
+  expect_error(avrefine(fit, data = x, series = se), class = "allanvar_error_argument")
+})
+
 test_that("analyze_imu(remove =) and the CLI's --remove take the effects out before the curve", {
   set.seed(111)
   n <- 6000
@@ -178,6 +202,11 @@ test_that("analyze_imu(remove =) and the CLI's --remove take the effects out bef
   s <- a$channels$gyro_x$series
   expect_identical(s$table$index, as.integer(spikes))
   expect_identical(s$removed, "spikes")
+  # with the loop, the pass is handed to avrefine(), not run again on its output
+  ar <- suppressWarnings(analyze_imu(r, refine = TRUE, progress = FALSE,
+                                     remove = "spikes"))
+  expect_identical(ar$channels$gyro_x$fit$series, ar$channels$gyro_x$series)
+  expect_identical(ar$channels$gyro_x$fit$refine$removed, "spikes")
   keep <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
   expect_null(keep$channels$gyro_x$series)
   expect_lt(a$channels$gyro_x$curve$adev[1], 0.97 * keep$channels$gyro_x$curve$adev[1])
