@@ -438,10 +438,10 @@ filter_evidence <- function(x, freq, max_lag = 16L, base_lags = 24:48,
 
 # Welch periodogram (Hann, 50% overlap, segments demeaned), one-sided PSD in
 # u^2/Hz, in O(n log seg): the segments are the columns of one matrix and
-# mvfft transforms them together. The matrix is built and the squared
-# moduli summed in C++ (src/evidence.cpp), one pass each, with R's own
-# rounding (colMeans, Mod, rowSums), so the PSD is the same to the bit as
-# the R expression in the comments.
+# mvfft transforms them together, two real segments per complex column.
+# The matrix is built and the squared moduli summed in C++
+# (src/evidence.cpp), one pass each; the PSD is the R expression in the
+# comments to rounding.
 welch_psd_lin <- function(x, freq, seg) {
   n <- length(x)
   seg <- as.integer(min(seg, 2^floor(log2(n))))

@@ -209,7 +209,7 @@ BEGIN_RCPP
 END_RCPP
 }
 // welch_segments
-Rcpp::NumericMatrix welch_segments(const Rcpp::NumericVector& x, const Rcpp::IntegerVector& starts, const Rcpp::NumericVector& win);
+Rcpp::ComplexMatrix welch_segments(const Rcpp::NumericVector& x, const Rcpp::IntegerVector& starts, const Rcpp::NumericVector& win);
 RcppExport SEXP _allanvar_welch_segments(SEXP xSEXP, SEXP startsSEXP, SEXP winSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;

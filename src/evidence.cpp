@@ -73,53 +73,63 @@ Rcpp::NumericVector detrend_line(const Rcpp::NumericVector& x) {
 
 // Welch periodogram (R/filter-noise.R, welch_psd_lin()) without R's many
 // passes over a seg x k index matrix: the segments x[s .. s + seg - 1]
-// (1-based starts) as the columns of one matrix, each minus its mean and
-// times the window, in one pass. The mean is a long double sum divided by
-// seg, as R's colMeans(), so the FFT input is the same to the bit.
+// (1-based starts), each minus its mean (a long double sum over seg, as R's
+// colMeans()) and times the window, in one pass. Two real segments go into
+// one complex column, a + i b (Press et al., Numerical Recipes, sec. 12.3,
+// "FFT of two real functions simultaneously"), so that half the transforms
+// are needed; an odd last segment has b = 0.
 // [[Rcpp::export(rng = false)]]
-Rcpp::NumericMatrix welch_segments(const Rcpp::NumericVector& x,
+Rcpp::ComplexMatrix welch_segments(const Rcpp::NumericVector& x,
                                    const Rcpp::IntegerVector& starts,
                                    const Rcpp::NumericVector& win) {
   const R_xlen_t seg = win.size();
   const R_xlen_t k = starts.size();
-  Rcpp::NumericMatrix out(seg, k);
+  const R_xlen_t cols = (k + 1) / 2;
+  Rcpp::ComplexMatrix out(seg, cols);
   const double* v = x.begin();
   const double* w = win.begin();
-  double* o = out.begin();
+  Rcomplex* o = out.begin();
   for (R_xlen_t j = 0; j < k; ++j) {
     const double* s = v + (static_cast<R_xlen_t>(starts[j]) - 1);
     long double sum = 0;
     for (R_xlen_t i = 0; i < seg; ++i) sum += s[i];
     sum /= static_cast<long double>(seg);
     const double m = static_cast<double>(sum);
-    double* col = o + j * seg;
-    for (R_xlen_t i = 0; i < seg; ++i) col[i] = (s[i] - m) * w[i];
+    Rcomplex* col = o + (j / 2) * seg;
+    if (j % 2 == 0) {
+      for (R_xlen_t i = 0; i < seg; ++i) {
+        col[i].r = (s[i] - m) * w[i];
+        col[i].i = 0.0;
+      }
+    } else {
+      for (R_xlen_t i = 0; i < seg; ++i) col[i].i = (s[i] - m) * w[i];
+    }
     if ((j & 0xFFF) == 0) Rcpp::checkUserInterrupt();
   }
   return out;
 }
 
-// acc + the row sums of |Z[1:half, ]|^2 for the transformed segments Z:
-// |z| by hypot() (R's Mod()), squared, summed over the columns in long
-// double (R's rowSums()) and then added to acc in double, as
-// acc + rowSums(Mod(Z[seq_len(half), ])^2) does.
+// acc + the sum over segments of |A_f|^2 for f = 0..half-1, from the
+// transforms Z = A + i B of the packed pairs: |A_f|^2 + |B_f|^2 =
+// (|Z_f|^2 + |Z_(seg-f)|^2) / 2 for real a, b.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector welch_accumulate(const Rcpp::ComplexMatrix& z, int half,
                                      const Rcpp::NumericVector& acc) {
   const R_xlen_t seg = z.nrow();
   const R_xlen_t k = z.ncol();
   const R_xlen_t h = half;
-  std::vector<long double> rs(h, 0.0L);
+  std::vector<double> rs(h, 0.0);
   const Rcomplex* p = z.begin();
   for (R_xlen_t j = 0; j < k; ++j) {
     const Rcomplex* col = p + j * seg;
-    for (R_xlen_t i = 0; i < h; ++i) {
-      const double m = std::hypot(col[i].r, col[i].i);
-      rs[i] += m * m;
+    for (R_xlen_t f = 0; f < h; ++f) {
+      const Rcomplex& a = col[f];
+      const Rcomplex& b = col[f == 0 ? 0 : seg - f];
+      rs[f] += 0.5 * ((a.r * a.r + a.i * a.i) + (b.r * b.r + b.i * b.i));
     }
   }
   Rcpp::NumericVector out(h);
-  for (R_xlen_t i = 0; i < h; ++i) out[i] = acc[i] + static_cast<double>(rs[i]);
+  for (R_xlen_t f = 0; f < h; ++f) out[f] = acc[f] + rs[f];
   return out;
 }
 
