@@ -14,22 +14,16 @@ welch_psd <- function(x, freq, seg = NULL) {
   starts <- seq(1, n - seg + 1, by = seg / 2)
   half <- seg / 2 + 1
   acc <- numeric(half)
-  tap <- function(s) {
-    xs <- x[s:(s + seg - 1)]
-    (xs - mean(xs)) * w
-  }
   # Two real segments a, b per complex transform z = fft(a + i b): the sum
   # of their periodograms is (|z_k|^2 + |z_(seg-k)|^2) / 2, so half the
-  # transforms give the same sum (to rounding).
-  mirror <- c(1L, seg:(seg - half + 2L))
-  np <- length(starts) %/% 2L
-  for (i in seq_len(np)) {
-    z <- Mod(stats::fft(complex(real = tap(starts[2L * i - 1L]),
-                                imaginary = tap(starts[2L * i]))))^2
-    acc <- acc + (z[seq_len(half)] + z[mirror]) / 2
-  }
-  if (length(starts) %% 2L) {
-    acc <- acc + Mod(stats::fft(tap(starts[length(starts)]))[seq_len(half)])^2
+  # transforms give the same sum (to rounding). The segments (demeaned,
+  # windowed) are packed and the sums taken in C++ (src/evidence.cpp, as
+  # welch_psd_lin()), in chunks of columns that bound the memory.
+  chunk <- 2L * max(1L, (2^21) %/% seg)
+  for (c0 in seq.int(1L, length(starts), by = chunk)) {
+    st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
+    acc <- welch_accumulate(stats::mvfft(welch_segments(x, as.integer(st), w)),
+                            as.integer(half), acc)
   }
   p <- acc / length(starts) / (freq * U)
   p[2:(half - 1)] <- 2 * p[2:(half - 1)]

@@ -27,6 +27,34 @@ test_that("a periodogram line is found at f0 with its amplitude and significance
   expect_lte(sum(fa > 0), 1)
 })
 
+test_that("welch_psd()'s C++ segments give the all-R periodogram to rounding", {
+  # The reference: the form welch_psd() had in R (each pair of detrended
+  # segments demeaned, windowed and transformed as one complex vector).
+  ref <- function(x, freq) {
+    n <- length(x)
+    seg <- min(2^floor(log2(max(n / 8, 64))), 2^floor(log2(n)))
+    t <- seq_len(n) - (n + 1) / 2
+    x <- x - mean(x) - t * sum(t * x) / sum(t^2)
+    w <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
+    starts <- seq(1, n - seg + 1, by = seg / 2)
+    half <- seg / 2 + 1
+    acc <- numeric(half)
+    for (s in starts) {
+      xs <- x[s:(s + seg - 1)]
+      acc <- acc + Mod(stats::fft((xs - mean(xs)) * w))[seq_len(half)]^2
+    }
+    p <- acc / length(starts) / (freq * sum(w^2))
+    p[2:(half - 1)] <- 2 * p[2:(half - 1)]
+    p
+  }
+  set.seed(17)
+  # 330 samples: 9 segments of 64 (an odd one out); 5000: 18 of 512
+  for (n in c(330, 5000, 2e4)) {
+    x <- rnorm(n) + sin(seq_len(n)) + cumsum(rnorm(n)) * 0.01
+    expect_equal(welch_psd(x, 100)$psd, ref(x, 100), tolerance = 1e-12)
+  }
+})
+
 test_that("the quantization grid's C++ pass is the R expression to the bit", {
   # The reference: the all-R form quantization_grid() had before its gaps,
   # medians and on-grid count moved to C++.
