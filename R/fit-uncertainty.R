@@ -50,6 +50,8 @@ pinv <- function(A) {
 }
 
 pinv_raw <- function(A) {
+  # no free parameter (every coefficient fixed): nothing to invert
+  if (!length(A)) return(A)
   e <- eigen((A + t(A)) / 2, symmetric = TRUE)
   d <- e$values
   keep <- d > max(d) * 1e-12

@@ -384,3 +384,16 @@ test_that("avfit() and its methods raise classed errors with stable wording", {
                class = "allanvar_error_curve")
   expect_error(av_model(1, c(X = 1)), class = "allanvar_error_argument")
 })
+
+test_that("a fit with every coefficient fixed evaluates the model (no free parameter)", {
+  set.seed(12)
+  a <- allan(rnorm(1e4, sd = 1), 100)
+  f <- avfit(a, terms = c("N", "K"), fixed = c(N = 0.1, K = 1e-4))
+  expect_identical(unname(coef(f)), c(0.1, 1e-4))
+  expect_identical(unname(diag(vcov(f))), c(0, 0))
+  # every point is a degree of freedom; chi2 is the model's own misfit
+  # (N = 0.1 is the truth)
+  expect_equal(f$df.residual, f$nobs)
+  expect_lt(f$chi2, 3)
+  expect_true(is.finite(stats::BIC(f)))
+})
