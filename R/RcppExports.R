@@ -73,8 +73,8 @@ welch_accumulate <- function(z, half, acc) {
     .Call(`_allanvar_welch_accumulate`, z, half, acc)
 }
 
-grid_stats <- function(xs, x) {
-    .Call(`_allanvar_grid_stats`, xs, x)
+grid_stats <- function(x) {
+    .Call(`_allanvar_grid_stats`, x)
 }
 
 line_sums <- function(y, f, freq) {

@@ -226,15 +226,15 @@ acf_exponential <- function(x, freq, tc, cache = NULL) {
 }
 
 # Quantization grid: the step between adjacent distinct values and the
-# fraction of samples lying on that grid. After R's sort, the distinct
-# values, gaps, medians and the on-grid count come from one C++ pass
+# fraction of samples lying on that grid. The sort (a radix sort), the
+# distinct values, gaps, medians and the on-grid count are done in C++
 # (src/evidence.cpp, grid_stats()) with R's rounding; the R form was
 #   u <- unique(sort(x)); d <- diff(u); step <- median(d[d > 0])
 #   small <- d[d < 1.5 * step]; if (length(small)) step <- median(small)
 #   off <- (x - u[1]) / step; on <- mean(abs(off - round(off)) < 1e-3)
 quantization_grid <- function(x) {
   n <- length(x)
-  g <- grid_stats(sort(x), as.double(x))
+  g <- grid_stats(as.double(x))
   levels <- as.integer(g[1L])
   if (levels < 2L) {
     return(list(step = NA_real_, levels = levels, on_grid = 1,

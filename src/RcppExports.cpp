@@ -233,13 +233,12 @@ BEGIN_RCPP
 END_RCPP
 }
 // grid_stats
-Rcpp::NumericVector grid_stats(const Rcpp::NumericVector& xs, const Rcpp::NumericVector& x);
-RcppExport SEXP _allanvar_grid_stats(SEXP xsSEXP, SEXP xSEXP) {
+Rcpp::NumericVector grid_stats(const Rcpp::NumericVector& x);
+RcppExport SEXP _allanvar_grid_stats(SEXP xSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type xs(xsSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
-    rcpp_result_gen = Rcpp::wrap(grid_stats(xs, x));
+    rcpp_result_gen = Rcpp::wrap(grid_stats(x));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -564,7 +563,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_detrend_line", (DL_FUNC) &_allanvar_detrend_line, 1},
     {"_allanvar_welch_segments", (DL_FUNC) &_allanvar_welch_segments, 3},
     {"_allanvar_welch_accumulate", (DL_FUNC) &_allanvar_welch_accumulate, 3},
-    {"_allanvar_grid_stats", (DL_FUNC) &_allanvar_grid_stats, 2},
+    {"_allanvar_grid_stats", (DL_FUNC) &_allanvar_grid_stats, 1},
     {"_allanvar_line_sums", (DL_FUNC) &_allanvar_line_sums, 3},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
     {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},

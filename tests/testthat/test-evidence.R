@@ -56,8 +56,8 @@ test_that("welch_psd()'s C++ segments give the all-R periodogram to rounding", {
 })
 
 test_that("the quantization grid's C++ pass is the R expression to the bit", {
-  # The reference: the all-R form quantization_grid() had before its gaps,
-  # medians and on-grid count moved to C++.
+  # The reference: the all-R form quantization_grid() had before its sort,
+  # gaps, medians and on-grid count moved to C++.
   ref <- function(x) {
     xs <- sort(x)
     u <- xs[c(TRUE, xs[-1L] != xs[-length(x)])]
@@ -75,7 +75,11 @@ test_that("the quantization grid's C++ pass is the R expression to the bit", {
                 rep(1, 300), c(rep(0, 100), rep(1, 200)),
                 round(rnorm(5e3) * 3) * 0.1 + 0.05,
                 sample(c(0, 0.3, 0.7, 1.1), 1000, TRUE),
-                c(1, 2, 4, 8, 16, 32)[sample(6, 999, TRUE)])
+                c(1, 2, 4, 8, 16, 32)[sample(6, 999, TRUE)],
+                # signs, both zeros and the extremes (the radix sort's keys)
+                c(-0, 0, -1.5, 2, -0, 1e-300, -1e-300, -.Machine$double.xmax,
+                  .Machine$double.xmax, 3),
+                -abs(rnorm(500)))
   for (x in cases) {
     g <- quantization_grid(x)
     expect_identical(g[c("step", "levels", "on_grid")], ref(x))
