@@ -81,8 +81,15 @@ rel_mdae <- function(est) {
   100 * apply(abs(rel), 2L, stats::median)
 }
 
+# mean estimate over truth: the bias, which the RMSE mixes with the spread
+# (an estimator shrunk towards 0 trades one for the other)
+rel_mean <- function(est) {
+  colMeans(sweep(est, 2L, truth[colnames(est)], "/"))
+}
+
 rows <- list()
 mdae <- list()
+bias <- list()
 for (sc in names(scenarios)) {
 truth <- scenarios[[sc]]
 for (k in 1:2) {
@@ -103,6 +110,9 @@ for (k in 1:2) {
   mdae[[length(mdae) + 1L]] <- data.frame(
     scenario = sc, n = n, method = c("allanvar", "gmwm"),
     rbind(rel_mdae(ea), rel_mdae(eg[ok, , drop = FALSE])), check.names = FALSE)
+  bias[[length(bias) + 1L]] <- data.frame(
+    scenario = sc, n = n, method = c("allanvar", "gmwm"),
+    rbind(rel_mean(ea), rel_mean(eg[ok, , drop = FALSE])), check.names = FALSE)
 }
 }
 out <- do.call(rbind, rows)
@@ -120,3 +130,7 @@ md <- do.call(rbind, mdae)
 md[num] <- lapply(md[num], function(v) signif(v, 3))
 cat("\nMedian absolute relative error, percent:\n")
 print(md, row.names = FALSE)
+bi <- do.call(rbind, bias)
+bi[num] <- lapply(bi[num], function(v) signif(v, 3))
+cat("\nMean estimate / truth (1 = unbiased):\n")
+print(bi, row.names = FALSE)
