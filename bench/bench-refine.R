@@ -40,6 +40,9 @@ cases <- list(
   "spectral_lines (avdiagnose's lines)" = function(x) ns_fun("spectral_lines")(x, freq),
   "remove_lines (one line)" = function(x) ns_fun("remove_lines")(x, freq, 1.3),
   "acf_exponential (Tc = 0.05 s)" = function(x) ns_fun("acf_exponential")(x, freq, 0.05),
+  "quantization_grid (radix sort)" = function(x) ns_fun("quantization_grid")(x),
+  "welch_psd_lin (seg 512)" = function(x) ns_fun("welch_psd_lin")(x, freq, 512L),
+  "series_effects" = function(x) series_effects(x, freq),
   "avdiagnose (today)" = function(x) avdiagnose(x, freq),
   "avrefine(fit, data = x) (today's loop)" = function(x) {
     fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
