@@ -2,7 +2,9 @@
 # covariance kernel. Measures the installed package (compiled -O2;
 # pkgload::load_all() builds with -O0, which is several times slower for
 # Eigen code):
-#   R CMD INSTALL . && Rscript bench/bench-avfit.R
+#   R CMD INSTALL --preclean . && Rscript bench/bench-avfit.R
+# (--preclean: objects pkgload::load_all() left in src/ are built with -O0
+# and a plain install would reuse them; allan() ran 30x slower that way.)
 # ALLANVAR_LIB=<library> measures the allanvar installed there instead (to
 # compare two versions in one session of the machine).
 # Prints one row per case: what was timed, the size, the median elapsed

@@ -4,7 +4,9 @@
 # 1e6 samples. The series come from the generator written below (not
 # avsim()), so neither method is scored on its own simulator.
 #
-#   R CMD INSTALL . && Rscript bench/bench-gmwm.R [seeds_1e5] [seeds_1e6]
+#   R CMD INSTALL --preclean . && Rscript bench/bench-gmwm.R [seeds_1e5] [seeds_1e6]
+# (--preclean: objects pkgload::load_all() left in src/ are built with -O0
+# and a plain install would reuse them; allan() ran 30x slower that way.)
 #
 # simts is installed into a temporary library (or into
 # $ALLANVAR_BENCH_LIB when set, to keep it between runs); the time the

@@ -2,7 +2,9 @@
 # (issue 9, item 6): each raw-data diagnostic and the whole
 # avrefine(fit, data = x), at 1e5, 1e6, 4e6 and 1e7 samples, with R's
 # sum(x) on the same data as the yardstick. Measures the installed package:
-#   R CMD INSTALL . && Rscript bench/bench-refine.R [max_n] [reps]
+#   R CMD INSTALL --preclean . && Rscript bench/bench-refine.R [max_n] [reps]
+# (--preclean: objects pkgload::load_all() left in src/ are built with -O0
+# and a plain install would reuse them; allan() ran 30x slower that way.)
 # Prints one row per (case, n): the median elapsed seconds over `reps`
 # runs and the ratio to sum(x); then the growth exponent between sizes
 # (1 = linear). The series: white + random walk + a 1.3 Hz line + a
