@@ -575,7 +575,7 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     if (n >= allanvar::kAcfMinPoints) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
-      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j],
+      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], false,
                                  [&]() { return rn.ratio(m); });
     }
     store_id(id, out, j);
@@ -687,7 +687,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     if (m == 1 && N >= allanvar::kAcfMinPoints) {
       id = allanvar::acf_noise_id(v, N, !rate, dmax);
     } else {
-      id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn, mid_n[j]);
+      id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn, mid_n[j],
+                                    type == MODIFIED);
     }
     store_id(id, out, j);
   });

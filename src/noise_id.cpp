@@ -41,10 +41,18 @@ double b1_theory(double N, int mu) {
 
 // mu whose expected B1 lies nearest the measured one: boundaries at the
 // geometric means of neighbours, the arithmetic mean between mu 2 and 1
-// (Howe et al. 2000, Table 4, as Stable32); mu -2 (white or flicker PM) up
-// to 2 (flicker walk FM; the caller clamps to the statistic's range).
-int b1_mu(double b1, double N) {
+// (Howe et al. 2000, Table 4); mu -2 (white or flicker PM) up to 2 (flicker
+// walk FM; the caller clamps to the statistic's range). Stable32 takes N,
+// the count behind the expected B1, to be the statistic's number of terms
+// (n_stat); so do the PM / white FM / flicker FM boundaries here. Random-
+// walk FM is told from flicker FM with the count of averaged frequencies
+// the ratio was read from (n_own): with Stable32's N the expected B1 of
+// random walk (N/2) is out of reach at long tau, it is typed flicker or
+// white FM, and the 68% intervals of overlapping ADEV cover 0.62
+// (tests/testthat/test-edf.R).
+int b1_mu(double b1, double n_stat, double n_own) {
   for (int mu = 2; mu > -2; --mu) {
+    const double N = mu >= 1 ? n_own : n_stat;
     const double hi = b1_theory(N, mu), lo = b1_theory(N, mu - 1);
     const double bound = mu == 2 ? 0.5 * (hi + lo) : std::sqrt(hi * lo);
     if (b1 > bound) return mu;
@@ -69,12 +77,13 @@ double rn_theory(double m, int alpha) {
 
 // The type whose expected R(n) is nearest on a log scale (boundaries at the
 // geometric means of neighbours). Stable32 asks R(n) only for white against
-// flicker PM once B1 has said PM; B1 from a handful of averaged frequencies
-// says PM for white FM often enough that a white-FM record would get the
-// EDF of flicker PM (many times too large) at long tau, so all five types
-// are weighed (3 fewer of 711 Stable32 limits match, 68% coverage holds:
-// tests/testthat/test-edf.R).
-int rn_alpha(double rn, double m) {
+// flicker PM once B1 has said PM (pm_only, the modified family, where the
+// EDF of flicker PM is close to white FM's). For the unmodified types B1
+// from a handful of averaged frequencies says PM for white FM often enough
+// that a white-FM record would get the EDF of PM (near N) at long tau, so
+// there all five types are weighed.
+int rn_alpha(double rn, double m, bool pm_only) {
+  if (pm_only) return rn > std::sqrt(rn_theory(m, 1) * rn_theory(m, 2)) ? 1 : 2;
   // at very small m flicker PM's ratio is not below white FM's: PM only
   const int last = rn_theory(m, 1) < rn_theory(m, 0) ? -2 : 1;
   int alpha = 2;

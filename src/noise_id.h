@@ -16,7 +16,8 @@
 // The choices were checked against 9,582 noise types printed by Stable32 in
 // the allantools and allantoolkit test suites (tools/check-stable32*.R).
 //
-// Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms) with x(k) the
+// Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms, pm_only) with
+// pm_only for the modified family (R(n) splits PM only) and x(k) the
 // phase at k = 0 .. L-1 (any constant offset; for frequency data the running
 // sum of the samples, L = N + 1) and an RnCache filled once from the same
 // phase when some m has fewer than kAcfMinPoints points (needs_b1()).
@@ -135,10 +136,10 @@ NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
 // B1 ratio of the averaged frequencies ybar[0..n); rn() gives MVAR/AVAR at
 // m, called only when B1 points to white or flicker PM (NaN: unavailable).
 double b1_ratio(const double* ybar, R_xlen_t n);
-int b1_mu(double b1, double N);                // tau exponent mu of AVAR
+int b1_mu(double b1, double n_stat, double n_own);  // tau exponent of AVAR
 double b1_theory(double N, int mu);
 double rn_theory(double m, int alpha);          // expected MVAR/AVAR
-int rn_alpha(double rn, double m);              // alpha from R(n)
+int rn_alpha(double rn, double m, bool pm_only);  // alpha from R(n)
 
 // Phase values at a coarse grid (step s, at most ~4096 points) and their
 // prefix sums, for R(n) at long averaging factors (m >= L/30, so the window
@@ -218,7 +219,7 @@ inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase) {
 // 7,552 instead of 8,652 of 9,582 Stable32 noise types are matched).
 template <class RN>
 NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
-                    double nterms, RN rn) {
+                    double nterms, bool pm_only, RN rn) {
   NoiseId out;
   out.points = n;
   std::vector<double> ybar;
@@ -232,12 +233,12 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
   const double b1 = b1_ratio(ybar.data(), na);
   if (!std::isfinite(b1)) return out;
   const double N = nterms >= 2 ? nterms : static_cast<double>(na);
-  const int mu = b1_mu(b1, N);
+  const int mu = b1_mu(b1, N, static_cast<double>(na));
   if (mu == -2) {
     // white or flicker PM: R(n) tells them apart where it can be read,
     // else flicker PM (Stable32's choice for the unmodified types)
     const double r = m > 1 ? rn() : NAN;
-    out.alpha_int = std::isfinite(r) ? rn_alpha(r, static_cast<double>(m)) : 1;
+    out.alpha_int = std::isfinite(r) ? rn_alpha(r, static_cast<double>(m), pm_only) : 1;
     out.method = std::isfinite(r) ? NOISE_ID_B1_RN : NOISE_ID_B1;
   } else {
     out.alpha_int = -mu - 1;  // mu -1, 0, 1, 2 -> alpha 0, -1, -2, -3
@@ -250,7 +251,8 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
 // Noise type at m from the phase x(k), k < L.
 template <class X>
 NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
-                       bool phase, RnCache& rn, double nterms) {
+                       bool phase, RnCache& rn, double nterms,
+                       bool pm_only) {
   const R_xlen_t n = acf_points(L, m, phase);
   if (n >= kAcfMinPoints) {
     if (phase) {
@@ -264,7 +266,7 @@ NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
   for (R_xlen_t i = 0; i < n; ++i) {
     z[i] = phase ? x(i * m) : x((i + 1) * m) - x(i * m);
   }
-  return b1_noise_id(z.data(), n, phase, m, nterms, [&]() {
+  return b1_noise_id(z.data(), n, phase, m, nterms, pm_only, [&]() {
     if (rn.empty()) rn.build(x, L);  // build it beforehand to share it
     return rn.ratio(m);
   });
