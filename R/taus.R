@@ -26,7 +26,10 @@ allan_type_code <- function(type) {
 allan_opts <- function(type, rate, octave = FALSE,
                        threads = allanvar_threads()) {
   list(type = allan_type_code(type), rate = isTRUE(rate),
-       octave = isTRUE(octave), threads = as.integer(threads))
+       octave = isTRUE(octave), threads = as.integer(threads),
+       # options(allanvar.noise_id = "stable32"): B1 exactly as Stable32
+       # (src/noise_id.cpp, b1_mu())
+       stable32_b1 = identical(getOption("allanvar.noise_id"), "stable32"))
 }
 
 # Largest cluster size with at least one term, for L phase points (L = N + 1

@@ -554,8 +554,8 @@ inline void store_id(const allanvar::NoiseId& id, Channel& out, size_t j) {
 void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<Level>& lev,
                      const std::vector<R_xlen_t>& mid,
-                     const std::vector<double>& mid_n, int dmax, int threads,
-                     bool main, Channel& out) {
+                     const std::vector<double>& mid_n, int dmax,
+                     bool stable32_n, int threads, bool main, Channel& out) {
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
     if (allanvar::needs_b1(N + 1, m, false)) {
@@ -575,7 +575,7 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     if (n >= allanvar::kAcfMinPoints) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
-      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], false,
+      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], false, stable32_n,
                                  [&]() { return rn.ratio(m); });
     }
     store_id(id, out, j);
@@ -629,7 +629,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
       out.sums[j] = lev[lj].acc.value();
     }
-    octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, threads, main, out);
+    octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, opts.stable32_b1,
+                    threads, main, out);
     return;
   }
 
@@ -688,7 +689,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       id = allanvar::acf_noise_id(v, N, !rate, dmax);
     } else {
       id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn, mid_n[j],
-                                    type == MODIFIED);
+                                    type == MODIFIED, opts.stable32_b1);
     }
     store_id(id, out, j);
   });

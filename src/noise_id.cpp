@@ -49,7 +49,8 @@ double b1_theory(double N, int mu) {
 // the ratio was read from (n_own): with Stable32's N the expected B1 of
 // random walk (N/2) is out of reach at long tau, it is typed flicker or
 // white FM, and the 68% intervals of overlapping ADEV cover 0.62
-// (tests/testthat/test-edf.R).
+// (tests/testthat/test-edf.R). options(allanvar.noise_id = "stable32")
+// passes n_own = n_stat, Stable32's rule, for comparisons with it.
 int b1_mu(double b1, double n_stat, double n_own) {
   for (int mu = 2; mu > -2; --mu) {
     const double N = mu >= 1 ? n_own : n_stat;

@@ -7,7 +7,7 @@
 //    the WHOLE decimated series (phase data: every m-th phase point;
 //    frequency data: averages of m samples) while it has at least
 //    kAcfMinPoints (30) points. As Stable32: no detrending (removing drift
-//    is the user's preprocessing) and r1 scaled by (n - 1)/n;
+//    is the user's preprocessing);
 //  * below that, Barnes' B1 ratio (standard / Allan variance of the averaged
 //    frequencies; Barnes 1969, Howe et al. 2000 Tables 3-4) with N the
 //    number of terms of the statistic, as Stable32, and the R(n) ratio
@@ -16,8 +16,9 @@
 // The choices were checked against 9,582 noise types printed by Stable32 in
 // the allantools and allantoolkit test suites (tools/check-stable32*.R).
 //
-// Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms, pm_only) with
-// pm_only for the modified family (R(n) splits PM only) and x(k) the
+// Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms, pm_only,
+// stable32_n) with pm_only for the modified family (R(n) splits PM only),
+// stable32_n for Stable32's N at every B1 boundary (b1_mu()), and x(k) the
 // phase at k = 0 .. L-1 (any constant offset; for frequency data the running
 // sum of the samples, L = N + 1) and an RnCache filled once from the same
 // phase when some m has fewer than kAcfMinPoints points (needs_b1()).
@@ -54,11 +55,12 @@ NoiseId acf_noise_id(const double* z, R_xlen_t n, bool phase, int dmax);
 
 namespace noise_id_detail {
 
-// delta = r1 / (1 + r1) of Riley & Greenhall from r1 = num / den, r1
-// scaled by (n - 1)/n as Stable32 does.
-inline double delta_of(double num, double den, R_xlen_t n) {
-  const double nn = static_cast<double>(n);
-  const double r1 = den > 0 ? num / den * (nn - 1) / nn : 0.0;
+// delta = r1 / (1 + r1) of Riley & Greenhall from r1 = num / den (NIST SP
+// 1065 eq. 72). Stable32 is said to scale r1 by (n - 1)/n (allantoolkit);
+// that matches 21 more of 9,582 Stable32 noise types but none of the 711
+// limits, and SP 1065's definition is kept.
+inline double delta_of(double num, double den, R_xlen_t) {
+  const double r1 = den > 0 ? num / den : 0.0;
   return r1 / (1.0 + r1);
 }
 
@@ -219,7 +221,7 @@ inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase) {
 // 7,552 instead of 8,652 of 9,582 Stable32 noise types are matched).
 template <class RN>
 NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
-                    double nterms, bool pm_only, RN rn) {
+                    double nterms, bool pm_only, bool stable32_n, RN rn) {
   NoiseId out;
   out.points = n;
   std::vector<double> ybar;
@@ -233,7 +235,7 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
   const double b1 = b1_ratio(ybar.data(), na);
   if (!std::isfinite(b1)) return out;
   const double N = nterms >= 2 ? nterms : static_cast<double>(na);
-  const int mu = b1_mu(b1, N, static_cast<double>(na));
+  const int mu = b1_mu(b1, N, stable32_n ? N : static_cast<double>(na));
   if (mu == -2) {
     // white or flicker PM: R(n) tells them apart where it can be read,
     // else flicker PM (Stable32's choice for the unmodified types)
@@ -252,7 +254,7 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
 template <class X>
 NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
                        bool phase, RnCache& rn, double nterms,
-                       bool pm_only) {
+                       bool pm_only, bool stable32_n) {
   const R_xlen_t n = acf_points(L, m, phase);
   if (n >= kAcfMinPoints) {
     if (phase) {
@@ -266,7 +268,8 @@ NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
   for (R_xlen_t i = 0; i < n; ++i) {
     z[i] = phase ? x(i * m) : x((i + 1) * m) - x(i * m);
   }
-  return b1_noise_id(z.data(), n, phase, m, nterms, pm_only, [&]() {
+  return b1_noise_id(z.data(), n, phase, m, nterms, pm_only, stable32_n,
+                     [&]() {
     if (rn.empty()) rn.build(x, L);  // build it beforehand to share it
     return rn.ratio(m);
   });

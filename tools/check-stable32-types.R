@@ -325,6 +325,10 @@ check_stable32_types <- function(roots = strsplit(Sys.getenv("ALLANVAR_PEER_DATA
 }
 
 if (sys.nframe() == 0L) {
+  # ALLANVAR_NOISE_ID=stable32: B1 with Stable32's N at every boundary
+  if (nzchar(Sys.getenv("ALLANVAR_NOISE_ID"))) {
+    options(allanvar.noise_id = Sys.getenv("ALLANVAR_NOISE_ID"))
+  }
   if (file.exists("DESCRIPTION") && requireNamespace("pkgload", quietly = TRUE)) {
     pkgload::load_all(quiet = TRUE)
   } else {

@@ -169,6 +169,10 @@ summarise_stable32 <- function(res) {
 }
 
 if (sys.nframe() == 0L) {
+  # ALLANVAR_NOISE_ID=stable32: B1 with Stable32's N at every boundary
+  if (nzchar(Sys.getenv("ALLANVAR_NOISE_ID"))) {
+    options(allanvar.noise_id = Sys.getenv("ALLANVAR_NOISE_ID"))
+  }
   root <- Sys.getenv("ALLANVAR_PEER_DATA")
   if (!nzchar(root)) stop("set ALLANVAR_PEER_DATA to an allantools checkout")
   if (file.exists("DESCRIPTION") && requireNamespace("pkgload", quietly = TRUE)) {
