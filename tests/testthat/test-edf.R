@@ -154,3 +154,77 @@ test_that("68% coverage 0.60-0.76 for white/flicker/RW FM and white/flicker PM",
     expect_true(all(cov >= 0.60 & cov <= 0.76), info = paste(g, toString(cov)))
   }
 })
+
+test_that("the noise type at a tau is read from the data, whatever else is asked", {
+  # no row copies its type from a neighbour: each tau alone gives the same
+  # alpha and EDF as in a grid, at short (lag-1 ACF) and long (B1) tau
+  set.seed(31)
+  x <- cumsum(rnorm(4000))
+  for (type in c("overlapping", "modified", "hadamard", "total")) {
+    a <- allan(x, 1, taus = "octave", type = type)
+    for (i in c(1L, nrow(a) - 1L, nrow(a))) {
+      b <- allan(x, 1, taus = I(a$m[i]), type = type)
+      expect_identical(b$alpha, a$alpha[i], info = paste(type, a$m[i]))
+      expect_equal(b$edf, a$edf[i], info = paste(type, a$m[i]))
+    }
+  }
+})
+
+test_that("random-walk FM stays random walk at long tau; Stable32's B1 rule does not", {
+  # B1 with Stable32's N (the statistic's term count, far above the few
+  # averaged frequencies at long tau) cannot reach random walk's expected
+  # ratio N/2; the default tells it with the count the ratio was read from.
+  set.seed(32)
+  x <- cumsum(rnorm(2048))
+  a <- allan(x, 1, taus = I(c(256, 512)))
+  expect_equal(a$alpha, c(-2L, -2L))
+  old <- options(allanvar.noise_id = "stable32")
+  on.exit(options(old))
+  b <- allan(x, 1, taus = I(c(256, 512)))
+  expect_true(all(b$alpha > -2L))
+})
+
+test_that("Theo rows too long to identify get a type, not decades-wide limits", {
+  set.seed(33)
+  for (type in c("theo1", "theoh")) {
+    a <- allan(rnorm(1000), 1, taus = "octave", type = type)
+    ok <- !is.na(a$lower)
+    expect_true(all(ok), info = type)
+    expect_true(all(a$lower < a$adev & a$adev < a$upper), info = type)
+    expect_true(all(a$upper / a$lower < 3), info = type)
+    expect_false(anyNA(a$alpha), info = type)
+  }
+})
+
+test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows) and for further types", {
+  # Own generators as above; rows with fewer than 64 averaged frequencies
+  # (identified by B1 / R(n) or the lag-1 ACF from 30 points) and the
+  # further statistics. tools/mc-coverage.R prints the full table.
+  old <- options(allanvar.threads = 1)
+  on.exit(options(old))
+  set.seed(34)
+  N <- 512
+  gens <- list(wfm = function() rnorm(N), rwfm = function() cumsum(rnorm(N)))
+  cover <- function(type, gen, reps) {
+    res <- lapply(seq_len(reps), function(i) allan(gen(), 1, type = type))
+    ms <- Reduce(intersect, lapply(res, function(a) a$m))
+    get <- function(col) sapply(res, function(a) a[[col]][match(ms, a$m)])
+    truth <- sqrt(rowMeans(get("avar")))
+    hits <- get("lower") <= truth & truth <= get("upper")
+    keep <- apply(get("edf"), 1, stats::median) >= 3
+    list(m = ms[keep], cov = rowMeans(hits)[keep])
+  }
+  for (g in names(gens)) {
+    r <- cover("overlapping", gens[[g]], 300)
+    long <- N / r$m < 64
+    expect_gte(sum(long), 3)
+    expect_true(all(r$cov[long] >= 0.60 & r$cov[long] <= 0.76),
+                info = paste("overlapping long tau", g, toString(r$cov[long])))
+    for (type in c("tdev", "mtotdev", "total", "theo1")) {
+      r <- cover(type, gens[[g]], 150)
+      expect_gte(length(r$cov), 3)
+      expect_true(all(r$cov >= 0.60 & r$cov <= 0.76),
+                  info = paste(type, g, toString(round(r$cov, 3))))
+    }
+  }
+})
