@@ -558,7 +558,7 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
                      bool stable32_n, int threads, bool main, Channel& out) {
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(N + 1, m, false)) {
+    if (allanvar::needs_b1(N + 1, m, false, stable32_n)) {
       rn.build_from_rate(v, N, c);
       break;
     }
@@ -572,7 +572,7 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const double* z = lj == 0 ? v : lev[lj].z.data();
     const R_xlen_t n = lj == 0 ? N : static_cast<R_xlen_t>(lev[lj].z.size());
     allanvar::NoiseId id;
-    if (n >= allanvar::kAcfMinPoints) {
+    if (n >= allanvar::acf_min_points(stable32_n)) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
       id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], false, stable32_n,
@@ -675,7 +675,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   const R_xlen_t Lp = rate ? N + 1 : N;
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(Lp, m, !rate)) {
+    if (allanvar::needs_b1(Lp, m, !rate, opts.stable32_b1)) {
       rn.build(phase, Lp);
       break;
     }
@@ -685,7 +685,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     if (allanvar::interrupted()) return;
     const R_xlen_t m = mid[j];
     allanvar::NoiseId id;
-    if (m == 1 && N >= allanvar::kAcfMinPoints) {
+    if (m == 1 && N >= allanvar::acf_min_points(opts.stable32_b1)) {
       id = allanvar::acf_noise_id(v, N, !rate, dmax);
     } else {
       id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn, mid_n[j],
