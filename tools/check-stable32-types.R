@@ -9,6 +9,8 @@
 #   git -C <mirror> archive HEAD tests | tar -x -C /tmp/allantools
 #   ALLANVAR_PEER_DATA=/tmp/allantools:/tmp/allantoolkit \
 #     Rscript tools/check-stable32-types.R
+# ALLANVAR_NOISE_ID=stable32 identifies the noise by Stable32's rules
+# (options(allanvar.noise_id = "stable32"), src/noise_id.h).
 # Run from the repository root (it loads the package with pkgload) or with
 # allanvar installed. tests/testthat/test-types-stable32.R runs it when the
 # variable is set.

@@ -3,6 +3,9 @@
 #
 #   ALLANVAR_PEER_DATA=/path/to/allantools Rscript tools/check-stable32.R
 #
+# With ALLANVAR_NOISE_ID=stable32 the noise is identified by Stable32's
+# rules (options(allanvar.noise_id = "stable32"), src/noise_id.h).
+#
 # The reference files (tests/*/...txt) are Stable32 tables: AF, tau, number of
 # terms, alpha, min sigma, sigma, max sigma. They are fetched, never
 # committed. A limit "agrees" when it is within 25% of Stable32's half-width
