@@ -258,7 +258,10 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
   if (mu == -2) {
     // white or flicker PM: R(n) tells them apart where it can be read,
     // else flicker PM (Stable32's choice for the unmodified types)
+    // (R(n) unreadable: flicker PM under Stable32's rules, else no type,
+    // the widest interval)
     const double r = m > 1 ? rn() : NAN;
+    if (!std::isfinite(r) && !stable32_n) return out;
     out.alpha_int = std::isfinite(r) ? rn_alpha(r, static_cast<double>(m), pm_only) : 1;
     out.method = std::isfinite(r) ? NOISE_ID_B1_RN : NOISE_ID_B1;
   } else {
