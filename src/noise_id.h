@@ -262,7 +262,7 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
     // the widest interval)
     const double r = m > 1 ? rn() : NAN;
     if (!std::isfinite(r) && !stable32_n) return out;
-    out.alpha_int = std::isfinite(r) ? rn_alpha(r, static_cast<double>(m), pm_only) : 1;
+    out.alpha_int = std::isfinite(r) ? rn_alpha(r, static_cast<double>(m), pm_only && stable32_n) : 1;
     out.method = std::isfinite(r) ? NOISE_ID_B1_RN : NOISE_ID_B1;
   } else {
     out.alpha_int = -mu - 1;  // mu -1, 0, 1, 2 -> alpha 0, -1, -2, -3
