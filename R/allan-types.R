@@ -507,13 +507,6 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
         t1 <- T / (0.75 * (L - mt) * mt^2) * sc_rate
         alpha[theo_row] <- extra_alpha(v, freq, round(0.75 * mt), "overlapping",
                                        input, L)
-        if (anyNA(alpha[theo_row])) {
-          # too few averaged frequencies at these taus: the run's type from
-          # TheoBR's factor (R/edf.R)
-          fill <- theo_kf_alpha(theobr_factor(v, freq, rate, L))
-          alpha[theo_row] <- ifelse(is.na(alpha[theo_row]), fill,
-                                    alpha[theo_row])
-        }
         if (type == "theo1") {
           if (debias) t1 <- t1 * debias_factor("theo1", alpha[theo_row], mt)
         } else {

@@ -85,17 +85,3 @@ allan_ci <- function(avar, edf, conf) {
   # sqrt of each factor: avar * hi may overflow where the limit does not
   list(lower = sqrt(avar) * sqrt(lo), upper = sqrt(avar) * sqrt(hi))
 }
-
-# Noise exponent from TheoBR's bias-removal factor kf = AVAR/Theo1 (NIST SP
-# 1065 eq. 33): the nominal Theo1 biases 0.4, 0.6, 1.0, 1.71, 2.24 for
-# alpha = 2, 1, 0, -1, -2 (Howe & Tasset 2004), boundaries at the geometric
-# means of neighbours, as Stable32 types a TheoBR/TheoH run. Used for the
-# Theo rows whose own tau has too few averaged frequencies to be identified
-# (B1 needs three): there the smallest EDF over the types would give limits
-# many decades wide. NA when kf is not finite.
-theo_kf_alpha <- function(kf) {
-  if (!is.finite(kf)) return(NA_integer_)
-  nominal <- c(0.4, 0.6, 1.0, 1.71, 2.24)
-  bound <- sqrt(nominal[-1] * nominal[-5])
-  c(2L, 1L, 0L, -1L, -2L)[sum(kf >= bound) + 1L]
-}

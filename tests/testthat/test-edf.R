@@ -184,18 +184,6 @@ test_that("random-walk FM stays random walk at long tau; Stable32's B1 rule does
   expect_true(all(b$alpha > -2L))
 })
 
-test_that("Theo rows too long to identify get a type, not decades-wide limits", {
-  set.seed(33)
-  for (type in c("theo1", "theoh")) {
-    a <- allan(rnorm(1000), 1, taus = "octave", type = type)
-    ok <- !is.na(a$lower)
-    expect_true(all(ok), info = type)
-    expect_true(all(a$lower < a$adev & a$adev < a$upper), info = type)
-    expect_true(all(a$upper / a$lower < 3), info = type)
-    expect_false(anyNA(a$alpha), info = type)
-  }
-})
-
 test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows), TDEV and TOTDEV", {
   # Own generators as above; rows with fewer than 64 averaged frequencies
   # (identified by B1 and R(n)) and the
