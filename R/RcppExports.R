@@ -57,6 +57,18 @@ edf_interpolate_cpp <- function(m, sub, es, alpha) {
     .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
 }
 
+acf_sums <- function(x, max_lag) {
+    .Call(`_allanvar_acf_sums`, x, max_lag)
+}
+
+detrend_line <- function(x) {
+    .Call(`_allanvar_detrend_line`, x)
+}
+
+line_sums <- function(y, f, freq) {
+    .Call(`_allanvar_line_sums`, y, f, freq)
+}
+
 lz4_decompress_cpp <- function(x, expected) {
     .Call(`_allanvar_lz4_decompress_cpp`, x, expected)
 }
@@ -73,8 +85,8 @@ mcap_imu <- function(buf, op, off, len, ids, enc) {
     .Call(`_allanvar_mcap_imu`, buf, op, off, len, ids, enc)
 }
 
-pdev_sums_cpp <- function(v, rate, m, threads) {
-    .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads)
+pdev_sums_cpp <- function(v, rate, m, threads, method = 0L) {
+    .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads, method)
 }
 
 csv_field_faults <- function(bytes, sep, expected) {
@@ -121,8 +133,8 @@ rosbag_imu <- function(buf, off, len, comp, size, conns, threads = 1L) {
     .Call(`_allanvar_rosbag_imu`, buf, off, len, comp, size, conns, threads)
 }
 
-theo1_sums_cpp <- function(v, rate, m, threads) {
-    .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads)
+theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
+    .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }
 
 theo1_all_cpp <- function(v, rate, kmax_d, need) {

@@ -32,6 +32,16 @@
 #'     "datasheet"`) and refined models.}
 #'   \item{`steps`}{the refinement steps of every axis, with the columns of
 #'     `avrefine()$steps`.}
+#'   \item{`unexplained`}{the residual structure the loop left unexplained
+#'     per axis, with the columns of `avrefine()$unexplained`.}
+#'   \item{`check`}{issue 9's checks per axis (`data-raw/adis16405-check.R`):
+#'     `acf1`, `filter` (a filter term was added), `enbw` (its
+#'     noise-equivalent bandwidth, Hz), `line_055` (a sinusoid at 0.5-0.6 Hz),
+#'     `sinusoids` (their frequencies), `contradicted` (accepted steps the raw
+#'     data contradict), `chi2`, `n_fit` (the fitted white level), `n_ref`
+#'     (the white level read where the ADEV slope is -1/2), `n_err` (percent),
+#'     `converged`, `unexplained` (rows), `tau_from` (first tau fitted),
+#'     `effects`.}
 #'   \item{`source`}{attribution.}
 #' }
 #' The fitted `avfit` objects themselves are in

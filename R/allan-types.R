@@ -75,9 +75,15 @@
 #'
 #' **Cost**: MTIE builds a table of window extremes level by level
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
-#' \eqn{O(L)} per tau; the Total family \eqn{O(L m)} per tau; Theo1
-#' \eqn{O(L m)} per tau, and TheoBR's factor \eqn{O(L^2)} once (Lewis's
-#' recurrence, evaluated in double-double arithmetic).
+#' \eqn{O(L)} per tau; the Total family \eqn{O(L)} per tau (each
+#' window's quadratic form in closed form, from prefix sums over blocks of
+#' \eqn{4m} windows; directly, \eqn{O(L m)}, below \eqn{m = 8}); Theo1 per
+#' tau the cheaper of its definition (\eqn{O(L m)}) and an expansion into
+#' FFT correlations over blocks of the phase (\eqn{O(L \log^2 m)}, agreeing
+#' with the definition to about \eqn{10^{-12}}), and TheoBR's factor
+#' \eqn{O(L^2)} once (Lewis's recurrence, evaluated in double-double
+#' arithmetic), so `"theobr"` and `"theoh"` stay slow beyond about
+#' \eqn{10^5} samples.
 #' @param debias For `"mtotdev"`, `"ttotdev"`, `"htotdev"` and `"theo1"`:
 #'   apply NIST SP 1065's noise-dependent bias correction (default `TRUE`);
 #'   see "Further statistics". Ignored by the other types.
@@ -548,6 +554,21 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   top <- allan_max_m(base, L)
   mm <- pmax(1, pmin(m, top))
   u <- sort(unique(mm))
+  mx <- max(abs(v))
+  if (length(u) <= 200L && mx > 1e-100 && mx < 1e100) {
+    # the kernel's noise identification, as allan() calls it (the term
+    # counts are part of the identification), without allan()'s limits:
+    # allan() identifies every row itself up to 200 rows and rescales only
+    # data whose sums over- or underflow, kept out by the range above.
+    res <- allan_call_kernel(
+      allan_sums_cpp(v, length(v), u, allan_nterms(base, u, L), u,
+                     allan_opts(base, input == "rate")),
+      length(v), 1L)
+    tab <- allan_type_table()
+    lo <- if (tab$d[match(base, tab$name)] == 3) -4L else -2L
+    a <- pmin(2L, pmax(lo, as.integer(res$alpha_int[, 1L])))
+    return(a[match(mm, u)])
+  }
   a <- allan(v, freq, taus = I(u / freq), type = base, input = input)
   a$alpha[match(mm, a$m)]
 }

@@ -203,7 +203,7 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
     g <- imu_guidance(a)
     g <- g[!g$channel %in% names(dead), , drop = FALSE]
     if (nrow(g)) {
-      msg <- paste0(r$name, ": the record is short for some readings:\n",
+      msg <- paste0(r$name, ": guidance on the record and its readings:\n",
                     paste0("  - ", g$channel, ": ", g$message, collapse = "\n"))
       warning(structure(class = c("allanvar_guidance", "allanvar_warning",
                                   "warning", "condition"),

@@ -49,7 +49,7 @@
 #' * Without raw data, `$refine$unconfirmed` lists the accepted effects that
 #'   could not be confirmed.
 #' * With raw data, the series' non-stationary effects (steps, warm-up,
-#'   spikes) are read first by `series_effects()` when the package has it,
+#'   spikes) are read first by [series_effects()],
 #'   kept in `$series`, and removed from the data only when named in
 #'   `remove`.
 #'
@@ -169,28 +169,30 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     data <- check_values(data, min_n = 256L, arg = "data")
     check_diagnosable(data, "data")
     # Non-stationary effects (steps, warm-up, spikes) are read from the
-    # series first (R/series.R, when present); what the user asks to remove
-    # is taken out of the data the loop then sees.
-    ser <- if (exists("series_effects", mode = "function"))
-      series_effects(data, freq, remove = remove) else NULL
-    if (!is.null(ser) && length(ser$removed)) data <- ser$x
+    # series first (R/series.R); what the user asks to remove is taken out
+    # of the data the loop then sees.
+    ser <- series_effects(data, freq, remove = remove)
+    if (length(ser$removed)) data <- ser$x
     raw <- avdiagnose(data, freq)
     # Bins of a broad band (a resonance) are not lines: they are not
-    # proposed or matched as sinusoids.
-    raw$lines <- lines_outside_bands(raw$lines, find_bands(data, freq))
+    # proposed or matched as sinusoids. The bands themselves propose and
+    # confirm a resonance.
+    raw$bands <- find_bands(data, freq)
+    raw$lines <- lines_outside_bands(raw$lines, raw$bands)
   }
   # The series the raw-data checks of an effect see: the data with the
-  # significant periodogram lines taken out (a sinusoid disturbs the ACF
-  # that confirms a Gauss-Markov process; the line checks read the
-  # periodogram, not this series). Computed once, when first needed.
+  # significant periodogram lines taken out and the broad bands brought
+  # down to their background (a sinusoid disturbs the ACF that confirms a
+  # Gauss-Markov process, a resonance the short-lag ACF that confirms the
+  # filter; the line and band checks read the raw periodogram, not this
+  # series). Its short-lag ACF (filter_evidence()) proposes the filter.
   clean <- NULL
-  evidence_series <- function(effect) {
-    if (is.null(data)) return(NULL)
-    if (is.null(clean)) {
-      clean <<- if (nrow(raw$lines)) remove_lines(data, freq, raw$lines$f0) else data
-    }
-    clean
+  if (!is.null(data)) {
+    clean <- if (nrow(raw$lines)) remove_lines(data, freq, raw$lines$f0) else data
+    clean <- remove_bands(clean, freq, raw$bands)
+    raw$filter <- filter_evidence(clean, freq)
   }
+  evidence_series <- function(effect) clean
   rejected <- new_rejected()
   # The settings every refit uses, explicitly: the fit's own, overridden by
   # the arguments in `...`.
@@ -205,6 +207,19 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   steps <- list()
   current <- fit
   sig <- NULL
+  # A refit that frees the parameters of the effects accepted earlier must
+  # leave each of them valid and not contradicted by the raw data (a
+  # resonance whose tc runs off to a pure tone no longer matches its band).
+  earlier_hold <- function(f) {
+    for (st in steps) {
+      if (!any(startsWith(names(stats::coef(f)), paste0(st$label, ".")))) next
+      par <- instance_params(stats::coef(f), f$layout, st$label)
+      if (!is.null(inadmissible(st$effect, par, f$data$tau, freq))) return(FALSE)
+      ev <- raw_evidence(st$effect, as.list(par), raw, evidence_series(st$effect), freq)
+      if (isFALSE(ev$support)) return(FALSE)
+    }
+    TRUE
+  }
   for (step in seq_len(max_steps)) {
     tau <- current$data$tau
     z <- stats::residuals(current)
@@ -280,6 +295,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
           if (is.null(why) && isFALSE(ev$support)) {
             why <- paste("contradicted by the raw data:", ev$text)
           }
+          if (is.null(why) && !earlier_hold(f)) {
+            why <- "moves an effect accepted earlier to values the raw data contradict"
+          }
           list(par = par, why = why, ev = ev)
         }
         jd <- judge(new)
@@ -331,7 +349,8 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         ev2 <- raw_evidence(best$trial$effect, as.list(p2), raw,
                             evidence_series(best$trial$effect), freq)
         if (!isFALSE(ev2$support) &&
-            is.null(inadmissible(best$trial$effect, p2, tau, freq))) {
+            is.null(inadmissible(best$trial$effect, p2, tau, freq)) &&
+            earlier_hold(full)) {
           best$fit <- full
           best$crit <- crit(full)
           best$params <- p2
@@ -378,7 +397,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       trimmed <- try_refit(args, function(cnd, stage) {
         failures <<- add_failure(failures, cnd, length(steps) + 1L, "tau_range", stage)
       }, "refit without the first points")
-      if (!is.null(trimmed)) {
+      if (!is.null(trimmed) && earlier_hold(trimmed)) {
         tau_range <- c(keep_from, max(tau_all))
         message(sprintf(paste(
           "avrefine(): no catalogue effect describes the first points (tau %s-%s s);",
@@ -643,14 +662,17 @@ candidate_trials <- function(traced, present, candidates, sig) {
     data.frame(tau_from = NA_real_, tau_to = NA_real_,
                description = "no residual signature", stringsAsFactors = FALSE)
   for (k in kinds) {
-    t <- traced[traced$effect == k, , drop = FALSE]
+    t <- if (nrow(traced)) traced[split_term(traced$effect)$kind == k, , drop = FALSE]
+      else traced
     if (nrow(t)) {
       nonlinear <- any(effect_entry(k)$params$role == "nonlinear")
       take <- if (nonlinear) seq_len(min(2L, nrow(t))) else 1L
       # every raw-data proposal that pins a value (each periodogram line)
-      # is tried, not only the two best-scoring starts
+      # is tried, not only the two best-scoring starts; so is the best
+      # start of every variant proposed (each filter family the raw data
+      # support): the criterion chooses among them
       pinned <- which(lengths(t$pin) > 0L)
-      take <- union(take, pinned)
+      take <- union(union(take, pinned), which(!duplicated(t$effect)))
       t$traced <- rep(TRUE, nrow(t))
       rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
     } else {

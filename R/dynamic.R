@@ -129,7 +129,7 @@ dynamic_allan <- function(x, freq, window = NULL, step = NULL, taus = "octave",
     alpha <- check_number(alpha, "alpha", min(dyn_alphas(type)), 2,
                           integer = TRUE)
   }
-  nt <- dyn_nterms(type, m, Lw)
+  nt <- allan_nterms(type, m, Lw)
   # Scaled by a power of two (exact) so that squares of data near the
   # double range neither overflow nor underflow; scaled back, and refused
   # when the variance itself cannot be represented (as in allan()).
@@ -171,20 +171,11 @@ dyn_alphas <- function(type) {
   if (tab$d[match(type, tab$name)] == 3L) -4:2 else -2:2
 }
 
-# Largest cluster size with a term in L phase points, and the number of
-# terms at each m (as in allan()).
+# Largest cluster size with a term in L phase points (the number of terms
+# at each m is allan_nterms(), R/taus.R).
 dyn_max_m <- function(type, L) {
   switch(type, standard = , overlapping = floor((L - 1) / 2),
          modified = floor(L / 3), floor((L - 1) / 3))
-}
-
-dyn_nterms <- function(type, m, L) {
-  switch(type,
-    standard = floor((L - 1) / m) - 1,
-    overlapping = L - 2 * m,
-    modified = L - 3 * m + 1,
-    hadamard = floor((L - 1) / m) - 2,
-    ohadamard = L - 3 * m)
 }
 
 dyn_norm <- function(type, m) {

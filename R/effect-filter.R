@@ -61,7 +61,8 @@ effect_filter <- function() {
       evidence = function(par, raw, x, freq) {
         if (is.null(x)) return(list(text = "", support = NA))
         sp <- filter_spec_of(variant, par, 1 / freq)
-        filter_raw_support(sp, par[["Nf"]], filter_evidence(x, freq),
+        # raw$filter: filter_evidence() of this same series, read once
+        filter_raw_support(sp, par[["Nf"]], raw$filter %||% filter_evidence(x, freq),
                            stats::var(x), freq)
       }
     ))
@@ -85,6 +86,26 @@ effect_filter <- function() {
       # the model's white line runs above the first points
       if (ctx$kind != "short_end" || ctx$sign >= 0) return(NULL)
       list(init = list(L = 2), score = 2)
+    },
+    # The raw data propose the filter themselves when the short-lag ACF
+    # beyond the slow processes is significant: one start per family the
+    # lag-1 excess can be inverted for (moving average, first- and
+    # second-order low-pass); the criterion picks the family.
+    propose = function(raw, tau, sig) {
+      fe <- raw$filter
+      if (is.null(fe) || !isTRUE(fe$filtered)) return(list())
+      out <- list()
+      for (v in c("ma", "lp1", "lp2")) {
+        st <- fe$start[[v]]
+        if (is.null(st)) next
+        out[[length(out) + 1L]] <- list(
+          effect = if (v == "ma") "filter" else paste0("filter:", v),
+          init = st, tau_from = min(tau), tau_to = 4 * min(tau), score = 2,
+          note = sprintf(paste("proposed by the raw lag-1 autocorrelation beyond the",
+                               "slow processes, %.3f (z = %.0f): %s family"),
+                         fe$r1, fe$z1, v))
+      }
+      out
     },
     evidence = entry("ma")$evidence,
     # the filter keeps the DC level: N is the white reading
@@ -124,7 +145,35 @@ effect_resonance <- function() {
     },
     evidence = function(par, raw, x, freq) {
       if (is.null(x)) return(list(text = "", support = NA))
-      resonance_raw_support(par[["sigma"]], par[["fr"]], par[["tc"]], find_bands(x, freq))
+      # the bands of the raw data (raw$bands), not of `x`, the series with
+      # the bands brought down to their background
+      resonance_raw_support(par[["sigma"]], par[["fr"]], par[["tc"]],
+                            raw$bands %||% find_bands(x, freq))
+    },
+    # A broad band of the periodogram proposes a resonance twice: its
+    # centre pinned where find_bands() measures it (the curve alone may
+    # place fr poorly: it sees the band only through the AV's sinc filter),
+    # and free from there (a band that is not quite Lorentzian puts its
+    # AV-equivalent centre elsewhere). The criterion chooses; the raw-data
+    # check still asks for the band within half its width of fr.
+    propose = function(raw, tau, sig) {
+      b <- raw$bands
+      out <- list()
+      if (is.null(b) || !nrow(b)) return(out)
+      hi <- min(0.5 / min(tau), 0.499 * raw$freq)
+      b <- b[b$f_center > 1 / max(tau) & b$f_center < hi, , drop = FALSE]
+      b <- b[order(-b$power), , drop = FALSE]
+      for (j in seq_len(min(2L, nrow(b)))) {
+        st <- resonance_start(b[j, ])
+        note <- sprintf("proposed by a spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance)",
+                        format_num(b$f_center[j], 4), format(signif(b$width[j], 2)),
+                        100 * b$share[j])
+        one <- list(init = st, tau_from = 0.371 / st$fr / 2, tau_to = 2 / st$fr,
+                    score = 2, note = note)
+        out[[length(out) + 1L]] <- c(one, list(pin = list(fr = b$f_center[j])))
+        out[[length(out) + 1L]] <- one
+      }
+      out
     },
     peak_tau = function(par) 0.371 / par[["fr"]],
     describe = function(values) {

@@ -22,8 +22,12 @@ evidence_sinusoid <- function(par, raw, x, freq) {
     }
   }
   if (is.finite(f0) && f0 < 4 * res) {
-    return(list(text = sprintf("f0 = %s Hz is below the periodogram resolution",
-                               format_num(f0)), support = NA))
+    # Within 4 bins of DC the raw data cannot tell a sinusoid from the drift
+    # or random walk beside it: with the raw data at hand such a "sinusoid"
+    # is a fitting device for the long-tau end, not an effect.
+    return(list(text = sprintf(paste("f0 = %s Hz is within 4 bins (%s Hz) of DC, where",
+                                     "the periodogram cannot tell a sinusoid from drift"),
+                               format_num(f0), format_num(4 * res)), support = FALSE))
   }
   list(text = sprintf("no periodogram line near %s Hz", format_num(f0)),
        support = FALSE)

@@ -8,17 +8,28 @@ welch_psd <- function(x, freq, seg = NULL) {
   n <- length(x)
   if (is.null(seg)) seg <- 2^floor(log2(max(n / 8, 64)))
   seg <- min(seg, 2^floor(log2(n)))
-  t <- seq_len(n)
-  x <- stats::residuals(stats::lm.fit(cbind(1, t), x))
+  x <- detrend_linear(x)
   w <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
   U <- sum(w^2)
   starts <- seq(1, n - seg + 1, by = seg / 2)
   half <- seg / 2 + 1
   acc <- numeric(half)
-  for (s in starts) {
+  tap <- function(s) {
     xs <- x[s:(s + seg - 1)]
-    xs <- (xs - mean(xs)) * w
-    acc <- acc + Mod(stats::fft(xs)[seq_len(half)])^2
+    (xs - mean(xs)) * w
+  }
+  # Two real segments a, b per complex transform z = fft(a + i b): the sum
+  # of their periodograms is (|z_k|^2 + |z_(seg-k)|^2) / 2, so half the
+  # transforms give the same sum (to rounding).
+  mirror <- c(1L, seg:(seg - half + 2L))
+  np <- length(starts) %/% 2L
+  for (i in seq_len(np)) {
+    z <- Mod(stats::fft(complex(real = tap(starts[2L * i - 1L]),
+                                imaginary = tap(starts[2L * i]))))^2
+    acc <- acc + (z[seq_len(half)] + z[mirror]) / 2
+  }
+  if (length(starts) %% 2L) {
+    acc <- acc + Mod(stats::fft(tap(starts[length(starts)]))[seq_len(half)])^2
   }
   p <- acc / length(starts) / (freq * U)
   p[2:(half - 1)] <- 2 * p[2:(half - 1)]
@@ -37,16 +48,24 @@ spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 5L) {
   nb <- length(p)
   lp <- log(p)
   bg <- rep(NA_real_, nb)
-  # Background: running median of log PSD with a window ~20% of frequency.
+  # Background: running median of log PSD with a window ~20% of frequency
+  # (stats::runmed(lp, k, endrule = "median") per octave band). Each band's
+  # median runs over the band and 2k bins either side only, and the end
+  # rule is applied only at the ends of the whole vector, in O(k) by
+  # smooth_ends(): the same values as a runmed() of the whole vector per
+  # band, at O(nb) in all instead of O(nb) per band plus smoothEnds()'s
+  # O(k^2).
   bands <- unique(c(2^(0:floor(log2(nb))), nb + 1))
   for (b in seq_len(length(bands) - 1L)) {
     lo <- bands[b]
     hi <- bands[b + 1L] - 1L
     k <- max(11L, 2L * floor(0.1 * lo) + 1L)
     k <- min(k, 2L * floor((nb - 1L) / 2L) - 1L)
-    idx <- lo:hi
-    rm <- stats::runmed(lp, k, endrule = "median")
-    bg[idx] <- rm[idx]
+    from <- max(1L, lo - 2L * k)
+    to <- min(nb, hi + 2L * k)
+    rm <- stats::runmed(lp[from:to], k, endrule = "keep")
+    rm <- smooth_ends(rm, k, left = from == 1L, right = to == nb)
+    bg[lo:hi] <- rm[(lo:hi) - from + 1L]
   }
   nu <- w$nu
   # Median of log(chi2_nu/nu) differs from log of the mean.
@@ -82,11 +101,81 @@ spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 5L) {
   lines
 }
 
-# Autocorrelation of x (mean removed) at lags 0..max_lag via FFT.
+# x minus its least-squares line on 1..n (the residuals of
+# lm.fit(cbind(1, t), x) in closed form: centred t is orthogonal to 1), in
+# two passes over x in C++ (src/evidence.cpp) instead of five vectors of n.
+detrend_linear <- function(x) detrend_line(as.double(x))
+
+# stats::smoothEnds(y, k) (Tukey's end-point rule, the runmed() end rule
+# "median") at the chosen ends, in O(k log k) instead of O(k^2): the medians
+# of the growing windows y[1:j] (j = 3, 5, ..., k - 2) come from one sort
+# and a linked list from which the window's elements are removed, longest
+# window first, moving the median pointer by a step or two each time.
+smooth_ends <- function(y, k, left = TRUE, right = TRUE) {
+  k2 <- as.integer(k) %/% 2L
+  n <- length(y)
+  if (k2 < 1L) return(y)
+  sm <- y
+  med3 <- function(a, b, c) sort(c(a, b, c))[2L]
+  if (k2 >= 2L) {
+    J <- 2L * k2 - 1L
+    if (left) sm[2:k2] <- growing_medians(y[seq_len(J)])
+    if (right) sm[n - (2:k2) + 1L] <- growing_medians(y[n - seq_len(J) + 1L])
+  }
+  if (left) sm[1L] <- med3(y[1L], sm[2L], sm[2L] - 2L * (sm[3L] - sm[2L]))
+  if (right) sm[n] <- med3(y[n], sm[n - 1L], sm[n - 1L] - 2L * (sm[n - 2L] - sm[n - 1L]))
+  sm
+}
+
+# Medians of e[1:j] for j = 3, 5, ..., length(e) (odd), in that order.
+growing_medians <- function(e) {
+  J <- length(e)
+  o <- order(e)
+  rk <- integer(J)
+  rk[o] <- seq_len(J)
+  nxt <- c(seq_len(J - 1L) + 1L, NA_integer_)
+  prv <- c(NA_integer_, seq_len(J - 1L))
+  m <- (J + 1L) %/% 2L
+  lower <- m - 1L
+  out <- numeric((J - 1L) %/% 2L)
+  out[length(out)] <- e[o[m]]
+  L <- J
+  while (L > 3L) {
+    for (x in c(rk[L], rk[L - 1L])) {
+      if (x < m) {
+        lower <- lower - 1L
+      } else if (x == m) {
+        if (!is.na(nxt[m])) m <- nxt[m] else {
+          m <- prv[m]
+          lower <- lower - 1L
+        }
+      }
+      p <- prv[x]
+      q <- nxt[x]
+      if (!is.na(p)) nxt[p] <- q
+      if (!is.na(q)) prv[q] <- p
+    }
+    L <- L - 2L
+    target <- (L - 1L) %/% 2L
+    while (lower > target) { m <- prv[m]; lower <- lower - 1L }
+    while (lower < target) { m <- nxt[m]; lower <- lower + 1L }
+    out[(L - 1L) %/% 2L] <- e[o[m]]
+  }
+  out
+}
+
+# Autocorrelation of x (mean removed) at lags 0..max_lag: direct sums
+# (C++, src/evidence.cpp) for a few dozen lags, otherwise an FFT zero-padded
+# to n + max_lag (enough for lags up to max_lag: the circular products
+# never wrap into them).
 acf_fft <- function(x, max_lag) {
   n <- length(x)
   x <- x - mean(x)
-  nfft <- 2^ceiling(log2(2 * n))
+  if (max_lag <= 64L) {
+    a <- acf_sums(x, as.integer(max_lag))
+    return(a / a[1L])
+  }
+  nfft <- stats::nextn(n + max_lag + 1L)
   f <- stats::fft(c(x, numeric(nfft - n)))
   a <- Re(stats::fft(Mod(f)^2, inverse = TRUE))[seq_len(max_lag + 1L)] / nfft
   a / a[1L]
@@ -96,7 +185,8 @@ block_means <- function(x, m) {
   m <- as.integer(m)
   nb <- length(x) %/% m
   if (m <= 1L) return(x)
-  colMeans(matrix(x[seq_len(nb * m)], nrow = m))
+  # .colMeans reads the first nb * m values in place (no copy, no matrix)
+  .colMeans(x, m, nb)
 }
 
 # Exponential ACF (a Gauss-Markov process) near a correlation time `tc` (s):
@@ -107,8 +197,7 @@ acf_exponential <- function(x, freq, tc) {
   b <- block_means(x, m)
   nb <- length(b)
   if (nb < 40L) return(list(tc = NA_real_, r1 = NA_real_, z = NA_real_, m = m))
-  t <- seq_len(nb)
-  b <- stats::residuals(stats::lm.fit(cbind(1, t), b))
+  b <- detrend_linear(b)
   max_lag <- min(nb - 2L, 48L)
   r <- acf_fft(b, max_lag)[-1L]
   lag <- seq_len(max_lag)
@@ -132,7 +221,11 @@ acf_exponential <- function(x, freq, tc) {
 # fraction of samples lying on that grid.
 quantization_grid <- function(x) {
   n <- length(x)
-  u <- sort(unique(x))
+  # sort(unique(x)) without the hash table: the distinct values of the
+  # sorted series
+  xs <- sort(x)
+  u <- xs[c(TRUE, xs[-1L] != xs[-n])]
+  rm(xs)
   if (length(u) < 2L) {
     return(list(step = NA_real_, levels = length(u), on_grid = 1,
                 quantized = FALSE, sd_lsb = NA_real_))
@@ -166,12 +259,12 @@ linear_trend <- function(x, freq, blocks = 100L) {
 lag1_noise_id <- function(x, m = 1L) {
   b <- block_means(x, m)
   if (length(b) < 30L) return(NA_real_)
-  t <- seq_along(b)
-  b <- stats::residuals(stats::lm.fit(cbind(1, t), b))
+  b <- detrend_linear(b)
   d <- 0L
   repeat {
     bc <- b - mean(b)
-    r1 <- sum(bc[-1L] * bc[-length(bc)]) / sum(bc^2)
+    a <- acf_sums(bc, 1L)
+    r1 <- a[2L] / a[1L]
     delta <- r1 / (1 + r1)
     if (delta < 0.25 || d >= 2L) break
     b <- diff(b)
@@ -245,8 +338,8 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
   alpha <- check_number(alpha, "alpha", 0, 1, open = TRUE)
   check_diagnosable(x, "x")
   n <- length(x)
-  xc <- x - mean(x)
-  r1 <- sum(xc[-1L] * xc[-n]) / sum(xc^2)
+  a1 <- acf_sums(x - mean(x), 1L)
+  r1 <- a1[2L] / a1[1L]
   ms <- 10^(0:floor(log10(n / 30)))
   alphas <- vapply(ms, function(m) lag1_noise_id(x, m), 0)
   structure(list(

@@ -100,27 +100,45 @@ check_control <- function(control) {
 }
 
 # The fitting problem at fixed EDF: log data, weights, the model plan.
+# What every amplitude solve of the search needs and that does not change
+# between them is worked out here once: the amplitude coefficients, which
+# are fixed, their labels, and the basis columns of the terms without
+# nonlinear parameters (N, B, K...), which do not depend on the values
+# being searched.
 fit_problem <- function(data, tau0, lay, bias_correct, corr) {
   y <- log(data$avar) - if (bias_correct) log_bias(data$edf) else 0
   s <- log_sd(data$edf)
-  list(data = data, tau0 = tau0, lay = lay, plan = model_plan(lay), y = y,
-       s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct)
+  plan <- model_plan(lay)
+  is_amp <- lay$role == "amp"
+  amp <- list(name = lay$name[is_amp], fixed = lay$fixed[is_amp],
+              label = lay$label[is_amp], value = lay$value[is_amp])
+  const <- vapply(plan, function(p) !length(p$nl), NA)
+  basis0 <- plan_basis(plan[const], data$tau, tau0, stats::setNames(lay$value, lay$name))
+  list(data = data, tau0 = tau0, lay = lay, plan = plan, y = y,
+       s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct,
+       amp = amp, plan_nl = plan[!const], basis0 = basis0,
+       values = stats::setNames(lay$value, lay$name))
 }
 
 # Solve for the squared amplitudes at nonlinear values `nlv` (named by
 # coefficient). `off`: instance labels left out (amplitude 0) for this
 # solve. Returns c (named by free amplitude coefficient), objective,
-# iterations, converged and the layout with the nonlinear values set.
-solve_amps <- function(pr, nlv, control, off = NULL) {
-  lay <- pr$lay
-  if (length(nlv)) lay$value[match(names(nlv), lay$name)] <- nlv
-  values <- stats::setNames(lay$value, lay$name)
-  Bm <- plan_basis(pr$plan, pr$data$tau, pr$tau0, values)
-  amp <- lay[lay$role == "amp", , drop = FALSE]
+# iterations, converged and (unless `layout = FALSE`, as in the search's
+# objective) the layout with the nonlinear values set.
+solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE) {
+  values <- pr$values
+  if (length(nlv)) values[names(nlv)] <- nlv
+  amp <- pr$amp
+  Bm <- cbind(pr$basis0, plan_basis(pr$plan_nl, pr$data$tau, pr$tau0, values))
   free <- amp$name[!amp$fixed & !amp$label %in% off]
   offset <- numeric(nrow(pr$data))
   for (i in which(amp$fixed)) offset <- offset + amp$value[i]^2 * Bm[, amp$name[i]]
   cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
+  lay <- NULL
+  if (layout) {
+    lay <- pr$lay
+    if (length(nlv)) lay$value[match(names(nlv), lay$name)] <- nlv
+  }
   if (!length(free)) {
     obj <- if (all(offset > 0)) sum(wmul(pr$W, pr$y - log(offset))^2) else Inf
     return(list(c = cc, objective = obj, iterations = 0L, converged = TRUE,
@@ -146,7 +164,8 @@ fit_search <- function(pr, start, prev, control) {
   evals <- 0L
   obj <- function(lognl, off = NULL) {
     evals <<- evals + 1L
-    solve_amps(pr, stats::setNames(exp(lognl), names(nlv)), control, off)$objective
+    solve_amps(pr, stats::setNames(exp(lognl), names(nlv)), control, off,
+               layout = FALSE)$objective
   }
   nm <- NULL
   if (length(nlrows)) {

@@ -21,6 +21,12 @@
 #' * **N**: a -1/2 region (or a fitted N) must exist.
 #' * **any fitted term** whose relative standard error (from the fit's
 #'   `vcov`) exceeds 50% is reported as not resolvable.
+#' * **non-stationary effects** of the raw series (spikes/outliers, bias
+#'   steps, warm-up, transients; [series_effects()], run by [avrefine()]
+#'   when it has the data, so by [analyze_imu()] with `refine = TRUE` or
+#'   `remove`) that were left in the series: one line per kind with the
+#'   count, the first times, the largest size in noise standard deviations,
+#'   the change they make to the Allan deviation, and how to remove them.
 #'
 #' [analyze_imu()] runs these checks and warns when any fails.
 #'
@@ -147,11 +153,36 @@ channel_guidance <- function(ch) {
       }
     }
   }
+  msg <- c(msg, series_guidance(if (!is.null(ch$series)) ch$series else ch$fit$series,
+                                hours))
   if (!is.null(ch$fit_error)) {
     msg <- c(msg, paste0("fit not used (", ch$fit_error,
                          "): values read from the slope lines."))
   }
   msg
+}
+
+# One line per kind of non-stationary effect (spikes, steps, ...) found in
+# the raw series and left in it: how many, where, how large, what it does
+# to the Allan deviation, and how to take it out. The words come from the
+# catalogue entry.
+series_guidance <- function(se, hours) {
+  if (is.null(se) || !NROW(se$table)) return(character())
+  tab <- se$table[!se$table$removed, , drop = FALSE]
+  vapply(unique(tab$kind), function(kind) {
+    k <- tab[tab$kind == kind, , drop = FALSE]
+    at <- paste0(vapply(utils::head(k$time, 3L), hours, ""), collapse = ", ")
+    if (nrow(k) > 3L) at <- paste0(at, ", ...")
+    ch <- se$adev_kinds[se$adev_kinds$kind == kind, , drop = FALSE]
+    worst <- if (nrow(ch) && any(is.finite(ch$change)))
+      which.max(abs(replace(ch$change, !is.finite(ch$change), 0))) else NA_integer_
+    effect <- if (is.na(worst)) "" else sprintf(
+      "; left in, they change the Allan deviation by up to %+.0f%% (at tau = %s)",
+      100 * ch$change[worst], hours(ch$tau[worst]))
+    sprintf("%d x %s in the raw series (at %s; up to %.3g standard deviations)%s: take them out with remove = \"%s\" (command line: --remove %s).",
+            nrow(k), effect_entry(kind)$title, at, max(abs(k$z), na.rm = TRUE),
+            effect, kind, kind)
+  }, "", USE.NAMES = FALSE)
 }
 
 # tau where K^2 tau / 3 = N^2 / tau + (2 ln2 / pi) B^2 (positive root).

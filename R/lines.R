@@ -223,16 +223,22 @@ remove_lines <- function(x, freq, f0) {
   n <- length(x)
   t <- (seq_len(n) - 1) / freq
   xc <- x - mean(x)
-  fitted <- function(f, y) {
-    X <- cbind(sin(2 * pi * f * t), cos(2 * pi * f * t))
-    X %*% solve(crossprod(X), crossprod(X, y))
+  # least-squares amplitudes on sin and cos at f from their sums (C++,
+  # src/lines.cpp: no trig per sample, no n x 2 matrix); the fitted power
+  # sum(fitted^2) is b'X'y
+  amps <- function(f, y) {
+    m <- line_sums(y, f, freq)
+    xy <- m[4:5]
+    b <- solve(matrix(m[c(1L, 3L, 3L, 2L)], 2L), xy)
+    list(b = b, power = sum(b * xy))
   }
   bin <- freq / n
   for (f in f0) {
-    o <- stats::optimize(function(g) -sum(fitted(g, xc)^2),
+    o <- stats::optimize(function(g) -amps(g, xc)$power,
                          c(max(bin / 2, f - 2 * bin), f + 2 * bin),
                          tol = bin * 1e-3)
-    xc <- xc - fitted(o$minimum, xc)
+    b <- amps(o$minimum, xc)$b
+    xc <- xc - b[1L] * sin(2 * pi * o$minimum * t) - b[2L] * cos(2 * pi * o$minimum * t)
   }
   as.numeric(xc) + mean(x)
 }

@@ -150,7 +150,7 @@ resonance_start <- function(band) {
 # What the raw data say about a fitted resonance: a band of find_bands()
 # whose centre lies within half its width (or 2 resolution bins) of f_r is
 # support; its power within a factor 3 of sigma^2 as well; no band at all
-# near f_r contradicts it.
+# near f_r contradicts it, as does a width 1/(pi tc) more than 3x off the band's.
 resonance_raw_support <- function(sigma, fr, tc, bands) {
   if (!nrow(bands)) {
     return(list(text = sprintf("no spectral band near %s Hz", format(signif(fr, 3))),
@@ -162,8 +162,43 @@ resonance_raw_support <- function(sigma, fr, tc, bands) {
   j <- which.min(d)
   near <- d[j] <= max(0.5 * bands$width[j], 2 * res)
   pr <- bands$power[j] / sigma^2
-  txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x the fitted)",
+  # a resonance is a band, not a tone: its width 1/(pi tc) must match the
+  # band's within a factor 3 (both at least the resolution)
+  wr <- max(bands$width[j], res) / max(1 / (pi * tc), res)
+  txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x and width %.2g x the fitted)",
                  format(signif(bands$f_center[j], 4)), format(signif(bands$width[j], 2)),
-                 100 * bands$share[j], pr)
-  list(text = txt, support = near && pr > 1 / 3 && pr < 3)
+                 100 * bands$share[j], pr, wr)
+  list(text = txt, support = near && pr > 1 / 3 && pr < 3 && wr > 1 / 3 && wr < 3)
+}
+
+# The series with each broad band of find_bands() brought down to its
+# background: every FFT bin is scaled by sqrt(bg / (bg + M(f))), where M is
+# the band's fitted Lorentzian (one-sided PSD) and bg the background PSD
+# read 3-6 band widths away (M taken off), so that the expected power of
+# each bin becomes the background's. Phases are kept, so the white noise
+# and the filter's roll-off under the band stay; only the band's excess
+# goes. Used for the raw-data checks of the other effects (the filter's
+# short-lag ACF, a Gauss-Markov ACF), which a resonance disturbs.
+remove_bands <- function(x, freq, bands) {
+  if (is.null(bands) || !nrow(bands)) return(x)
+  n <- length(x)
+  m <- mean(x)
+  tau0 <- 1 / freq
+  X <- stats::fft(x - m)
+  f <- (seq_len(n) - 1) * freq / n
+  fa <- pmin(f, freq - f)
+  P <- 2 * Mod(X)^2 / (n * freq)
+  for (k in seq_len(nrow(bands))) {
+    b <- bands[k, ]
+    M <- 2 * resonance_psd(fa, tau0, sqrt(b$power), b$f_center, b$tc)
+    w <- max(b$width, b$f_to - b$f_from)
+    d <- abs(fa - b$f_center)
+    near <- d > 3 * w & d < 6 * w
+    bg <- mean(P[near] - M[near])
+    if (!is.finite(bg) || bg <= 0) next
+    g <- sqrt(bg / (bg + M))
+    X <- X * g
+    P <- P * g^2
+  }
+  Re(stats::fft(X, inverse = TRUE)) / n + m
 }

@@ -69,7 +69,8 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
     for (e in usable) {
       if (is.null(e$propose)) next
       for (p in e$propose(raw, tau, sig)) {
-        add(e$name, p$tau_from, p$tau_to, p$init,
+        # a proposal may name a variant of its entry ("filter:lp2")
+        add(p$effect %||% e$name, p$tau_from, p$tau_to, p$init,
             paste0(overlapping_signature(sig, p$tau_from, p$tau_to), "; ", p$note),
             p$score, p$pin)
       }

@@ -7,28 +7,8 @@
 # compile without optimisation). Prints a table of median elapsed times and
 # ratios; takes about a minute.
 
-lib <- tempfile("allanlib")
-dir.create(lib)
-status <- system2(file.path(R.home("bin"), "R"),
-                  c("CMD", "INSTALL", "--preclean", "--no-test-load",
-                    paste0("--library=", lib), "."),
-                  stdout = FALSE, stderr = FALSE)
-if (status != 0) stop("R CMD INSTALL failed")
-library(allanvar, lib.loc = lib)
-
-# Median elapsed seconds over `reps` runs, after one warm-up run.
-timed <- function(expr, reps = 5) {
-  f <- substitute(expr)
-  e <- parent.frame()
-  eval(f, e)
-  if (requireNamespace("bench", quietly = TRUE)) {
-    b <- bench::mark(eval(f, e), iterations = reps, check = FALSE,
-                     memory = FALSE, filter_gc = FALSE)
-    return(as.numeric(b$median))
-  }
-  stats::median(vapply(seq_len(reps),
-                       function(i) system.time(eval(f, e))[["elapsed"]], 0))
-}
+source(file.path("bench", "common.R"))
+lib <- bench_install()
 
 rows <- list()
 add <- function(task, N, seconds, base, reps) {

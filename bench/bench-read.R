@@ -7,15 +7,11 @@
 # It installs the package into a temporary library (byte-compiled, as users
 # have it), writes its files into tempdir(), and needs the lz4 and zstd
 # command-line tools for the compressed bags. About 5 minutes.
-stopifnot(file.exists("DESCRIPTION"))
-lib <- tempfile("benchlib")
-dir.create(lib)
-st <- system2(file.path(R.home("bin"), "R"),
-              c("CMD", "INSTALL", "--no-test-load", paste0("--library=", lib), "."),
-              stdout = FALSE, stderr = FALSE)
-if (st != 0) stop("R CMD INSTALL failed")
+source(file.path("bench", "common.R"))
+lib <- bench_install()
 .libPaths(c(lib, .libPaths()))
-library(allanvar)
+# No warm-up run: each file was just written, so it is in the page cache.
+formals(timed)$warm <- FALSE
 source(file.path("tools", "make-bag-fixtures.R"))
 options(allanvar.threads = 2L)
 
@@ -39,15 +35,6 @@ rec <- list(sec = 1403636579 + (0:(n - 1)) %/% 100, nsec = ((0:(n - 1)) %% 100) 
 dir <- tempfile("benchread")
 dir.create(dir)
 
-timed <- function(expr, reps = 3L) {
-  e <- substitute(expr)
-  pf <- parent.frame()
-  t <- vapply(seq_len(reps), function(i) {
-    gc(FALSE)
-    system.time(eval(e, pf))[["elapsed"]]
-  }, 0)
-  stats::median(t)
-}
 rows <- list()
 add <- function(task, size, s, note = "") {
   rows[[length(rows) + 1L]] <<- data.frame(task = task, size = size, median_s = s,
@@ -64,9 +51,9 @@ csv <- file.path(dir, "imu.csv")
 write_imu_csv(rec, csv)
 csv_mb <- sprintf("%.0f MB", file.size(csv) / 2^20)
 invisible(read_imu(csv))
-add("read_imu(), Kalibr CSV 1e6 x 7", csv_mb, timed(read_imu(csv)))
+add("read_imu(), Kalibr CSV 1e6 x 7", csv_mb, timed(read_imu(csv), 3L))
 add("data.table::fread(), same file", csv_mb,
-    timed(data.table::fread(csv, nThread = 2L, showProgress = FALSE)))
+    timed(data.table::fread(csv, nThread = 2L, showProgress = FALSE), 3L))
 add("utils::read.csv(), same file", csv_mb, timed(utils::read.csv(csv), 1L), "one run")
 
 # Bags, 1e6 messages of /imu0 (and a few of two other topics).
@@ -91,7 +78,7 @@ for (k in seq_along(bag_files)) {
   r <- read_imu(f, topic = "/imu0")
   same <- identical(unname(r$data), unname(ref$data)) && identical(r$time, ref$time)
   add(paste0("read_imu(), ", nm), sprintf("1e6 msgs, %.0f MB", file.size(f) / 2^20),
-      timed(read_imu(f, topic = "/imu0")),
+      timed(read_imu(f, topic = "/imu0"), 3L),
       if (same) "record identical to the CSV's" else "RECORD DIFFERS FROM THE CSV")
   if (grepl("bz2", nm)) {
     # Do the decompression threads pay? The same read on one thread.

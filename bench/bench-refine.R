@@ -37,7 +37,9 @@ cases <- list(
   "detect_spikes" = function(x) ns_fun("detect_spikes")(x, freq),
   "detect_steps" = function(x) ns_fun("detect_steps")(x, freq),
   "detect_warmup" = function(x) ns_fun("detect_warmup")(x, freq),
-  "old spectral_lines (runmed per octave)" = function(x) ns_fun("spectral_lines")(x, freq),
+  "spectral_lines (avdiagnose's lines)" = function(x) ns_fun("spectral_lines")(x, freq),
+  "remove_lines (one line)" = function(x) ns_fun("remove_lines")(x, freq, 1.3),
+  "acf_exponential (Tc = 0.05 s)" = function(x) ns_fun("acf_exponential")(x, freq, 0.05),
   "avdiagnose (today)" = function(x) avdiagnose(x, freq),
   "avrefine(fit, data = x) (today's loop)" = function(x) {
     fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
@@ -48,8 +50,10 @@ rows <- list()
 for (n in ns) {
   x <- gen(n)
   r <- if (n >= 4e6) 1L else reps
-  # sum(x) is too quick for one timing: 20 in a row, divided
-  base <- time_med(function() for (i in 1:20) sum(x), 3L) / 20
+  # sum(x) is too quick for one timing: enough in a row for about 2e8
+  # additions (system.time() resolves 1 ms), divided
+  k <- max(20L, ceiling(2e8 / n))
+  base <- time_med(function() for (i in seq_len(k)) sum(x), 3L) / k
   for (nm in names(cases)) {
     f <- cases[[nm]]
     sec <- time_med(function() f(x), r)

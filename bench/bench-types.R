@@ -13,17 +13,11 @@
 #                        unpacked in /tmp/allantools); timed with python3 and
 #                        numpy, each call under `timeout` (BENCH_PY_TIMEOUT,
 #                        default 120 s).
-# Prints one table: median elapsed seconds (3 runs after a warm-up for
+# Prints one table: median elapsed seconds (3 or 9 runs after a first for
 # calls under 5 s, else one run), ratio to sum(x), allantools' time.
 
-lib <- tempfile("allanlib")
-dir.create(lib)
-status <- system2(file.path(R.home("bin"), "R"),
-                  c("CMD", "INSTALL", "--preclean", "--no-test-load",
-                    paste0("--library=", lib), "."),
-                  stdout = FALSE, stderr = FALSE)
-if (status != 0) stop("R CMD INSTALL failed")
-library(allanvar, lib.loc = lib)
+source(file.path("bench", "common.R"))
+lib <- bench_install()
 
 env_num <- function(name, default) {
   v <- Sys.getenv(name)
@@ -33,7 +27,7 @@ sizes <- env_num("BENCH_TYPES_N", c(1e4, 1e5, 1e6))
 cap <- env_num("BENCH_TYPES_CAP", 30)
 py_timeout <- env_num("BENCH_PY_TIMEOUT", 120)
 
-timed <- function(expr) {
+timed_adaptive <- function(expr) {
   f <- substitute(expr)
   e <- parent.frame()
   t1 <- system.time(eval(f, e))[["elapsed"]]
@@ -74,11 +68,13 @@ py_time <- function(fun, file) {
   v <- suppressWarnings(as.numeric(utils::tail(out, 1)))
   if (length(v) != 1L || is.na(v)) NA_real_ else v
 }
-py_name <- c(overlapping = "oadev", modified = "mdev", tdev = "tdev",
+py_name <- c(standard = "adev", overlapping = "oadev", modified = "mdev",
+             hadamard = "hdev", ohadamard = "ohdev", total = "totdev", tdev = "tdev",
              mtotdev = "mtotdev", ttotdev = "ttotdev", htotdev = "htotdev",
              theo1 = "theo1", mtie = "mtie", tierms = "tierms", pdev = "pdev")
 
-types <- c("overlapping", "modified", "tdev", "tierms", "mtie", "pdev",
+types <- c("standard", "overlapping", "modified", "hadamard", "ohadamard",
+           "total", "tdev", "tierms", "mtie", "pdev",
            "mtotdev", "ttotdev", "htotdev", "theo1", "theobr", "theoh")
 options(allanvar.threads = 2)
 set.seed(1)
@@ -100,7 +96,7 @@ for (N in sizes) {
                                               allantools = NA)
       next
     }
-    t <- timed(allan(y, 1, type = ty))
+    t <- timed_adaptive(allan(y, 1, type = ty))
     py <- if (have_py && ty %in% names(py_name) && !ty %in% py_stopped) {
       py_time(py_name[[ty]], f)
     } else {
@@ -114,9 +110,9 @@ for (N in sizes) {
                                             allantools = signif(py, 3))
     message(sprintf("%-12s %8.0e %10.4g s  %8.1f x sum  allantools %s", ty, N,
                     t[1], t[1] / s, format(signif(py, 3))))
-    # not run at the next size when it would take over 10 caps (the Theo
-    # family is O(N^2) at octave taus, the others about O(N log N))
-    p <- if (ty %in% c("theo1", "theobr", "theoh")) 2 else 1.1
+    # not run at the next size when it would take over 10 caps (TheoBR's
+    # factor, so TheoBR and TheoH, is O(N^2); the others about O(N log N))
+    p <- if (ty %in% c("theobr", "theoh")) 2 else 1.1
     if (t[1] > cap || t[1] * 10^p > 10 * cap) stopped <- c(stopped, ty)
   }
   rows[[length(rows) + 1L]] <- data.frame(type = "sum(x)", N = N,

@@ -23,9 +23,14 @@ check_axis <- function(x, freq, av, dg, ref) {
     cf[[grep("Nf$", names(cf), value = TRUE)[1]]] else NA_real_
   enbw <- NA_real_
   if (has_filter) {
-    L <- cf[grep("\\.L$", names(cf), value = TRUE)[1]]
-    if (length(L) && is.finite(L)) {
-      enbw <- filter_bandwidth(list(family = "ma", L = max(1, L)), 1 / freq)$enbw
+    # the family the loop chose: "filter" (moving average) or "filter:lp1/lp2"
+    v <- split_term(grep("^filter", ref$terms, value = TRUE)[1])$variant
+    if (!nzchar(v)) v <- "ma"
+    p <- if (v == "ma") "L" else "fc"
+    val <- unname(cf[grep(paste0("\\.", p, "$"), names(cf), value = TRUE)[1]])
+    if (length(val) && is.finite(val)) {
+      nl <- stats::setNames(list(val), p)
+      enbw <- filter_bandwidth(filter_spec_of(v, nl, 1 / freq), 1 / freq)$enbw
     }
   }
   f0 <- cf[grepl("\\.f0$", names(cf))]
@@ -54,10 +59,23 @@ if (!exists("adis_check_define_only")) {
   order <- expand.grid(unit = 1:3, axis = c("gyro_x", "accel_z", "gyro_z",
                                             "accel_x", "gyro_y", "accel_y"),
                        stringsAsFactors = FALSE)
+  # ADIS_AXES="1:gyro_y,3:accel_x" runs a subset and appends its rows (so a
+  # loaded machine can rerun a few axes); the commit column says which code
+  # produced each row.
+  only <- Sys.getenv("ADIS_AXES", "")
+  append <- nzchar(only)
+  if (append) {
+    want <- strsplit(strsplit(only, ",")[[1]], ":")
+    order <- data.frame(unit = as.integer(vapply(want, `[`, "", 1)),
+                        axis = vapply(want, `[`, "", 2),
+                        stringsAsFactors = FALSE)
+  }
+  commit <- tryCatch(system2("git", c("rev-parse", "--short", "HEAD"),
+                             stdout = TRUE), error = function(e) "?")
   cols <- c("unit", "axis", "acf1", "filter", "enbw", "line_055", "sinusoids",
             "contradicted", "chi2", "n_fit", "n_ref", "n_err", "converged",
-            "unexplained", "tau_from", "effects", "seconds")
-  writeLines(paste(cols, collapse = "\t"), out)
+            "unexplained", "tau_from", "effects", "seconds", "commit")
+  if (!append || !file.exists(out)) writeLines(paste(cols, collapse = "\t"), out)
   cache <- list()
   for (i in seq_len(nrow(order))) {
     k <- order$unit[i]; axis <- order$axis[i]
@@ -72,6 +90,12 @@ if (!exists("adis_check_define_only")) {
     ref <- suppressMessages(avrefine(fit0, data = x, max_steps = 5))
     row <- check_axis(x, freq, av, dg, ref)
     row$seconds <- as.numeric(Sys.time() - t0, units = "secs")
+    row$commit <- commit[1]
+    # ADIS_SAVE=dir keeps each refined fit for inspection (outside the tree)
+    if (nzchar(Sys.getenv("ADIS_SAVE"))) {
+      saveRDS(list(datasheet = fit0, refined = ref),
+              file.path(Sys.getenv("ADIS_SAVE"), sprintf("fits_%d_%s.rds", k, axis)))
+    }
     row <- cbind(data.frame(unit = k, axis = axis), row)
     fmt <- function(v) if (is.numeric(v)) format(signif(v, 4)) else as.character(v)
     cat(paste(vapply(row[cols], fmt, ""), collapse = "\t"), "\n", sep = "",

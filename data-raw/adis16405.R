@@ -12,7 +12,9 @@
 # licensed CC BY-NC-SA 4.0.
 #
 # Run from the package root:  Rscript data-raw/adis16405.R
-# (about 10 minutes on one core).
+# (about 10 minutes on one core), or, after
+#   ADIS_SAVE=/tmp/refs Rscript data-raw/adis16405-check.R
+# as  ADIS_REFS=/tmp/refs Rscript data-raw/adis16405.R  to reuse its fits.
 
 pkgload::load_all(".", quiet = TRUE)
 
@@ -29,7 +31,7 @@ adis_check_define_only <- TRUE
 source("data-raw/adis16405-check.R")
 av_rows <- list(); diag_rows <- list(); line_rows <- list()
 coef_rows <- list(); step_rows <- list(); fit_rows <- list(); noise_rows <- list()
-fits <- list()
+fits <- list(); unexpl_rows <- list()
 
 for (k in 1:3) {
   m <- readRDS(file.path(shared, sprintf("adis16405_unit%d.rds", k)))
@@ -41,8 +43,17 @@ for (k in 1:3) {
     id <- sprintf("unit%d/%s", k, axis)
     av <- allan(x, freq, taus = 10, type = "overlapping")
     dg <- avdiagnose(x, freq)
-    fit0 <- avfit(av, terms = c("N", "B", "K"))
-    ref <- avrefine(fit0, data = x, max_steps = 5)
+    # ADIS_REFS=dir reuses the fits data-raw/adis16405-check.R kept
+    # (ADIS_SAVE=dir there): the same calls, not run twice on a loaded machine
+    saved <- file.path(Sys.getenv("ADIS_REFS", ""), sprintf("fits_%d_%s.rds", k, axis))
+    if (nzchar(Sys.getenv("ADIS_REFS")) && file.exists(saved)) {
+      kept <- readRDS(saved)
+      fit0 <- kept$datasheet
+      ref <- kept$refined
+    } else {
+      fit0 <- avfit(av, terms = c("N", "B", "K"))
+      ref <- avrefine(fit0, data = x, max_steps = 5)
+    }
     key <- data.frame(unit = k, axis = axis, sensor = sensor,
                       rate_unit = units[[sensor]], stringsAsFactors = FALSE)
     av_rows[[id]] <- cbind(key[rep(1, nrow(av)), ], as.data.frame(av)[
@@ -79,6 +90,8 @@ for (k in 1:3) {
       converged = fit0$convergence$converged && ref$convergence$converged,
       failed_refits = NROW(ref$refine$failures),
       stringsAsFactors = FALSE))
+    un <- ref$unexplained
+    if (NROW(un)) unexpl_rows[[id]] <- cbind(key[rep(1, nrow(un)), ], un, row.names = NULL)
     fits[[id]] <- list(datasheet = fit0, refined = ref)
     check_rows[[id]] <- cbind(key, check_axis(x, freq, av, dg, ref))
     cat(sprintf("%-14s chi2 %8.1f -> %7.2f  rms %5.1f%% -> %5.1f%%  [%s]  %.0f s\n", id,
@@ -98,11 +111,11 @@ writeLines(capture.output({
   bw <- tapply(check$enbw, check$sensor, function(v) diff(range(v, na.rm = TRUE)) /
                  mean(v, na.rm = TRUE) * 100)
   cat("\nENBW spread per sensor type (range / mean, %):\n"); print(round(bw, 1))
-}), "data-raw/adis16405-check.txt")
+}), "data-raw/adis16405-check-summary.txt")
 adis16405_av <- list(
   av = bind(av_rows), diagnostics = bind(diag_rows), lines = bind(line_rows),
   noise_id = bind(noise_rows), fits = bind(fit_rows), coef = bind(coef_rows),
-  steps = bind(step_rows),
+  steps = bind(step_rows), unexplained = bind(unexpl_rows), check = check,
   source = paste("ADIS16405 static recordings, 3 units x 6 axes, 100 Hz, 1e6",
                  "samples each. Department of Geomatics Engineering, University",
                  "of Calgary, via the imudata R package; CC BY-NC-SA 4.0."))

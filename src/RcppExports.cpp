@@ -187,6 +187,39 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// acf_sums
+Rcpp::NumericVector acf_sums(const Rcpp::NumericVector& x, int max_lag);
+RcppExport SEXP _allanvar_acf_sums(SEXP xSEXP, SEXP max_lagSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< int >::type max_lag(max_lagSEXP);
+    rcpp_result_gen = Rcpp::wrap(acf_sums(x, max_lag));
+    return rcpp_result_gen;
+END_RCPP
+}
+// detrend_line
+Rcpp::NumericVector detrend_line(const Rcpp::NumericVector& x);
+RcppExport SEXP _allanvar_detrend_line(SEXP xSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    rcpp_result_gen = Rcpp::wrap(detrend_line(x));
+    return rcpp_result_gen;
+END_RCPP
+}
+// line_sums
+Rcpp::NumericVector line_sums(const Rcpp::NumericVector& y, double f, double freq);
+RcppExport SEXP _allanvar_line_sums(SEXP ySEXP, SEXP fSEXP, SEXP freqSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< double >::type f(fSEXP);
+    Rcpp::traits::input_parameter< double >::type freq(freqSEXP);
+    rcpp_result_gen = Rcpp::wrap(line_sums(y, f, freq));
+    return rcpp_result_gen;
+END_RCPP
+}
 // lz4_decompress_cpp
 Rcpp::RawVector lz4_decompress_cpp(const Rcpp::RawVector& x, double expected);
 RcppExport SEXP _allanvar_lz4_decompress_cpp(SEXP xSEXP, SEXP expectedSEXP) {
@@ -238,15 +271,16 @@ BEGIN_RCPP
 END_RCPP
 }
 // pdev_sums_cpp
-Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
-RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
+RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
     Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(pdev_sums_cpp(v, rate, m, threads));
+    Rcpp::traits::input_parameter< int >::type method(methodSEXP);
+    rcpp_result_gen = Rcpp::wrap(pdev_sums_cpp(v, rate, m, threads, method));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -379,15 +413,16 @@ BEGIN_RCPP
 END_RCPP
 }
 // theo1_sums_cpp
-Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads);
-RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP) {
+Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
+RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
     Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(theo1_sums_cpp(v, rate, m, threads));
+    Rcpp::traits::input_parameter< int >::type method(methodSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_sums_cpp(v, rate, m, threads, method));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -490,11 +525,14 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
+    {"_allanvar_acf_sums", (DL_FUNC) &_allanvar_acf_sums, 2},
+    {"_allanvar_detrend_line", (DL_FUNC) &_allanvar_detrend_line, 1},
+    {"_allanvar_line_sums", (DL_FUNC) &_allanvar_line_sums, 3},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
     {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
     {"_allanvar_mcap_chunk_raw", (DL_FUNC) &_allanvar_mcap_chunk_raw, 3},
     {"_allanvar_mcap_imu", (DL_FUNC) &_allanvar_mcap_imu, 6},
-    {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 4},
+    {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 5},
     {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
     {"_allanvar_int64_rel_seconds", (DL_FUNC) &_allanvar_int64_rel_seconds, 3},
     {"_allanvar_int64_to_double", (DL_FUNC) &_allanvar_int64_to_double, 1},
@@ -506,7 +544,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},
     {"_allanvar_rosbag_imu", (DL_FUNC) &_allanvar_rosbag_imu, 7},
-    {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 4},
+    {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
     {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},

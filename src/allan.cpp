@@ -9,6 +9,7 @@
 // drift or length of the record.
 #include "buffer.h"
 #include "checks.h"
+#include "local-phase.h"
 #include "noise_id.h"
 #include "opts-allan.h"
 #include "parallel.h"
@@ -178,12 +179,8 @@ void build_split(const double* v, R_xlen_t n, double c, double bound,
 // for k in [k0, k1): two terms per vector (GCC/Clang vector extensions,
 // plain SSE2 on x86-64), two independent accumulators.
 #if defined(__GNUC__)
-typedef double v2d __attribute__((vector_size(16)));
-inline v2d ld2(const double* p) {
-  v2d v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
+using allanvar::v2d;
+using allanvar::ld2;
 #endif
 
 template <int D>
@@ -355,22 +352,28 @@ void strided(const Split& X, const std::vector<R_xlen_t>& ms,
 
 // Total variance (NIST SP 1065 eq. 25): second differences centred on
 // i = 1 .. L-2 of the phase extended by point reflection at both ends,
-// x*(-j) = 2x(0) - x(j), x*(L-1+j) = 2x(L-1) - x(L-1-j).
+// x*(-j) = 2x(0) - x(j), x*(L-1+j) = 2x(L-1) - x(L-1-j). The centres
+// i in [m, L-1-m] reflect nothing: they are the overlapping estimator's
+// terms, summed by its cache-blocked kernel; only the (at most 2m) centres
+// near the ends are evaluated here.
 void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
            bool main, double* out) {
   const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
   const double* h = X.hi.data();
   const double* l = X.lo.data();
-  run_items(static_cast<R_xlen_t>(ms.size()), threads, main, [&](R_xlen_t j) {
+  const size_t nt = ms.size();
+  std::vector<R_xlen_t> inner(nt, 0);
+  for (size_t j = 0; j < nt; ++j) inner[j] = std::max<R_xlen_t>(0, L - 2 * ms[j]);
+  overlapped<2>(X, ms, inner, threads, main, out);
+  if (allanvar::interrupt_state().stop.load()) return;
+  std::vector<double> edge(nt, 0.0);
+  run_items(static_cast<R_xlen_t>(nt), threads, main, [&](R_xlen_t j) {
     if (allanvar::interrupted()) return;
     const R_xlen_t m = ms[j];
     // one term has at most 5 points, total weight 8: exact on the hi grid
-    Acc a;
-    double s = 0;
-    R_xlen_t cnt = 0;
-    for (R_xlen_t i = 1; i <= L - 2; ++i) {
+    auto term = [&](R_xlen_t i) {
       double dh = -2.0 * h[i], dl = -2.0 * l[i];
-      R_xlen_t a0 = i - m;
+      const R_xlen_t a0 = i - m;
       if (a0 >= 0) {
         dh += h[a0];
         dl += l[a0];
@@ -378,7 +381,7 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
         dh += 2.0 * h[0] - h[-a0];
         dl += 2.0 * l[0] - l[-a0];
       }
-      R_xlen_t a1 = i + m;
+      const R_xlen_t a1 = i + m;
       if (a1 <= L - 1) {
         dh += h[a1];
         dl += l[a1];
@@ -387,17 +390,39 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
         dh += 2.0 * h[L - 1] - h[r];
         dl += 2.0 * l[L - 1] - l[r];
       }
-      const double d = dh + dl;
-      s += d * d;
-      if (++cnt == kBlock) {
-        a.add(s);
-        s = 0;
-        cnt = 0;
+      return dh + dl;
+    };
+    // the centres outside [m, L-1-m]
+    R_xlen_t r0[2] = {1, std::max(m, L - m)};
+    R_xlen_t r1[2] = {std::min(m - 1, L - 2), L - 2};
+    if (inner[j] == 0) {
+      r1[0] = L - 2;
+      r1[1] = -1;
+    }
+    Acc a;
+    double s = 0;
+    R_xlen_t cnt = 0;
+    for (int z = 0; z < 2; ++z) {
+      for (R_xlen_t i = r0[z]; i <= r1[z]; ++i) {
+        const double d = term(i);
+        s += d * d;
+        if (++cnt == kBlock) {
+          a.add(s);
+          s = 0;
+          cnt = 0;
+          if (allanvar::interrupted()) return;
+        }
       }
     }
     a.add(s);
-    out[j] = a.value();
+    edge[j] = a.value();
   });
+  for (size_t j = 0; j < nt; ++j) {
+    Acc a;
+    a.add(out[j]);
+    a.add(edge[j]);
+    out[j] = a.value();
+  }
 }
 
 // Non-overlapping AV at m = 2^j straight from the rate samples: cluster sums

@@ -12,6 +12,7 @@
 #include <Rcpp.h>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 namespace allanvar {
@@ -22,6 +23,38 @@ inline void phase_two_sum(double a, double b, double& s, double& e) {
   const double bb = s - a;
   e = (a - (s - bb)) + (b - bb);
 }
+
+// Per-tau totals of partial sums (one per work item), each compensated
+// (TwoSum), so that the order of the items does not matter beyond 1e-16.
+class TauSums {
+ public:
+  explicit TauSums(size_t nt) : s_(nt, 0.0), e_(nt, 0.0), any_(nt, false) {}
+  void add(size_t t, double v) {
+    double s, e;
+    phase_two_sum(s_[t], v, s, e);
+    s_[t] = s;
+    e_[t] += e;
+    any_[t] = true;
+  }
+  bool any(size_t t) const { return any_[t]; }
+  double value(size_t t) const { return s_[t] + e_[t]; }
+
+ private:
+  std::vector<double> s_, e_;
+  std::vector<bool> any_;
+};
+
+#if defined(__GNUC__)
+// Two doubles per SSE2 vector (GCC/Clang vector extensions; baseline
+// x86-64 has SSE2), loaded from any address.
+typedef double v2d __attribute__((vector_size(16)));
+inline v2d ld2(const double* p) {
+  v2d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void st2(double* p, v2d v) { std::memcpy(p, &v, sizeof v); }
+#endif
 
 // The input as a phase sequence: rate samples y (x(0) = 0, x(j) = y(0) +
 // ... + y(j - 1), L = N + 1 points; the caller scales by tau0) or the

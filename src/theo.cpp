@@ -6,10 +6,15 @@
 //   T_k = sum_{i < N-m} sum_{L=1..k} (1/L) (x(i) - x(i+L) + x(i+m) - x(i+m-L))^2
 // (L = m/2 - delta of SP 1065's inner index).
 //
-// Two evaluations:
-//  * theo1_sums_cpp: T_k at the requested m, straight from the definition:
-//    for each L one pass of a four-point stencil over the phase split hi +
-//    lo (src/local-phase.h), exact on the hi grid. O(N k) per m.
+// Three evaluations:
+//  * theo1_sums_cpp: T_k at the requested m, per m the cheaper of
+//    - the definition: for each L one pass of a four-point stencil over the
+//      phase split hi + lo (src/local-phase.h), exact on the hi grid;
+//      O(N k) per m;
+//    - the blocked expansion (theo_block below): FFT correlations of
+//      locally detrended blocks of 6k to 12k points plus two triangle sums
+//      by divide and conquer; O(N log^2 k) per m, within about 1e-12 of
+//      the definition whatever the noise type.
 //  * theo1_all_cpp: T_k for every k = 1..kmax in O(N kmax + kmax^2), the
 //    complexity of the all-tau Allan variance, by the recurrence idea of
 //    B. Lewis, "A fast algorithm for calculation of Theo1" (IEEE TUFFC
@@ -22,6 +27,7 @@
 //    (src/dd.h) on the exact hi + lo phase: the result agrees with the
 //    direct evaluation to about 1e-15 whatever the noise type.
 #include "dd.h"
+#include "fft.h"
 #include "local-phase.h"
 #include "parallel.h"
 #include <algorithm>
@@ -32,17 +38,145 @@ namespace {
 
 using allanvar::DD;
 
+// ---- Fast T_k for one k (m = 2k): O(N log^2 k) instead of O(N k). ----
+// The starting indices i are cut into blocks; a block of Mb indices needs
+// the W = Mb + 2k phase points z = x(a + j), taken with a line removed
+// (local_phase(): T_k ignores a constant and a linear term), so the
+// expansion below cancels only as much as the local wander of the phase
+// over 4 to 5 k points allows, whatever the noise type. With
+// s_i = z_i + z_{i+m}, g the kernel of weights of the inner points
+// (g(t) = 1/t for t < k, 2/k at t = k, 1/(m - t) above) and
+// w(d) = 1/(k - d), the block's part of T_k is
+//   H_k sum_i s_i^2 - 2 sum_t g(t) sum_i s_i z_{i+t}
+//   + sum_t g(t) sum_i z_{i+t}^2 + 2 sum_{d<k} w(d) P(d),
+//   P(d) = sum_{c = k}^{W-k-1} z_{c-d} z_{c+d}
+// (expand d_i(L)^2 = (s_i - z_{i+L} - z_{i+m-L})^2 and sum over L with
+// weight 1/L; d = k - L). The correlations come from FFTs of the block
+// (src/fft.h); P(d) is the full autocorrelation at lag 2d minus the pairs
+// centred within k of either end of the block, two triangles summed by
+// divide and conquer: a square of the triangle by one FFT, two half
+// triangles recursively.
+
+struct FastScratch {
+  allanvar::FFTPlans plans;
+  std::vector<allanvar::cplx> buf, buf2;
+  std::vector<double> z, zr, s, c, c2, p2;
+};
+
+// sum over p + d < n (p, d >= 0) of z[p0 + p] z[p0 + p + 2 (d0 + d)] / (k - d0 - d)
+double theo_triangle(const double* z, R_xlen_t k, R_xlen_t p0, R_xlen_t d0,
+                     R_xlen_t n, FastScratch& S) {
+  if (n <= 0) return 0.0;
+  if (n <= 48) {
+    double acc = 0;
+    for (R_xlen_t d = 0; d < n; ++d) {
+      const R_xlen_t lag = 2 * (d0 + d);
+      double t = 0;
+      for (R_xlen_t p = p0; p < p0 + n - d; ++p) t += z[p] * z[p + lag];
+      acc += t / static_cast<double>(k - d0 - d);
+    }
+    return acc;
+  }
+  const R_xlen_t h = (n + 1) / 2, q = n - h;
+  // square: p in [p0, p0 + h), d in [d0, d0 + q)
+  double sq = 0;
+  if (h * q <= 4096) {
+    for (R_xlen_t d = 0; d < q; ++d) {
+      const R_xlen_t lag = 2 * (d0 + d);
+      double t = 0;
+      for (R_xlen_t p = p0; p < p0 + h; ++p) t += z[p] * z[p + lag];
+      sq += t / static_cast<double>(k - d0 - d);
+    }
+  } else {
+    const size_t nt = static_cast<size_t>(2 * q - 1);
+    S.c.resize(nt);
+    allanvar::real_correlation(z + p0, h, z + p0 + 2 * d0, h + nt - 1, nt,
+                               S.c.data(), S.plans, S.buf, S.buf2);
+    for (R_xlen_t d = 0; d < q; ++d)
+      sq += S.c[2 * d] / static_cast<double>(k - d0 - d);
+  }
+  if (allanvar::interrupted()) return 0.0;  // the result is thrown away
+  return sq + theo_triangle(z, k, p0 + h, d0, q, S) +
+         theo_triangle(z, k, p0, d0 + q, h, S);
+}
+
+// The block's part of T_k (see above); z has W = Mb + 2k points.
+double theo_block(const double* z, R_xlen_t W, R_xlen_t k, FastScratch& S) {
+  const R_xlen_t m = 2 * k, Mb = W - m;
+  double H = 0;
+  for (R_xlen_t L = k; L >= 1; --L) H += 1.0 / static_cast<double>(L);
+  auto g = [k, m](R_xlen_t t) {
+    if (t < k) return 1.0 / static_cast<double>(t);
+    if (t == k) return 2.0 / static_cast<double>(k);
+    return 1.0 / static_cast<double>(m - t);
+  };
+  S.s.resize(Mb);
+  double ss = 0;
+  for (R_xlen_t i = 0; i < Mb; ++i) {
+    S.s[i] = z[i] + z[i + m];
+    ss += S.s[i] * S.s[i];
+  }
+  S.p2.resize(W + 1);
+  S.p2[0] = 0;
+  for (R_xlen_t j = 0; j < W; ++j) S.p2[j + 1] = S.p2[j] + z[j] * z[j];
+  // sum_t g(t) sum_i s_i z_{i+t}, t in [1, m), and the autocorrelation of
+  // z at lags 2d < m, from one pair of transforms
+  S.c.resize(m);
+  S.c2.resize(m - 1);
+  allanvar::real_correlation2(S.s.data(), Mb, z, W, m, S.c.data(), m - 1,
+                              S.c2.data(), S.plans, S.buf, S.buf2);
+  double cross = 0, sq = 0;
+  for (R_xlen_t t = 1; t < m; ++t) {
+    cross += g(t) * S.c[t];
+    sq += g(t) * (S.p2[t + Mb] - S.p2[t]);
+  }
+  // sum_d w(d) P(d)
+  double pd = 0;
+  for (R_xlen_t d = 0; d < k; ++d)
+    pd += S.c2[2 * d] / static_cast<double>(k - d);
+  pd -= theo_triangle(z, k, 0, 0, k, S);
+  S.zr.assign(z, z + W);
+  std::reverse(S.zr.begin(), S.zr.end());
+  pd -= theo_triangle(S.zr.data(), k, 0, 0, k, S);
+  return H * ss - 2 * cross + sq + 2 * pd;
+}
+
+// Rough costs (arbitrary units) of the two evaluations of one k.
+double theo_direct_cost(R_xlen_t N, R_xlen_t k) {
+  return 1.0 * static_cast<double>(N - 2 * k) * static_cast<double>(k);
+}
+
+// Blocks of 6k to 12k starting indices, so that the autocorrelation's
+// transform (B + 4k points) fills a power of two; longer blocks would
+// cancel more (the local phase wander grows with the block).
+R_xlen_t theo_block_len(R_xlen_t N, R_xlen_t k) {
+  const R_xlen_t n = static_cast<R_xlen_t>(allanvar::fft_size(10 * k));
+  return std::min(N - 2 * k, n - 4 * k);
+}
+
+double theo_fast_cost(R_xlen_t N, R_xlen_t k) {
+  const R_xlen_t B = theo_block_len(N, k);
+  const double nb = std::ceil(static_cast<double>(N - 2 * k) / B);
+  const double n = static_cast<double>(allanvar::fft_size(B + 4 * k));
+  const double lk = std::log2(static_cast<double>(k) + 2);
+  // calibrated against the direct stencil (one thread, N = 2^17)
+  return nb * (3.0 * n * std::log2(n) + 8.0 * k * lk * lk);
+}
+
 struct Item {
   size_t tau;
-  R_xlen_t l0, l1;  // L in [l0, l1)
+  R_xlen_t l0, l1;  // direct: L in [l0, l1); fast: l0 = block start, l1 = -1
 };
 
 }  // namespace
 
-// T_k for each even m = 2k of one channel (NA where m > L - 1).
+// T_k for each even m = 2k of one channel (NA where m > L - 1): for each m
+// the cheaper of the direct stencil sum and the fast blocked expansion.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
-                                   const Rcpp::NumericVector& m, int threads) {
+                                   const Rcpp::NumericVector& m, int threads,
+                                   int method = 0) {
+  const allanvar::InterruptScope scope;
   const allanvar::PhaseInput in{v.begin(), v.size(), rate};
   allanvar::SplitPhase X;
   allanvar::split_phase(in, X);
@@ -53,6 +187,14 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
     if (mm < 2 || mm % 2 != 0 || mm > N - 1) continue;
     const R_xlen_t k = mm / 2;
+    // method: 0 the cheaper, 1 direct, 2 fast (for the tests)
+    const bool fast = method == 2 ||
+        (method == 0 && theo_fast_cost(N, k) < theo_direct_cost(N, k));
+    if (fast) {
+      const R_xlen_t B = theo_block_len(N, k);
+      for (R_xlen_t a = 0; a < N - mm; a += B) items.push_back(Item{t, a, -1});
+      continue;
+    }
     // about 2^22 stencil terms per item, for interrupt latency and balance
     const R_xlen_t per =
         std::max<R_xlen_t>(1, (R_xlen_t(1) << 22) / std::max<R_xlen_t>(1, N - mm));
@@ -62,11 +204,22 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   std::vector<double> part(items.size(), 0.0);
   const double* h = X.hi.data();
   const double* l = X.lo.data();
-  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()),
-                         std::max(1, threads), [&](R_xlen_t it, int) {
+  const int nthr = std::max(1, threads);
+  std::vector<FastScratch> scratch(nthr);
+  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nthr,
+                         [&](R_xlen_t it, int worker) {
     const Item& I = items[it];
     const R_xlen_t mm = static_cast<R_xlen_t>(ms[I.tau]);
     const R_xlen_t n = N - mm;
+    if (I.l1 < 0) {
+      FastScratch& S = scratch[worker];
+      const R_xlen_t Mb = std::min(theo_block_len(N, mm / 2), n - I.l0);
+      const R_xlen_t W = Mb + mm;
+      S.z.resize(W);
+      allanvar::local_phase(in, I.l0, W, S.z.data());
+      part[it] = theo_block(S.z.data(), W, mm / 2, S);
+      return;
+    }
     double acc = 0;
     for (R_xlen_t b0 = 0; b0 < n; b0 += 4096) {
       const R_xlen_t b1 = std::min(n, b0 + 4096);
@@ -104,6 +257,7 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     if (any[t]) out[t] = tot[t].value();
   return out;
 }
+
 
 // Exact products of the phase hi + lo for the recurrence: hi is split once
 // into 26-bit halves (Veltkamp), so hi_a hi_b = p + e exactly in 7 flops

@@ -18,13 +18,9 @@
 namespace {
 
 #if defined(__GNUC__)
-typedef double v2d __attribute__((vector_size(16)));
-inline v2d ld2(const double* p) {
-  v2d v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void st2(double* p, v2d v) { std::memcpy(p, &v, sizeof v); }
+using allanvar::v2d;
+using allanvar::ld2;
+using allanvar::st2;
 #endif
 
 // Compensated total of block sums.

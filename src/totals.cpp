@@ -14,6 +14,7 @@
 // normalises (MTOT: / (12 m^5 n tau^2/m^2), HTOT: / (36 m^3 n)).
 // O(m) per window; windows are processed in blocks of local phase
 // (src/local-phase.h; both statistics ignore a linear phase term).
+#include "dd.h"
 #include "local-phase.h"
 #include "parallel.h"
 #include <algorithm>
@@ -106,9 +107,94 @@ struct PlanItem {
 struct Plan {
   double tt = 0;  // coefficient of T^2
   std::vector<PlanItem> items;
+  // the TS items merged: sum over them of coef T (sum of S_k, k in [a, b])
+  // = T (sum_o ts_w[o] ZZ(n + ts_off[o]) - ts_c1 Z(n) - ts_c2 beta); their
+  // dozens of ranges share six end points
+  std::vector<R_xlen_t> ts_off;
+  std::vector<double> ts_w;
+  double ts_c1 = 0, ts_c2 = 0;
+  // the SAME and ANTI items merged (all but their anti-diagonal products):
+  // per window, zn sum_o zn_z ZZ(n+o) + beta (S0 + n S1 + n^2 S2) with
+  // S0 = sum_o (b_m2 M2 + b_m10 M1 + b_z0 ZZ)(n+o), S1 = sum_o (b_m11 M1 +
+  // b_z1 ZZ)(n+o), S2 = sum_o b_z2 ZZ(n+o), plus the lag products
+  // sum l_w LP[l_lag](n + l_off) and czz zn^2 + cbz beta zn + cbb beta^2.
+  // Their ranges share about seven end points.
+  std::vector<R_xlen_t> off;
+  std::vector<double> zn_z, b_z0, b_z1, b_z2, b_m10, b_m11, b_m2;
+  std::vector<int> l_lag;
+  std::vector<R_xlen_t> l_off;
+  std::vector<double> l_w;
+  double czz = 0, cbz = 0, cbb = 0;
+  size_t slot(R_xlen_t o) {
+    size_t k = 0;
+    while (k < off.size() && off[k] != o) ++k;
+    if (k == off.size()) {
+      off.push_back(o);
+      for (std::vector<double>* v : {&zn_z, &b_z0, &b_z1, &b_z2, &b_m10,
+                                     &b_m11, &b_m2})
+        v->push_back(0.0);
+    }
+    return k;
+  }
+  // coef times MQ(n + alpha, sg, n + lo, n + hi - 1) (see block_q_fast),
+  // multiplied by -beta: the sum over u of q(sg (u - A)) Z(u) is half of
+  // dM2 + (sg - 2A) dM1 + (A^2 - sg A) dZZ, A = n + alpha
+  void add_mq(double coef, double alpha, int sg, R_xlen_t lo, R_xlen_t hi) {
+    const double f = -0.5 * coef;
+    for (int z = 0; z < 2; ++z) {
+      const size_t k = slot(z == 0 ? hi : lo);
+      const double sf = z == 0 ? f : -f;
+      b_m2[k] += sf;
+      b_m10[k] += sf * (sg - 2 * alpha);
+      b_m11[k] += sf * -2.0;
+      b_z0[k] += sf * (alpha * alpha - sg * alpha);
+      b_z1[k] += sf * (2 * alpha - sg);
+      b_z2[k] += sf;
+    }
+  }
+  // -coef zn (ZZ(n + hi) - ZZ(n + lo))
+  void add_zn(double coef, R_xlen_t lo, R_xlen_t hi) {
+    zn_z[slot(hi)] -= coef;
+    zn_z[slot(lo)] += coef;
+  }
 };
 
 inline double qk(R_xlen_t k) { return 0.5 * static_cast<double>(k) * (k + 1); }
+
+// a b exactly, as a double-double
+inline allanvar::DD dd_prod(double a, double b) {
+  double p, e;
+  allanvar::dd_two_prod(a, b, p, e);
+  return allanvar::DD(p, e);
+}
+
+// sum over t in [a, b] of the polynomial f of degree <= d (d <= 4) in
+// O(d^2) instead of O(b - a): Newton's forward differences at a times
+// binomial coefficients, sum_j Delta^j f(a) C(b - a + 1, j + 1), in
+// double-double (f's values are integers below 2^100, so the differences
+// are exact and the result is the correctly rounded sum but for ~1e-30)
+template <class F>
+double poly_sum(R_xlen_t a, R_xlen_t b, int d, F f) {
+  using allanvar::DD;
+  if (b < a) return 0.0;
+  const double n = static_cast<double>(b - a + 1);
+  DD v[5];
+  for (int i = 0; i <= d; ++i) v[i] = f(a + i);
+  for (int j = 1; j <= d; ++j)
+    for (int i = d; i >= j; --i) v[i] = v[i] - v[i - 1];
+  DD tot, ff(1.0);
+  double fact = 1;
+  for (int j = 0; j <= d; ++j) {
+    ff = ff * (n - j);      // n (n - 1) ... (n - j), exact below 2^106
+    fact *= (j + 1);        // (j + 1)!
+    DD t = v[j] * ff;
+    // t / fact to double-double accuracy
+    const double q1 = t.hi / fact;
+    const DD r = t - dd_prod(q1, fact);
+    tot = tot + (DD(q1) + DD(r.hi / fact));
+  }
+  return tot.value();
+}
 
 // index state: 0 below 0 (S = 0), 1 inside [0, 3m-1], 2 above (S = T)
 inline int state(R_xlen_t i, R_xlen_t n3) { return i < 0 ? 0 : (i < n3 ? 1 : 2); }
@@ -180,26 +266,79 @@ Plan make_plan(R_xlen_t m) {
   }
   for (PlanItem& it : P.items) {
     if (it.kind == ITEM_TS) {
-      for (R_xlen_t k = it.a; k <= it.b; ++k) it.q1 += qk(k);
+      it.q1 = poly_sum(it.a, it.b, 2, [](R_xlen_t k) { return allanvar::DD(qk(k)); });
+      P.ts_c1 += it.coef * static_cast<double>(it.b - it.a + 1);
+      P.ts_c2 += it.coef * it.q1;
+      // W(n + a + 1, n + b + 1) = ZZ(n + b + 2) - ZZ(n + a + 1)
+      for (int z = 0; z < 2; ++z) {
+        const R_xlen_t o = z == 0 ? it.b + 2 : it.a + 1;
+        const double wv = z == 0 ? it.coef : -it.coef;
+        size_t k = 0;
+        while (k < P.ts_off.size() && P.ts_off[k] != o) ++k;
+        if (k == P.ts_off.size()) {
+          P.ts_off.push_back(o);
+          P.ts_w.push_back(0.0);
+        }
+        P.ts_w[k] += wv;
+      }
     } else if (it.kind == ITEM_SAME) {
-      for (R_xlen_t t = it.a; t <= it.b; ++t) {
-        it.q1 += qk(t);
-        it.q2 += qk(t - it.c);
-        it.qq += qk(t) * qk(t - it.c);
-      }
+      const R_xlen_t c = it.c;
+      it.q1 = poly_sum(it.a, it.b, 2, [](R_xlen_t t) { return allanvar::DD(qk(t)); });
+      it.q2 = poly_sum(it.a, it.b, 2, [c](R_xlen_t t) { return allanvar::DD(qk(t - c)); });
+      it.qq = poly_sum(it.a, it.b, 4, [c](R_xlen_t t) { return dd_prod(qk(t), qk(t - c)); });
     } else {
-      for (R_xlen_t t = it.a; t <= it.b; ++t) {
-        it.q1 += qk(t);
-        it.q2 += qk(it.c - t);
-        it.qq += qk(t) * qk(it.c - t);
-      }
+      const R_xlen_t c = it.c;
+      it.q1 = poly_sum(it.a, it.b, 2, [](R_xlen_t t) { return allanvar::DD(qk(t)); });
+      it.q2 = poly_sum(it.a, it.b, 2, [c](R_xlen_t t) { return allanvar::DD(qk(c - t)); });
+      it.qq = poly_sum(it.a, it.b, 4, [c](R_xlen_t t) { return dd_prod(qk(t), qk(c - t)); });
     }
   }
+  std::vector<PlanItem> rest;
+  for (const PlanItem& it : P.items)
+    if (it.kind != ITEM_TS) rest.push_back(it);
+  P.items.swap(rest);
+  for (const PlanItem& it : P.items) {
+    const double K = it.coef, cnt = static_cast<double>(it.b - it.a + 1);
+    const R_xlen_t a = it.a, b = it.b;
+    P.czz += K * cnt;
+    P.cbb += K * it.qq;
+    P.cbz += K * (it.q1 + it.q2);
+    if (it.kind == ITEM_SAME) {
+      const R_xlen_t c = it.c;
+      P.l_lag.push_back(static_cast<int>(c / m));
+      P.l_off.push_back(b + 2);
+      P.l_w.push_back(K);
+      P.l_lag.push_back(static_cast<int>(c / m));
+      P.l_off.push_back(a + 1);
+      P.l_w.push_back(-K);
+      P.add_zn(K, a + 1, b + 2);
+      P.add_zn(K, a + 1 - c, b + 2 - c);
+      P.add_mq(K, static_cast<double>(1 - c), 1, a + 1 - c, b + 2 - c);
+      P.add_mq(K, static_cast<double>(1 + c), 1, a + 1, b + 2);
+    } else {
+      const R_xlen_t e = it.c;
+      P.add_zn(K, a + 1, b + 2);
+      P.add_zn(K, e + 1 - b, e + 2 - a);
+      P.add_mq(K, static_cast<double>(e + 1), -1, e + 1 - b, e + 2 - a);
+      P.add_mq(K, static_cast<double>(e + 1), -1, a + 1, b + 2);
+    }
+  }
+  // offsets whose weights cancelled exactly (integers) are dropped
+  std::vector<R_xlen_t> off;
+  std::vector<double> wt;
+  for (size_t k = 0; k < P.ts_off.size(); ++k) {
+    if (P.ts_w[k] != 0) {
+      off.push_back(P.ts_off[k]);
+      wt.push_back(P.ts_w[k]);
+    }
+  }
+  P.ts_off.swap(off);
+  P.ts_w.swap(wt);
   return P;
 }
 
 struct FastScratch {
-  std::vector<double> Z, ZZ, M1, M2, PE, zn, beta, T;
+  std::vector<double> Z, ZZ, M1, M2, PE;
   std::vector<std::vector<double> > LP;  // lags 0, m, 2m
 };
 
@@ -236,75 +375,40 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
   const double* ZZ = w.ZZ.data();
   const double* M1 = w.M1.data();
   const double* M2 = w.M2.data();
-  auto W = [&](R_xlen_t a, R_xlen_t b) { return ZZ[b + 1] - ZZ[a]; };
-  // sum over u in [u0, u1] of q(sg (u - A)) Z(u), q(x) = (x^2 + x) / 2
-  auto MQ = [&](double A, int sg, R_xlen_t u0, R_xlen_t u1) {
-    const double m0 = ZZ[u1 + 1] - ZZ[u0], m1 = M1[u1 + 1] - M1[u0],
-                 m2 = M2[u1 + 1] - M2[u0];
-    return 0.5 * (m2 + (sg - 2 * A) * m1 + (A * A - sg * A) * m0);
-  };
   const double bden = static_cast<double>(h) * static_cast<double>(n3 - h);
-  // per window: Z(n), the slope beta_n and T_n; then one pass over the
-  // windows per plan item, so that each pass streams through a few arrays
-  // (a pass per window over all items would touch ~250 scattered places)
-  w.zn.resize(nb);
-  w.beta.resize(nb);
-  w.T.resize(nb);
+  // per window: Z(n), the slope beta_n and T_n, and the merged plan (a
+  // few dozen places of ZZ, M1, M2 and the lag products, at about seven
+  // distinct offsets)
   double total = 0;
+  const size_t nts = P.ts_off.size();
+  const R_xlen_t* tso = P.ts_off.data();
+  const double* tsw = P.ts_w.data();
+  const size_t no = P.off.size(), nl = P.l_off.size();
+  const R_xlen_t* off = P.off.data();
+  const double *zz = P.zn_z.data(), *z0 = P.b_z0.data(), *z1 = P.b_z1.data(),
+               *z2 = P.b_z2.data(), *m10 = P.b_m10.data(),
+               *m11 = P.b_m11.data(), *m2 = P.b_m2.data();
+  const double* Lp[3] = {w.LP[0].data(), w.LP[1].data(), w.LP[2].data()};
   for (R_xlen_t n = 0; n < nb; ++n) {
     const double zn = Z[n];
     const double beta =
         ((Z[n + n3] - Z[n + n3 - h]) - (Z[n + h] - Z[n])) / bden;
     const double T = (Z[n + n3] - zn) - beta * qk(n3 - 1);
-    w.zn[n] = zn;
-    w.beta[n] = beta;
-    w.T[n] = T;
-    total += P.tt * T * T;
-  }
-  const double* zv = w.zn.data();
-  const double* bv = w.beta.data();
-  const double* Tv = w.T.data();
-  for (const PlanItem& it : P.items) {
-    const R_xlen_t a = it.a, b = it.b;
-    const double cnt = static_cast<double>(b - a + 1);
-    double acc = 0;
-    if (it.kind == ITEM_TS) {
-      for (R_xlen_t n = 0; n < nb; ++n) {
-        const double sumS = W(n + a + 1, n + b + 1) - cnt * zv[n] - bv[n] * it.q1;
-        acc += Tv[n] * sumS;
-      }
-    } else if (it.kind == ITEM_SAME) {
-      const R_xlen_t c = it.c;
-      const double* L = w.LP[c / m].data();
-      for (R_xlen_t n = 0; n < nb; ++n) {
-        const double zn = zv[n], beta = bv[n];
-        const double uu = L[n + b + 2] - L[n + a + 1] -
-                          zn * (W(n + a + 1, n + b + 1) + W(n + a + 1 - c, n + b + 1 - c)) +
-                          cnt * zn * zn;
-        // sum q_t U_{t-c}: u = n + t + 1 - c, t = u - (n + 1 - c)
-        const double qu1 = MQ(static_cast<double>(n + 1 - c), 1, n + a + 1 - c,
-                              n + b + 1 - c) - zn * it.q1;
-        // sum q_{t-c} U_t: u = n + t + 1, t - c = u - (n + 1 + c)
-        const double qu2 = MQ(static_cast<double>(n + 1 + c), 1, n + a + 1,
-                              n + b + 1) - zn * it.q2;
-        acc += uu - beta * (qu1 + qu2) + beta * beta * it.qq;
-      }
-    } else {
-      const R_xlen_t e = it.c;
-      for (R_xlen_t n = 0; n < nb; ++n) {
-        const double zn = zv[n], beta = bv[n];
-        // the anti-diagonal products of Z are added for the whole block below
-        const double uu = -zn * (W(n + a + 1, n + b + 1) + W(n + e + 1 - b, n + e + 1 - a)) +
-                          cnt * zn * zn;
-        const double A = static_cast<double>(n + e + 1);
-        // sum q_t U_{e-t}: u = n + e + 1 - t, t = A - u
-        const double qu1 = MQ(A, -1, n + e + 1 - b, n + e + 1 - a) - zn * it.q1;
-        // sum q_{e-t} U_t: u = n + t + 1, e - t = A - u
-        const double qu2 = MQ(A, -1, n + a + 1, n + b + 1) - zn * it.q2;
-        acc += uu - beta * (qu1 + qu2) + beta * beta * it.qq;
-      }
+    double v = 0;
+    for (size_t k = 0; k < nts; ++k) v += tsw[k] * ZZ[n + tso[k]];
+    double vz = 0, s0 = 0, s1 = 0, s2 = 0, vl = 0;
+    for (size_t k = 0; k < no; ++k) {
+      const double zk = ZZ[n + off[k]], m1k = M1[n + off[k]];
+      vz += zz[k] * zk;
+      s0 += m2[k] * M2[n + off[k]] + m10[k] * m1k + z0[k] * zk;
+      s1 += m11[k] * m1k + z1[k] * zk;
+      s2 += z2[k] * zk;
     }
-    total += it.coef * acc;
+    for (size_t k = 0; k < nl; ++k) vl += P.l_w[k] * Lp[P.l_lag[k]][n + P.l_off[k]];
+    const double dn = static_cast<double>(n);
+    total += T * (P.tt * T + (v - P.ts_c1 * zn - P.ts_c2 * beta)) + vl +
+             zn * (vz + P.czz * zn + P.cbz * beta) +
+             beta * ((s0 + dn * (s1 + dn * s2)) + P.cbb * beta);
   }
   // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t)
   const double* PE = w.PE.data();
@@ -418,17 +522,9 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     part[it] = acc;
   });
   Rcpp::NumericVector out(ms.size(), NA_REAL);
-  std::vector<double> tot(ms.size(), 0.0), cor(ms.size(), 0.0);
-  std::vector<bool> any(ms.size(), false);
-  for (size_t it = 0; it < items.size(); ++it) {
-    const size_t t = items[it].tau;
-    double s, e;
-    allanvar::phase_two_sum(tot[t], part[it], s, e);
-    tot[t] = s;
-    cor[t] += e;
-    any[t] = true;
-  }
+  allanvar::TauSums sums(ms.size());
+  for (size_t it = 0; it < items.size(); ++it) sums.add(items[it].tau, part[it]);
   for (size_t t = 0; t < ms.size(); ++t)
-    if (any[t]) out[t] = tot[t] + cor[t];
+    if (sums.any(t)) out[t] = sums.value(t);
   return out;
 }

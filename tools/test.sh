@@ -6,6 +6,6 @@ cd "$(dirname "$0")/.."
 bash tools/setup.sh
 lib=$(mktemp -d)
 trap 'rm -rf "$lib"' EXIT
-R CMD INSTALL --no-test-load --library="$lib" . >"$lib/install.log" 2>&1 || {
+R CMD INSTALL --preclean --no-test-load --library="$lib" . >"$lib/install.log" 2>&1 || {
   cat "$lib/install.log"; exit 1; }
 R_LIBS="$lib${R_LIBS:+:$R_LIBS}" Rscript --vanilla tools/run-tests.R

@@ -83,3 +83,73 @@ test_that("avdiagnose() errors are classed and worded", {
     avdiagnose(rnorm(1000), 1, alpha = 2)
   })
 })
+
+# The linear-time kernels against their definitions (base R on the same
+# data): the running-median end rule against stats::smoothEnds(), the lag
+# sums against shifted products, the detrend against lm.fit() residuals,
+# the paired-segment Welch PSD against one FFT per segment.
+test_that("smooth_ends() is stats::smoothEnds(), ties and -Inf included", {
+  set.seed(11)
+  for (i in 1:60) {
+    n <- sample(c(5:30, 200), 1)
+    k <- 2L * sample(seq_len((n - 1) %/% 2), 1) + 1L
+    y <- switch(i %% 3 + 1, rnorm(n), round(rnorm(n) * 2), c(-Inf, rnorm(n - 1)))
+    expect_identical(smooth_ends(y, k), stats::smoothEnds(y, k))
+  }
+  # one end only: the other is left as it was
+  y <- rnorm(50)
+  s <- smooth_ends(y, 9, left = FALSE)
+  expect_identical(s[1:5], y[1:5])
+  expect_identical(s[46:50], stats::smoothEnds(y, 9)[46:50])
+})
+
+test_that("spectral_lines' background equals runmed() of the whole periodogram per band", {
+  set.seed(12)
+  x <- rnorm(2e5) + 0.3 * sin(2 * pi * 1.3 * seq_len(2e5) / 100) +
+    cumsum(rnorm(2e5, sd = 0.01))
+  w <- welch_psd(x, 100)
+  lp <- log(w$psd)
+  nb <- length(lp)
+  ref <- rep(NA_real_, nb)
+  bands <- unique(c(2^(0:floor(log2(nb))), nb + 1))
+  for (b in seq_len(length(bands) - 1L)) {
+    lo <- bands[b]
+    hi <- bands[b + 1L] - 1L
+    k <- min(max(11L, 2L * floor(0.1 * lo) + 1L), 2L * floor((nb - 1L) / 2L) - 1L)
+    ref[lo:hi] <- stats::runmed(lp, k, endrule = "median")[lo:hi]
+  }
+  nu <- w$nu
+  ratio <- w$psd / exp(ref - log(stats::qchisq(0.5, nu) / nu))
+  l <- spectral_lines(x, 100)
+  expect_equal(l$ratio[1], max(ratio[5:(nb - 2)]), tolerance = 1e-12)
+  expect_equal(l$f0[1], 1.3, tolerance = 1e-3)
+})
+
+test_that("acf_sums, detrend_line and the paired Welch PSD match their definitions", {
+  set.seed(13)
+  x <- as.numeric(stats::filter(rnorm(5003), 0.7, method = "recursive"))
+  xc <- x - mean(x)
+  direct <- vapply(0:40, function(k) sum(xc[seq_len(5003 - k)] * xc[(k + 1):5003]), 0)
+  expect_equal(acf_sums(xc, 40L), direct, tolerance = 1e-13)
+  expect_equal(acf_sums(xc[1:3], 5L), c(sum(xc[1:3]^2), sum(xc[1:2] * xc[2:3]),
+                                          xc[1] * xc[3], 0, 0, 0))
+  t <- seq_along(x)
+  expect_equal(detrend_linear(x + 0.01 * t),
+               unname(stats::residuals(stats::lm.fit(cbind(1, t), x + 0.01 * t))),
+               tolerance = 1e-12)
+  # Welch: one FFT per segment, odd and even segment counts
+  for (n in c(4096, 4096 + 1024)) {
+    y <- x[seq_len(n)]
+    w <- welch_psd(y, 10, seg = 1024)
+    yd <- detrend_linear(y)
+    win <- 0.5 - 0.5 * cos(2 * pi * (0:1023) / 1024)
+    starts <- seq(1, n - 1024 + 1, by = 512)
+    acc <- Reduce(`+`, lapply(starts, function(s) {
+      ys <- yd[s:(s + 1023)]
+      Mod(stats::fft((ys - mean(ys)) * win)[1:513])^2
+    }))
+    p <- acc / length(starts) / (10 * sum(win^2))
+    p[2:512] <- 2 * p[2:512]
+    expect_equal(w$psd, p, tolerance = 1e-12)
+  }
+})

@@ -54,3 +54,27 @@ test_that("imu_guidance() errors are classed and worded", {
   expect_snapshot(error = TRUE, imu_guidance(1))
   expect_error(imu_guidance(1), class = "allanvar_error_argument")
 })
+
+test_that("spikes left in the raw series are reported with how to remove them", {
+  # Own generator: white noise with three isolated spikes of 40 sigma.
+  set.seed(11)
+  n <- 1e5
+  x <- rnorm(n, sd = 0.01)
+  at <- c(5001, 40001, 80001)
+  x[at] <- x[at] + 0.4
+  r <- imu_record(cbind(gyro_x = x), freq = 100, units = c(gyro = "rad/s"))
+  a <- suppressWarnings(analyze_imu(r, progress = FALSE))
+  g <- imu_guidance(a)$message
+  line <- grep("spike", g, value = TRUE)
+  expect_length(line, 1L)
+  expect_match(line, "^3 x isolated spike")
+  expect_match(line, "at 50 s, 400 s, 800 s")
+  expect_match(line, "remove = \"spikes\" \\(command line: --remove spikes\\)")
+  # removed on request: no longer reported as left in
+  b <- suppressWarnings(analyze_imu(r, progress = FALSE, remove = "spikes"))
+  expect_identical(grep("spike", imu_guidance(b)$message, value = TRUE), character())
+  expect_identical(b$channels$gyro_x$series$removed, "spikes")
+  # without raw-data analysis (refine = FALSE, nothing removed) nothing is claimed
+  c0 <- suppressWarnings(analyze_imu(r, progress = FALSE, refine = FALSE))
+  expect_identical(grep("spike", imu_guidance(c0)$message, value = TRUE), character())
+})

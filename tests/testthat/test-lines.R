@@ -104,3 +104,18 @@ test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinu
   # and the line is gone from the periodogram
   expect_true(is.na(match_line(0.2, find_lines(y, freq))))
 })
+
+test_that("line_sums() (phase rotation in blocks) equals the sums of sin and cos", {
+  set.seed(14)
+  n <- 100003
+  freq <- 100
+  y <- rnorm(n)
+  t <- (seq_len(n) - 1) / freq
+  for (f in c(0.013, 1.3, 49.7)) {
+    s <- sin(2 * pi * f * t)
+    c <- cos(2 * pi * f * t)
+    expect_equal(line_sums(y, f, freq),
+                 c(sum(s * s), sum(c * c), sum(s * c), sum(s * y), sum(c * y)),
+                 tolerance = 1e-10)
+  }
+})

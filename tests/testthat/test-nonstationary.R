@@ -2,16 +2,11 @@
 # noise, a random walk (cumsum), a Gauss-Markov process (stats::filter),
 # plus the deterministic effect.
 
-gen_base <- function(n, white = 0.1, rw = 5e-5, seed) {
-  set.seed(seed)
-  rnorm(n, sd = white) + cumsum(rnorm(n, sd = rw))
-}
-
 test_that("a bias step is found: time within 1% of the record, size within 20%", {
   n <- 2e5
   freq <- 100
   for (seed in 1:3) {
-    x <- gen_base(n, seed = seed)
+    x <- gen_white_walk(n, seed = seed)
     at <- 123457
     x[at:n] <- x[at:n] + 0.03
     st <- detect_steps(x, freq)
@@ -25,7 +20,7 @@ test_that("a bias step is found: time within 1% of the record, size within 20%",
 
 test_that("two steps of opposite sign are both found", {
   n <- 2e5
-  x <- gen_base(n, seed = 7)
+  x <- gen_white_walk(n, seed = 7)
   x[50001:n] <- x[50001:n] + 0.04
   x[150001:n] <- x[150001:n] - 0.05
   st <- detect_steps(x, 100)
@@ -57,7 +52,7 @@ test_that("an exponential warm-up is found with its time constant within 30%", {
   freq <- 100
   t <- (seq_len(n) - 1) / freq
   for (seed in 1:3) {
-    x <- gen_base(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / 100)
+    x <- gen_white_walk(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / 100)
     w <- detect_warmup(x, freq)
     expect_true(w$present)
     expect_equal(w$tc, 100, tolerance = 0.3)
@@ -66,7 +61,7 @@ test_that("an exponential warm-up is found with its time constant within 30%", {
   # controls: no warm-up in white + random walk
   hits <- 0L
   for (seed in 11:20) {
-    hits <- hits + detect_warmup(gen_base(2e5, rw = 2e-4, seed = seed), freq)$present
+    hits <- hits + detect_warmup(gen_white_walk(2e5, rw = 2e-4, seed = seed), freq)$present
   }
   expect_lte(hits, 1L)
 })
@@ -75,7 +70,7 @@ test_that("spikes are all found and none invented, also on quantized data", {
   n <- 2e5
   freq <- 100
   for (seed in 1:3) {
-    x <- gen_base(n, seed = seed)
+    x <- gen_white_walk(n, seed = seed)
     at <- sort(sample.int(n, 12))
     x[at] <- x[at] + sample(c(-1, 1), 12, TRUE) * runif(12, 1, 3)
     q <- round(x / 0.05) * 0.05              # on a 0.05 grid, sd = 2 steps
@@ -89,7 +84,7 @@ test_that("spikes are all found and none invented, also on quantized data", {
   # controls: Gaussian, filtered and coarsely quantized noise without spikes
   hits <- 0L
   for (seed in 1:10) {
-    x <- gen_base(n, seed = 300 + seed)
+    x <- gen_white_walk(n, seed = 300 + seed)
     f <- as.numeric(stats::filter(x, rep(0.25, 4), sides = 1))[-(1:3)]
     q <- round(x / 0.1) * 0.1                 # sd = 1 step
     hits <- hits + (nrow(detect_spikes(x, freq)) > 0L) +
@@ -100,7 +95,7 @@ test_that("spikes are all found and none invented, also on quantized data", {
 
 test_that("spikes inflate the short-tau Allan deviation; the correction removes it", {
   n <- 2e5
-  x <- gen_base(n, seed = 9)
+  x <- gen_white_walk(n, seed = 9)
   at <- sample.int(n, 40)
   xs <- x
   xs[at] <- xs[at] + 2
@@ -115,7 +110,7 @@ test_that("spikes inflate the short-tau Allan deviation; the correction removes 
 test_that("a ramp is not a step, and a short pulse is a transient, not two steps", {
   n <- 2e5
   freq <- 100
-  x <- gen_base(n, seed = 12)
+  x <- gen_white_walk(n, seed = 12)
   # a ramp of 1 over 300 s in the middle: far above the noise at the
   # longest windows (z ~ 20), but a slow change, not a step
   r <- x + 1 * pmin(pmax((seq_len(n) - 90000) / 30000, 0), 1)

@@ -2,16 +2,11 @@
 # here with base R (white noise, a random walk by cumsum, a Gauss-Markov by
 # stats::filter) plus the deterministic effect, never with avsim().
 
-gen_series <- function(n, white = 0.1, rw = 5e-5, seed) {
-  set.seed(seed)
-  rnorm(n, sd = white) + cumsum(rnorm(n, sd = rw))
-}
-
 test_that("a bias step: time within 1% of the record, size within 20%; removed on request", {
   n <- 2e5
   freq <- 100
   for (seed in 1:2) {
-    x <- gen_series(n, seed = 10 + seed)
+    x <- gen_white_walk(n, seed = 10 + seed)
     at <- 123457
     x[at:n] <- x[at:n] + 0.03
     se <- series_effects(x, freq)
@@ -42,7 +37,7 @@ test_that("an exponential warm-up: time constant within 30%", {
   t <- (seq_len(n) - 1) / freq
   for (seed in 1:2) {
     for (tc in c(30, 120)) {
-      x <- gen_series(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / tc)
+      x <- gen_white_walk(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / tc)
       se <- series_effects(x, freq, remove = "warmup")
       w <- se$table[se$table$kind == "warmup", ]
       expect_equal(nrow(w), 1L)
@@ -59,7 +54,7 @@ test_that("spikes: all found, none invented; removal restores the short-tau ADEV
   n <- 1e5
   freq <- 100
   for (seed in 1:3) {
-    clean <- gen_series(n, seed = 30 + seed)
+    clean <- gen_white_walk(n, seed = 30 + seed)
     set.seed(300 + seed)
     at <- sort(sample(10:(n - 10), 12))
     size <- sample(c(-1, 1), 12, replace = TRUE) * runif(12, 1, 3)  # 10-30 sd
@@ -98,7 +93,7 @@ test_that("the effects together: each kind found once, `all` removes every one",
   n <- 2e5
   freq <- 100
   t <- (seq_len(n) - 1) / freq
-  x <- gen_series(n, rw = 2e-5, seed = 61) + 0.1 * exp(-t / 50)
+  x <- gen_white_walk(n, rw = 2e-5, seed = 61) + 0.1 * exp(-t / 50)
   x[150001:n] <- x[150001:n] - 0.04
   x[c(20000, 90000)] <- x[c(20000, 90000)] + c(2, -2.5)
   se <- series_effects(x, freq, remove = "all")
@@ -115,7 +110,7 @@ test_that("the effects together: each kind found once, `all` removes every one",
 })
 
 test_that("a ts comes back as a ts; freq is taken from it", {
-  x <- stats::ts(gen_series(5000, seed = 71), start = 3, frequency = 50)
+  x <- stats::ts(gen_white_walk(5000, seed = 71), start = 3, frequency = 50)
   x[1000] <- x[1000] + 2
   se <- series_effects(x, remove = "spikes")
   expect_true(stats::is.ts(se$x))
@@ -125,17 +120,17 @@ test_that("a ts comes back as a ts; freq is taken from it", {
 })
 
 test_that("series_effects() prints what it found and what it removed", {
-  x <- gen_series(2e4, seed = 81)
+  x <- gen_white_walk(2e4, seed = 81)
   x[5000] <- x[5000] + 2
   x[12001:2e4] <- x[12001:2e4] + 0.08
   expect_snapshot({
     print(series_effects(x, 100, remove = "spikes"))
-    print(series_effects(gen_series(2e4, seed = 82), 100))
+    print(series_effects(gen_white_walk(2e4, seed = 82), 100))
   })
 })
 
 test_that("series_effects() errors are classed and worded", {
-  x <- gen_series(1000, seed = 91)
+  x <- gen_white_walk(1000, seed = 91)
   expect_snapshot(error = TRUE, {
     series_effects()
     series_effects(x)
@@ -154,7 +149,7 @@ test_that("avrefine() reports the series effects and removes those asked for", {
   skip_if_not("remove" %in% names(formals(avrefine)))
   n <- 1e5
   freq <- 100
-  x <- gen_series(n, rw = 1e-5, seed = 101)
+  x <- gen_white_walk(n, rw = 1e-5, seed = 101)
   x[60001:n] <- x[60001:n] + 0.03
   x[c(7000, 33000)] <- x[c(7000, 33000)] + 2
   fit <- avfit(allan(x, freq), terms = c("N", "K"))

@@ -278,12 +278,18 @@ test_that("print says the statistic and the unit; plot labels the axis", {
   }
 })
 
+# White PM, white FM, random-walk FM and a large offset with drift (the
+# cancellation cases of the closed-form kernels), N points each.
+four_noises <- function(N) {
+  list(wpm = rnorm(N), wfm = cumsum(rnorm(N)),
+       rwfm = cumsum(cumsum(rnorm(N))),
+       drift = 1e6 + 1e3 * (1:N) + 0.01 * (1:N)^2 + cumsum(rnorm(N)))
+}
+
 test_that("the Total family's closed form equals its direct evaluation", {
   set.seed(15)
   N <- 4000
-  sets <- list(wpm = rnorm(N), wfm = cumsum(rnorm(N)),
-               rwfm = cumsum(cumsum(rnorm(N))),
-               drift = 1e6 + 1e3 * (1:N) + 0.01 * (1:N)^2 + cumsum(rnorm(N)))
+  sets <- four_noises(N)
   m <- c(8, 9, 16, 31, 100, 257, 1000, 1333)
   for (nm in names(sets)) {
     x <- sets[[nm]]
@@ -342,4 +348,24 @@ test_that("types without a gap rule refuse NA with a classed error", {
     expect_error(allan(x, 1, type = type, input = "integrated"),
                  class = "allanvar_error_gaps")
   }
+})
+
+test_that("PDEV's global kernel equals its blocked kernel and a plain sum", {
+  set.seed(17)
+  N <- 4000
+  sets <- four_noises(N)
+  m <- c(2, 3, 8, 31, 100, 257, 1000, 1999)
+  for (nm in names(sets)) {
+    x <- sets[[nm]]
+    blocked <- pdev_sums_cpp(x, FALSE, m, 2L, 1L)
+    global <- pdev_sums_cpp(x, FALSE, m, 2L, 2L)
+    chosen <- pdev_sums_cpp(x, FALSE, m, 1L, 0L)
+    expect_lt(max(abs(global / blocked - 1)), 1e-11, label = nm)
+    expect_lt(max(abs(chosen / blocked - 1)), 1e-11, label = nm)
+  }
+  # white PM: the plain sum of the definition has no cancellation to fear
+  x <- sets$wpm
+  mm <- c(2, 7, 500, 1999)
+  ref <- vapply(mm, function(k) ref_pvar(x, k) * (N - 2 * k) * k^6 / 18, 0)
+  expect_lt(max(abs(pdev_sums_cpp(x, FALSE, mm, 2L, 2L) / ref - 1)), 1e-13)
 })

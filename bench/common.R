@@ -1,0 +1,37 @@
+# What every bench script shares: the package installed into a temporary
+# library (optimised and byte-compiled, as users have it; pkgload would
+# compile without optimisation) and a median timer. Sourced from the
+# repository root: source("bench/common.R").
+stopifnot(file.exists("DESCRIPTION"))
+
+# Installs the working tree into a temporary library and attaches it;
+# returns the library path (for child processes).
+bench_install <- function() {
+  lib <- tempfile("allanlib")
+  dir.create(lib)
+  status <- system2(file.path(R.home("bin"), "R"),
+                    c("CMD", "INSTALL", "--preclean", "--no-test-load",
+                      paste0("--library=", lib), "."),
+                    stdout = FALSE, stderr = FALSE)
+  if (status != 0) stop("R CMD INSTALL failed")
+  library(allanvar, lib.loc = lib)
+  lib
+}
+
+# Median elapsed seconds over `reps` runs (after one warm-up run unless
+# `warm = FALSE`); bench::mark when available (sub-millisecond resolution),
+# else system.time().
+timed <- function(expr, reps = 5, warm = TRUE) {
+  f <- substitute(expr)
+  e <- parent.frame()
+  if (warm) eval(f, e)
+  if (reps > 1 && requireNamespace("bench", quietly = TRUE)) {
+    b <- bench::mark(eval(f, e), iterations = reps, check = FALSE,
+                     memory = FALSE, filter_gc = FALSE)
+    return(as.numeric(b$median))
+  }
+  stats::median(vapply(seq_len(reps), function(i) {
+    gc(FALSE)
+    system.time(eval(f, e))[["elapsed"]]
+  }, 0))
+}

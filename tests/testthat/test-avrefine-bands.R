@@ -1,0 +1,87 @@
+# The loop's rules for a filtered sensor with a resonance (issue 9, items 1,
+# 2 and 4), on series from generators written here (not avsim): white noise
+# through a second-order Butterworth low-pass (bilinear transform), a
+# damped resonance as a real AR(2) with poles r exp(+-iw), a random walk.
+
+# Second-order Butterworth low-pass at cutoff fc, unit DC gain.
+butter2 <- function(e, fc, freq) {
+  wc <- tan(pi * fc / freq)
+  d <- 1 + sqrt(2) * wc + wc^2
+  b <- wc^2 / d * c(1, 2, 1)
+  a <- c(2 * (wc^2 - 1), 1 - sqrt(2) * wc + wc^2) / d
+  u <- stats::filter(e, b, sides = 1L)[-(1:2)]
+  as.numeric(stats::filter(u, -a, method = "recursive"))
+}
+
+# AR(2) resonance at fr with damping time tc (innovation sd s).
+ar2_resonance <- function(n, fr, tc, s, freq) {
+  r <- exp(-1 / (freq * tc))
+  w <- 2 * pi * fr / freq
+  z <- stats::filter(stats::rnorm(n + 2000L, sd = s), c(2 * r * cos(w), -r^2),
+                     method = "recursive")
+  as.numeric(z[-(1:2000)])
+}
+
+test_that("remove_bands takes a resonance's excess out and keeps the white noise", {
+  set.seed(11)
+  n <- 2^17
+  freq <- 100
+  w <- stats::rnorm(n)
+  x <- w + ar2_resonance(n, 15, 0.3, 0.3, freq)
+  b <- find_bands(x, freq)
+  expect_equal(nrow(b), 1L)
+  y <- remove_bands(x, freq, b)
+  expect_equal(nrow(find_bands(y, freq)), 0L)
+  # what is left is (nearly) the white noise: its variance and a lag-1 ACF
+  # near 0, where the resonance alone gives a strongly positive one
+  r1 <- function(v) stats::acf(v, lag.max = 1, plot = FALSE)$acf[2]
+  expect_gt(r1(x), 0.2)
+  expect_lt(abs(r1(y)), 0.03)
+  expect_equal(stats::var(y), stats::var(w), tolerance = 0.1)
+  # no band: the series is returned unchanged
+  expect_identical(remove_bands(w, freq, b[0, ]), w)
+})
+
+test_that("a filtered sensor with a resonance: the low-pass family, the band's centre, no slow sinusoid", {
+  skip_on_cran()
+  set.seed(3)
+  n <- 2e5
+  freq <- 100
+  N <- 0.05
+  e <- stats::rnorm(n + 2L, sd = N * sqrt(freq))
+  x <- butter2(e, 20, freq) + ar2_resonance(n, 15, 0.3, 0.1, freq) +
+    cumsum(stats::rnorm(n, sd = 1e-4))
+  fit <- avfit(allan(x, freq, taus = 10, type = "overlapping"), terms = c("N", "B", "K"))
+  ref <- suppressMessages(avrefine(fit, data = x, max_steps = 4))
+  st <- ref$steps
+  cf <- stats::coef(ref)
+  # the filter term, as a low-pass family with its cutoff within 10%, and
+  # the white level at DC within 10%
+  expect_true(any(grepl("^filter", ref$terms)))
+  expect_true("filter:lp2" %in% ref$terms)
+  expect_equal(unname(cf[["filter_lp2.fc"]]), 20, tolerance = 0.1)
+  expect_equal(unname(cf[["filter_lp2.Nf"]]), N, tolerance = 0.1)
+  # the resonance, its centre pinned within the periodogram's resolution
+  expect_true("resonance" %in% st$effect)
+  expect_lt(abs(cf[["resonance.fr"]] - 15), 0.2)
+  # every step is confirmed by the raw data; no sinusoid stands in for the
+  # random walk at the long-tau end
+  expect_false(any(st$confirmed %in% FALSE))
+  expect_false("sinusoid" %in% st$effect)
+})
+
+test_that("with raw data, a sinusoid within 4 periodogram bins of DC is not taken", {
+  set.seed(5)
+  n <- 1e5
+  freq <- 100
+  x <- cumsum(stats::rnorm(n, sd = 0.01)) + stats::rnorm(n)
+  raw <- avdiagnose(x, freq)
+  res <- attr(raw$lines, "resolution")
+  ev <- evidence_sinusoid(list(amp = 1, f0 = 2 * res), raw, x, freq)
+  expect_false(ev$support)
+  expect_match(ev$text, "within 4 bins")
+  # a real line well above DC is still confirmed
+  y <- x + 0.5 * sin(2 * pi * 3 * (seq_len(n) - 1) / freq)
+  raw2 <- avdiagnose(y, freq)
+  expect_true(evidence_sinusoid(list(amp = 0.5, f0 = 3), raw2, y, freq)$support)
+})
