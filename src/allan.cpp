@@ -580,10 +580,11 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<Level>& lev,
                      const std::vector<R_xlen_t>& mid,
                      const std::vector<double>& mid_n, int dmax,
-                     bool stable32_n, int threads, bool main, Channel& out) {
+                     bool stable32_n, R_xlen_t acf_min, int threads,
+                     bool main, Channel& out) {
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(N + 1, m, false, stable32_n)) {
+    if (allanvar::needs_b1(N + 1, m, false, acf_min)) {
       rn.build_from_rate(v, N, c);
       break;
     }
@@ -597,7 +598,7 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const double* z = lj == 0 ? v : lev[lj].z.data();
     const R_xlen_t n = lj == 0 ? N : static_cast<R_xlen_t>(lev[lj].z.size());
     allanvar::NoiseId id;
-    if (n >= allanvar::acf_min_points(stable32_n)) {
+    if (n >= acf_min) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
       id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], false, stable32_n,
@@ -655,7 +656,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       out.sums[j] = lev[lj].acc.value();
     }
     octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, opts.stable32_b1,
-                    threads, main, out);
+                    opts.acf_min, threads, main, out);
     return;
   }
 
@@ -700,7 +701,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   const R_xlen_t Lp = rate ? N + 1 : N;
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(Lp, m, !rate, opts.stable32_b1)) {
+    if (allanvar::needs_b1(Lp, m, !rate, opts.acf_min)) {
       rn.build(phase, Lp);
       break;
     }
@@ -710,11 +711,12 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     if (allanvar::interrupted()) return;
     const R_xlen_t m = mid[j];
     allanvar::NoiseId id;
-    if (m == 1 && N >= allanvar::acf_min_points(opts.stable32_b1)) {
+    if (m == 1 && N >= opts.acf_min) {
       id = allanvar::acf_noise_id(v, N, !rate, dmax);
     } else {
       id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn, mid_n[j],
-                                    type == MODIFIED, opts.stable32_b1);
+                                    type == MODIFIED, opts.stable32_b1,
+                                    opts.acf_min);
     }
     store_id(id, out, j);
   });

@@ -17,7 +17,8 @@
 // the allantools and allantoolkit test suites (tools/check-stable32*.R).
 //
 // Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms, pm_only,
-// stable32_n) with pm_only for the modified family (R(n) splits PM only),
+// stable32_n, acf_min) with acf_min the fewest points the ACF is read from,
+// and pm_only for the modified family (R(n) splits PM only),
 // stable32_n for Stable32's N at every B1 boundary (b1_mu()), and x(k) the
 // phase at k = 0 .. L-1 (any constant offset; for frequency data the running
 // sum of the samples, L = N + 1) and an RnCache filled once from the same
@@ -230,8 +231,8 @@ inline R_xlen_t acf_points(R_xlen_t L, R_xlen_t m, bool phase) {
   return phase ? (L - 1) / m + 1 : (L - 1) / m;
 }
 
-inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase, bool stable32) {
-  return acf_points(L, m, phase) < acf_min_points(stable32);
+inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase, R_xlen_t acf_min) {
+  return acf_points(L, m, phase) < acf_min;
 }
 
 // B1 (and R(n)) from the decimated series z (phase or averaged frequency);
@@ -276,9 +277,9 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
 template <class X>
 NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
                        bool phase, RnCache& rn, double nterms,
-                       bool pm_only, bool stable32_n) {
+                       bool pm_only, bool stable32_n, R_xlen_t acf_min) {
   const R_xlen_t n = acf_points(L, m, phase);
-  if (n >= acf_min_points(stable32_n)) {
+  if (n >= acf_min) {
     if (phase) {
       return acf_noise_id_at([&](R_xlen_t i) { return x(i * m); }, n, true,
                              dmax);
