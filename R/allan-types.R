@@ -71,7 +71,10 @@
 #' MTOT and TTOT \eqn{b L/m - c} (SP 1065 Table 11), HTOT
 #' \eqn{(L/m)/(b_0 + b_1 m/L)} for FM noise from \eqn{m = 16} (Howe et al.
 #' 2000) and the overlapping Allan EDF otherwise, Theo1 and TheoBR Howe and
-#' Peppler's formulas in \eqn{0.75 m}, PDEV the modified Allan EDF.
+#' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV the modified Allan
+#' EDF. The noise type of a Theo1 row is the overlapping Allan variance's at
+#' \eqn{0.75 m}, or at \eqn{(L - 1)/3} beyond it (no fewer than three
+#' cluster averages).
 #'
 #' **Cost**: MTIE builds a table of window extremes level by level
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost

@@ -37,7 +37,12 @@ allan_opts <- function(type, rate, octave = FALSE,
 # points, B1 with the statistic's term count at every boundary);
 # "stable32-acf" and "stable32-b1" each half alone (diagnostics).
 noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default")) {
-  rule <- if (is.character(rule) && length(rule) == 1L) rule else "default"
+  known <- c("default", "stable32", "stable32-acf", "stable32-b1")
+  if (!(is.character(rule) && length(rule) == 1L && rule %in% known)) {
+    abort("`options(allanvar.noise_id)` must be one of ",
+          paste0("\"", known, "\"", collapse = ", "), "; not ",
+          paste(format(rule), collapse = " "), ".", class = "option")
+  }
   list(b1 = rule %in% c("stable32", "stable32-b1"),
        acf_min = if (rule %in% c("stable32", "stable32-acf")) 30L else 64L)
 }

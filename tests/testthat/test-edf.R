@@ -170,6 +170,15 @@ test_that("the noise type at a tau is read from the data, whatever else is asked
   }
 })
 
+test_that("an unknown noise-identification rule is refused, naming the option", {
+  old <- options(allanvar.noise_id = "Stable32")
+  on.exit(options(old))
+  expect_error(allan(rnorm(100), 1), "allanvar.noise_id",
+               class = "allanvar_error_option")
+  options(allanvar.noise_id = NULL)
+  expect_equal(allan(rnorm(100), 1)$m, 2^(0:5))
+})
+
 test_that("random-walk FM stays random walk at long tau; Stable32's B1 rule does not", {
   # B1 with Stable32's N (the statistic's term count, far above the few
   # averaged frequencies at long tau) cannot reach random walk's expected
