@@ -6,12 +6,15 @@
 //    "Power law noise identification using the lag 1 autocorrelation") on
 //    the WHOLE decimated series (phase data: every m-th phase point;
 //    frequency data: averages of m samples) while it has at least
-//    kAcfMinPoints (30) points. As Stable32: no detrending (removing drift
+//    acf_min points (64 by default, R/taus.R noise_id_rules(); Stable32 and
+//    allantools: 30). As Stable32: no detrending of phase (removing drift
 //    is the user's preprocessing);
 //  * below that, Barnes' B1 ratio (standard / Allan variance of the averaged
 //    frequencies; Barnes 1969, Howe et al. 2000 Tables 3-4) with N the
-//    number of terms of the statistic, as Stable32, and the R(n) ratio
-//    MVAR/AVAR to tell white from flicker PM (SP 1065 5.6.1).
+//    number of terms of the statistic, as Stable32 (by default random walk
+//    is told from flicker FM with the count of averaged frequencies: see
+//    b1_mu()), and the R(n) ratio MVAR/AVAR where B1 says PM (SP 1065
+//    5.6.1; rn_alpha()).
 // Every m is identified from the data alone, never copied from another m.
 // The choices were checked against 9,582 noise types printed by Stable32 in
 // the allantools and allantoolkit test suites (tools/check-stable32*.R).
@@ -22,7 +25,7 @@
 // stable32_n for Stable32's N at every B1 boundary (b1_mu()), and x(k) the
 // phase at k = 0 .. L-1 (any constant offset; for frequency data the running
 // sum of the samples, L = N + 1) and an RnCache filled once from the same
-// phase when some m has fewer than kAcfMinPoints points (needs_b1()).
+// phase when some m has fewer than acf_min points (needs_b1()).
 #ifndef ALLANVAR_NOISE_ID_H
 #define ALLANVAR_NOISE_ID_H
 
@@ -46,16 +49,11 @@ struct NoiseId {
   R_xlen_t points = 0;          // length of the series it was read from
 };
 
-// Stable32 and allantools use the lag-1 ACF from 30 points on. Between 30
-// and 63 points it misreads white FM often enough (r1 has standard error
-// 1/sqrt(n)) to push the 68% coverage of overlapping ADEV to 0.645
-// (tests/testthat/test-edf.R), so by default B1 and R(n) take over below
-// 64 points; options(allanvar.noise_id = "stable32") uses 30.
-const R_xlen_t kAcfMinPoints = 64;
-const R_xlen_t kAcfMinPointsStable32 = 30;
-inline R_xlen_t acf_min_points(bool stable32) {
-  return stable32 ? kAcfMinPointsStable32 : kAcfMinPoints;
-}
+// acf_min: Stable32 and allantools use the lag-1 ACF from 30 points on.
+// Between 30 and 63 points it misreads white FM often enough (r1 has
+// standard error 1/sqrt(n)) to push the 68% coverage of overlapping ADEV to
+// 0.645 (tests/testthat/test-edf.R), so by default B1 and R(n) take over
+// below 64 points; options(allanvar.noise_id = "stable32") uses 30.
 
 // Lag-1 ACF method on z[0..n): decimated phase (phase = true) or averaged
 // frequency. dmax: most differences taken (2 for Allan, 3 for Hadamard).
