@@ -71,7 +71,10 @@
 #' MTOT and TTOT \eqn{b L/m - c} (SP 1065 Table 11), HTOT
 #' \eqn{(L/m)/(b_0 + b_1 m/L)} for FM noise from \eqn{m = 16} (Howe et al.
 #' 2000) and the overlapping Allan EDF otherwise, Theo1 and TheoBR Howe and
-#' Peppler's formulas in \eqn{0.75 m}, PDEV the modified Allan EDF.
+#' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV the modified Allan
+#' EDF. The noise type of a Theo1 row is the overlapping Allan variance's at
+#' \eqn{0.75 m}, or at \eqn{(L - 1)/3} beyond it (no fewer than three
+#' cluster averages).
 #'
 #' **Cost**: MTIE builds a table of window extremes level by level
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
@@ -362,6 +365,11 @@ extra_edf_known <- function(type, m, L, alpha, n) {
     pdev = allan_edf_direct("modified", m, L - 3 * m + 1, L,
                             pmin(2L, pmax(-2L, a)))
   )
+  # Outside its range an approximation can fall to or below 0; Theo1's
+  # random-walk one does for 0.75 m > 0.63 N (a root of its quadratic), and
+  # is tiny just before it. There one degree of freedom (Theo1's term count
+  # is ~N m / 2, far from the truth); elsewhere the number of terms.
+  if (type %in% c("theo1", "theobr")) return(ifelse(is.finite(e) & e >= 1, e, 1))
   ifelse(is.finite(e) & e > 0, e, pmax(1, n))
 }
 
@@ -548,10 +556,14 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
 }
 
 # Noise exponent at cluster sizes m from the noise identification of
-# allan() for a related type (the m beyond that type's range take the
-# identification at its largest m).
+# allan() for a related type. The m beyond the largest one it can identify
+# (that type's range, and 3 averaged frequencies for B1) take the
+# identification there: a function of the data alone, whatever taus are
+# asked. (Theo1 reaches 0.75 m = 0.75 (N - 1), where the Allan variance has
+# 1 or 2 averaged frequencies and no type could be read; with no type the
+# widest interval gave limits decades wide where Stable32 prints EDF ~ 4.)
 extra_alpha <- function(v, freq, m, base, input, L) {
-  top <- allan_max_m(base, L)
+  top <- min(allan_max_m(base, L), max(1, floor((L - 1) / 3)))
   mm <- pmax(1, pmin(m, top))
   u <- sort(unique(mm))
   mx <- max(abs(v))

@@ -44,19 +44,28 @@
 #' do it:
 #' * while the decimated series has at least 64 points (cluster averages of
 #'   rate input, linearly detrended; every m-th phase point of integrated
-#'   input, quadratically detrended), Riley and Greenhall's lag-1
+#'   input, as it is, as Stable32 reads it), Riley and Greenhall's lag-1
 #'   autocorrelation method over the whole series, differencing at most
 #'   twice (three times for Hadamard types). Stable32 and allantools start
 #'   at 30 points; between 30 and 63 the lag-1 autocorrelation misreads
 #'   white FM often enough to push the 68% coverage below 0.65 (Monte
 #'   Carlo, N = 1024), so B1 is used there too;
 #' * below that, Barnes' B1 ratio (standard over Allan variance of the
-#'   cluster averages); where it points to phase noise, the ratio R(n) of
-#'   the modified to the Allan variance picks among white and flicker PM and
-#'   the three FM types;
+#'   cluster averages) against its expected values for N = the statistic's
+#'   number of terms and Howe et al.'s (2000) boundaries, as Stable32;
+#'   random-walk against flicker FM with N = the number of cluster averages
+#'   (with Stable32's N random walk is out of reach at long tau and the 68%
+#'   intervals cover 0.58-0.62 on random-walk FM); where B1 points to phase
+#'   noise, the ratio R(n) of the modified to the Allan variance picks among
+#'   white and flicker PM and the three FM types;
 #' * with fewer than three cluster averages (or phase noise that R(n) cannot
 #'   check), the type is unknown: `alpha` is `NA` and the EDF is the
 #'   smallest over the admissible types (the widest interval).
+#'
+#' `options(allanvar.noise_id = "stable32")` applies Stable32's rules
+#' instead (the autocorrelation from 30 points, B1's N = the number of terms
+#' at every boundary, R(n) only between white and flicker PM for the
+#' modified family), for comparisons with Stable32's tables.
 #'
 #' Then:
 #' * for white (\eqn{\alpha = 0}) or random-walk (\eqn{\alpha = -2}) rate

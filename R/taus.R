@@ -25,8 +25,26 @@ allan_type_code <- function(type) {
 # The options the sums kernel reads (src/opts-allan.h), built once per call.
 allan_opts <- function(type, rate, octave = FALSE,
                        threads = allanvar_threads()) {
+  rules <- noise_id_rules()
   list(type = allan_type_code(type), rate = isTRUE(rate),
-       octave = isTRUE(octave), threads = as.integer(threads))
+       octave = isTRUE(octave), threads = as.integer(threads),
+       stable32_b1 = rules$b1, acf_min = rules$acf_min)
+}
+
+# The noise-identification rules (src/noise_id.h): by default the lag-1 ACF
+# from 64 points and random walk told by B1 with its own count;
+# options(allanvar.noise_id = "stable32") gives Stable32's (ACF from 30
+# points, B1 with the statistic's term count at every boundary);
+# "stable32-acf" and "stable32-b1" each half alone (diagnostics).
+noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default")) {
+  known <- c("default", "stable32", "stable32-acf", "stable32-b1")
+  if (!(is.character(rule) && length(rule) == 1L && rule %in% known)) {
+    abort("`options(allanvar.noise_id)` must be one of ",
+          paste0("\"", known, "\"", collapse = ", "), "; not ",
+          paste(format(rule), collapse = " "), ".", class = "option")
+  }
+  list(b1 = rule %in% c("stable32", "stable32-b1"),
+       acf_min = if (rule %in% c("stable32", "stable32-acf")) 30L else 64L)
 }
 
 # Largest cluster size with at least one term, for L phase points (L = N + 1

@@ -578,11 +578,13 @@ inline void store_id(const allanvar::NoiseId& id, Channel& out, size_t j) {
 // (level 0: the samples themselves); R(n) from the running sum of v - c.
 void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<Level>& lev,
-                     const std::vector<R_xlen_t>& mid, int dmax, int threads,
+                     const std::vector<R_xlen_t>& mid,
+                     const std::vector<double>& mid_n, int dmax,
+                     bool stable32_n, R_xlen_t acf_min, int threads,
                      bool main, Channel& out) {
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(N + 1, m, false)) {
+    if (allanvar::needs_b1(N + 1, m, false, acf_min)) {
       rn.build_from_rate(v, N, c);
       break;
     }
@@ -596,10 +598,10 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const double* z = lj == 0 ? v : lev[lj].z.data();
     const R_xlen_t n = lj == 0 ? N : static_cast<R_xlen_t>(lev[lj].z.size());
     allanvar::NoiseId id;
-    if (n >= allanvar::kAcfMinPoints) {
+    if (n >= acf_min) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
-      id = allanvar::b1_noise_id(z, n, false, m, dmax,
+      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], false, stable32_n,
                                  [&]() { return rn.ratio(m); });
     }
     store_id(id, out, j);
@@ -619,6 +621,18 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   out.alpha_int.assign(ni, NA_INTEGER);
   out.id_method.assign(ni, allanvar::NOISE_ID_NONE);
   const int dmax = allanvar::estimator_info(type).d;
+  // the statistic's number of terms at each noise-id row (B1's N)
+  std::vector<double> mid_n(ni, 0.0);
+  for (size_t j = 0; j < ni; ++j) {
+    const auto it = std::lower_bound(ms.begin(), ms.end(), mid[j]);
+    if (it != ms.end() && *it == mid[j]) {
+      mid_n[j] = static_cast<double>(nterms[it - ms.begin()]);
+    } else {
+      for (size_t k = 0; k < nt; ++k) {
+        if (ms[k] == mid[j]) mid_n[j] = static_cast<double>(nterms[k]);
+      }
+    }
+  }
   if (type == STANDARD && rate && octave) {
     // Any constant works as the centre here (cluster sums are double-double
     // and constants cancel); NaN or Inf shows up in the sums.
@@ -641,7 +655,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
       out.sums[j] = lev[lj].acc.value();
     }
-    octave_noise_id(v, N, v[0], lev, mid, dmax, threads, main, out);
+    octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, opts.stable32_b1,
+                    opts.acf_min, threads, main, out);
     return;
   }
 
@@ -686,7 +701,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   const R_xlen_t Lp = rate ? N + 1 : N;
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(Lp, m, !rate)) {
+    if (allanvar::needs_b1(Lp, m, !rate, opts.acf_min)) {
       rn.build(phase, Lp);
       break;
     }
@@ -696,10 +711,12 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     if (allanvar::interrupted()) return;
     const R_xlen_t m = mid[j];
     allanvar::NoiseId id;
-    if (m == 1 && N >= allanvar::kAcfMinPoints) {
+    if (m == 1 && N >= opts.acf_min) {
       id = allanvar::acf_noise_id(v, N, !rate, dmax);
     } else {
-      id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn);
+      id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn, mid_n[j],
+                                    type == MODIFIED, opts.stable32_b1,
+                                    opts.acf_min);
     }
     store_id(id, out, j);
   });

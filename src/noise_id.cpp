@@ -8,12 +8,7 @@
 namespace allanvar {
 
 
-// Least-squares polynomial (degree 1 for frequency, 2 for phase) removed
-// with the orthogonal polynomials of the equally spaced points
-// p1 = i - c, p2 = p1^2 - (n^2 - 1)/12; then the lag-1 ACF, differencing
-// while delta >= 0.25 and d < dmax (Riley & Greenhall 2004, eq. 2-4). The
-// first step reads z twice and stores nothing (most records stop there);
-// differencing works on a copy of the residuals.
+// The lag-1 ACF method on a stored series.
 NoiseId acf_noise_id(const double* z, R_xlen_t n, bool phase, int dmax) {
   return acf_noise_id_at([z](R_xlen_t i) { return z[i]; }, n, phase, dmax);
 }
@@ -44,19 +39,26 @@ double b1_theory(double N, int mu) {
   return N * (1 - std::pow(N, mu)) / (2 * (N - 1) * (1 - std::pow(2.0, mu)));
 }
 
-// mu whose expected B1 lies nearest the measured one on a log scale
-// (boundaries at the geometric means of neighbours); mu -2 (white or
-// flicker PM) up to 1 (random-walk FM), or 3 for the Hadamard family.
-int b1_mu(double b1, R_xlen_t n, int dmax) {
-  const int mu_max = dmax >= 3 ? 3 : 1;
-  const double N = static_cast<double>(n);
-  int mu = -2;
-  while (mu < mu_max) {
-    const double bound = std::sqrt(b1_theory(N, mu) * b1_theory(N, mu + 1));
-    if (b1 < bound) break;
-    ++mu;
+// mu whose expected B1 lies nearest the measured one: boundaries at the
+// geometric means of neighbours, the arithmetic mean between mu 2 and 1
+// (Howe et al. 2000, Table 4); mu -2 (white or flicker PM) up to 2 (flicker
+// walk FM; the caller clamps to the statistic's range). Stable32 takes N,
+// the count behind the expected B1, to be the statistic's number of terms
+// (n_stat); so do the PM / white FM / flicker FM boundaries here. Random-
+// walk FM is told from flicker FM with the count of averaged frequencies
+// the ratio was read from (n_own): with Stable32's N the expected B1 of
+// random walk (N/2) is out of reach at long tau, it is typed flicker or
+// white FM, and the 68% intervals of overlapping ADEV cover 0.62
+// (tests/testthat/test-edf.R). options(allanvar.noise_id = "stable32")
+// passes n_own = n_stat, Stable32's rule, for comparisons with it.
+int b1_mu(double b1, double n_stat, double n_own) {
+  for (int mu = 2; mu > -2; --mu) {
+    const double N = mu >= 1 ? n_own : n_stat;
+    const double hi = b1_theory(N, mu), lo = b1_theory(N, mu - 1);
+    const double bound = mu == 2 ? 0.5 * (hi + lo) : std::sqrt(hi * lo);
+    if (b1 > bound) return mu;
   }
-  return mu;
+  return -2;
 }
 
 // Expected MVAR/AVAR at m (SP 1065 section 5.2.5 and Table 3): white PM
@@ -75,11 +77,14 @@ double rn_theory(double m, int alpha) {
 }
 
 // The type whose expected R(n) is nearest on a log scale (boundaries at the
-// geometric means of neighbours). B1 cannot tell PM from FM with a handful
-// of averaged frequencies; R(n), read from every overlapping term, can, so
-// a PM reading of B1 is checked against all five types: a white-FM record
-// is not given the EDF of white PM (near N) at long tau.
-int rn_alpha(double rn, double m) {
+// geometric means of neighbours). Stable32 asks R(n) only for white against
+// flicker PM once B1 has said PM (pm_only, the modified family, where the
+// EDF of flicker PM is close to white FM's). For the unmodified types B1
+// from a handful of averaged frequencies says PM for white FM often enough
+// that a white-FM record would get the EDF of PM (near N) at long tau, so
+// there all five types are weighed.
+int rn_alpha(double rn, double m, bool pm_only) {
+  if (pm_only) return rn > std::sqrt(rn_theory(m, 1) * rn_theory(m, 2)) ? 1 : 2;
   // at very small m flicker PM's ratio is not below white FM's: PM only
   const int last = rn_theory(m, 1) < rn_theory(m, 0) ? -2 : 1;
   int alpha = 2;

@@ -1,19 +1,31 @@
 // Power-law noise identification at one averaging factor m, as NIST SP 1065
-// (section 5.6) and Stable32 do it:
+// (section 5.6) and Stable32 do it (W.J. Riley, "Handbook of Frequency
+// Stability Analysis", NIST SP 1065, 5.6; the Stable32 manual, "Noise
+// identification"):
 //  * the lag-1 autocorrelation method of Riley & Greenhall (2004, EFTF,
 //    "Power law noise identification using the lag 1 autocorrelation") on
-//    the WHOLE decimated series (phase data: every m-th phase point,
-//    quadratic detrend; frequency data: averages of m samples, linear
-//    detrend) while it has at least kAcfMinPoints (64) points;
+//    the WHOLE decimated series (phase data: every m-th phase point;
+//    frequency data: averages of m samples) while it has at least
+//    acf_min points (64 by default, R/taus.R noise_id_rules(); Stable32 and
+//    allantools: 30). As Stable32: no detrending of phase (removing drift
+//    is the user's preprocessing);
 //  * below that, Barnes' B1 ratio (standard / Allan variance of the averaged
-//    frequencies; Barnes 1969, Howe et al. 2000 Table 3), with the R(n)
-//    ratio MVAR/AVAR to tell white from flicker PM (SP 1065 5.6.1).
+//    frequencies; Barnes 1969, Howe et al. 2000 Tables 3-4) with N the
+//    number of terms of the statistic, as Stable32 (by default random walk
+//    is told from flicker FM with the count of averaged frequencies: see
+//    b1_mu()), and the R(n) ratio MVAR/AVAR where B1 says PM (SP 1065
+//    5.6.1; rn_alpha()).
 // Every m is identified from the data alone, never copied from another m.
+// The choices were checked against 9,582 noise types printed by Stable32 in
+// the allantools and allantoolkit test suites (tools/check-stable32*.R).
 //
-// Use: identify_noise(x, L, m, dmax, phase_data, rn) with x(k) the phase at
-// k = 0 .. L-1 (any constant offset; for frequency data the running sum of
-// the samples, L = N + 1) and an RnCache filled once from the same phase
-// when some m has fewer than kAcfMinPoints points (needs_b1()).
+// Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms, pm_only,
+// stable32_n, acf_min) with acf_min the fewest points the ACF is read from,
+// and pm_only for the modified family (R(n) splits PM only),
+// stable32_n for Stable32's N at every B1 boundary (b1_mu()), and x(k) the
+// phase at k = 0 .. L-1 (any constant offset; for frequency data the running
+// sum of the samples, L = N + 1) and an RnCache filled once from the same
+// phase when some m has fewer than acf_min points (needs_b1()).
 #ifndef ALLANVAR_NOISE_ID_H
 #define ALLANVAR_NOISE_ID_H
 
@@ -37,13 +49,11 @@ struct NoiseId {
   R_xlen_t points = 0;          // length of the series it was read from
 };
 
-// Allantools and Stable32 use the lag-1 ACF from 30 points on. Between 30
-// and 63 points it misreads white FM often enough (r1 has standard error
-// 1/sqrt(n)) to push the 68% coverage of overlapping ADEV below 0.65 (Monte
-// Carlo, N = 1024; tests/testthat/test-edf.R), and with 64 more Stable32
-// limits agree (377 against 374 of 402 rows), so B1 and R(n) take over
-// below 64 points.
-const R_xlen_t kAcfMinPoints = 64;
+// acf_min: Stable32 and allantools use the lag-1 ACF from 30 points on.
+// Between 30 and 63 points it misreads white FM often enough (r1 has
+// standard error 1/sqrt(n)) to push the 68% coverage of overlapping ADEV to
+// 0.645 (tests/testthat/test-edf.R), so by default B1 and R(n) take over
+// below 64 points; options(allanvar.noise_id = "stable32") uses 30.
 
 // Lag-1 ACF method on z[0..n): decimated phase (phase = true) or averaged
 // frequency. dmax: most differences taken (2 for Allan, 3 for Hadamard).
@@ -51,8 +61,11 @@ NoiseId acf_noise_id(const double* z, R_xlen_t n, bool phase, int dmax);
 
 namespace noise_id_detail {
 
-// delta = r1 / (1 + r1) of Riley & Greenhall from r1 = num / den.
-inline double delta_of(double num, double den) {
+// delta = r1 / (1 + r1) of Riley & Greenhall from r1 = num / den (NIST SP
+// 1065 eq. 72). Stable32 is said to scale r1 by (n - 1)/n (allantoolkit);
+// that matches 21 more of 9,582 Stable32 noise types but none of the 711
+// limits, and SP 1065's definition is kept.
+inline double delta_of(double num, double den, R_xlen_t) {
   const double r1 = den > 0 ? num / den : 0.0;
   return r1 / (1.0 + r1);
 }
@@ -70,121 +83,53 @@ inline double lag1_delta(const double* e, R_xlen_t n) {
     a += prev * d;
     prev = d;
   }
-  return delta_of(a, b);
+  return delta_of(a, b, n);
 }
 
 }  // namespace noise_id_detail
 
-// Least-squares polynomial (degree 1 for frequency, 2 for phase) removed
-// with the orthogonal polynomials of the equally spaced points
-// p1 = i - c, p2 = p1^2 - (n^2 - 1)/12; then the lag-1 ACF, differencing
-// while delta >= 0.25 and d < dmax (Riley & Greenhall 2004, eq. 2-4). The
-// first step reads z(i) twice and stores nothing (most records stop
-// there); differencing works on a copy of the residuals.
-namespace noise_id_detail {
-
-// Sums of v = z - z0 against 1, p1, p2 (two interleaved chains each).
-template <bool QUAD, class Z>
-inline void fit_sums(const Z& z, R_xlen_t n, double c, double q, double* s) {
-  const double z0 = z(0);
-  double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
-  double p = -c;
-  R_xlen_t i = 0;
-  for (; i + 2 <= n; i += 2, p += 2) {
-    const double v = z(i) - z0, w = z(i + 1) - z0;
-    a0 += v;
-    b0 += w;
-    a1 += v * p;
-    b1 += w * (p + 1);
-    if (QUAD) {
-      a2 += v * (p * p - q);
-      b2 += w * ((p + 1) * (p + 1) - q);
-    }
-  }
-  for (; i < n; ++i, p += 1) {
-    const double v = z(i) - z0;
-    a0 += v;
-    a1 += v * p;
-    if (QUAD) a2 += v * (p * p - q);
-  }
-  s[0] = a0 + b0;
-  s[1] = a1 + b1;
-  s[2] = a2 + b2;
-}
-
-// Lag-0 and lag-1 sums of the residuals e_i = z_i - z0 - fit(p_i).
-template <bool QUAD, class Z>
-inline void resid_sums(const Z& z, R_xlen_t n, double c, double q,
-                const double* a, double* out) {
-  const double z0 = z(0);
-  auto e_at = [&](R_xlen_t i, double p) {
-    return (z(i) - z0) - a[0] - a[1] * p - (QUAD ? a[2] * (p * p - q) : 0.0);
-  };
-  double S1 = 0, S2 = 0, Sc = 0, T1 = 0, T2 = 0, Tc = 0;
-  double prev = e_at(0, -c);
-  const double e0 = prev;
-  S1 = prev;
-  S2 = prev * prev;
-  double p = 1 - c;
-  R_xlen_t i = 1;
-  for (; i + 2 <= n; i += 2, p += 2) {
-    const double e = e_at(i, p), f = e_at(i + 1, p + 1);
-    S1 += e;
-    T1 += f;
-    S2 += e * e;
-    T2 += f * f;
-    Sc += prev * e;
-    Tc += e * f;
-    prev = f;
-  }
-  for (; i < n; ++i, p += 1) {
-    const double e = e_at(i, p);
-    S1 += e;
-    S2 += e * e;
-    Sc += prev * e;
-    prev = e;
-  }
-  out[0] = S1 + T1;
-  out[1] = S2 + T2;
-  out[2] = Sc + Tc;
-  out[3] = e0;
-  out[4] = prev;
-}
-
-}  // namespace noise_id_detail
-
+// The lag-1 ACF of z(0..n), differencing while delta >= 0.25 and d < dmax
+// (Riley & Greenhall 2004, eq. 2-4). The first step reads z(i) twice
+// (mean, then sums about it) and stores nothing (most series stop there);
+// differencing works on a copy.
 template <class Z>
 NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
   using namespace noise_id_detail;
   NoiseId out;
   out.points = n;
   if (n < 4) return out;
-  const bool quad = phase;
   const double nn = static_cast<double>(n);
-  const double c = (nn - 1) / 2;
-  const double q = (nn * nn - 1) / 12;
   const double z0 = z(0);
-  double s[3];
-  if (quad) {
-    fit_sums<true>(z, n, c, q, s);
-  } else {
-    fit_sums<false>(z, n, c, q, s);
+  double s0 = 0, s1 = 0;
+  R_xlen_t i = 0;
+  for (; i + 2 <= n; i += 2) {
+    s0 += z(i) - z0;
+    s1 += z(i + 1) - z0;
   }
-  double a[3];
-  a[0] = s[0] / nn;
-  a[1] = s[1] / (nn * (nn * nn - 1) / 12);
-  a[2] = quad ? s[2] / (nn * (nn * nn - 1) * (nn * nn - 4) / 180) : 0;
-  double r[5];
-  if (quad) {
-    resid_sums<true>(z, n, c, q, a, r);
-  } else {
-    resid_sums<false>(z, n, c, q, a, r);
+  if (i < n) s0 += z(i) - z0;
+  const double mu = (s0 + s1) / nn + z0;
+  // averaged frequencies: a linear drift removed (its slope b about the
+  // centre c); phase is read as it is, as Stable32 does
+  const double c = (nn - 1) / 2;
+  double b = 0;
+  if (!phase) {
+    double sp = 0;
+    for (i = 0; i < n; ++i) sp += (static_cast<double>(i) - c) * (z(i) - mu);
+    b = sp / (nn * (nn * nn - 1) / 12);
   }
-  const double S1 = r[0], S2 = r[1], Sc = r[2], e0 = r[3], elast = r[4];
-  const double mu = S1 / nn;
-  const double num = Sc - mu * (2 * S1 - e0 - elast) + (nn - 1) * mu * mu;
-  const double den = S2 - nn * mu * mu;
-  double rho = delta_of(num, den);
+  auto res = [&](R_xlen_t k) {
+    return z(k) - mu - b * (static_cast<double>(k) - c);
+  };
+  double S2 = 0, Sc = 0;
+  double prev = res(0);
+  S2 = prev * prev;
+  for (i = 1; i < n; ++i) {
+    const double e = res(i);
+    S2 += e * e;
+    Sc += prev * e;
+    prev = e;
+  }
+  double rho = delta_of(Sc, S2, n);
   int d = 0;
   std::vector<double> e;
   R_xlen_t len = n;
@@ -199,27 +144,22 @@ NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
     }
     if (e.empty()) {
       e.resize(n);
-      for (R_xlen_t i = 0; i < n; ++i) {
-        const double p = static_cast<double>(i) - c;
-        e[i] = (z(i) - z0) - a[0] - a[1] * p - a[2] * (p * p - q);
-      }
+      for (R_xlen_t k = 0; k < n; ++k) e[k] = res(k);
     }
-    for (R_xlen_t i = 0; i + 1 < len; ++i) e[i] = e[i + 1] - e[i];
+    for (R_xlen_t k = 0; k + 1 < len; ++k) e[k] = e[k + 1] - e[k];
     --len;
     ++d;
     rho = lag1_delta(e.data(), len);
   }
 }
 
-
-
 // B1 ratio of the averaged frequencies ybar[0..n); rn() gives MVAR/AVAR at
 // m, called only when B1 points to white or flicker PM (NaN: unavailable).
 double b1_ratio(const double* ybar, R_xlen_t n);
-int b1_mu(double b1, R_xlen_t n, int dmax);   // tau exponent mu of AVAR
+int b1_mu(double b1, double n_stat, double n_own);  // tau exponent of AVAR
 double b1_theory(double N, int mu);
 double rn_theory(double m, int alpha);          // expected MVAR/AVAR
-int rn_alpha(double rn, double m);              // alpha from R(n)
+int rn_alpha(double rn, double m, bool pm_only);  // alpha from R(n)
 
 // Phase values at a coarse grid (step s, at most ~4096 points) and their
 // prefix sums, for R(n) at long averaging factors (m >= L/30, so the window
@@ -289,14 +229,17 @@ inline R_xlen_t acf_points(R_xlen_t L, R_xlen_t m, bool phase) {
   return phase ? (L - 1) / m + 1 : (L - 1) / m;
 }
 
-inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase) {
-  return acf_points(L, m, phase) < kAcfMinPoints;
+inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase, R_xlen_t acf_min) {
+  return acf_points(L, m, phase) < acf_min;
 }
 
-// B1 (and R(n)) from the decimated series z (phase or averaged frequency).
+// B1 (and R(n)) from the decimated series z (phase or averaged frequency);
+// nterms: the statistic's number of terms at m, Stable32's N of the
+// expected B1 (SP 1065 5.6; with the count of averaged frequencies instead,
+// 7,552 instead of 8,652 of 9,582 Stable32 noise types are matched).
 template <class RN>
 NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
-                    int dmax, RN rn) {
+                    double nterms, bool pm_only, bool stable32_n, RN rn) {
   NoiseId out;
   out.points = n;
   std::vector<double> ybar;
@@ -309,17 +252,19 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
   if (na < 3) return out;
   const double b1 = b1_ratio(ybar.data(), na);
   if (!std::isfinite(b1)) return out;
-  const int mu = b1_mu(b1, na, dmax);
+  const double N = nterms >= 2 ? nterms : static_cast<double>(na);
+  const int mu = b1_mu(b1, N, stable32_n ? N : static_cast<double>(na));
   if (mu == -2) {
-    const double r = rn();
-    if (std::isfinite(r) && m > 1) {
-      out.alpha_int = rn_alpha(r, static_cast<double>(m));
-      out.method = NOISE_ID_B1_RN;
-    } else {
-      return out;  // PM or not cannot be told: no type (widest interval)
-    }
+    // white or flicker PM: R(n) tells them apart where it can be read,
+    // else flicker PM (Stable32's choice for the unmodified types)
+    // (R(n) unreadable: flicker PM under Stable32's rules, else no type,
+    // the widest interval)
+    const double r = m > 1 ? rn() : NAN;
+    if (!std::isfinite(r) && !stable32_n) return out;
+    out.alpha_int = std::isfinite(r) ? rn_alpha(r, static_cast<double>(m), pm_only && stable32_n) : 1;
+    out.method = std::isfinite(r) ? NOISE_ID_B1_RN : NOISE_ID_B1;
   } else {
-    out.alpha_int = -mu - 1;  // mu -1, 0, 1, 2, 3 -> alpha 0, -1, ..., -4
+    out.alpha_int = -mu - 1;  // mu -1, 0, 1, 2 -> alpha 0, -1, -2, -3
     out.method = NOISE_ID_B1;
   }
   out.alpha = out.alpha_int;
@@ -329,9 +274,10 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
 // Noise type at m from the phase x(k), k < L.
 template <class X>
 NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
-                       bool phase, RnCache& rn) {
+                       bool phase, RnCache& rn, double nterms,
+                       bool pm_only, bool stable32_n, R_xlen_t acf_min) {
   const R_xlen_t n = acf_points(L, m, phase);
-  if (n >= kAcfMinPoints) {
+  if (n >= acf_min) {
     if (phase) {
       return acf_noise_id_at([&](R_xlen_t i) { return x(i * m); }, n, true,
                              dmax);
@@ -343,7 +289,8 @@ NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
   for (R_xlen_t i = 0; i < n; ++i) {
     z[i] = phase ? x(i * m) : x((i + 1) * m) - x(i * m);
   }
-  return b1_noise_id(z.data(), n, phase, m, dmax, [&]() {
+  return b1_noise_id(z.data(), n, phase, m, nterms, pm_only, stable32_n,
+                     [&]() {
     if (rn.empty()) rn.build(x, L);  // build it beforehand to share it
     return rn.ratio(m);
   });

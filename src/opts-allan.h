@@ -15,6 +15,8 @@ struct AllanOptions {
   bool rate;     // rate samples (else integrated: phase, angle, velocity)
   bool octave;   // standard type at m = 2^j: the pairwise one-pass kernel
   int threads;   // threads the kernel may use (>= 1)
+  bool stable32_b1 = false;  // B1's N as Stable32 for every boundary
+  R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
 };
 
 inline bool opt_flag(const Rcpp::List& o, const char* name) {
@@ -40,6 +42,12 @@ inline AllanOptions allan_options(const Rcpp::List& o) {
   opts.octave = opt_flag(o, "octave");
   opts.threads = opt_int(o, "threads");
   if (opts.threads < 1) opts.threads = 1;
+  if (o.containsElementNamed("stable32_b1"))
+    opts.stable32_b1 = opt_flag(o, "stable32_b1");
+  if (o.containsElementNamed("acf_min")) {
+    opts.acf_min = opt_int(o, "acf_min");
+    if (opts.acf_min < 4) Rcpp::stop("internal: allan option `acf_min` < 4");
+  }
   if (opts.octave && (opts.type != STANDARD || !opts.rate))
     Rcpp::stop("internal: the octave kernel is for standard rate input only");
   return opts;

@@ -9,6 +9,8 @@
 #   git -C <mirror> archive HEAD tests | tar -x -C /tmp/allantools
 #   ALLANVAR_PEER_DATA=/tmp/allantools:/tmp/allantoolkit \
 #     Rscript tools/check-stable32-types.R
+# ALLANVAR_NOISE_ID=stable32 identifies the noise by Stable32's rules
+# (options(allanvar.noise_id = "stable32"), src/noise_id.h).
 # Run from the repository root (it loads the package with pkgload) or with
 # allanvar installed. tests/testthat/test-types-stable32.R runs it when the
 # variable is set.
@@ -325,6 +327,10 @@ check_stable32_types <- function(roots = strsplit(Sys.getenv("ALLANVAR_PEER_DATA
 }
 
 if (sys.nframe() == 0L) {
+  # ALLANVAR_NOISE_ID=stable32: B1 with Stable32's N at every boundary
+  if (nzchar(Sys.getenv("ALLANVAR_NOISE_ID"))) {
+    options(allanvar.noise_id = Sys.getenv("ALLANVAR_NOISE_ID"))
+  }
   if (file.exists("DESCRIPTION") && requireNamespace("pkgload", quietly = TRUE)) {
     pkgload::load_all(quiet = TRUE)
   } else {
