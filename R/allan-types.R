@@ -75,7 +75,8 @@
 #'
 #' **Cost**: MTIE builds a table of window extremes level by level
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
-#' \eqn{O(L)} per tau; the Total family \eqn{O(L)} per tau (each
+#' \eqn{O(L)} per tau (PDEV at octave \eqn{m} a few operations per term,
+#' by a doubling recursion from \eqn{m} to \eqn{2m}); the Total family \eqn{O(L)} per tau (each
 #' window's quadratic form in closed form, from prefix sums over blocks of
 #' \eqn{4m} windows; directly, \eqn{O(L m)}, below \eqn{m = 8}); Theo1 per
 #' tau the cheaper of its definition (\eqn{O(L m)}) and an expansion into
