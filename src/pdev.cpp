@@ -396,10 +396,8 @@ std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
   while (j0 < K) {
     const R_xlen_t n = L - (R_xlen_t(2) << j0) + 1;
     int j1 = j0 + 1;
-    while (j1 < K && j1 - j0 < 6 &&
-           (R_xlen_t(2) << (j1 + 1)) * 4 * kRanges <= n)
-      ++j1;
-    const bool split = (R_xlen_t(2) << j1) * 4 * kRanges <= n;
+    while (j1 < K && (R_xlen_t(2) << (j1 + 1)) * 8 * kRanges <= n) ++j1;
+    const bool split = (R_xlen_t(2) << j1) * 8 * kRanges <= n;
     if (!split) j1 = K;
     const int nr = split ? kRanges : 1;
     const bool last = j1 == K;
