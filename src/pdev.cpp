@@ -354,26 +354,36 @@ std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
   std::vector<double> sums(K + 1, 0.0);
   const R_xlen_t n0 = L - 1;  // level 0: E_1(i), i < L - 1
   std::unique_ptr<double[]> Sa, Ea(new double[n0]), Sb, Eb;
-  // the mean increment, compensated (any constant would do; this one keeps
-  // E_1 centred)
-  double c;
-  {
-    double s = 0, e = 0;
-    for (R_xlen_t i = 0; i < n0; ++i) {
-      double h, lo, t, te;
-      in.increment(i, h, lo);
-      allanvar::phase_two_sum(s, h, t, te);
-      s = t;
-      e += te + lo;
-    }
-    c = (s + e) / static_cast<double>(n0);
-  }
+  // E_1 centred by the mean increment: any constant would do (S ignores
+  // it exactly), so a plain sum is enough; each E_1 is then the rounded
+  // exact increment less c
   double* E = Ea.get();
-  for (R_xlen_t i = 0; i < n0; ++i) {
-    double h, lo, r, re;
-    in.increment(i, h, lo);
-    allanvar::phase_two_sum(h, -c, r, re);
-    E[i] = -(r + (re + lo));
+  if (in.rate) {
+    double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+    R_xlen_t i = 0;
+    for (; i + 4 <= n0; i += 4) {
+      a0 += in.v[i];
+      a1 += in.v[i + 1];
+      a2 += in.v[i + 2];
+      a3 += in.v[i + 3];
+    }
+    for (; i < n0; ++i) a0 += in.v[i];
+    const double c = ((a0 + a1) + (a2 + a3)) / static_cast<double>(n0);
+    for (i = 0; i < n0; ++i) E[i] = c - in.v[i];
+  } else {
+    double a0 = 0;
+    for (R_xlen_t i = 0; i < n0; ++i) {
+      double h, lo;
+      in.increment(i, h, lo);
+      a0 += h;
+    }
+    const double c = a0 / static_cast<double>(n0);
+    for (R_xlen_t i = 0; i < n0; ++i) {
+      double h, lo, r, re;
+      in.increment(i, h, lo);
+      allanvar::phase_two_sum(h, -c, r, re);
+      E[i] = -(r + (re + lo));
+    }
   }
   {
     double s0 = 0, s1 = 0;
