@@ -362,6 +362,7 @@ std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
     double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
     R_xlen_t i = 0;
     for (; i + 4 <= n0; i += 4) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
       a0 += in.v[i];
       a1 += in.v[i + 1];
       a2 += in.v[i + 2];
@@ -369,16 +370,21 @@ std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
     }
     for (; i < n0; ++i) a0 += in.v[i];
     const double c = ((a0 + a1) + (a2 + a3)) / static_cast<double>(n0);
-    for (i = 0; i < n0; ++i) E[i] = c - in.v[i];
+    for (i = 0; i < n0; ++i) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
+      E[i] = c - in.v[i];
+    }
   } else {
     double a0 = 0;
     for (R_xlen_t i = 0; i < n0; ++i) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
       double h, lo;
       in.increment(i, h, lo);
       a0 += h;
     }
     const double c = a0 / static_cast<double>(n0);
     for (R_xlen_t i = 0; i < n0; ++i) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
       double h, lo, r, re;
       in.increment(i, h, lo);
       allanvar::phase_two_sum(h, -c, r, re);
@@ -389,6 +395,7 @@ std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
     double s0 = 0, s1 = 0;
     R_xlen_t i = 0;
     for (; i + 2 < L - 1; i += 2) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
       const double d0 = E[i] - E[i + 1], d1 = E[i + 1] - E[i + 2];
       s0 += d0 * d0;
       s1 += d1 * d1;
