@@ -555,7 +555,7 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   top <- allan_max_m(base, L)
   mm <- pmax(1, pmin(m, top))
   u <- sort(unique(mm))
-  mx <- max(abs(v))
+  mx <- max(abs(range(v)))  # no copy of v (finite here)
   if (length(u) <= 200L && mx > 1e-100 && mx < 1e100) {
     # the kernel's noise identification, as allan() calls it (the term
     # counts are part of the identification), without allan()'s limits:
