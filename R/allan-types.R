@@ -78,7 +78,8 @@
 #'
 #' **Cost**: MTIE builds a table of window extremes level by level
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
-#' \eqn{O(L)} per tau; the Total family \eqn{O(L)} per tau (each
+#' \eqn{O(L)} per tau (PDEV at octave \eqn{m} a few operations per term,
+#' by a doubling recursion from \eqn{m} to \eqn{2m}); the Total family \eqn{O(L)} per tau (each
 #' window's quadratic form in closed form, from prefix sums over blocks of
 #' \eqn{4m} windows; directly, \eqn{O(L m)}, below \eqn{m = 8}); Theo1 per
 #' tau the cheaper of its definition (\eqn{O(L m)}) and an expansion into
@@ -566,7 +567,7 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   top <- min(allan_max_m(base, L), max(1, floor((L - 1) / 3)))
   mm <- pmax(1, pmin(m, top))
   u <- sort(unique(mm))
-  mx <- max(abs(v))
+  mx <- max(abs(range(v)))  # no copy of v (finite here)
   if (length(u) <= 200L && mx > 1e-100 && mx < 1e100) {
     # the kernel's noise identification, as allan() calls it (the term
     # counts are part of the identification), without allan()'s limits:

@@ -14,6 +14,8 @@
 #include "parallel.h"
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <stdexcept>
 #include <vector>
 
 namespace {
@@ -175,6 +177,277 @@ double local_terms(const double* hx, const double* lx, R_xlen_t mm,
   return s0 + s1;
 }
 
+// ---- Octave m (powers of two): a doubling recursion, no prefix sums ----
+//
+// With G_m(i) = sum_{k<m} ((m - 1)/2 - k) x(i + k) and A_m(i) = sum_{k<m}
+// x(i + k), S_i = G_m(i) - G_m(i + m) (S of the header), and splitting a
+// window of 2m into two of m gives G_2m(i) = G_m(i) + m/2 A_m(i) +
+// G_m(i + m) - m/2 A_m(i + m). In differences, with E_m(i) = A_m(i) -
+// A_m(i + m):
+//   S_2m(i) = S_m(i) + 2 S_m(i + m) + S_m(i + 2m) + m/2 (E_m(i) - E_m(i + 2m)),
+//   E_2m(i) = E_m(i) + 2 E_m(i + m) + E_m(i + 2m),
+// from S_1 = 0 and E_1(i) = x(i) - x(i + 1) = -(increment i) less the mean
+// increment (PVAR ignores a linear phase term; any constant would do). Every
+// value is of the size of the statistic itself (no running sum of the
+// phase), each level costs a few operations per term, and the levels run
+// as a wavefront over tiles so that they meet in cache. Level j (m = 2^j)
+// holds indices [0, L - 2^(j+1) + 1); its terms are i < L - 2^(j+1).
+
+const R_xlen_t kTile = 2048;
+const int kRanges = 2;
+
+// One level's values: global index i at ring position i % R (or, for the
+// whole arrays a group starts from, at i: R = 0).
+struct Level {
+  double* S = nullptr;  // nullptr: S is zero (level 0)
+  double* E = nullptr;
+  std::unique_ptr<double[]> own_s, own_e;
+  R_xlen_t R = 0, prod = 0, hi = 0;
+  R_xlen_t pos(R_xlen_t i) const { return R ? i % R : i; }
+  // contiguous run from i without wrapping
+  R_xlen_t run(R_xlen_t i) const { return R ? R - i % R : R_xlen_t(1) << 62; }
+};
+
+// Level j + 1 at [0, len) from level j (m = 2^j) read at i, i + m, i + 2m
+// (pointers s0, s1, s2 and e0, e1, e2; Z: S_m = 0, s* unused); returns the
+// sum of squares of os[0, nsq), nsq <= len.
+template <bool Z>
+inline double double_level(const double* s0, const double* s1,
+                           const double* s2, const double* e0,
+                           const double* e1, const double* e2, double h,
+                           R_xlen_t len, R_xlen_t nsq, double* os,
+                           double* oe) {
+  R_xlen_t k = 0;
+  double acc = 0;
+#if defined(__GNUC__)
+  using allanvar::v2d;
+  using allanvar::ld2;
+  using allanvar::st2;
+  const v2d hv = {h, h};
+  v2d q0 = {0, 0}, q1 = {0, 0};
+  auto one = [&](R_xlen_t i) {
+    const v2d a = ld2(e0 + i), b = ld2(e1 + i), c = ld2(e2 + i);
+    v2d o = hv * (a - c);
+    if (!Z) {
+      const v2d t = ld2(s1 + i);
+      o = ((ld2(s0 + i) + ld2(s2 + i)) + (t + t)) + o;
+    }
+    st2(os + i, o);
+    st2(oe + i, (a + c) + (b + b));
+    return o;
+  };
+  for (; k + 4 <= nsq; k += 4) {
+    const v2d o0 = one(k), o1 = one(k + 2);
+    q0 += o0 * o0;
+    q1 += o1 * o1;
+  }
+  q0 += q1;
+  acc = q0[0] + q0[1];
+  for (; k + 2 <= nsq; k += 2) {
+    const v2d o = one(k);
+    acc += o[0] * o[0] + o[1] * o[1];
+  }
+#endif
+  auto scalar = [&](R_xlen_t i) {
+    const double a = e0[i], b = e1[i], c = e2[i];
+    const double sv = Z ? 0.0 : (s0[i] + s2[i]) + (s1[i] + s1[i]);
+    const double o = sv + h * (a - c);
+    os[i] = o;
+    oe[i] = (a + c) + (b + b);
+    return o;
+  };
+  for (; k < nsq; ++k) {
+    const double o = scalar(k);
+    acc += o * o;
+  }
+#if defined(__GNUC__)
+  for (; k + 2 <= len; k += 2) one(k);
+#endif
+  for (; k < len; ++k) scalar(k);
+  return acc;
+}
+
+// Levels j0 + 1 .. j1 from level j0 (whole arrays S0, E0; S0 == nullptr:
+// zero) for the indices [a, b) of every level and the margin the higher
+// levels of this call need: adds the sum of S_m^2 over the terms in
+// [a, b) to sq[j]; writes level j1 on [a, b) into S1, E1 when given.
+// Level j's ring holds the 2^(j+1) + 2 tiles its reader needs; a level
+// waits while its reader has not consumed the oldest values.
+void octave_wave(const double* S0, const double* E0, int j0, int j1,
+                 R_xlen_t a, R_xlen_t b, R_xlen_t L, double* sq, double* S1,
+                 double* E1) {
+  const int nl = j1 - j0;
+  std::vector<Level> lv(nl + 1);
+  auto npts = [L](int j) { return L - (R_xlen_t(2) << j) + 1; };
+  lv[0].S = const_cast<double*>(S0);
+  lv[0].E = const_cast<double*>(E0);
+  lv[0].R = 0;
+  lv[0].prod = npts(j0);
+  for (int k = 1; k <= nl; ++k) {
+    const int j = j0 + k;
+    const R_xlen_t margin = (R_xlen_t(2) << j1) - (R_xlen_t(2) << j);
+    Level& v = lv[k];
+    v.prod = a;
+    v.hi = std::min(npts(j), b + margin);
+    v.R = k < nl ? (R_xlen_t(2) << j) + 2 * kTile : kTile;
+    v.own_s.reset(new double[v.R]);
+    v.own_e.reset(new double[v.R]);
+    v.S = v.own_s.get();
+    v.E = v.own_e.get();
+  }
+  long sweeps = 0;
+  for (;;) {
+    if ((++sweeps & 63) == 0 && allanvar::interrupted()) return;
+    bool moved = false;
+    for (int k = 1; k <= nl; ++k) {
+      Level& v = lv[k];
+      const R_xlen_t p = v.prod;
+      if (p >= v.hi) continue;
+      const R_xlen_t len = std::min(kTile, v.hi - p);
+      const R_xlen_t m = R_xlen_t(1) << (j0 + k - 1);
+      const Level& u = lv[k - 1];
+      if (k > 1 && u.prod < p + len + 2 * m) continue;  // input not ready
+      if (k < nl && lv[k + 1].prod < lv[k + 1].hi &&
+          p + len - lv[k + 1].prod > v.R)
+        continue;  // its reader still needs the values this tile would replace
+      const int j = j0 + k;
+      const R_xlen_t q1 = std::min(b, npts(j) - 1);  // terms end
+      const double h = 0.5 * static_cast<double>(m);
+      for (R_xlen_t i = p; i < p + len;) {
+        R_xlen_t l = std::min(p + len - i, v.run(i));
+        l = std::min(l, u.run(i));
+        l = std::min(l, u.run(i + m));
+        l = std::min(l, u.run(i + 2 * m));
+        const R_xlen_t i0 = u.pos(i), i1 = u.pos(i + m), i2 = u.pos(i + 2 * m);
+        double* os = v.S + v.pos(i);
+        double* oe = v.E + v.pos(i);
+        const R_xlen_t nsq = std::max<R_xlen_t>(0, std::min(l, q1 - i));
+        sq[j] += u.S == nullptr
+                     ? double_level<true>(nullptr, nullptr, nullptr, u.E + i0,
+                                          u.E + i1, u.E + i2, h, l, nsq, os, oe)
+                     : double_level<false>(u.S + i0, u.S + i1, u.S + i2,
+                                           u.E + i0, u.E + i1, u.E + i2, h, l,
+                                           nsq, os, oe);
+        if (k == nl && S1 != nullptr) {
+          const R_xlen_t w1 = std::min(i + l, b);
+          if (w1 > i) {
+            std::copy(os, os + (w1 - i), S1 + i);
+            std::copy(oe, oe + (w1 - i), E1 + i);
+          }
+        }
+        i += l;
+      }
+      v.prod = p + len;
+      moved = true;
+    }
+    if (!moved) break;
+  }
+  for (int k = 1; k <= nl; ++k)
+    if (lv[k].prod < lv[k].hi) throw std::logic_error("pdev: octave levels stalled");
+}
+
+// Sums of (2 S_i)^2 for m = 2^j, j = 1..K (sums[j]) and of squared second
+// differences (sums[0]); every level is needed up to K.
+std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
+                                int nw) {
+  const R_xlen_t L = in.length();
+  std::vector<double> sums(K + 1, 0.0);
+  const R_xlen_t n0 = L - 1;  // level 0: E_1(i), i < L - 1
+  std::unique_ptr<double[]> Sa, Ea(new double[n0]), Sb, Eb;
+  // E_1 centred by the mean increment: any constant would do (S ignores
+  // it exactly), so a plain sum is enough; each E_1 is then the rounded
+  // exact increment less c
+  double* E = Ea.get();
+  if (in.rate) {
+    double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+    R_xlen_t i = 0;
+    for (; i + 4 <= n0; i += 4) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
+      a0 += in.v[i];
+      a1 += in.v[i + 1];
+      a2 += in.v[i + 2];
+      a3 += in.v[i + 3];
+    }
+    for (; i < n0; ++i) a0 += in.v[i];
+    const double c = ((a0 + a1) + (a2 + a3)) / static_cast<double>(n0);
+    for (i = 0; i < n0; ++i) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
+      E[i] = c - in.v[i];
+    }
+  } else {
+    double a0 = 0;
+    for (R_xlen_t i = 0; i < n0; ++i) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
+      double h, lo;
+      in.increment(i, h, lo);
+      a0 += h;
+    }
+    const double c = a0 / static_cast<double>(n0);
+    for (R_xlen_t i = 0; i < n0; ++i) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
+      double h, lo, r, re;
+      in.increment(i, h, lo);
+      allanvar::phase_two_sum(h, -c, r, re);
+      E[i] = -(r + (re + lo));
+    }
+  }
+  {
+    double s0 = 0, s1 = 0;
+    R_xlen_t i = 0;
+    for (; i + 2 < L - 1; i += 2) {
+      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
+      const double d0 = E[i] - E[i + 1], d1 = E[i + 1] - E[i + 2];
+      s0 += d0 * d0;
+      s1 += d1 * d1;
+    }
+    for (; i < L - 2; ++i) {
+      const double d = E[i] - E[i + 1];
+      s0 += d * d;
+    }
+    sums[0] = s0 + s1;
+  }
+  // groups of levels: kRanges ranges of indices (for threads; fixed, so
+  // that the sums do not depend on the number of threads) while the margin
+  // the group's top level needs (2^(j1+1)) stays small beside each range
+  int j0 = 0;
+  while (j0 < K) {
+    const R_xlen_t n = L - (R_xlen_t(2) << j0) + 1;
+    int j1 = j0 + 1;
+    while (j1 < K && (R_xlen_t(2) << (j1 + 1)) * 8 * kRanges <= n) ++j1;
+    const bool split = (R_xlen_t(2) << j1) * 8 * kRanges <= n;
+    if (!split) j1 = K;
+    const int nr = split ? kRanges : 1;
+    const bool last = j1 == K;
+    if (!last && !Sb) {
+      const R_xlen_t n1 = L - (R_xlen_t(2) << j1) + 1;
+      Sb.reset(new double[n1]);
+      Eb.reset(new double[n1]);
+    }
+    std::vector<std::vector<double> > sq(nr, std::vector<double>(K + 1, 0.0));
+    const R_xlen_t nj = L - (R_xlen_t(2) << (j0 + 1)) + 1;  // level j0 + 1
+    allanvar::parallel_for(nr, nw, [&](R_xlen_t r, int) {
+      const R_xlen_t a = nj * r / nr, b = nj * (r + 1) / nr;
+      octave_wave(Sa.get(), Ea.get(), j0, j1, a, b, L, sq[r].data(),
+                  last ? nullptr : Sb.get(), last ? nullptr : Eb.get());
+    });
+    if (allanvar::interrupted()) return sums;
+    for (int r = 0; r < nr; ++r)
+      for (int j = j0 + 1; j <= j1; ++j) sums[j] += sq[r][j];
+    if (!last) {
+      // the next group reads these; the old arrays take its output (they
+      // are longer than it)
+      Sa.swap(Sb);
+      Ea.swap(Eb);
+      if (!Sb) {
+        Sb.reset(new double[n0]);
+      }
+    }
+    j0 = j1;
+  }
+  for (int j = 1; j <= K; ++j) sums[j] *= 4.0;
+  return sums;
+}
+
 const R_xlen_t kChunk = 1 << 16;  // terms per parallel item (global kernel)
 const R_xlen_t kBlock = 4096;     // terms per cache block, every tau in turn
 
@@ -183,7 +456,10 @@ const R_xlen_t kBlock = 4096;     // terms per cache block, every tau in turn
 // Sums of (2 S_i)^2 (m >= 2) or of squared second differences (m = 1) over
 // the terms of every m, for one channel. method: 0 chooses (the global
 // kernel, and the blocked one for the m where the global kernel's rounding
-// bound exceeds 1e-13 relative), 1 the blocked kernel, 2 the global one.
+// bound exceeds 1e-13 relative; the doubling recursion for the powers of
+// two when most levels up to the largest are asked for), 1 the blocked
+// kernel, 2 the global one, 3 the doubling recursion for the powers of two
+// (the global kernel for the other m).
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
                                   const Rcpp::NumericVector& m, int threads,
@@ -194,14 +470,9 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   const std::vector<double> ms(m.begin(), m.end());
   const size_t nt = ms.size();
   const int nw = std::max(1, threads);
-  // the phase once, split hi + lo; each block re-centres it (its first
-  // point and the chord's slope removed), exact differences on the hi grid
-  allanvar::SplitPhase X;
-  allanvar::split_phase(in, X);
-  const double* hx = X.hi.data();
-  const double* lx = X.lo.data();
   std::vector<R_xlen_t> mv(nt, 0), nterm(nt, 0);
   std::vector<bool> glob(nt, false);
+  std::vector<double> res(nt, 0.0);
   for (size_t t = 0; t < nt; ++t) {
     const R_xlen_t mm = static_cast<R_xlen_t>(ms[t]);
     const R_xlen_t M = mm == 1 ? L - 2 : L - 2 * mm;
@@ -210,9 +481,45 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     nterm[t] = M;
     glob[t] = method != 1 && mm >= 2 && mm < (R_xlen_t(1) << 26);
   }
+  // powers of two by the doubling recursion when it pays: it walks every
+  // level up to the largest, so it is chosen when at least half of them
+  // are asked for (method 3: always)
+  std::vector<bool> oct(nt, false);
+  int K = -1, nask = 0;
+  if (method == 0 || method == 3) {
+    for (size_t t = 0; t < nt; ++t) {
+      const R_xlen_t mm = mv[t];
+      if (mm < 1 || (mm & (mm - 1)) != 0) continue;
+      int j = 0;
+      while ((R_xlen_t(1) << j) < mm) ++j;
+      K = std::max(K, j);
+      ++nask;
+    }
+    if (K >= 0 && (method == 3 || 2 * nask >= K + 1)) {
+      const std::vector<double> os = octave_sums(in, K, nw);
+      if (allanvar::interrupted()) scope.finish();
+      for (size_t t = 0; t < nt; ++t) {
+        const R_xlen_t mm = mv[t];
+        if (mm < 1 || (mm & (mm - 1)) != 0) continue;
+        int j = 0;
+        while ((R_xlen_t(1) << j) < mm) ++j;
+        oct[t] = true;
+        glob[t] = false;
+        res[t] = os[j];
+      }
+    }
+  }
   Rcpp::NumericVector out(nt, NA_REAL);
-  std::vector<double> res(nt, 0.0);
   std::vector<bool> redo(nt, false);
+  // the phase once, split hi + lo, for the other m; each block re-centres
+  // it (its first point and the chord's slope removed), exact differences
+  // on the hi grid
+  allanvar::SplitPhase X;
+  bool any_other = false;
+  for (size_t t = 0; t < nt; ++t) any_other = any_other || (mv[t] >= 1 && !oct[t]);
+  if (any_other) allanvar::split_phase(in, X);
+  const double* hx = X.hi.data();
+  const double* lx = X.lo.data();
   bool any_glob = false;
   for (size_t t = 0; t < nt; ++t) any_glob = any_glob || glob[t];
   if (any_glob) {
@@ -255,7 +562,7 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   std::vector<Item> items;
   for (size_t t = 0; t < nt; ++t) {
     const R_xlen_t mm = mv[t], M = nterm[t];
-    if (mm < 1 || (glob[t] && !redo[t])) continue;
+    if (mm < 1 || oct[t] || (glob[t] && !redo[t])) continue;
     // blocks of a few m: the prefix sums then cancel by at most (span/m)^2.5
     const R_xlen_t B = std::max<R_xlen_t>(2 * mm, std::min<R_xlen_t>(1024, 32 * mm));
     for (R_xlen_t i0 = 0; i0 < M; i0 += B)
@@ -287,7 +594,7 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   for (size_t t = 0; t < nt; ++t) {
     if (sums.any(t)) {
       out[t] = sums.value(t);
-    } else if (glob[t]) {
+    } else if (glob[t] || oct[t]) {
       out[t] = res[t];
     }
   }

@@ -302,6 +302,31 @@ test_that("the Total family's closed form equals its direct evaluation", {
   }
 })
 
+test_that("PDEV's doubling recursion (octave m) equals the other kernels", {
+  set.seed(18)
+  N <- 20000  # long enough for every grouping of levels (src/pdev.cpp)
+  sets <- four_noises(N)
+  sets$offset <- cumsum(rnorm(N, 1e6))
+  m <- 2^(0:13)
+  for (nm in names(sets)) {
+    x <- sets[[nm]]
+    blocked <- pdev_sums_cpp(x, FALSE, m, 2L, 1L)
+    octave <- pdev_sums_cpp(x, FALSE, m, 2L, 3L)
+    expect_lt(max(abs(octave / blocked - 1)), 1e-10, label = nm)
+    # the same sums whatever the number of threads, and chosen by default
+    expect_identical(pdev_sums_cpp(x, FALSE, m, 1L, 3L), octave, label = nm)
+    expect_identical(pdev_sums_cpp(x, FALSE, m, 2L, 0L), octave, label = nm)
+    y <- diff(x)
+    expect_lt(max(abs(pdev_sums_cpp(y, TRUE, m, 2L, 3L) / blocked - 1)),
+              1e-10, label = nm)
+  }
+  # against the definition, where a plain sum has nothing to cancel
+  x <- sets$wpm
+  mm <- c(2, 64, 4096, 8192)
+  ref <- vapply(mm, function(k) ref_pvar(x, k) * (N - 2 * k) * k^6 / 18, 0)
+  expect_lt(max(abs(pdev_sums_cpp(x, FALSE, mm, 2L, 3L) / ref - 1)), 1e-12)
+})
+
 test_that("PDEV keeps its digits on long random-walk records", {
   set.seed(16)
   N <- 4000
