@@ -575,7 +575,7 @@ extra_alpha <- function(v, freq, m, base, input, L) {
     # data whose sums over- or underflow, kept out by the range above.
     res <- allan_call_kernel(
       allan_sums_cpp(v, length(v), u, allan_nterms(base, u, L), u,
-                     allan_opts(base, input == "rate")),
+                     allan_opts(base, input == "rate", sums = FALSE)),
       length(v), 1L)
     tab <- allan_type_table()
     lo <- if (tab$d[match(base, tab$name)] == 3) -4L else -2L

@@ -24,11 +24,12 @@ allan_type_code <- function(type) {
 
 # The options the sums kernel reads (src/opts-allan.h), built once per call.
 allan_opts <- function(type, rate, octave = FALSE,
-                       threads = allanvar_threads()) {
+                       threads = allanvar_threads(), sums = TRUE) {
   rules <- noise_id_rules()
   list(type = allan_type_code(type), rate = isTRUE(rate),
        octave = isTRUE(octave), threads = as.integer(threads),
-       stable32_b1 = rules$b1, acf_min = rules$acf_min)
+       stable32_b1 = rules$b1, acf_min = rules$acf_min,
+       sums = isTRUE(sums))
 }
 
 # The noise-identification rules (src/noise_id.h): by default the lag-1 ACF

@@ -682,7 +682,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     build_prefix(v, N, c, bound, level, X, threads, main);
   }
   double* o = out.sums.data();
-  switch (type) {
+  // identification alone (other statistics' noise type) needs no sums
+  if (opts.sums) switch (type) {
     case STANDARD: strided<2>(X, ms, nterms, threads, main, o); break;
     case OVERLAPPING: overlapped<2>(X, ms, nterms, threads, main, o); break;
     case MODIFIED: overlapped<3>(X, ms, nterms, threads, main, o); break;

@@ -17,6 +17,7 @@ struct AllanOptions {
   int threads;   // threads the kernel may use (>= 1)
   bool stable32_b1 = false;  // B1's N as Stable32 for every boundary
   R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
+  bool sums = true;          // false: noise identification only (no sums)
 };
 
 inline bool opt_flag(const Rcpp::List& o, const char* name) {
@@ -48,6 +49,7 @@ inline AllanOptions allan_options(const Rcpp::List& o) {
     opts.acf_min = opt_int(o, "acf_min");
     if (opts.acf_min < 4) Rcpp::stop("internal: allan option `acf_min` < 4");
   }
+  if (o.containsElementNamed("sums")) opts.sums = opt_flag(o, "sums");
   if (opts.octave && (opts.type != STANDARD || !opts.rate))
     Rcpp::stop("internal: the octave kernel is for standard rate input only");
   return opts;

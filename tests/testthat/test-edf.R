@@ -268,3 +268,14 @@ test_that("Theo1's EDF (Howe & Peppler, SP 1065) matches Monte Carlo at a known 
                 info = paste(g, toString(signif(e[keep] / mc[keep], 3))))
   }
 })
+
+test_that("the further types' noise type (identification without sums) is allan()'s own", {
+  set.seed(31)
+  x <- cumsum(rnorm(3000)) + rnorm(3000, sd = 5)
+  m <- c(1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1000)
+  for (base in c("modified", "ohadamard", "overlapping")) {
+    ref <- allan(x, 1, taus = I(m), type = base)
+    got <- allanvar:::extra_alpha(x, 1, m, base, "rate", length(x) + 1)
+    expect_identical(as.integer(got[match(ref$m, m)]), as.integer(ref$alpha))
+  }
+})
