@@ -394,9 +394,23 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       args <- refit_args(current, current$terms, settings,
                          start = stats::coef(current)[current$layout$role == "nonlinear"])
       args$tau_range <- c(keep_from, Inf)
-      trimmed <- try_refit(args, function(cnd, stage) {
+      rec <- function(cnd, stage) {
         failures <<- add_failure(failures, cnd, length(steps) + 1L, "tau_range", stage)
-      }, "refit without the first points")
+      }
+      trimmed <- try_refit(args, rec, "refit without the first points")
+      # without the first points a free nonlinear parameter may run off to
+      # values the raw data contradict (a resonance's tc to a pure tone);
+      # then the effects keep the nonlinear values the full curve gave them
+      # and only the amplitudes are refitted
+      if (is.null(trimmed) || !earlier_hold(trimmed)) {
+        nl <- stats::coef(current)[current$layout$role == "nonlinear"]
+        nl <- nl[!names(nl) %in% names(settings$fixed)]
+        if (length(nl)) {
+          args_h <- refit_args(current, current$terms, settings, hold = nl)
+          args_h$tau_range <- c(keep_from, Inf)
+          trimmed <- try_refit(args_h, rec, "refit without the first points, nonlinear held")
+        }
+      }
       if (!is.null(trimmed) && earlier_hold(trimmed)) {
         tau_range <- c(keep_from, max(tau_all))
         message(sprintf(paste(
