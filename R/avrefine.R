@@ -252,6 +252,59 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     }
     TRUE
   }
+  # The filter's family was chosen against the model of the step it entered
+  # at; the effects added since can change which family describes the
+  # short-tau end (a first-order low-pass chosen before the 0.55 Hz line ran
+  # to its Nyquist bound). So it is chosen again on the final model: each
+  # other family refitted with everything free; the criterion chooses, and
+  # the new family must be admissible and not contradicted by the raw data,
+  # nor move an effect accepted earlier to values the raw data contradict.
+  # When no candidate pays, the loop asks this once more and goes on after
+  # a change (the effects that pay may differ under the new family).
+  rechoose_filter <- function() {
+    fi <- grep("^filter", current$terms, value = TRUE)
+    if (length(fi) == 1L && length(steps)) {
+      rest <- current$terms[current$terms != fi]
+      old_lab <- term_labels(current$terms)[current$terms == fi]
+      nl_cur <- stats::coef(current)[current$layout$role == "nonlinear"]
+      swap <- NULL
+      for (v in setdiff(c("filter", "filter:lp1", "filter:lp2"), fi)) {
+        lab <- new_label(rest, v)
+        st <- raw$filter$start[[if (v == "filter") "ma" else sub("^filter:", "", v)]]
+        start <- c(nl_cur[!startsWith(names(nl_cur), paste0(old_lab, "."))],
+                   if (length(st)) stats::setNames(unlist(st), paste0(lab, ".", names(st))))
+        start <- start[names(start) %in% coef_layout(c(rest, v))$name]
+        args <- refit_args(current, c(rest, v), settings, start = start)
+        g <- try_refit(args, function(cnd, stage) {
+          failures <<- add_failure(failures, cnd, length(steps) + 1L, v, stage)
+        }, "filter family chosen again")
+        if (is.null(g) || !is.finite(crit(g)) ||
+            crit(g) >= min(crit(current), swap$crit %||% Inf) - min_gain) next
+        par <- instance_params(stats::coef(g), g$layout, lab)
+        if (!is.null(inadmissible(v, par, g$data$tau, freq))) next
+        ev <- raw_evidence(v, as.list(par), raw, evidence_series(v), freq)
+        if (isFALSE(ev$support) || !earlier_hold(g)) next
+        swap <- list(fit = g, crit = crit(g), effect = v, label = lab, par = par, ev = ev)
+      }
+      if (!is.null(swap)) {
+        loc <- locate_signature(sig, swap$fit, swap$label)
+        evidence <- paste0("the filter family chosen again on the final model (was ",
+                           fi, "); ", loc$text)
+        if (nzchar(swap$ev$text)) evidence <- paste0(evidence, "; raw data: ", swap$ev$text)
+        steps[[length(steps) + 1L]] <<- new_steps(
+          effect = swap$effect, label = swap$label,
+          tau_from = loc$tau_from, tau_to = loc$tau_to,
+          params = format_params(swap$par, swap$effect),
+          evidence = evidence, confirmed = swap$ev$support,
+          chi2_before = current$chi2, chi2_after = swap$fit$chi2,
+          rms_before = current$rms, rms_after = swap$fit$rms,
+          crit_before = crit(current), crit_after = swap$crit)
+        current <<- swap$fit
+        return(TRUE)
+      }
+    }
+    FALSE
+  }
   for (step in seq_len(max_steps)) {
     tau <- current$data$tau
     z <- stats::residuals(current)
@@ -363,7 +416,10 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       }
       if (!is.null(best)) break
     }
-    if (is.null(best)) break
+    if (is.null(best)) {
+      if (rechoose_filter()) next
+      break
+    }
     if (length(best$pin)) settings$fixed <- c(settings$fixed, best$pin)
     # Refit the winner with the held nonlinear parameters free again (the new
     # one starts where screening put it).
@@ -409,6 +465,8 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       crit_before = c0, crit_after = best$crit)
     current <- best$fit
   }
+  # the loop may have ended on a step that chose the family again
+  rechoose_filter()
   all_steps <- Reduce(bind_steps, steps, fit$steps)
   # What is left: residual structure no catalogue effect explained.
   sig <- residual_signatures(current$data$tau, stats::residuals(current), level = level)
@@ -426,9 +484,23 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       args <- refit_args(current, current$terms, settings,
                          start = stats::coef(current)[current$layout$role == "nonlinear"])
       args$tau_range <- c(keep_from, Inf)
-      trimmed <- try_refit(args, function(cnd, stage) {
+      rec <- function(cnd, stage) {
         failures <<- add_failure(failures, cnd, length(steps) + 1L, "tau_range", stage)
-      }, "refit without the first points")
+      }
+      trimmed <- try_refit(args, rec, "refit without the first points")
+      # without the first points a free nonlinear parameter may run off to
+      # values the raw data contradict (a resonance's tc to a pure tone);
+      # then the effects keep the nonlinear values the full curve gave them
+      # and only the amplitudes are refitted
+      if (is.null(trimmed) || !earlier_hold(trimmed)) {
+        nl <- stats::coef(current)[current$layout$role == "nonlinear"]
+        nl <- nl[!names(nl) %in% names(settings$fixed)]
+        if (length(nl)) {
+          args_h <- refit_args(current, current$terms, settings, hold = nl)
+          args_h$tau_range <- c(keep_from, Inf)
+          trimmed <- try_refit(args_h, rec, "refit without the first points, nonlinear held")
+        }
+      }
       if (!is.null(trimmed) && earlier_hold(trimmed)) {
         tau_range <- c(keep_from, max(tau_all))
         message(sprintf(paste(

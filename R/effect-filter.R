@@ -151,11 +151,12 @@ effect_resonance <- function() {
                             raw$bands %||% find_bands(x, freq))
     },
     # A broad band of the periodogram proposes a resonance twice: its
-    # centre pinned where find_bands() measures it (the curve alone may
-    # place fr poorly: it sees the band only through the AV's sinc filter),
-    # and free from there (a band that is not quite Lorentzian puts its
-    # AV-equivalent centre elsewhere). The criterion chooses; the raw-data
-    # check still asks for the band within half its width of fr.
+    # centre and width pinned where find_bands() measures them (the curve
+    # sees the band only through the AV's sinc filter: it places fr poorly
+    # and cannot tell a band 0.5 Hz wide from a tone, so a free tc runs
+    # off), and free from there (a band that is not quite Lorentzian puts
+    # its AV-equivalent centre elsewhere). The criterion chooses; the
+    # raw-data check still asks for the band within half its width of fr.
     propose = function(raw, tau, sig) {
       b <- raw$bands
       out <- list()
@@ -170,7 +171,7 @@ effect_resonance <- function() {
                         100 * b$share[j])
         one <- list(init = st, tau_from = 0.371 / st$fr / 2, tau_to = 2 / st$fr,
                     score = 2, note = note)
-        out[[length(out) + 1L]] <- c(one, list(pin = list(fr = b$f_center[j])))
+        out[[length(out) + 1L]] <- c(one, list(pin = list(fr = b$f_center[j], tc = b$tc[j])))
         out[[length(out) + 1L]] <- one
       }
       out

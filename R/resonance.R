@@ -61,9 +61,9 @@ sim_resonance <- function(n, tau0, sigma, fr, tc) {
 #'
 #' Narrow-band processes found at a coarse resolution (`seg` samples per
 #' Welch segment, default 512). Pass 1: bins standing above a wide (about
-#' an octave) running-median background by a factor `min_ratio`,
-#' significant by the Welch EDF, in contiguous runs of at least `min_bins`
-#' bins. Pass 2: those runs, widened by their own width on each side, are
+#' an octave) running-median background significantly (the Welch
+#' estimate's chi-square with its EDF, false-alarm rate `alpha` over the
+#' bins searched), in contiguous runs of at least `min_bins` bins. Pass 2: those runs, widened by their own width on each side, are
 #' masked and the background is re-read from the bins around them (a band
 #' lifts the median of its own window). Each band is then described by the
 #' resonance model fitted to the excess over the background by least
@@ -72,8 +72,7 @@ sim_resonance <- function(n, tau0, sigma, fr, tc) {
 #' sigma^2) and `share` of the series' variance.
 #' Cost O(n log seg).
 #' @noRd
-find_bands <- function(x, freq, seg = 512L, min_ratio = 2, min_bins = 3L,
-                       alpha = 1e-3) {
+find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
   n <- length(x)
   tau0 <- 1 / freq
   seg <- as.integer(min(seg, 2^floor(log2(n / 8))))
@@ -83,12 +82,27 @@ find_bands <- function(x, freq, seg = 512L, min_ratio = 2, min_bins = 3L,
   lp <- log(pmax(p, .Machine$double.xmin))
   corr <- log(stats::qchisq(0.5, w$nu) / w$nu)
   octave <- function(i) 2L * as.integer(max(8, 0.35 * i)) + 1L
+  edge <- octave(1L) %/% 2L + 1L
   runs <- function(bg) {
     ratio <- p / bg
     pval <- stats::pchisq(ratio * w$nu, w$nu, lower.tail = FALSE)
-    hot <- ratio > min_ratio & pval * nb < alpha
-    hot[seq_len(min(4L, nb))] <- FALSE
+    # significant against the Welch estimate's chi-square (EDF nu), with a
+    # false-alarm rate alpha over the nb bins searched (Bonferroni); no
+    # fixed power ratio (a weak band over a long record is still a band)
+    hot <- ratio > 1 & pval * nb < alpha
+    # only where the background window is centred: at the low end it slides
+    # up in frequency and under-reads a falling spectrum (RW, GM, roll-off)
+    hot[seq_len(min(nb, edge))] <- FALSE
+    # one band is one run: a gap between hot runs shorter than min_bins, or
+    # than a quarter of the wider neighbour (a broad band's tail broken up
+    # by the noise), is closed, so one band is not fitted as two
     r <- rle(hot)
+    nr <- length(r$values)
+    nbr <- pmax(c(0L, r$lengths[-nr]), c(r$lengths[-1L], 0L))
+    gap <- !r$values & (r$lengths < min_bins | 4L * r$lengths < nbr) &
+      seq_len(nr) > 1L & seq_len(nr) < nr
+    r$values[gap] <- TRUE
+    r <- rle(inverse.rle(r))
     ends <- cumsum(r$lengths)
     starts <- ends - r$lengths + 1L
     keep <- which(r$values & r$lengths >= min_bins)
@@ -116,7 +130,11 @@ find_bands <- function(x, freq, seg = 512L, min_ratio = 2, min_bins = 3L,
     fc <- sum(w$f[j] * ex) / sum(ex)
     sdf <- sqrt(sum((w$f[j] - fc)^2 * ex) / sum(ex))
     wd <- length(j)
-    reg <- max(2L, r2$from[k] - 2L * wd):min(nb, r2$to[k] + 2L * wd)
+    # the fit region stops short of the neighbouring bands (else a weak
+    # band's fit slides onto a strong neighbour)
+    lo <- if (k > 1L) r2$to[k - 1L] + 1L else 2L
+    hi <- if (k < length(r2$from)) r2$from[k + 1L] - 1L else nb
+    reg <- max(2L, lo, r2$from[k] - 2L * wd):min(nb, hi, r2$to[k] + 2L * wd)
     fit <- fit_lorentz(w$f[reg], p[reg] - bg[reg], bg[reg], tau0,
                        fc, sum(ex) * w$df, max(sdf, w$df))
     data.frame(f_center = fit$fr, f_from = w$f[j[1L]], f_to = w$f[j[length(j)]],

@@ -85,3 +85,30 @@ test_that("with raw data, a sinusoid within 4 periodogram bins of DC is not take
   raw2 <- avdiagnose(y, freq)
   expect_true(evidence_sinusoid(list(amp = 0.5, f0 = 3), raw2, y, freq)$support)
 })
+
+test_that("a weak narrow band (below 2x its background): a resonance at the band's centre and width, not a tone", {
+  skip_on_cran()
+  # a 10 Hz band 0.6 Hz wide (tc = 0.5 s) carrying under 1% of the variance
+  # over a 4-tap moving average: the case the old fixed 2x threshold missed
+  # and a free damping time turned into a tone
+  set.seed(21)
+  n <- 4e5
+  freq <- 100
+  N <- 0.05
+  e <- stats::rnorm(n + 3L, sd = N * sqrt(freq))
+  z <- ar2_resonance(n, 10, 0.5, 1, freq)
+  x <- stats::filter(e, rep(0.25, 4), sides = 1L)[-(1:3)] +
+    0.08 * N * sqrt(freq) * z / stats::sd(z) + cumsum(stats::rnorm(n, sd = 1e-4))
+  b <- find_bands(x, freq)
+  expect_equal(nrow(b), 1L)
+  expect_lt(b$peak_ratio, 2)
+  fit <- avfit(allan(x, freq, taus = 10, type = "overlapping"), terms = c("N", "B", "K"))
+  ref <- suppressMessages(avrefine(fit, data = x, max_steps = 4))
+  cf <- stats::coef(ref)
+  expect_true("resonance" %in% ref$steps$effect)
+  expect_lt(abs(cf[["resonance.fr"]] - 10), attr(b, "resolution"))
+  # its width 1/(pi tc) within 3x of the band's, not a tone
+  expect_lt(abs(log(cf[["resonance.tc"]] / 0.5)), log(3))
+  expect_false(any(ref$steps$confirmed %in% FALSE))
+  expect_false(any(abs(cf[grepl("\\.f0$", names(cf))] - 10) < 1))
+})

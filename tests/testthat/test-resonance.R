@@ -75,3 +75,39 @@ test_that("the raw data support a resonance where a band is, and contradict one 
   expect_false(resonance_raw_support(0.8, 7, 0.08, b)$support)
   expect_false(resonance_raw_support(0.8, 20, 0.08, find_bands(rnorm(n), 100))$support)
 })
+
+test_that("find_bands invents no band on smooth spectra (own generators, 10 seeds each)", {
+  # white, a 4-tap moving average, a first-order low-pass, white + random
+  # walk and white + a slow Gauss-Markov: monotone spectra with no band;
+  # the threshold is the Welch chi-square's alone (no fixed power ratio)
+  n <- 2e5
+  gens <- list(
+    white = function() rnorm(n),
+    ma4 = function() as.numeric(stats::filter(rnorm(n + 3), rep(0.25, 4), sides = 1))[-(1:3)],
+    lp1 = function() as.numeric(stats::filter(rnorm(n), 0.7, method = "recursive")),
+    rw = function() rnorm(n) + cumsum(rnorm(n, sd = 0.05)),
+    gm = function() rnorm(n) + 3 * as.numeric(stats::filter(
+      rnorm(n, sd = sqrt(1 - 0.999^2)), 0.999, method = "recursive")))
+  for (nm in names(gens)) {
+    found <- vapply(1:10, function(s) {
+      set.seed(700 + s)
+      nrow(find_bands(gens[[nm]](), 100))
+    }, 0L)
+    expect_equal(sum(found), 0L, label = nm)
+  }
+})
+
+test_that("find_bands finds a weak band (peak about 1.5x the background) at 1e6 samples", {
+  # a band far below the old fixed 2x threshold, significant by the EDF
+  set.seed(41)
+  n <- 1e6
+  r <- exp(-0.01 / 0.5)
+  w0 <- 2 * pi * 10 / 100
+  z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
+  x <- as.numeric(stats::filter(rnorm(n + 3), rep(0.25, 4), sides = 1))[-(1:3)] +
+    0.1 * z / stats::sd(z)
+  b <- find_bands(x, 100)
+  expect_equal(nrow(b), 1L)
+  expect_equal(b$f_center, 10, tolerance = 0.02)
+  expect_lt(b$peak_ratio, 2)
+})
