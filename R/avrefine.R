@@ -291,14 +291,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
         evidence <- paste0("the filter family chosen again on the final model (was ",
                            fi, "); ", loc$text)
         if (nzchar(swap$ev$text)) evidence <- paste0(evidence, "; raw data: ", swap$ev$text)
-        steps[[length(steps) + 1L]] <<- new_steps(
-          effect = swap$effect, label = swap$label,
-          tau_from = loc$tau_from, tau_to = loc$tau_to,
-          params = format_params(swap$par, swap$effect),
-          evidence = evidence, confirmed = swap$ev$support,
-          chi2_before = current$chi2, chi2_after = swap$fit$chi2,
-          rms_before = current$rms, rms_after = swap$fit$rms,
-          crit_before = crit(current), crit_after = swap$crit)
+        steps[[length(steps) + 1L]] <<- step_row(
+          swap$effect, swap$label, loc, swap$par, evidence, swap$ev$support,
+          current, swap$fit, crit(current), swap$crit)
         current <<- swap$fit
         return(TRUE)
       }
@@ -455,14 +450,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
       evidence <- paste0(evidence, "; raw data: ", best$ev$text,
                          if (isFALSE(best$ev$support)) " (NOT supported by the raw data)")
     }
-    steps[[length(steps) + 1L]] <- new_steps(
-      effect = tr$effect, label = best$label,
-      tau_from = loc$tau_from, tau_to = loc$tau_to,
-      params = format_params(best$params, tr$effect),
-      evidence = evidence, confirmed = best$ev$support,
-      chi2_before = current$chi2, chi2_after = best$fit$chi2,
-      rms_before = current$rms, rms_after = best$fit$rms,
-      crit_before = c0, crit_after = best$crit)
+    steps[[length(steps) + 1L]] <- step_row(
+      tr$effect, best$label, loc, best$params, evidence, best$ev$support,
+      current, best$fit, c0, best$crit)
     current <- best$fit
   }
   # the loop may have ended on a step that chose the family again
@@ -833,4 +823,17 @@ max_share <- function(fit, label) {
   comp <- fit$components
   if (!label %in% colnames(comp)) return(1)
   max(comp[, label] / rowSums(comp))
+}
+
+# One accepted step: the effect, where its signature sits (`loc`), its
+# parameters, the evidence, and the fit before and after it.
+step_row <- function(effect, label, loc, par, evidence, confirmed, before,
+                     after, crit_before, crit_after) {
+  new_steps(effect = effect, label = label,
+            tau_from = loc$tau_from, tau_to = loc$tau_to,
+            params = format_params(par, effect),
+            evidence = evidence, confirmed = confirmed,
+            chi2_before = before$chi2, chi2_after = after$chi2,
+            rms_before = before$rms, rms_after = after$rms,
+            crit_before = crit_before, crit_after = crit_after)
 }
