@@ -154,6 +154,15 @@ filter_acf <- function(spec, tau0, lags) {
   g / tau0
 }
 
+# S = sum_k g(k) and C = sum_{j >= 1} j g(j) of the moving average of
+# length L in closed form (g(k) = max(L - |k|, 0) / (tot tau0), unit DC).
+ma_sums <- function(L, tau0) {
+  fl <- floor(L)
+  tot <- L + 2 * (fl * L - fl * (fl + 1) / 2)
+  list(S = 1 / tau0,
+       C = (L * fl * (fl + 1) / 2 - fl * (fl + 1) * (2 * fl + 1) / 6) / (tot * tau0))
+}
+
 # Lags beyond which the autocovariance is zero (FIR, ma) or Inf (IIR).
 filter_support <- function(spec) {
   if (spec$family == "ma") return(ceiling(spec$L))
@@ -169,7 +178,7 @@ filter_support <- function(spec) {
 # It needs lags < 2m only, and for m >= K collapses to
 #   AV(m) = S / m - 3 C / m^2,  S = g(0) + 2 sum_{j>=1} g(j),  C = sum_j j g(j),
 # so each m costs O(min(m, K)). m must be whole here.
-acov_av <- function(m, g) {
+acov_av <- function(m, g, sums = NULL) {
   K <- length(g)
   gz <- function(k) {
     out <- numeric(length(k))
@@ -179,6 +188,12 @@ acov_av <- function(m, g) {
   }
   S <- g[1L] + 2 * sum(g[-1L])
   C <- sum(seq_len(K - 1L) * g[-1L])
+  # `sums` (S and C of the whole support) when g holds only the first lags:
+  # then every m is below K and reads lags < 2m < K
+  if (!is.null(sums)) {
+    S <- sums$S
+    C <- sums$C
+  }
   vapply(m, function(mm) {
     if (mm >= K) return(S / mm - 3 * C / mm^2)
     i <- seq_len(mm - 1L)
@@ -210,22 +225,32 @@ filter_av <- function(m, spec, tau0) {
     return(Re(out) / tau0)
   }
   K <- filter_support(spec)
-  g <- filter_acf(spec, tau0, 0:(K - 1L))
+  # AV(m) below the support reads lags < 2m only: a moving average longer
+  # than the curve (a search may try L = 1e9) must not allocate its support
+  need <- if (spec$family == "ma") min(K, 2 * ceiling(max(m)) + 2) else K
+  g <- filter_acf(spec, tau0, 0:(need - 1L))
   whole <- abs(m - round(m)) < 1e-9
   out <- numeric(length(m))
-  if (any(whole)) out[whole] <- acov_av(round(m[whole]), g)
+  if (any(whole)) {
+    out[whole] <- if (need == K) acov_av(round(m[whole]), g) else
+      acov_av(round(m[whole]), g, sums = ma_sums(spec$L, tau0))
+  }
   frac <- which(!whole)
   if (length(frac)) {
     mf <- m[frac]
     big <- mf >= K
-    S <- g[1L] + 2 * sum(g[-1L])
-    C <- sum(seq_len(K - 1L) * g[-1L])
+    sc <- if (need == K) list(S = g[1L] + 2 * sum(g[-1L]),
+                              C = sum(seq_len(K - 1L) * g[-1L])) else
+      ma_sums(spec$L, tau0)
+    S <- sc$S
+    C <- sc$C
     out[frac[big]] <- S / mf[big] - 3 * C / mf[big]^2
     sm <- frac[!big]
     if (length(sm)) {
       lo <- pmax(floor(m[sm]), 1)
       w <- m[sm] - lo
-      out[sm] <- (1 - w) * acov_av(lo, g) + w * acov_av(lo + 1, g)
+      sums <- if (need == K) NULL else ma_sums(spec$L, tau0)
+      out[sm] <- (1 - w) * acov_av(lo, g, sums) + w * acov_av(lo + 1, g, sums)
     }
   }
   out

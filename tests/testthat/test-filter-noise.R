@@ -229,3 +229,20 @@ test_that("the C++ Welch periodogram is R's matrix expression to rounding", {
   x <- rnorm(2.2e6)
   expect_equal(welch_psd_lin(x, 10, 4096L)$psd, ref(x, 10, 4096L), tolerance = 1e-12)
 })
+
+test_that("a moving average far longer than the curve's clusters needs only the lags it reads", {
+  # the search may try L far beyond the record: only lags < 2m are read
+  h <- rep(1 / 5000, 5000)
+  expect_equal(filter_av(m, filter_spec("ma", L = 5000), tau0), av_linear(h, m, 1 / tau0),
+               tolerance = 1e-10)
+  frac <- c(2.5, 7.25, 50.5)
+  lo <- floor(frac)
+  w <- frac - lo
+  expect_equal(filter_av(frac, filter_spec("ma", L = 5000), tau0),
+               (1 - w) * av_linear(h, lo, 1 / tau0) + w * av_linear(h, lo + 1, 1 / tau0),
+               tolerance = 1e-10)
+  # L = 1e9 (as a search may propose; filter_spec() itself refuses it)
+  # would need 8 GB of lags; the answer is finite and positive
+  v <- filter_av(c(1, 10, 1000), filter_spec_of("ma", list(L = 1e9), tau0), tau0)
+  expect_true(all(is.finite(v) & v > 0))
+})
