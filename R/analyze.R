@@ -57,7 +57,7 @@
 #' @param remove Non-stationary effects to take out of each axis before its
 #'   Allan deviation is computed (see [series_effects()]): e.g.
 #'   `c("spikes", "steps")`, or `"all"`; none by default. What was found
-#'   and removed is kept in each channel's `series`.
+#'   and removed is kept in each channel's `series` (without its series `x`).
 #' @param ... Further arguments passed to [avfit()].
 #' @return For one recording, an object of class `"imu_analysis"`: a list
 #'   with `name`, `freq`, `n` (samples used), `duration` (s), `record` (the
@@ -276,7 +276,7 @@ analyze_channel <- function(job, opts) {
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = failure$message, fit_condition = failure$condition,
-              coef = coef, readings = readings, series = series)
+              coef = coef, readings = readings, series = series_kept(series))
   res$guidance <- imu_guidance(res)
   res
 }

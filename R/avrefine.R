@@ -115,7 +115,8 @@
 #'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range) and
 #'   `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,
 #'   strength in sigma, size = largest ADEV error inside in percent,
-#'   description) and `series` the series pass (or NULL). The object keeps
+#'   description) and `series` the series pass (or NULL) without its
+#'   cleaned series `x` (the result does not carry a copy of the data). The object keeps
 #'   class `avfit`
 #'   (with `avrefine` in front, whose print method lists the steps), so
 #'   every avfit method applies.
@@ -507,7 +508,7 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   # Curve only: the accepted effects the raw data could not confirm.
   new_steps_df <- all_steps[seq_len(nrow(all_steps)) > NROW(fit$steps), , drop = FALSE]
   unconfirmed <- if (is.null(data)) new_steps_df$label else character()
-  current$series <- ser
+  current$series <- series_kept(ser)
   if (!is.null(raw)) raw$cache <- NULL
   current$refine <- list(candidates = candidates, criterion = criterion,
                          min_gain = min_gain, level = level, diagnostics = raw,

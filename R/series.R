@@ -146,6 +146,13 @@ remove_series <- function(x, freq, table) {
   x
 }
 
+# What a result keeps of a series pass: everything but the cleaned series
+# `x` (a fit or an analysis must not carry a second copy of the data).
+series_kept <- function(s) {
+  if (!is.null(s)) s$x <- NULL
+  s
+}
+
 # Allan deviation before and after taking out every instance found, and
 # per kind, on allan()'s octave grid.
 series_adev <- function(x, freq, table) {

@@ -119,8 +119,14 @@ adis16405_av <- list(
   source = paste("ADIS16405 static recordings, 3 units x 6 axes, 100 Hz, 1e6",
                  "samples each. Department of Geomatics Engineering, University",
                  "of Calgary, via the imudata R package; CC BY-NC-SA 4.0."))
-# Drop the raw-data-free parts the fits do not need to keep the file small.
-slim <- function(f) { f$call <- NULL; f }
+# Drop the parts the fits do not need to keep the file small, and never
+# ship the recordings: no series pass may carry the data (its `x`; fits
+# saved by older code kept it).
+slim <- function(f) {
+  f$call <- NULL
+  if (!is.null(f$series)) f$series$x <- NULL
+  f
+}
 fits <- lapply(fits, function(p) lapply(p, slim))
 
 dir.create("data", showWarnings = FALSE)
