@@ -229,27 +229,22 @@ filter_av <- function(m, spec, tau0) {
   # than the curve (a search may try L = 1e9) must not allocate its support
   need <- if (spec$family == "ma") min(K, 2 * ceiling(max(m)) + 2) else K
   g <- filter_acf(spec, tau0, 0:(need - 1L))
+  # S and C of the whole support: from g when it holds all of it
+  sums <- if (need < K) ma_sums(spec$L, tau0) else NULL
   whole <- abs(m - round(m)) < 1e-9
   out <- numeric(length(m))
-  if (any(whole)) {
-    out[whole] <- if (need == K) acov_av(round(m[whole]), g) else
-      acov_av(round(m[whole]), g, sums = ma_sums(spec$L, tau0))
-  }
+  if (any(whole)) out[whole] <- acov_av(round(m[whole]), g, sums)
   frac <- which(!whole)
   if (length(frac)) {
     mf <- m[frac]
     big <- mf >= K
-    sc <- if (need == K) list(S = g[1L] + 2 * sum(g[-1L]),
-                              C = sum(seq_len(K - 1L) * g[-1L])) else
-      ma_sums(spec$L, tau0)
-    S <- sc$S
-    C <- sc$C
+    S <- if (is.null(sums)) g[1L] + 2 * sum(g[-1L]) else sums$S
+    C <- if (is.null(sums)) sum(seq_len(K - 1L) * g[-1L]) else sums$C
     out[frac[big]] <- S / mf[big] - 3 * C / mf[big]^2
     sm <- frac[!big]
     if (length(sm)) {
       lo <- pmax(floor(m[sm]), 1)
       w <- m[sm] - lo
-      sums <- if (need == K) NULL else ma_sums(spec$L, tau0)
       out[sm] <- (1 - w) * acov_av(lo, g, sums) + w * acov_av(lo + 1, g, sums)
     }
   }

@@ -3,6 +3,15 @@
 # means written out as a double sum), numerical integration of the PSD, and
 # a real AR(2) generator written here.
 
+# A band at fr Hz with decay time tc s: white noise through a real AR(2)
+# (poles r exp(+-i w0)), scaled to unit standard deviation, at 100 Hz.
+ar2_band <- function(n, fr, tc) {
+  r <- exp(-0.01 / tc)
+  w0 <- 2 * pi * fr / 100
+  z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
+  z / stats::sd(z)
+}
+
 av_double_sum <- function(m, g) {
   # AV = [Var(mean1) + Var(mean2) - 2 Cov(mean1, mean2)] / 2 with
   # mean1, mean2 adjacent windows of m samples
@@ -66,10 +75,8 @@ test_that("band start values recover the resonance from an independent generator
 test_that("the raw data support a resonance where a band is, and contradict one elsewhere", {
   set.seed(33)
   n <- 2e5
-  r <- exp(-0.01 / 0.08)
-  w0 <- 2 * pi * 20 / 100
-  z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
-  x <- rnorm(n) + 0.8 * z / stats::sd(z)
+  z <- ar2_band(n, 20, 0.08)
+  x <- rnorm(n) + 0.8 * z
   b <- find_bands(x, 100)
   expect_true(resonance_raw_support(0.8, 20, 0.08, b)$support)
   expect_false(resonance_raw_support(0.8, 7, 0.08, b)$support)
@@ -101,11 +108,9 @@ test_that("find_bands finds a weak band (peak about 1.5x the background) at 1e6 
   # a band far below the old fixed 2x threshold, significant by the EDF
   set.seed(41)
   n <- 1e6
-  r <- exp(-0.01 / 0.5)
-  w0 <- 2 * pi * 10 / 100
-  z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
+  z <- ar2_band(n, 10, 0.5)
   x <- as.numeric(stats::filter(rnorm(n + 3), rep(0.25, 4), sides = 1))[-(1:3)] +
-    0.1 * z / stats::sd(z)
+    0.1 * z
   b <- find_bands(x, 100)
   expect_equal(nrow(b), 1L)
   expect_equal(b$f_center, 10, tolerance = 0.02)
