@@ -34,7 +34,11 @@
 #   edf_alpha(tau, tau0, nl)  power-law exponent used for the EDF at each
 #                 tau; NA marks a deterministic term (no estimation variance)
 #   nl_range(tau, freq)  named list of c(lo, hi): where each nonlinear
-#                 parameter is searched
+#                 parameter's grid is laid (the search's first look)
+#   nl_bounds(tau, freq)  named list of c(lo, hi): the hard limits of each
+#                 nonlinear parameter, what the curve and the record can see
+#                 (no search step, start or refit leaves them); NULL: the
+#                 nl_range
 #   trace(ctx)  from a residual signature (see trace.R) to list(init =
 #                 start values, score = how well it matches), or NULL
 #   propose(raw, tau, sig)  candidates read from the raw-data diagnostics
@@ -128,6 +132,7 @@ new_effect <- function(name, title, params, component = "av",
                        formula = "", signature = "",
                        basis = NULL, psd = NULL, acf = NULL, sim = NULL,
                        sim_check = NULL, edf_alpha = NULL, nl_range = NULL,
+                       nl_bounds = NULL,
                        trace = NULL, propose = NULL, evidence = NULL,
                        peak_tau = NULL, reading = NULL, fold = NULL,
                        discrete = NULL, describe = NULL, detect = NULL,
@@ -137,7 +142,8 @@ new_effect <- function(name, title, params, component = "av",
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
        basis = basis, psd = psd, acf = acf, sim = sim, sim_check = sim_check,
-       edf_alpha = edf_alpha, nl_range = nl_range, trace = trace,
+       edf_alpha = edf_alpha, nl_range = nl_range, nl_bounds = nl_bounds,
+       trace = trace,
        propose = propose, evidence = evidence, peak_tau = peak_tau,
        reading = reading, fold = fold, discrete = discrete,
        describe = describe, detect = detect, remove = remove,
@@ -173,7 +179,7 @@ validate_effect <- function(e) {
   e$params <- p
   fun_ok <- function(f) is.null(f) || is.function(f)
   for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
-              "nl_range", "trace", "propose", "evidence", "peak_tau",
+              "nl_range", "nl_bounds", "trace", "propose", "evidence", "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
@@ -249,6 +255,13 @@ effect_entry <- function(kind, variant = NULL) {
   e$variant <- variant
   e$bare <- FALSE
   validate_effect(e)
+}
+
+# The hard limits of nonlinear parameter `param` of entry `e` on a curve
+# over `tau` sampled at `freq` (NULL: unknown): c(lo, hi), never inverted.
+effect_nl_bounds <- function(e, param, tau, freq) {
+  b <- (e$nl_bounds %||% e$nl_range)(tau, freq)[[param]]
+  sort(as.double(b))
 }
 
 # Entries whose `field` is not NULL, in canonical order.
