@@ -208,6 +208,10 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     # proposed or matched as sinusoids. The bands themselves propose and
     # confirm a resonance.
     raw$bands <- find_bands(data, freq)
+    # each band's own spectrum (the measured-band effect's proposal)
+    raw$band_spectra <- Filter(Negate(is.null), lapply(seq_len(nrow(raw$bands)), function(j) {
+      measure_band(data, freq, raw$bands[j, ])
+    }))
     raw$lines <- lines_outside_bands(raw$lines, raw$bands)
   }
   # The series the raw-data checks of an effect see: the data with the
@@ -612,6 +616,9 @@ refit_args <- function(fit, terms, settings, start = NULL, hold = NULL) {
   st <- c(st, prev)
   args$start <- if (length(st)) st else NULL
   if (length(hold)) args$fixed <- c(settings$fixed, hold)
+  # values pinned for a term the new model no longer has (a replaced one)
+  if (length(args$fixed)) args$fixed <- args$fixed[names(args$fixed) %in% names_new]
+  if (!length(args$fixed)) args$fixed <- NULL
   if (length(args$fixed)) {
     args$fixed <- args$fixed[!duplicated(names(args$fixed))]
     if (length(args$start)) {

@@ -80,7 +80,7 @@ catalogue <- function() {
 builtin_effects <- function() {
   list(effect_quantization(), effect_white(), effect_flicker(),
        effect_random_walk(), effect_ramp(), effect_gauss_markov(),
-       effect_sinusoid(), effect_filter(), effect_resonance(),
+       effect_sinusoid(), effect_filter(), effect_resonance(), effect_band(),
        # series effects, in the order series_effects() detects them
        effect_spike(), effect_warmup(), effect_bias_step(), effect_transient())
 }
@@ -117,11 +117,14 @@ unregister_effect <- function(name) {
 }
 
 # One parameter of an entry.
+# `hidden`: a measured value carried for the entry's own use (a tabulated
+# spectrum), left out of the step summaries.
 effect_param <- function(name, role = c("amp", "nonlinear"), unit, meaning,
-                         profile = NA_character_, print_unit = FALSE) {
+                         profile = NA_character_, print_unit = FALSE,
+                         hidden = FALSE) {
   role <- role[1L]
   data.frame(name = name, role = role, unit = unit, meaning = meaning,
-             profile = profile, print_unit = print_unit,
+             profile = profile, print_unit = print_unit, hidden = hidden,
              stringsAsFactors = FALSE)
 }
 
@@ -170,6 +173,7 @@ validate_effect <- function(e) {
   }
   if (is.null(p$profile)) p$profile <- NA_character_
   if (is.null(p$print_unit)) p$print_unit <- FALSE
+  if (is.null(p$hidden)) p$hidden <- FALSE
   if (anyDuplicated(p$name) || !all(grepl("^[A-Za-z][A-Za-z0-9_]*$", p$name))) {
     bad("parameter names must be unique identifiers.")
   }
