@@ -15,7 +15,8 @@
 #   params      data frame from effect_param(): name, role ("amp" or
 #                 "nonlinear"), unit, meaning, profile ("smooth" or
 #                 "oscillatory": how the AV varies with a nonlinear
-#                 parameter, which sets the search grid), print_unit
+#                 parameter, which sets the search grid), print_unit,
+#                 hidden (a measured value left out of step summaries)
 #   repeatable  may appear several times in a model (gm1, gm2, ...)
 #   variants    NULL, or a function(variant) returning the fields that
 #                 replace the entry's for that variant (NULL when the variant
