@@ -815,7 +815,7 @@ candidate_trials <- function(traced, present, candidates, sig) {
       take <- union(union(take, pinned), which(!duplicated(t$effect)))
       t$traced <- rep(TRUE, nrow(t))
       rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
-    } else {
+    } else if (!isTRUE(effect_entry(k)$proposed_only)) {
       r <- data.frame(
         effect = k, tau_from = strongest$tau_from, tau_to = strongest$tau_to,
         signature = paste0(strongest$description, " (no signature specific to ", k, ")"),

@@ -62,6 +62,9 @@
 #   detect(x, freq), remove(x, freq, par)  for "series" components
 #   replaces    kinds this entry takes the place of when the loop adds it
 #                 (the filter replaces N: its DC level is the white level)
+#   proposed_only  TRUE when the loop tries the entry only where the raw
+#                 data propose it (its parameters are measured, not
+#                 searched: a tabulated band spectrum)
 #   admissible(par, tau, freq)  NULL when a fitted instance is a valid
 #                 instance of this effect on this curve, else the reason it
 #                 is not (a sub-sample GM is a filter; a sinusoid outside
@@ -141,7 +144,7 @@ new_effect <- function(name, title, params, component = "av",
                        peak_tau = NULL, reading = NULL, fold = NULL,
                        discrete = NULL, describe = NULL, detect = NULL,
                        remove = NULL, replaces = character(),
-                       admissible = NULL) {
+                       admissible = NULL, proposed_only = FALSE) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -151,7 +154,8 @@ new_effect <- function(name, title, params, component = "av",
        propose = propose, evidence = evidence, peak_tau = peak_tau,
        reading = reading, fold = fold, discrete = discrete,
        describe = describe, detect = detect, remove = remove,
-       replaces = replaces, admissible = admissible)
+       replaces = replaces, admissible = admissible,
+       proposed_only = proposed_only)
 }
 
 validate_effect <- function(e) {

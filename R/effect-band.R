@@ -210,6 +210,8 @@ effect_band <- function() {
                                              collapse = ", "))
     },
     # the measured band is the resonance's band as the data show it
-    replaces = "resonance"
+    replaces = "resonance",
+    # its spectrum is measured, never searched: tried only where proposed
+    proposed_only = TRUE
   )
 }
