@@ -87,3 +87,17 @@ test_that("the loop takes the measured band where the Lorentzian cannot describe
   # the hidden spectrum stays out of the step summary
   expect_false(grepl("s1=", st$params))
 })
+
+test_that("without a band in the raw data the band is never tried", {
+  skip_on_cran()
+  set.seed(73)
+  freq <- 100
+  n <- 2^18
+  x <- rnorm(n, sd = 0.02 * sqrt(freq)) + cumsum(rnorm(n, sd = 2e-4 / sqrt(freq)))
+  ref <- suppressMessages(avrefine(avfit(allan(x, freq), terms = c("N", "B", "K")),
+                                   data = x, max_steps = 3))
+  expect_false("band" %in% ref$terms)
+  expect_false("band" %in% ref$refine$rejected$effect)
+  expect_false("band" %in% ref$refine$failures$effect)
+  expect_true(isTRUE(allanvar:::effect_entry("band")$proposed_only))
+})
