@@ -208,6 +208,10 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
     # proposed or matched as sinusoids. The bands themselves propose and
     # confirm a resonance.
     raw$bands <- find_bands(data, freq)
+    # each band's own spectrum (the measured-band effect's proposal)
+    raw$band_spectra <- Filter(Negate(is.null), lapply(seq_len(nrow(raw$bands)), function(j) {
+      measure_band(data, freq, raw$bands[j, ])
+    }))
     raw$lines <- lines_outside_bands(raw$lines, raw$bands)
   }
   # The series the raw-data checks of an effect see: the data with the
@@ -243,16 +247,22 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   # A refit that frees the parameters of the effects accepted earlier must
   # leave each of them valid and not contradicted by the raw data (a
   # resonance whose tc runs off to a pure tone no longer matches its band).
-  earlier_hold <- function(f) {
+  # (earlier_broken(): the labels of those that do not hold)
+  earlier_broken <- function(f) {
+    out <- character()
     for (st in steps) {
       if (!any(startsWith(names(stats::coef(f)), paste0(st$label, ".")))) next
       par <- instance_params(stats::coef(f), f$layout, st$label)
-      if (!is.null(inadmissible(st$effect, par, f$data$tau, freq))) return(FALSE)
+      if (!is.null(inadmissible(st$effect, par, f$data$tau, freq))) {
+        out <- c(out, st$label)
+        next
+      }
       ev <- raw_evidence(st$effect, as.list(par), raw, evidence_series(st$effect), freq)
-      if (isFALSE(ev$support)) return(FALSE)
+      if (isFALSE(ev$support)) out <- c(out, st$label)
     }
-    TRUE
+    out
   }
+  earlier_hold <- function(f) !length(earlier_broken(f))
   # The filter's family was chosen against the model of the step it entered
   # at; the effects added since can change which family describes the
   # short-tau end (a first-order low-pass chosen before the 0.55 Hz line ran
@@ -376,10 +386,12 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
           if (is.null(why) && isFALSE(ev$support)) {
             why <- paste("contradicted by the raw data:", ev$text)
           }
+          moved <- FALSE
           if (is.null(why) && !earlier_hold(f)) {
             why <- "moves an effect accepted earlier to values the raw data contradict"
+            moved <- TRUE
           }
-          list(par = par, why = why, ev = ev)
+          list(par = par, why = why, ev = ev, moved = moved)
         }
         jd <- judge(new)
         if (!is.null(jd$why) && length(hold_now)) {
@@ -396,6 +408,35 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
               new <- free
               c1 <- crit(free)
               jd <- jf
+            }
+          }
+        }
+        # A refit that moves effects accepted earlier to values the raw data
+        # contradict is tried once more with those effects' nonlinear values
+        # held where they were accepted (the rest free): the new effect is
+        # judged beside the earlier ones as the raw data confirmed them,
+        # charged for the held values as a screen is.
+        if (isTRUE(jd$moved)) {
+          broken <- earlier_broken(new)
+          keep <- nl_now[vapply(names(nl_now), function(nm) {
+            any(startsWith(nm, paste0(broken, ".")))
+          }, NA)]
+          if (length(keep)) {
+            args <- refit_args(current, new$terms, settings,
+                               start = stats::coef(new)[new$layout$role == "nonlinear"],
+                               hold = c(keep, pin))
+            held <- try_refit(args, function(cnd, stage) {
+              failures <<- add_failure(failures, cnd, step, tr$effect, stage)
+            }, "refit with earlier effects held")
+            c_held <- if (is.null(held)) Inf else crit(held) + pen * length(keep)
+            if (is.finite(c_held) && c_held < c0 - min_gain &&
+                held$chi2 < 0.9 * current$chi2 && max_share(held, lab) >= 0.02) {
+              jh <- judge(held)
+              if (is.null(jh$why)) {
+                new <- held
+                c1 <- c_held
+                jd <- jh
+              }
             }
           }
         }
@@ -575,6 +616,9 @@ refit_args <- function(fit, terms, settings, start = NULL, hold = NULL) {
   st <- c(st, prev)
   args$start <- if (length(st)) st else NULL
   if (length(hold)) args$fixed <- c(settings$fixed, hold)
+  # values pinned for a term the new model no longer has (a replaced one)
+  if (length(args$fixed)) args$fixed <- args$fixed[names(args$fixed) %in% names_new]
+  if (!length(args$fixed)) args$fixed <- NULL
   if (length(args$fixed)) {
     args$fixed <- args$fixed[!duplicated(names(args$fixed))]
     if (length(args$start)) {
@@ -771,7 +815,7 @@ candidate_trials <- function(traced, present, candidates, sig) {
       take <- union(union(take, pinned), which(!duplicated(t$effect)))
       t$traced <- rep(TRUE, nrow(t))
       rows[[length(rows) + 1L]] <- t[take, , drop = FALSE]
-    } else {
+    } else if (!isTRUE(effect_entry(k)$proposed_only)) {
       r <- data.frame(
         effect = k, tau_from = strongest$tau_from, tau_to = strongest$tau_to,
         signature = paste0(strongest$description, " (no signature specific to ", k, ")"),

@@ -15,7 +15,8 @@
 #   params      data frame from effect_param(): name, role ("amp" or
 #                 "nonlinear"), unit, meaning, profile ("smooth" or
 #                 "oscillatory": how the AV varies with a nonlinear
-#                 parameter, which sets the search grid), print_unit
+#                 parameter, which sets the search grid), print_unit,
+#                 hidden (a measured value left out of step summaries)
 #   repeatable  may appear several times in a model (gm1, gm2, ...)
 #   variants    NULL, or a function(variant) returning the fields that
 #                 replace the entry's for that variant (NULL when the variant
@@ -34,7 +35,11 @@
 #   edf_alpha(tau, tau0, nl)  power-law exponent used for the EDF at each
 #                 tau; NA marks a deterministic term (no estimation variance)
 #   nl_range(tau, freq)  named list of c(lo, hi): where each nonlinear
-#                 parameter is searched
+#                 parameter's grid is laid (the search's first look)
+#   nl_bounds(tau, freq)  named list of c(lo, hi): the hard limits of each
+#                 nonlinear parameter, what the curve and the record can see
+#                 (no search step, start or refit leaves them); NULL: the
+#                 nl_range
 #   trace(ctx)  from a residual signature (see trace.R) to list(init =
 #                 start values, score = how well it matches), or NULL
 #   propose(raw, tau, sig)  candidates read from the raw-data diagnostics
@@ -57,6 +62,9 @@
 #   detect(x, freq), remove(x, freq, par)  for "series" components
 #   replaces    kinds this entry takes the place of when the loop adds it
 #                 (the filter replaces N: its DC level is the white level)
+#   proposed_only  TRUE when the loop tries the entry only where the raw
+#                 data propose it (its parameters are measured, not
+#                 searched: a tabulated band spectrum)
 #   admissible(par, tau, freq)  NULL when a fitted instance is a valid
 #                 instance of this effect on this curve, else the reason it
 #                 is not (a sub-sample GM is a filter; a sinusoid outside
@@ -76,7 +84,7 @@ catalogue <- function() {
 builtin_effects <- function() {
   list(effect_quantization(), effect_white(), effect_flicker(),
        effect_random_walk(), effect_ramp(), effect_gauss_markov(),
-       effect_sinusoid(), effect_filter(), effect_resonance(),
+       effect_sinusoid(), effect_filter(), effect_resonance(), effect_band(),
        # series effects, in the order series_effects() detects them
        effect_spike(), effect_warmup(), effect_bias_step(), effect_transient())
 }
@@ -113,11 +121,14 @@ unregister_effect <- function(name) {
 }
 
 # One parameter of an entry.
+# `hidden`: a measured value carried for the entry's own use (a tabulated
+# spectrum), left out of the step summaries.
 effect_param <- function(name, role = c("amp", "nonlinear"), unit, meaning,
-                         profile = NA_character_, print_unit = FALSE) {
+                         profile = NA_character_, print_unit = FALSE,
+                         hidden = FALSE) {
   role <- role[1L]
   data.frame(name = name, role = role, unit = unit, meaning = meaning,
-             profile = profile, print_unit = print_unit,
+             profile = profile, print_unit = print_unit, hidden = hidden,
              stringsAsFactors = FALSE)
 }
 
@@ -128,20 +139,23 @@ new_effect <- function(name, title, params, component = "av",
                        formula = "", signature = "",
                        basis = NULL, psd = NULL, acf = NULL, sim = NULL,
                        sim_check = NULL, edf_alpha = NULL, nl_range = NULL,
+                       nl_bounds = NULL,
                        trace = NULL, propose = NULL, evidence = NULL,
                        peak_tau = NULL, reading = NULL, fold = NULL,
                        discrete = NULL, describe = NULL, detect = NULL,
                        remove = NULL, replaces = character(),
-                       admissible = NULL) {
+                       admissible = NULL, proposed_only = FALSE) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
        basis = basis, psd = psd, acf = acf, sim = sim, sim_check = sim_check,
-       edf_alpha = edf_alpha, nl_range = nl_range, trace = trace,
+       edf_alpha = edf_alpha, nl_range = nl_range, nl_bounds = nl_bounds,
+       trace = trace,
        propose = propose, evidence = evidence, peak_tau = peak_tau,
        reading = reading, fold = fold, discrete = discrete,
        describe = describe, detect = detect, remove = remove,
-       replaces = replaces, admissible = admissible)
+       replaces = replaces, admissible = admissible,
+       proposed_only = proposed_only)
 }
 
 validate_effect <- function(e) {
@@ -164,6 +178,7 @@ validate_effect <- function(e) {
   }
   if (is.null(p$profile)) p$profile <- NA_character_
   if (is.null(p$print_unit)) p$print_unit <- FALSE
+  if (is.null(p$hidden)) p$hidden <- FALSE
   if (anyDuplicated(p$name) || !all(grepl("^[A-Za-z][A-Za-z0-9_]*$", p$name))) {
     bad("parameter names must be unique identifiers.")
   }
@@ -173,7 +188,7 @@ validate_effect <- function(e) {
   e$params <- p
   fun_ok <- function(f) is.null(f) || is.function(f)
   for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
-              "nl_range", "trace", "propose", "evidence", "peak_tau",
+              "nl_range", "nl_bounds", "trace", "propose", "evidence", "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
@@ -249,6 +264,13 @@ effect_entry <- function(kind, variant = NULL) {
   e$variant <- variant
   e$bare <- FALSE
   validate_effect(e)
+}
+
+# The hard limits of nonlinear parameter `param` of entry `e` on a curve
+# over `tau` sampled at `freq` (NULL: unknown): c(lo, hi), never inverted.
+effect_nl_bounds <- function(e, param, tau, freq) {
+  b <- (e$nl_bounds %||% e$nl_range)(tau, freq)[[param]]
+  sort(as.double(b))
 }
 
 # Entries whose `field` is not NULL, in canonical order.

@@ -30,6 +30,35 @@ filter_variant <- function(variant) {
       if (variant == "ma") list(L = c(1.001, 64))
       else list(fc = c(freq / 2000, if (variant == "lp2") 0.499 * freq else 0.5 * freq))
     },
+    # The filter acts between the sampling interval and the longest tau:
+    # L from 1 sample (white) to tau_max; fc from 1/(2 pi tau_max) to
+    # Nyquist (lp2's bilinear form needs fc below it).
+    nl_bounds = function(tau, freq) {
+      span <- if (is.null(freq)) max(tau) / min(tau) else max(tau) * freq
+      nyq <- if (is.null(freq)) 0.5 / min(tau) else 0.5 * freq
+      if (variant == "ma") list(L = c(1, max(span, 1.001)))
+      else list(fc = c(min(1 / (2 * pi * max(tau)), nyq / 1000),
+                       if (variant == "lp2") 0.998 * nyq else nyq))
+    },
+    # At its bounds the filter is no filter the data show: L = 1 is white
+    # noise, and a first-order low-pass at Nyquist is as near white as
+    # that family gets (lag-1 correlation 3 - sqrt(8) = 0.17, its least):
+    # the fit has run into the family's edge, not onto a cutoff, so the
+    # data ask for another family, or for N.
+    admissible = function(par, tau, freq) {
+      if (variant == "ma" && is.finite(par[["L"]]) && par[["L"]] <= 1.001) {
+        return(sprintf("L = %s samples: that is white noise (N), not a filter",
+                       format_num(par[["L"]])))
+      }
+      if (variant == "lp1" && !is.null(freq) &&
+          (!is.finite(par[["fc"]]) || par[["fc"]] >= 0.499 * freq)) {
+        return(sprintf(paste("fc = %s Hz is at the Nyquist bound, the edge of the",
+                             "first-order family (the nearest it comes to white",
+                             "noise), not a cutoff the data show"),
+                       format_num(par[["fc"]])))
+      }
+      NULL
+    },
     formula = paste0("N^2 x exact AV of the ", variant,
                      " filter's autocovariance (unit DC gain)")
   )
@@ -82,6 +111,8 @@ effect_filter <- function() {
     },
     edf_alpha = function(tau, tau0, nl) rep(0, length(tau)),
     nl_range = base$nl_range,
+    nl_bounds = base$nl_bounds,
+    admissible = base$admissible,
     trace = function(ctx) {
       # the model's white line runs above the first points
       if (ctx$kind != "short_end" || ctx$sign >= 0) return(NULL)
@@ -142,6 +173,14 @@ effect_resonance <- function() {
     nl_range = function(tau, freq) {
       hi <- if (is.null(freq)) 0.5 / min(tau) else 0.499 * freq
       list(fr = c(hi / 100, hi), tc = c(min(tau) / 2, max(tau)))
+    },
+    # fr within the band the curve sees and below Nyquist; tc from a sample
+    # (a band as wide as the spectrum) to the record (a line)
+    nl_bounds = function(tau, freq) {
+      b <- visible_band(min(tau), max(tau), freq)
+      hi <- if (is.null(freq)) b[["hi"]] else min(b[["hi"]], 0.499 * freq)
+      tc_lo <- if (is.null(freq)) min(tau) / 4 else min(1 / freq, min(tau) / 2)
+      list(fr = c(min(b[["lo"]], hi / 100), hi), tc = c(tc_lo, max(tau)))
     },
     evidence = function(par, raw, x, freq) {
       if (is.null(x)) return(list(text = "", support = NA))

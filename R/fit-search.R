@@ -15,7 +15,11 @@
 #' variance varies smoothly with, such as `tc`; `grid_oscillatory` for
 #' those it oscillates with, such as `f0`), or, when it has a start value,
 #' on `grid_start` points within a factor `start_span` of it; the best grid
-#' point is refined by [stats::optimize()] to `tol` (in log units). Terms
+#' point is refined by [stats::optimize()] to `tol` (in log units). No
+#' step of the search leaves a parameter's bounds (the catalogue's
+#' `nl_bounds`: what the curve and the record can see, e.g. a filter
+#' between the sampling interval and the longest tau, a frequency below
+#' Nyquist); a start value outside them starts at the nearest bound. Terms
 #' enter greedily; with several nonlinear parameters, `cycles` passes refine
 #' each within a factor `local_span` of its value, and Nelder-Mead
 #' ([stats::optim()], `maxit` iterations, relative tolerance `reltol`)
@@ -162,16 +166,30 @@ fit_search <- function(pr, start, prev, control) {
   nlrows <- which(lay$role == "nonlinear" & !lay$fixed)
   nlv <- stats::setNames(numeric(length(nlrows)), lay$name[nlrows])
   evals <- 0L
+  # Every nonlinear parameter stays within its entry's hard bounds (what
+  # the curve and the record can see): outside them the objective is
+  # infinite, so neither a start, a grid nor Nelder-Mead can leave them.
+  lb <- ub <- numeric(length(nlrows))
   obj <- function(lognl, off = NULL) {
+    if (any(lognl < lb | lognl > ub)) return(Inf)
     evals <<- evals + 1L
     solve_amps(pr, stats::setNames(exp(lognl), names(nlv)), control, off,
                layout = FALSE)$objective
   }
   nm <- NULL
   if (length(nlrows)) {
-    ranges <- lapply(nlrows, function(i) {
-      e <- effect_entry(lay$kind[i], lay$variant[i])
-      e$nl_range(pr$data$tau, freq)[[lay$param[i]]]
+    entries <- lapply(nlrows, function(i) effect_entry(lay$kind[i], lay$variant[i]))
+    bounds <- lapply(seq_along(nlrows), function(k) {
+      effect_nl_bounds(entries[[k]], lay$param[nlrows[k]], pr$data$tau, freq)
+    })
+    lb <- log(vapply(bounds, `[`, 0, 1L))
+    ub <- log(vapply(bounds, `[`, 0, 2L))
+    clamp <- function(v, k) min(max(v, lb[k]), ub[k])
+    # the grid's range, within the bounds
+    ranges <- lapply(seq_along(nlrows), function(k) {
+      r <- entries[[k]]$nl_range(pr$data$tau, freq)[[lay$param[nlrows[k]]]]
+      r <- exp(c(clamp(log(r[1]), k), clamp(log(r[2]), k)))
+      if (r[1] < r[2]) r else bounds[[k]]
     })
     profile <- vapply(nlrows, function(i) {
       p <- effect_entry(lay$kind[i], lay$variant[i])$params
@@ -183,6 +201,7 @@ fit_search <- function(pr, start, prev, control) {
       nlv[k] <- if (!is.null(prev)) prev$layout$value[prev$layout$name == nm_k] else
         if (!is.null(start) && nm_k %in% names(start)) start[[nm_k]] else
           sqrt(prod(ranges[[k]]))
+      nlv[k] <- exp(clamp(log(nlv[[k]]), k))
     }
     # a parameter with a start (given, or from the previous pass) is refined
     # locally; the others are searched on the grid first
@@ -200,15 +219,15 @@ fit_search <- function(pr, start, prev, control) {
           } else NULL
           f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
           if (cy > 1L || !is.null(prev)) {
-            lo <- lognl[k] - log(control$local_span)
-            hi <- lognl[k] + log(control$local_span)
+            lo <- clamp(lognl[k] - log(control$local_span), k)
+            hi <- clamp(lognl[k] + log(control$local_span), k)
           } else {
             # a start value: a short grid around it; otherwise the whole range
             ng <- if (has_start[k]) control$grid_start else
               control[[paste0("grid_", profile[k])]]
             g <- if (has_start[k]) {
-              lognl[k] + seq(-log(control$start_span), log(control$start_span),
-                             length.out = ng)
+              vapply(lognl[k] + seq(-log(control$start_span), log(control$start_span),
+                                    length.out = ng), clamp, 0, k = k)
             } else {
               seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
             }
@@ -217,8 +236,10 @@ fit_search <- function(pr, start, prev, control) {
             lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
             lognl[k] <- g[i]
           }
-          o <- stats::optimize(f1, c(lo, hi), tol = control$tol)
-          if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
+          if (hi > lo) {
+            o <- stats::optimize(f1, c(lo, hi), tol = control$tol)
+            if (o$objective <= f1(lognl[k])) lognl[k] <- o$minimum
+          }
         }
       }
       nm <- NULL

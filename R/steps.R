@@ -52,6 +52,8 @@ bind_steps <- function(old, new) {
 format_params <- function(par, effect) {
   sp <- split_term(effect)
   p <- effect_entry(sp$kind, sp$variant)$params
+  hidden <- p$name[p$hidden %in% TRUE]
+  par <- par[!names(par) %in% hidden]
   nm <- names(par)
   txt <- vapply(seq_along(par), function(i) {
     j <- match(nm[i], p$name)

@@ -44,6 +44,30 @@ test_that("each low-pass variant fits its own curve (parameters within 10%)", {
   expect_equal(unname(cf[grepl("Nf$", names(cf))]), 0.01, tolerance = 0.1)
 })
 
+test_that("a filter run into its family's edge is not admitted; a real cutoff is", {
+  set.seed(53)
+  freq <- 100
+  w <- rnorm(2^17, sd = 0.01 * sqrt(freq))
+  # white noise: the first-order low-pass runs to its Nyquist bound (fc is
+  # never above it) and is not admitted as a filter
+  a <- allan(w, freq)
+  f <- avfit(a, terms = "filter:lp1")
+  fc <- unname(coef(f)[["filter_lp1.fc"]])
+  expect_lte(fc, freq / 2)
+  expect_gt(fc, 0.49 * freq)
+  expect_match(inadmissible("filter:lp1", c(Nf = 0.01, fc = fc), a$tau, freq),
+               "Nyquist bound")
+  # a moving average of one sample is white noise
+  expect_match(inadmissible("filter", c(Nf = 0.01, L = 1), a$tau, freq), "white noise")
+  # a first-order low-pass at 12 Hz (our own recursion) is admitted
+  a1 <- (2 - cos(2 * pi * 12 / freq)) - sqrt((2 - cos(2 * pi * 12 / freq))^2 - 1)
+  y <- as.numeric(stats::filter((1 - a1) * w, a1, method = "recursive"))
+  g <- avfit(allan(y, freq), terms = "filter:lp1")
+  expect_null(inadmissible("filter:lp1", c(Nf = 0.01, fc = coef(g)[["filter_lp1.fc"]]),
+                           a$tau, freq))
+  expect_null(inadmissible("filter", c(Nf = 0.01, L = 4), a$tau, freq))
+})
+
 test_that("a resonance term fits a narrow-band process", {
   set.seed(53)
   freq <- 100

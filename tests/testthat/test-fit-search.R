@@ -51,3 +51,31 @@ test_that("a fit that did not converge says so (maxit = 1)", {
   expect_output(print(bad2), "did NOT converge")
   expect_true(avfit(allan(x, f))$convergence$converged)
 })
+
+test_that("no nonlinear parameter leaves what the curve and record can see", {
+  # white noise from our own generator; starts far outside every bound (an
+  # unbounded search took the moving average to L = 2.5e9 samples and a
+  # GM to Tc = 4e8 s from these starts)
+  set.seed(11)
+  fw <- 100
+  av <- allan(rnorm(2^16, sd = 0.1 * sqrt(fw)), fw)
+  tmax <- max(av$tau)
+  ma <- avfit(av, "filter", start = c(filter.L = 7e8))
+  expect_gte(coef(ma)[["filter.L"]], 1)
+  expect_lte(coef(ma)[["filter.L"]], tmax * fw)
+  gm <- avfit(av, c("N", "gm"), start = c(gm1.tc = 1e9))
+  expect_lte(coef(gm)[["gm1.tc"]], 4 * tmax)
+  expect_gte(coef(gm)[["gm1.tc"]], min(av$tau) / 4)
+  # a band centre never above Nyquist, nor below what the curve sees
+  rs <- avfit(av, c("N", "resonance"), start = c(resonance.fr = 80))
+  expect_lte(coef(rs)[["resonance.fr"]], 0.499 * fw)
+  expect_gte(coef(rs)[["resonance.fr"]], 1 / tmax * (1 - 1e-9))
+  sn <- avfit(av, c("N", "sinusoid"), start = c(sinusoid1.f0 = 400))
+  expect_lte(coef(sn)[grep("f0$", names(coef(sn)))][[1]], fw / 2)
+  # the bounds are the entries' own
+  b <- effect_nl_bounds(effect_entry("filter", "lp1"), "fc", av$tau, fw)
+  expect_equal(b[2], fw / 2)
+  expect_equal(b[1], 1 / (2 * pi * tmax))
+  expect_equal(effect_nl_bounds(effect_entry("filter"), "L", av$tau, fw),
+               c(1, tmax * fw))
+})

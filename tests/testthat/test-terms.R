@@ -107,7 +107,7 @@ test_that("terms add in variance; by_term gives the parts", {
 test_that("catalogue listing and argument checks", {
   tt <- av_terms()
   expect_setequal(unique(tt$term[tt$component == "av"]),
-                  c("Q", "N", "B", "K", "R", "gm", "sinusoid", "filter", "resonance"))
+                  c("Q", "N", "B", "K", "R", "gm", "sinusoid", "filter", "resonance", "band"))
   expect_setequal(unique(tt$term[tt$component == "series"]),
                   c("spikes", "warmup", "steps", "transients"))
   expect_setequal(unique(tt$component), c("av", "series"))

@@ -1,0 +1,217 @@
+# Catalogue entry of a measured spectral band (issue 9): a narrow-band
+# process that no parametric shape describes (the ADIS16405 z gyros' band
+# near 20 Hz falls faster below its peak than a Lorentzian and has a
+# shoulder above it). Its spectrum IS the raw data's: the Welch estimate
+# over the band minus the background read on its flanks, tabulated on
+# `band_knots` equal intervals (piecewise constant, its power kept
+# exactly). Its Allan variance is the exact AV transfer function applied to
+# that spectrum. Nothing is fitted but a scale (amp^2), which the raw data
+# must confirm: within 2 of the band power's relative uncertainty `u`
+# (the Welch chi-square of the band's bins and the spread between two
+# background models). That makes it evidence, not a fitting device: the
+# curve is asked whether the band the periodogram shows explains it.
+#
+# AV of a one-sided rate PSD S1 at cluster size m (sampled rate, tau0):
+#   AV(m) = 2 int S1(f) sin^4(pi f m tau0) / (m sin(pi f tau0))^2 df
+# (white noise of variance s2: S1 = 2 s2 tau0 gives s2 / m; a line of
+# amplitude A gives the sinusoid's A^2 sin^4 / (m^2 sin^2)). Over a piece
+# where S1 is constant, int sin^4(a f) df = [F4(a f)] / a with
+# F4(x) = 3x/8 - sin(2x)/4 + sin(4x)/32; the denominator is taken at the
+# centres of `band_sub` sub-pieces. Continuous form (tau0 NULL): m
+# sin(pi f tau0) -> pi f tau.
+
+band_knots <- 24L
+band_sub <- 8L
+
+# The knot edges of a band [f_lo, f_hi].
+band_edges <- function(f_lo, f_hi, k = band_knots) seq(f_lo, f_hi, length.out = k + 1L)
+
+# AV per unit scale at taus `tau` of the piecewise-constant one-sided PSD
+# `s` (u^2/Hz) on the knots of [f_lo, f_hi].
+band_av <- function(tau, tau0, f_lo, f_hi, s) {
+  e <- band_edges(f_lo, f_hi, length(s) * band_sub)
+  si <- rep(s, each = band_sub)
+  lo <- e[-length(e)]
+  hi <- e[-1L]
+  ctr <- (lo + hi) / 2
+  F4 <- function(x) 3 * x / 8 - sin(2 * x) / 4 + sin(4 * x) / 32
+  vapply(tau, function(t) {
+    a <- pi * t
+    den <- if (is.null(tau0)) (pi * ctr * t)^2 else
+      ((t / tau0) * sin(pi * ctr * tau0))^2
+    2 * sum(si * (F4(a * hi) - F4(a * lo)) / a / den)
+  }, 0)
+}
+
+# Autocovariance at lags h (samples): sum_j s_j int cos(2 pi f h tau0) df.
+band_acf <- function(h, tau0, f_lo, f_hi, s) {
+  e <- band_edges(f_lo, f_hi, length(s))
+  vapply(h, function(l) {
+    if (l == 0) return(sum(s * diff(e)))
+    w <- 2 * pi * abs(l) * tau0
+    sum(s * diff(sin(w * e))) / w
+  }, 0)
+}
+
+# n samples of Gaussian noise with the band's spectrum (FFT synthesis:
+# independent cosine and sine amplitudes of variance S1(f_k) df at each
+# Fourier frequency).
+sim_band <- function(n, tau0, scale, f_lo, f_hi, s) {
+  freq <- 1 / tau0
+  k <- seq_len(n %/% 2L)
+  fk <- k * freq / n
+  j <- findInterval(fk, band_edges(f_lo, f_hi, length(s)), rightmost.closed = TRUE)
+  S1 <- numeric(length(fk))
+  inside <- j >= 1L & j <= length(s)
+  S1[inside] <- s[j[inside]]
+  sd <- sqrt(scale * S1 * freq / n)
+  c <- complex(n)
+  c[k + 1L] <- complex(real = stats::rnorm(length(k), sd = sd),
+                       imaginary = -stats::rnorm(length(k), sd = sd))
+  Re(stats::fft(c, inverse = TRUE))
+}
+
+# The band's spectrum measured from the raw series: `b` a row of
+# find_bands(). The background under it is log-quadratic in f through the
+# flanks (one band width either side, below 0.49 freq); a log-linear one
+# gives the systematic spread. Returns list(f_lo, f_hi, s, u, power) or
+# NULL when the band has no measurable excess.
+measure_band <- function(x, freq, b, seg = 512L, knots = band_knots) {
+  w <- welch_psd_lin(x - mean(x), freq, seg)
+  wd <- max(b$f_to - b$f_from, 4 * w$df)
+  fl <- (w$f > b$f_from - wd & w$f < b$f_from & w$f > 0) |
+    (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))
+  # the band's bins, and 2 more either side: the Hann window spreads each
+  # frequency over +-2 bins, so the band's edges leak that far
+  inb <- which(w$f >= b$f_from - 2 * w$df & w$f <= b$f_to + 2 * w$df & w$f > 0)
+  fl <- fl & (w$f < w$f[inb[1L]] | w$f > w$f[inb[length(inb)]])
+  if (sum(fl) < 6L || length(inb) < 2L) return(NULL)
+  excess <- function(degree) {
+    X <- outer(w$f[fl], 0:degree, `^`)
+    cf <- stats::lm.fit(X, log(w$psd[fl]))$coefficients
+    bg <- exp(drop(outer(w$f[inb], 0:degree, `^`) %*% cf))
+    pmax(w$psd[inb] - bg, 0)
+  }
+  ex <- excess(2L)
+  p2 <- sum(ex) * w$df
+  p1 <- sum(excess(1L)) * w$df
+  if (!(p2 > 0)) return(NULL)
+  f_lo <- w$f[inb[1L]] - w$df / 2
+  f_hi <- w$f[inb[length(inb)]] + w$df / 2
+  # the bins' power, cumulated over their edges, read at the knot edges
+  cum <- c(0, cumsum(ex) * w$df)
+  be <- c(f_lo, w$f[inb] + w$df / 2)
+  ke <- band_edges(f_lo, f_hi, knots)
+  s <- diff(stats::approx(be, cum, xout = ke, rule = 2)$y) / diff(ke)
+  # (a knot with no excess carries 1e-9 of the peak: fixed values are positive)
+  s <- pmax(s, 1e-9 * max(s))
+  # relative uncertainty: the bins' chi-square, the spread between the two
+  # backgrounds, and the power of the 2 outermost bins either side (where
+  # the window's leakage leaves the band's edges uncertain at that size)
+  k <- length(ex)
+  edge <- sum(ex[unique(c(1:2, (k - 1L):k))]) * w$df
+  u <- sqrt(2 / (w$nu * length(inb)) + ((p1 - p2) / p2)^2 + (edge / p2)^2)
+  list(f_lo = f_lo, f_hi = f_hi, s = s, u = u, power = p2)
+}
+
+band_params <- function() {
+  rbind(
+    effect_param("amp", "amp", "1", "square root of the band's scale (1: as measured)"),
+    effect_param("f_lo", "nonlinear", "Hz", "hertz (lower edge, measured)",
+                 profile = "smooth", print_unit = TRUE),
+    effect_param("f_hi", "nonlinear", "Hz", "hertz (upper edge, measured)",
+                 profile = "smooth", print_unit = TRUE),
+    effect_param("u", "nonlinear", "1", "relative uncertainty of the band's power",
+                 profile = "smooth", hidden = TRUE),
+    do.call(rbind, lapply(seq_len(band_knots), function(j) {
+      effect_param(paste0("s", j), "nonlinear", "u^2/Hz",
+                   "one-sided PSD of the band on knot j (measured)",
+                   profile = "smooth", hidden = TRUE)
+    })))
+}
+
+band_spectrum <- function(nl) {
+  vapply(seq_len(band_knots), function(j) nl[[paste0("s", j)]], 0)
+}
+
+effect_band <- function() {
+  new_effect(
+    name = "band", title = "measured spectral band",
+    params = band_params(),
+    repeatable = FALSE, slope = NA_real_, psd_alpha = NA_real_,
+    formula = paste("amp^2 x exact AV of the measured band spectrum:",
+                    "2 int S1(f) sin^4(pi f tau) / (m sin(pi f tau0))^2 df"),
+    signature = paste("a bump near tau ~ 0.37 / f of the band with damped",
+                      "nulls; a broad periodogram band of any shape"),
+    basis = function(tau, tau0, nl) {
+      band_av(tau, tau0, nl[["f_lo"]], nl[["f_hi"]], band_spectrum(nl))
+    },
+    psd = function(f, nl) {
+      j <- findInterval(f, band_edges(nl[["f_lo"]], nl[["f_hi"]]),
+                        rightmost.closed = TRUE)
+      s <- band_spectrum(nl)
+      out <- numeric(length(f))
+      ok <- j >= 1L & j <= length(s)
+      out[ok] <- s[j[ok]] / 2
+      out
+    },
+    acf = function(h, tau0, nl) {
+      band_acf(h, tau0, nl[["f_lo"]], nl[["f_hi"]], band_spectrum(nl))
+    },
+    sim = function(n, tau0, amp, nl) {
+      sim_band(n, tau0, amp[[1L]]^2, nl[["f_lo"]], nl[["f_hi"]], band_spectrum(nl))
+    },
+    edf_alpha = function(tau, tau0, nl) rep(0, length(tau)),
+    # every parameter but the scale is measured and pinned by propose();
+    # the ranges only describe where such values live
+    nl_range = function(tau, freq) {
+      hi <- if (is.null(freq)) 0.5 / min(tau) else 0.5 * freq
+      c(list(f_lo = c(hi / 1000, hi), f_hi = c(hi / 1000, hi), u = c(1e-6, 1)),
+        stats::setNames(rep(list(c(1e-300, 1e300)), band_knots),
+                        paste0("s", seq_len(band_knots))))
+    },
+    # The bands of the raw data propose their own spectrum: the strongest
+    # band the curve can see, every parameter but the scale pinned.
+    propose = function(raw, tau, sig) {
+      mb <- raw$band_spectra
+      if (!length(mb)) return(list())
+      hi <- min(0.5 / min(tau), 0.499 * raw$freq)
+      ok <- vapply(mb, function(m) (m$f_lo + m$f_hi) / 2 > 1 / max(tau) &&
+                     (m$f_lo + m$f_hi) / 2 < hi, NA)
+      mb <- mb[ok]
+      if (!length(mb)) return(list())
+      m <- mb[[which.max(vapply(mb, `[[`, 0, "power"))]]
+      fc <- (m$f_lo + m$f_hi) / 2
+      pin <- c(list(f_lo = m$f_lo, f_hi = m$f_hi, u = m$u),
+               stats::setNames(as.list(m$s), paste0("s", seq_along(m$s))))
+      list(list(init = list(amp = 1), pin = pin,
+                tau_from = 0.371 / m$f_hi / 2, tau_to = 2 / m$f_lo, score = 2,
+                note = sprintf(paste("proposed by the spectral band at %s-%s Hz",
+                                     "(its measured spectrum, power %s)"),
+                               format_num(m$f_lo, 4), format_num(m$f_hi, 4),
+                               format_num(m$power))))
+    },
+    # the scale the curve asks for must be the measured one, within twice
+    # the band power's relative uncertainty
+    evidence = function(par, raw, x, freq) {
+      sc <- par[["amp"]]^2
+      u <- par[["u"]]
+      ok <- is.finite(sc) && sc > 0 && abs(log(sc)) <= 2 * u
+      list(text = sprintf(paste("the measured band %s-%s Hz: the curve asks for %.3f x its",
+                                "power (uncertainty %.1f%%)"),
+                          format_num(par[["f_lo"]], 4), format_num(par[["f_hi"]], 4),
+                          sc, 100 * u),
+           support = ok)
+    },
+    peak_tau = function(par) 0.371 * 2 / (par[["f_lo"]] + par[["f_hi"]]),
+    describe = function(values) {
+      sprintf("measured band (%s Hz)", paste(sprintf("%s-%s", signif(values$f_lo, 3),
+                                                     signif(values$f_hi, 3)),
+                                             collapse = ", "))
+    },
+    # the measured band is the resonance's band as the data show it
+    replaces = "resonance",
+    # its spectrum is measured, never searched: tried only where proposed
+    proposed_only = TRUE
+  )
+}

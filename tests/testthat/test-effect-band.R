@@ -1,0 +1,103 @@
+# The measured-band entry: its AV transfer function against exact forms,
+# its measurement of a band from our own generator (a non-Lorentzian band
+# made here by shaping white noise in the frequency domain, not with the
+# package's simulator), its evidence rule, and the loop choosing it.
+
+# A band with a skewed, non-Lorentzian shape: steep below fpk, a shoulder
+# above; one-sided PSD `shape(f) * level` (u^2/Hz). Made by giving each
+# Fourier frequency independent Gaussian cosine and sine amplitudes.
+skewed_band <- function(n, freq, level = 1e-3, fpk = 20) {
+  shape <- function(f) {
+    ifelse(f < fpk - 3 | f > fpk + 6, 0,
+           ifelse(f < fpk, ((f - fpk + 3) / 3)^3, 1 - 0.5 * (f - fpk) / 6))
+  }
+  k <- seq_len(n / 2 - 1)
+  f <- k * freq / n
+  sd <- sqrt(shape(f) * level * freq / n)
+  z <- complex(n)
+  z[k + 1] <- complex(real = rnorm(length(k), sd = sd), imaginary = rnorm(length(k), sd = sd))
+  list(x = Re(fft(z, inverse = TRUE)),
+       power = integrate(function(f) shape(f) * level, fpk - 3, fpk + 6,
+                         subdivisions = 1000)$value)
+}
+
+test_that("the band's AV is the exact transfer function (white noise, a line)", {
+  tau0 <- 0.01
+  m <- c(1, 2, 3, 5, 8)
+  # white noise of variance 1: S1 = 2 tau0 over [0, Nyquist] gives 1/m
+  white <- allanvar:::band_av(m * tau0, tau0, 0, 50, rep(2 * tau0, 24))
+  expect_equal(white * m, rep(1, 5), tolerance = 0.01)
+  # a band 0.01 Hz wide of power A^2/2 is a sinusoid of amplitude A
+  A <- 0.3; f0 <- 12.3
+  s <- rep(A^2 / 2 / 0.01, 24)
+  line <- allanvar:::band_av(m * tau0, tau0, f0 - 0.005, f0 + 0.005, s)
+  exact <- A^2 * sin(pi * f0 * m * tau0)^4 / (m^2 * sin(pi * f0 * tau0)^2)
+  expect_equal(line, exact, tolerance = 1e-3)
+})
+
+test_that("a skewed band is measured from the raw series and its AV matches", {
+  set.seed(71)
+  freq <- 100
+  n <- 2^19
+  b <- skewed_band(n, freq)
+  x <- b$x + rnorm(n, sd = 0.02 * sqrt(freq))
+  bands <- allanvar:::find_bands(x, freq)
+  expect_gte(nrow(bands), 1)
+  j <- which.max(bands$power)
+  mb <- allanvar:::measure_band(x, freq, bands[j, ])
+  # the measured power within 5% of the true one (and within 3 u)
+  expect_equal(mb$power, b$power, tolerance = 0.05)
+  expect_lt(abs(log(mb$power / b$power)), 3 * mb$u + 0.02)
+  # the AV of the measured spectrum against the band alone, tau 0.02-1 s
+  a <- allan(b$x, freq, taus = c(2, 3, 5, 10, 30, 100) / freq)
+  th <- allanvar:::band_av(a$tau, 1 / freq, mb$f_lo, mb$f_hi, mb$s)
+  expect_equal(th, a$avar, tolerance = 0.1)
+  # the simulator has the same AV
+  y <- allanvar:::sim_band(n, 1 / freq, 1, mb$f_lo, mb$f_hi, mb$s)
+  expect_equal(allan(y, freq, taus = a$tau)$avar, th, tolerance = 0.1)
+})
+
+test_that("the curve's scale must be the measured one", {
+  e <- allanvar:::effect_entry("band")
+  par <- list(amp = 1, f_lo = 17, f_hi = 26, u = 0.03)
+  expect_true(e$evidence(par, NULL, NULL, 100)$support)
+  par$amp <- sqrt(1.05)
+  expect_true(e$evidence(par, NULL, NULL, 100)$support)
+  par$amp <- sqrt(1.2)
+  ev <- e$evidence(par, NULL, NULL, 100)
+  expect_false(ev$support)
+  expect_match(ev$text, "1.200 x its power")
+})
+
+test_that("the loop takes the measured band where the Lorentzian cannot describe it", {
+  skip_on_cran()
+  set.seed(72)
+  freq <- 100
+  n <- 2^19
+  b <- skewed_band(n, freq, level = 2e-3)
+  x <- b$x + rnorm(n, sd = 0.02 * sqrt(freq)) + cumsum(rnorm(n, sd = 2e-4 / sqrt(freq)))
+  fit0 <- avfit(allan(x, freq), terms = c("N", "B", "K"))
+  ref <- suppressMessages(avrefine(fit0, data = x, max_steps = 4))
+  expect_true("band" %in% ref$terms)
+  expect_false("resonance" %in% ref$terms)
+  st <- ref$steps[ref$steps$effect == "band", ]
+  expect_true(isTRUE(st$confirmed))
+  expect_lt(ref$chi2, 2)
+  expect_equal(coef(ref)[["N"]], 0.02, tolerance = 0.1)
+  # the hidden spectrum stays out of the step summary
+  expect_false(grepl("s1=", st$params))
+})
+
+test_that("without a band in the raw data the band is never tried", {
+  skip_on_cran()
+  set.seed(73)
+  freq <- 100
+  n <- 2^18
+  x <- rnorm(n, sd = 0.02 * sqrt(freq)) + cumsum(rnorm(n, sd = 2e-4 / sqrt(freq)))
+  ref <- suppressMessages(avrefine(avfit(allan(x, freq), terms = c("N", "B", "K")),
+                                   data = x, max_steps = 3))
+  expect_false("band" %in% ref$terms)
+  expect_false("band" %in% ref$refine$rejected$effect)
+  expect_false("band" %in% ref$refine$failures$effect)
+  expect_true(isTRUE(allanvar:::effect_entry("band")$proposed_only))
+})
