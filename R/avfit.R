@@ -192,9 +192,8 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
         edf_model(data$m, curve$n, curve$type, matrix(1, nrow(data), 1), 0,
                   curve$L)
       } else {
-        edf_model(data$m, curve$n, curve$type,
-                  model_components(data$tau, tau0, res$layout),
-                  model_alpha(data$tau, tau0, res$layout), curve$L)
+        edf_fit_model(data$m, curve$n, curve$type, data$tau, tau0,
+                      res$layout, curve$L)
       }
     }
     pr <- fit_problem(data, tau0, lay, bias_correct, corr)
