@@ -56,19 +56,25 @@ edf_model <- function(m, n, type, comp, alpha, L = n + 1) {
 }
 
 # EDF of a fitted model's AV estimates at the data taus: `lay` the layout
-# with values. The terms with a structure function in src/avfit.cpp (N, K,
-# Q, Gauss-Markov) get the exact EDF of their sum (Greenhall & Riley 2003,
-# cross terms included); other stochastic terms (B, filters, ...) join by
-# the per-term combination of edf_model(), and deterministic ones (ramp,
-# sinusoids) add to the AV only. Without tau0 (no freq) or with m out of
-# reach of the exact form, edf_model() alone.
+# with values. When every stochastic term has a structure function in
+# src/avfit.cpp (N, K, Q, Gauss-Markov) and there is more than one of them
+# or a Gauss-Markov term, the EDF is exact for their sum (Greenhall &
+# Riley 2003, cross terms included; the per-term combination overstates it
+# up to twofold where two terms are level); deterministic terms (ramp,
+# sinusoids) add to the AV only. Otherwise (a flicker or filter term, a
+# single power-law noise, which the engine of allan() already gives, or no
+# tau0) edf_model().
 edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
   comp <- model_components(tau, tau0, lay)
   alpha <- model_alpha(tau, tau0, lay)
   labels <- colnames(comp)
   kinds <- lay$kind[match(labels, lay$label)]
   exact <- kinds %in% c("N", "K", "Q", "gm")
-  if (is.null(tau0) || !any(exact)) return(edf_model(m, n, type, comp, alpha, L))
+  live <- colSums(comp) > 0
+  stoch <- live & colSums(!is.na(alpha)) > 0
+  use <- !is.null(tau0) && all(exact[stoch]) &&
+    (sum(stoch) > 1L || any(kinds[stoch] == "gm"))
+  if (!use) return(edf_model(m, n, type, comp, alpha, L))
   val <- stats::setNames(lay$value, lay$name)
   amp2 <- function(kind) if (kind %in% kinds) val[[kind]]^2 else 0
   gm <- labels[kinds == "gm"]
@@ -81,15 +87,7 @@ edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
                           amp2("N") / tau0, amp2("K") * tau0, amp2("Q") / tau0^2,
                           as.double(sig2), as.double(phi))
   av_g <- rowSums(comp[, exact, drop = FALSE])
-  tot <- rowSums(comp)
-  den <- av_g^2 / nu_g
-  for (k in which(!exact)) {
-    for (a in unique(stats::na.omit(alpha[, k]))) {
-      i <- which(alpha[, k] == a)
-      den[i] <- den[i] + comp[i, k]^2 / edf_power_law(m[i], n, type, a, L)
-    }
-  }
-  e <- tot^2 / den
+  e <- rowSums(comp)^2 / (av_g^2 / nu_g)
   bad <- !(is.finite(e) & e > 0)
   if (any(bad)) {
     e[bad] <- edf_model(m[bad], n, type, comp[bad, , drop = FALSE],

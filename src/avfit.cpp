@@ -382,10 +382,21 @@ double exact_edf_one(const StructureFn& V, double m, double M, bool overlapping,
   double s = 0.0;  // sum_{k >= 0} (M - k) R(k)^2 over the support
   if (overlapping) {
     const double kmax = std::min(M - 1.0, 2.0 * m + tail);
-    auto f = [&](double k) { double r = V.acov_d(k, m); return (M - k) * r * r; };
+    // white phase adds to R only at lags 0, m, 2m (spikes the trapezoid
+    // would smear): the smooth part is summed without it, the spikes added
+    StructureFn Vs = V;
+    Vs.p = 0.0;
+    auto f = [&](double k) { double r = Vs.acov_d(k, m); return (M - k) * r * r; };
     double br[4] = {0.0, std::min(m, kmax), std::min(2.0 * m, kmax), kmax};
     for (int i = 0; i < 3; ++i) s += segment_sum(br[i], br[i + 1], f, 64);
     s += f(kmax);
+    if (V.p > 0) {
+      for (double k : {0.0, m, 2.0 * m}) {
+        if (k > kmax) break;
+        const double r = V.acov_d(k, m), rs = Vs.acov_d(k, m);
+        s += (M - k) * (r * r - rs * rs);
+      }
+    }
   } else {
     const double jmax = std::min(M - 1.0, 2.0 + std::ceil(tail / m));
     for (double j = 0; j <= jmax; j += 1.0) {
