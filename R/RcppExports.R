@@ -37,6 +37,10 @@ avar_white_cov <- function(m, n, overlapping, threads) {
     .Call(`_allanvar_avar_white_cov`, m, n, overlapping, threads)
 }
 
+avfit_exact_edf <- function(m, M, overlapping, w, q, p, s2, phi) {
+    .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, w, q, p, s2, phi)
+}
+
 bz2_available_cpp <- function() {
     .Call(`_allanvar_bz2_available_cpp`)
 }

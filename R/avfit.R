@@ -56,7 +56,13 @@
 #' Q 2, N 0, B -1, K -2, a Gauss-Markov term -2, -1 or 0 as tau is below
 #' 0.5 Tc, below 3 Tc or above; the ramp and sinusoids are deterministic.
 #' The terms are combined as \eqn{\nu = (\sum_k AV_k)^2 / \sum_k
-#' (AV_k^2/\nu_k)}. The fit is iterated `edf_passes` times (see
+#' (AV_k^2/\nu_k)}. When every noise term of the model is one of N, K, Q
+#' and Gauss-Markov terms and there are several of them (or a Gauss-Markov
+#' term), the EDF is instead exact for their sum (Greenhall & Riley's sum
+#' over the autocovariance of the second differences, computed from each
+#' term's structure function): the combination above leaves out the cross
+#' terms between noises and overstates the EDF up to twofold where two
+#' terms are level. The fit is iterated `edf_passes` times (see
 #' [avfit_control()]; white-FM EDF first, then the model's).
 #'
 #' @section Uncertainty:
@@ -192,9 +198,8 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
         edf_model(data$m, curve$n, curve$type, matrix(1, nrow(data), 1), 0,
                   curve$L)
       } else {
-        edf_model(data$m, curve$n, curve$type,
-                  model_components(data$tau, tau0, res$layout),
-                  model_alpha(data$tau, tau0, res$layout), curve$L)
+        edf_fit_model(data$m, curve$n, curve$type, data$tau, tau0,
+                      res$layout, curve$L)
       }
     }
     pr <- fit_problem(data, tau0, lay, bias_correct, corr)

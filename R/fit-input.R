@@ -191,9 +191,8 @@ curve_of_fit <- function(fit) {
   }
   if (identical(fit$edf_source, "model") || identical(d$edf_source, "model")) {
     tau0 <- if (is.null(d$freq)) NULL else 1 / d$freq
-    comp <- model_components(d$data$tau, tau0, fit$layout)
-    d$data$edf <- edf_model(d$data$m, d$n, d$type, comp,
-                            model_alpha(d$data$tau, tau0, fit$layout), d$L)
+    d$data$edf <- edf_fit_model(d$data$m, d$n, d$type, d$data$tau, tau0,
+                                fit$layout, d$L)
     d$edf_source <- "previous"
   }
   d$source <- "avfit"

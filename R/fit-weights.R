@@ -3,11 +3,13 @@
 # spread of ln AV-hat, the white-noise correlation between points and the
 # whitening matrix built from them.
 #
-# The EDF comes from the one EDF engine of allan() (src/edf.cpp through
-# allan_edf_direct() in R/edf.R): each term instance gets the EDF of its
-# power-law exponent (catalogue `edf_alpha`), and the terms are combined as
-# nu = (sum_k AV_k)^2 / sum_k (AV_k^2 / nu_k); deterministic terms (alpha NA)
-# add no variance.
+# The EDF of the model's N, K, Q and Gauss-Markov terms is exact for their
+# sum (edf_fit_model(), src/avfit.cpp: Greenhall & Riley's sum over the
+# autocovariance of the second differences). Any other stochastic term
+# gets the EDF of its power-law exponent (catalogue `edf_alpha`) from the
+# one EDF engine of allan() (src/edf.cpp through allan_edf_direct() in
+# R/edf.R), combined as nu = (sum_k AV_k)^2 / sum_k (AV_k^2 / nu_k);
+# deterministic terms (alpha NA) add no variance.
 
 log_bias <- function(edf) digamma(edf / 2) - log(edf / 2)
 log_sd <- function(edf) sqrt(trigamma(edf / 2))
@@ -50,6 +52,47 @@ edf_model <- function(m, n, type, comp, alpha, L = n + 1) {
   # a model of deterministic terms only: white-noise EDF
   bad <- !is.finite(e)
   if (any(bad)) e[bad] <- edf_power_law(m[bad], n, type, 0, L)
+  pmin(pmax(e, 1), n)
+}
+
+# EDF of a fitted model's AV estimates at the data taus: `lay` the layout
+# with values. When every stochastic term has a structure function in
+# src/avfit.cpp (N, K, Q, Gauss-Markov) and there is more than one of them
+# or a Gauss-Markov term, the EDF is exact for their sum (Greenhall &
+# Riley 2003, cross terms included; the per-term combination overstates it
+# up to twofold where two terms are level); deterministic terms (ramp,
+# sinusoids) add to the AV only. Otherwise (a flicker or filter term, a
+# single power-law noise, which the engine of allan() already gives, or no
+# tau0) edf_model().
+edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
+  comp <- model_components(tau, tau0, lay)
+  alpha <- model_alpha(tau, tau0, lay)
+  labels <- colnames(comp)
+  kinds <- lay$kind[match(labels, lay$label)]
+  exact <- kinds %in% c("N", "K", "Q", "gm")
+  live <- colSums(comp) > 0
+  stoch <- live & colSums(!is.na(alpha)) > 0
+  use <- !is.null(tau0) && all(exact[stoch]) &&
+    (sum(stoch) > 1L || any(kinds[stoch] == "gm"))
+  if (!use) return(edf_model(m, n, type, comp, alpha, L))
+  val <- stats::setNames(lay$value, lay$name)
+  amp2 <- function(kind) if (kind %in% kinds) val[[kind]]^2 else 0
+  gm <- labels[kinds == "gm"]
+  sig2 <- vapply(gm, function(g) val[[paste0(g, ".sigma")]]^2, 0)
+  phi <- vapply(gm, function(g) exp(-tau0 / val[[paste0(g, ".tc")]]), 0)
+  mm <- pmax(round(m), 1)
+  nu_g <- avfit_exact_edf(as.double(mm),
+                          as.double(allan_nterms(engine_type(type), mm, L)),
+                          identical(type, "overlapping"),
+                          amp2("N") / tau0, amp2("K") * tau0, amp2("Q") / tau0^2,
+                          as.double(sig2), as.double(phi))
+  av_g <- rowSums(comp[, exact, drop = FALSE])
+  e <- rowSums(comp)^2 / (av_g^2 / nu_g)
+  bad <- !(is.finite(e) & e > 0)
+  if (any(bad)) {
+    e[bad] <- edf_model(m[bad], n, type, comp[bad, , drop = FALSE],
+                        alpha[bad, , drop = FALSE], L)
+  }
   pmin(pmax(e, 1), n)
 }
 

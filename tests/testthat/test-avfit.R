@@ -397,3 +397,63 @@ test_that("a fit with every coefficient fixed evaluates the model (no free param
   expect_lt(f$chi2, 3)
   expect_true(is.finite(stats::BIC(f)))
 })
+
+test_that("model EDF is exact for a sum of noises (cross terms, Monte Carlo)", {
+  # N + K + AR(1) at tau0 = 1 s, levels chosen so that all three are
+  # comparable near m = 64; own generator, plain-R estimator (helper-oav.R)
+  nn <- 4096
+  par <- c(N = 1, K = sqrt(3) / 64, sigma = 0.19, tc = 20)
+  lay <- coef_layout(c("N", "K", "gm"))
+  lay$value <- unname(par[c("N", "K", "sigma", "tc")])
+  m <- c(8, 64, 512)
+  ex <- edf_fit_model(m, nn, "overlapping", m, 1, lay)
+  mix <- edf_model(m, nn, "overlapping", model_components(m, 1, lay),
+                   model_alpha(m, 1, lay))
+  set.seed(11)
+  phi <- exp(-1 / par[["tc"]])
+  sims <- replicate(600, {
+    w <- rnorm(nn, sd = par[["sigma"]] * sqrt(1 - phi^2))
+    w[1] <- rnorm(1, sd = par[["sigma"]])
+    y <- rnorm(nn, sd = par[["N"]]) + cumsum(rnorm(nn, sd = par[["K"]])) +
+      as.numeric(stats::filter(w, phi, method = "recursive"))
+    vapply(m, function(mm) oav_ref(y, mm, 1), 0)
+  })
+  av <- rowSums(model_components(m, 1, lay))
+  # the model's AV is the mean of the estimates (unbiased estimator)
+  expect_equal(rowMeans(sims), av, tolerance = 0.06)
+  mc <- 2 * av^2 / apply(sims, 1, var)
+  # sampling error of a variance from 600 draws: 6-8 % at these EDFs
+  expect_equal(ex, mc, tolerance = 0.2)
+  # where the three are level (m = 64) the per-term combination, which
+  # leaves out the cross terms, is far too high (226 against 94)
+  expect_gt(mix[2], 1.5 * mc[2])
+})
+
+test_that("the exact EDF kernel reduces to the exact single-noise values", {
+  nn <- 1000
+  m <- c(1, 2, 5, 16, 64)
+  M <- nn + 1 - 2 * m
+  kern <- function(w, q, p = 0, overlapping = TRUE, mm = m, MM = M) {
+    avfit_exact_edf(mm, MM, overlapping, w, q, p, numeric(0), numeric(0))
+  }
+  # Isserlis moments for white and random-walk rate noise (src/edf.cpp)
+  expect_equal(kern(0.09, 0), allan_edf_direct("overlapping", m, M, nn + 1, rep(0L, 5)),
+               tolerance = 1e-8)
+  expect_equal(kern(0, 4), allan_edf_direct("overlapping", m, M, nn + 1, rep(-2L, 5)),
+               tolerance = 1e-8)
+  # white phase: d_i = e_{i+2m} - 2 e_{i+m} + e_i, R(0) = 6, R(m) = -4,
+  # R(2m) = 1 (m > 0), so EDF = M^2 36 / (36 M + 2 (16 (M - m) + (M - 2m)))
+  Mq <- M[4]
+  expect_equal(kern(0, 0, 1, mm = 16, MM = Mq),
+               Mq^2 * 36 / (36 * Mq + 2 * (16 * (Mq - 16) + (Mq - 32))))
+  # non-overlapping white noise: 2 M^2 / (3 M - 1), M second differences
+  Mn <- floor(4096 / 16) - 1
+  expect_equal(kern(1, 0, overlapping = FALSE, mm = 16, MM = Mn),
+               2 * Mn^2 / (3 * Mn - 1))
+  # a 9,999-tau table costs little (long sums on 64 nodes per stretch)
+  lay <- coef_layout(c("N", "K", "gm"))
+  lay$value <- c(0.01, 2e-4, 0.02, 2)
+  mm <- round(10^seq(0, 6, length.out = 9999))
+  e <- edf_fit_model(mm, 1e8, "overlapping", mm / 100, 0.01, lay)
+  expect_true(all(is.finite(e) & e >= 1))
+})
