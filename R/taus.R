@@ -33,15 +33,16 @@ allan_opts <- function(type, rate, octave = FALSE,
 }
 
 # The noise-identification rules (src/noise_id.h) for `type`:
-#  * "default": Stable32's (lag-1 ACF from 30 points, B1 with N = the
-#    statistic's number of terms), except where Monte Carlo coverage or
-#    SP 1065's published values reject them: for the total type random walk
-#    is told from flicker FM by B1 with its own count (b1_rw_own), and R(n)
-#    weighs all five types (rn_stable32 FALSE);
+#  * "default": Stable32's (B1 with N = the statistic's number of terms),
+#    except where Monte Carlo coverage or SP 1065's published values reject
+#    them: the lag-1 ACF from 64 points, not 30 (from 30, flicker PM's 68%
+#    coverage falls to 0.55 for TOTDEV at N/m = 32); for the total type
+#    random walk told from flicker FM by B1 with its own count (b1_rw_own);
+#    R(n) over all five types (rn_stable32 FALSE). The ACF threshold moves
+#    none of the limits compared with Stable32 (tools/check-stable32*.R);
 #  * "stable32": Stable32's rules throughout, for comparisons with it;
-#  * "coverage": the rules tuned for coverage (ACF from 64 points, random
-#    walk told by B1's own count for every type; allanvar before these
-#    rules).
+#  * "coverage": allanvar's rules before (random walk told by B1's own count
+#    for every type).
 noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default"),
                            type = "overlapping") {
   known <- c("default", "stable32", "coverage")
@@ -50,7 +51,7 @@ noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default"),
           paste0("\"", known, "\"", collapse = ", "), "; not ",
           paste(format(rule), collapse = " "), ".", class = "option")
   }
-  list(acf_min = if (rule == "coverage") 64L else 30L,
+  list(acf_min = if (rule == "stable32") 30L else 64L,
        b1_rw_own = rule == "coverage" || (rule == "default" && type == "total"),
        rn_stable32 = rule == "stable32")
 }

@@ -6,7 +6,7 @@
 //    "Power law noise identification using the lag 1 autocorrelation") on
 //    the WHOLE decimated series (phase data: every m-th phase point;
 //    frequency data: averages of m samples) while it has at least
-//    acf_min points (30, as Stable32 and allantools; R/taus.R
+//    acf_min points (64; Stable32 and allantools: 30; R/taus.R
 //    noise_id_rules()). As Stable32: no detrending of phase (removing drift
 //    is the user's preprocessing);
 //  * below that, Barnes' B1 ratio (standard / Allan variance of the averaged
@@ -44,7 +44,7 @@ enum NoiseIdMethod {
 
 // Which of Stable32's rules apply (options(allanvar.noise_id), R/taus.R).
 struct NoiseIdRules {
-  R_xlen_t acf_min = 30;     // fewest points the lag-1 ACF is read from
+  R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
   bool b1_rw_own = false;    // random walk vs flicker FM: B1 with its own count
   bool rn_stable32 = false;  // R(n): PM only for the modified family, and
                              // flicker PM where it cannot be read
@@ -57,11 +57,14 @@ struct NoiseId {
   R_xlen_t points = 0;          // length of the series it was read from
 };
 
-// acf_min: Stable32 and allantools use the lag-1 ACF from 30 points on, and
-// so does the default. Between 30 and 63 points it misreads white FM more
-// often (r1 has standard error 1/sqrt(n)): the 68% coverage of overlapping
-// ADEV at 32 points is 0.645 instead of 0.68 (tests/testthat/test-edf.R);
-// options(allanvar.noise_id = "coverage") reads it from 64.
+// acf_min: Stable32 and allantools use the lag-1 ACF from 30 points on.
+// Between 30 and 63 points it misreads (r1 has standard error 1/sqrt(n))
+// flicker PM as white PM often enough that TOTDEV's 68% intervals cover
+// 0.55 (overlapping: 0.58) at N/m = 32, N = 1024, and white FM's 0.645
+// (tools/mc-coverage.R, tests/testthat/test-edf.R); B1 with R(n) over the
+// whole record reads those rows, by default from 64 points; it changes none
+// of the limits compared with Stable32's (tools/check-stable32*.R).
+// options(allanvar.noise_id = "stable32") uses 30.
 
 // Lag-1 ACF method on z[0..n): decimated phase (phase = true) or averaged
 // frequency. dmax: most differences taken (2 for Allan, 3 for Hadamard).

@@ -16,7 +16,7 @@ struct AllanOptions {
   bool octave;   // standard type at m = 2^j: the pairwise one-pass kernel
   int threads;   // threads the kernel may use (>= 1)
   // noise identification (src/noise_id.h, R/taus.R noise_id_rules()):
-  R_xlen_t acf_min = 30;     // fewest points the lag-1 ACF is read from
+  R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
   bool b1_rw_own = false;    // random walk vs flicker FM by B1 with its own count
   bool rn_stable32 = false;  // R(n) as Stable32 (modified family: PM only)
   bool sums = true;          // false: noise identification only (no sums)
