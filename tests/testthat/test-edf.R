@@ -315,3 +315,33 @@ test_that("the further types' noise type (identification without sums) is allan(
     expect_identical(as.integer(got[match(ref$m, m)]), as.integer(ref$alpha))
   }
 })
+
+test_that("limits agree with Stable32's on >= 95% of its reference rows (issue 10)", {
+  # Both limits within 25% of Stable32's half-width, over every Stable32 run
+  # of allantools' and allantoolkit's test suites (tools/check-stable32.R,
+  # the Allan types, and tools/check-stable32-types.R, the further types),
+  # with the default noise identification. Not shipped: set
+  # ALLANVAR_PEER_DATA to the checkouts (":"-separated).
+  roots <- strsplit(Sys.getenv("ALLANVAR_PEER_DATA"), ":", fixed = TRUE)[[1]]
+  roots <- roots[dir.exists(roots)]
+  skip_if(!length(roots), "ALLANVAR_PEER_DATA does not point at allantools")
+  at <- roots[dir.exists(file.path(roots, "tests", "phasedat"))]
+  skip_if(!length(at), "no allantools checkout under ALLANVAR_PEER_DATA")
+  tools <- file.path("..", "..", "tools")
+  skip_if_not(file.exists(file.path(tools, "check-stable32.R")),
+              "tools/ is not beside the tests")
+  old <- options(allanvar.noise_id = NULL)
+  on.exit(options(old))
+  e1 <- new.env(parent = asNamespace("allanvar"))
+  sys.source(file.path(tools, "check-stable32.R"), envir = e1)
+  e2 <- new.env(parent = asNamespace("allanvar"))
+  sys.source(file.path(tools, "check-stable32-types.R"), envir = e2)
+  r1 <- e1$check_stable32(at[1])
+  ci <- r1$status == "ok" & r1$has_ci
+  d <- e2$check_stable32_types(roots, verbose = FALSE)
+  st <- !d$loose
+  ok <- sum(r1$limits_ok[ci], na.rm = TRUE) + sum(d$lim_ok[st], na.rm = TRUE)
+  of <- sum(ci) + sum(!is.na(d$lim_ok[st]))
+  expect_gt(of, 700)
+  expect_gte(ok / of, 0.95)
+})
