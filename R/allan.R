@@ -58,7 +58,7 @@
 #'   number of cluster averages: with Stable32's N random walk is out of
 #'   reach at long tau, and TOTDEV's 68% intervals cover only 0.57-0.59 of
 #'   random-walk FM at N/m = 4 (Monte Carlo, N = 1024 and 4096; the Allan
-#'   types stay at 0.60-0.63). Where B1 points to phase noise, the ratio
+#'   types stay at 0.60-0.65). Where B1 points to phase noise, the ratio
 #'   R(n) of the modified to the Allan variance picks among white and
 #'   flicker PM and the three FM types (Stable32 asks it only between white
 #'   and flicker PM for the modified family, which types NIST SP 1065's

@@ -47,7 +47,7 @@ double b1_theory(double N, int mu) {
 // (n_stat), far above the few averaged frequencies the ratio is read from
 // at long tau: random walk's expected B1 (N/2) is then out of reach and
 // random-walk FM is typed flicker or white FM. The 68% intervals still
-// cover 0.60-0.63 for the Allan types, but TOTDEV's cover 0.57-0.59 at
+// cover 0.60-0.65 for the Allan types, but TOTDEV's cover 0.57-0.59 at
 // N/m = 4 (N = 1024 and 4096; tools/mc-coverage.R), so for the total type
 // random walk is told from flicker FM with the count of averaged
 // frequencies (n_own; NoiseIdRules::b1_rw_own).
