@@ -580,8 +580,8 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<Level>& lev,
                      const std::vector<R_xlen_t>& mid,
                      const std::vector<double>& mid_n, int dmax,
-                     const allanvar::NoiseIdRules& rules, int threads,
-                     bool main, Channel& out) {
+                     bool modified, const allanvar::NoiseIdRules& rules,
+                     int threads, bool main, Channel& out) {
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
     if (allanvar::needs_b1(N + 1, m, false, rules.acf_min)) {
@@ -601,7 +601,7 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     if (n >= rules.acf_min) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
-      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], false, rules,
+      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], modified, rules,
                                  [&]() { return rn.ratio(m); });
     }
     store_id(id, out, j);
@@ -637,11 +637,20 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       }
     }
   }
-  if (type == STANDARD && rate && octave) {
+  // Identification alone at octave m of frequency data (another
+  // statistic's noise type) reads the same cluster sums, whatever the type.
+  bool octave_id = !opts.sums && rate && ni > 0;
+  for (R_xlen_t m : mid) {
+    if (m < 1 || m > N || (m & (m - 1)) != 0) octave_id = false;
+  }
+  if ((type == STANDARD && rate && octave) || octave_id) {
     // Any constant works as the centre here (cluster sums are double-double
     // and constants cancel); NaN or Inf shows up in the sums.
+    R_xlen_t top = 1;
+    for (R_xlen_t m : ms) top = std::max(top, m);
+    for (R_xlen_t m : mid) top = std::max(top, m);
     int J = 0;
-    while ((static_cast<R_xlen_t>(1) << (J + 1)) <= ms.back()) ++J;
+    while ((static_cast<R_xlen_t>(1) << (J + 1)) <= top) ++J;
     std::vector<bool> keep(J + 1, false);
     for (R_xlen_t m : mid) {
       int lj = 0;
@@ -654,13 +663,15 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
     }
-    for (size_t j = 0; j < nt; ++j) {
-      int lj = 0;
-      while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
-      out.sums[j] = lev[lj].acc.value();
+    if (opts.sums) {
+      for (size_t j = 0; j < nt; ++j) {
+        int lj = 0;
+        while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
+        out.sums[j] = lev[lj].acc.value();
+      }
     }
-    octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, rules, threads, main,
-                    out);
+    octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, type == MODIFIED,
+                    rules, threads, main, out);
     return;
   }
 
@@ -679,7 +690,10 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
 
   Split X;
-  const int level = type == MODIFIED ? (rate ? 2 : 1) : (rate ? 1 : 0);
+  // identification alone reads the phase: MODIFIED's extra level of sums
+  // (serial, the costliest pass) is built only for its sums
+  const bool two = type == MODIFIED && opts.sums;
+  const int level = (two ? 1 : 0) + (rate ? 1 : 0);
   if (level == 0) {
     build_split(v, N, c, bound, X);
   } else {
@@ -695,11 +709,11 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     case OHADAMARD: overlapped<3>(X, ms, nterms, threads, main, o); break;
     case TOTAL: total(X, ms, threads, main, o); break;
   }
-  // Noise id from the phase: X itself, or with MODIFIED (one more level of
-  // sums) its first differences. Frequency data at m = 1 are the samples.
+  // Noise id from the phase: X itself, or its first differences when
+  // MODIFIED's sums built one more level. Frequency data at m = 1 are the
+  // samples.
   const double* h = X.hi.data();
   const double* l = X.lo.data();
-  const bool two = type == MODIFIED;
   auto phase = [h, l, two](R_xlen_t k) -> double {
     return two ? (h[k + 1] - h[k]) + (l[k + 1] - l[k]) : h[k] + l[k];
   };
@@ -916,7 +930,10 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
   for (R_xlen_t i = 0; i < N; ++i) if (std::isnan(x[i])) v[i] = c;
   const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
   Split X;
-  const int level = type == MODIFIED ? (rate ? 2 : 1) : (rate ? 1 : 0);
+  // identification alone reads the phase: MODIFIED's extra level of sums
+  // (serial, the costliest pass) is built only for its sums
+  const bool two = type == MODIFIED && opts.sums;
+  const int level = (two ? 1 : 0) + (rate ? 1 : 0);
   try {
     if (level == 0) {
       build_split(v.data(), N, c, bound, X);

@@ -307,12 +307,19 @@ test_that("Theo1's EDF (Howe & Peppler, SP 1065) matches Monte Carlo at a known 
 
 test_that("the further types' noise type (identification without sums) is allan()'s own", {
   set.seed(31)
-  x <- cumsum(rnorm(3000)) + rnorm(3000, sd = 5)
-  m <- c(1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1000)
-  for (base in c("modified", "ohadamard", "overlapping")) {
-    ref <- allan(x, 1, taus = I(m), type = base)
-    got <- allanvar:::extra_alpha(x, 1, m, base, "rate", length(x) + 1)
-    expect_identical(as.integer(got[match(ref$m, m)]), as.integer(ref$alpha))
+  # random walk + white FM, white PM (differenced white) and pure white FM;
+  # octave m alone take the cluster-sum path, a non-octave m the prefix sums
+  xs <- list(cumsum(rnorm(3000)) + rnorm(3000, sd = 5), diff(rnorm(3001)),
+             rnorm(3000))
+  for (x in xs) {
+    for (m in list(2^(0:9), c(2^(0:9), 1000))) {
+      for (base in c("modified", "ohadamard", "overlapping")) {
+        ref <- allan(x, 1, taus = I(m), type = base)
+        got <- allanvar:::extra_alpha(x, 1, m, base, "rate", length(x) + 1)
+        expect_identical(as.integer(got[match(ref$m, m)]),
+                         as.integer(ref$alpha))
+      }
+    }
   }
 })
 
