@@ -48,24 +48,33 @@
 #'   autocorrelation method over the whole series, differencing at most
 #'   twice (three times for Hadamard types). Stable32 and allantools start
 #'   at 30 points; between 30 and 63 the lag-1 autocorrelation misreads
-#'   white FM often enough to push the 68% coverage below 0.65 (Monte
-#'   Carlo, N = 1024), so B1 is used there too;
+#'   flicker PM often enough that TOTDEV's 68% intervals cover 0.55 of it
+#'   at N/m = 32 (Monte Carlo, N = 1024), so B1 and R(n) are used there
+#'   (no limit compared with Stable32's changes);
 #' * below that, Barnes' B1 ratio (standard over Allan variance of the
 #'   cluster averages) against its expected values for N = the statistic's
-#'   number of terms and Howe et al.'s (2000) boundaries, as Stable32;
-#'   random-walk against flicker FM with N = the number of cluster averages
-#'   (with Stable32's N random walk is out of reach at long tau and the 68%
-#'   intervals cover 0.58-0.62 on random-walk FM); where B1 points to phase
-#'   noise, the ratio R(n) of the modified to the Allan variance picks among
-#'   white and flicker PM and the three FM types;
+#'   number of terms and Howe et al.'s (2000) boundaries, as Stable32.
+#'   For `"total"` random-walk against flicker FM is told with N = the
+#'   number of cluster averages: with Stable32's N random walk is out of
+#'   reach at long tau, and TOTDEV's 68% intervals cover only 0.57-0.59 of
+#'   random-walk FM at N/m = 4 (Monte Carlo, N = 1024 and 4096; the Allan
+#'   types stay at 0.60-0.65). Where B1 points to phase noise, the ratio
+#'   R(n) of the modified to the Allan variance picks among white and
+#'   flicker PM and the three FM types (Stable32 asks it only between white
+#'   and flicker PM for the modified family, which types NIST SP 1065's
+#'   white-FM NBS14 set flicker PM at m = 100 where SP 1065 corrects MTOT's
+#'   bias as white FM's);
 #' * with fewer than three cluster averages (or phase noise that R(n) cannot
 #'   check), the type is unknown: `alpha` is `NA` and the EDF is the
 #'   smallest over the admissible types (the widest interval).
 #'
 #' `options(allanvar.noise_id = "stable32")` applies Stable32's rules
-#' instead (the autocorrelation from 30 points, B1's N = the number of terms
-#' at every boundary, R(n) only between white and flicker PM for the
-#' modified family), for comparisons with Stable32's tables.
+#' throughout (also for `"total"` and R(n); flicker PM where R(n) cannot be
+#' read), for comparisons with Stable32's tables;
+#' `options(allanvar.noise_id = "coverage")` the rules of allanvar before
+#' (random walk told with the number of cluster averages for every type),
+#' whose 68% intervals cover random-walk FM at 0.65-0.72 where Stable32's
+#' cover 0.60-0.65.
 #'
 #' Then:
 #' * for white (\eqn{\alpha = 0}) or random-walk (\eqn{\alpha = -2}) rate

@@ -25,27 +25,35 @@ allan_type_code <- function(type) {
 # The options the sums kernel reads (src/opts-allan.h), built once per call.
 allan_opts <- function(type, rate, octave = FALSE,
                        threads = allanvar_threads(), sums = TRUE) {
-  rules <- noise_id_rules()
+  rules <- noise_id_rules(type = type)
   list(type = allan_type_code(type), rate = isTRUE(rate),
        octave = isTRUE(octave), threads = as.integer(threads),
-       stable32_b1 = rules$b1, acf_min = rules$acf_min,
-       sums = isTRUE(sums))
+       acf_min = rules$acf_min, b1_rw_own = rules$b1_rw_own,
+       rn_stable32 = rules$rn_stable32, sums = isTRUE(sums))
 }
 
-# The noise-identification rules (src/noise_id.h): by default the lag-1 ACF
-# from 64 points and random walk told by B1 with its own count;
-# options(allanvar.noise_id = "stable32") gives Stable32's (ACF from 30
-# points, B1 with the statistic's term count at every boundary);
-# "stable32-acf" and "stable32-b1" each half alone (diagnostics).
-noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default")) {
-  known <- c("default", "stable32", "stable32-acf", "stable32-b1")
+# The noise-identification rules (src/noise_id.h) for `type`:
+#  * "default": Stable32's (B1 with N = the statistic's number of terms),
+#    except where Monte Carlo coverage or SP 1065's published values reject
+#    them: the lag-1 ACF from 64 points, not 30 (from 30, flicker PM's 68%
+#    coverage falls to 0.55 for TOTDEV at N/m = 32); for the total type
+#    random walk told from flicker FM by B1 with its own count (b1_rw_own);
+#    R(n) over all five types (rn_stable32 FALSE). The ACF threshold moves
+#    none of the limits compared with Stable32 (tools/check-stable32*.R);
+#  * "stable32": Stable32's rules throughout, for comparisons with it;
+#  * "coverage": allanvar's rules before (random walk told by B1's own count
+#    for every type).
+noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default"),
+                           type = "overlapping") {
+  known <- c("default", "stable32", "coverage")
   if (!(is.character(rule) && length(rule) == 1L && rule %in% known)) {
     abort("`options(allanvar.noise_id)` must be one of ",
           paste0("\"", known, "\"", collapse = ", "), "; not ",
           paste(format(rule), collapse = " "), ".", class = "option")
   }
-  list(b1 = rule %in% c("stable32", "stable32-b1"),
-       acf_min = if (rule %in% c("stable32", "stable32-acf")) 30L else 64L)
+  list(acf_min = if (rule == "stable32") 30L else 64L,
+       b1_rw_own = rule == "coverage" || (rule == "default" && type == "total"),
+       rn_stable32 = rule == "stable32")
 }
 
 # Largest cluster size with at least one term, for L phase points (L = N + 1

@@ -580,11 +580,11 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<Level>& lev,
                      const std::vector<R_xlen_t>& mid,
                      const std::vector<double>& mid_n, int dmax,
-                     bool pm_only, bool stable32_n, R_xlen_t acf_min,
+                     bool modified, const allanvar::NoiseIdRules& rules,
                      int threads, bool main, Channel& out) {
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(N + 1, m, false, acf_min)) {
+    if (allanvar::needs_b1(N + 1, m, false, rules.acf_min)) {
       rn.build_from_rate(v, N, c);
       break;
     }
@@ -598,10 +598,10 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const double* z = lj == 0 ? v : lev[lj].z.data();
     const R_xlen_t n = lj == 0 ? N : static_cast<R_xlen_t>(lev[lj].z.size());
     allanvar::NoiseId id;
-    if (n >= acf_min) {
+    if (n >= rules.acf_min) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
     } else {
-      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], pm_only, stable32_n,
+      id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], modified, rules,
                                  [&]() { return rn.ratio(m); });
     }
     store_id(id, out, j);
@@ -621,6 +621,10 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   out.alpha_int.assign(ni, NA_INTEGER);
   out.id_method.assign(ni, allanvar::NOISE_ID_NONE);
   const int dmax = allanvar::estimator_info(type).d;
+  allanvar::NoiseIdRules rules;
+  rules.acf_min = opts.acf_min;
+  rules.b1_rw_own = opts.b1_rw_own;
+  rules.rn_stable32 = opts.rn_stable32;
   // the statistic's number of terms at each noise-id row (B1's N)
   std::vector<double> mid_n(ni, 0.0);
   for (size_t j = 0; j < ni; ++j) {
@@ -667,7 +671,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       }
     }
     octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, type == MODIFIED,
-                    opts.stable32_b1, opts.acf_min, threads, main, out);
+                    rules, threads, main, out);
     return;
   }
 
@@ -716,7 +720,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   const R_xlen_t Lp = rate ? N + 1 : N;
   allanvar::RnCache rn;
   for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(Lp, m, !rate, opts.acf_min)) {
+    if (allanvar::needs_b1(Lp, m, !rate, rules.acf_min)) {
       rn.build(phase, Lp);
       break;
     }
@@ -726,12 +730,11 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     if (allanvar::interrupted()) return;
     const R_xlen_t m = mid[j];
     allanvar::NoiseId id;
-    if (m == 1 && N >= opts.acf_min) {
+    if (m == 1 && N >= rules.acf_min) {
       id = allanvar::acf_noise_id(v, N, !rate, dmax);
     } else {
       id = allanvar::identify_noise(phase, Lp, m, dmax, !rate, rn, mid_n[j],
-                                    type == MODIFIED, opts.stable32_b1,
-                                    opts.acf_min);
+                                    type == MODIFIED, rules);
     }
     store_id(id, out, j);
   });

@@ -44,13 +44,13 @@ double b1_theory(double N, int mu) {
 // (Howe et al. 2000, Table 4); mu -2 (white or flicker PM) up to 2 (flicker
 // walk FM; the caller clamps to the statistic's range). Stable32 takes N,
 // the count behind the expected B1, to be the statistic's number of terms
-// (n_stat); so do the PM / white FM / flicker FM boundaries here. Random-
-// walk FM is told from flicker FM with the count of averaged frequencies
-// the ratio was read from (n_own): with Stable32's N the expected B1 of
-// random walk (N/2) is out of reach at long tau, it is typed flicker or
-// white FM, and the 68% intervals of overlapping ADEV cover 0.62
-// (tests/testthat/test-edf.R). options(allanvar.noise_id = "stable32")
-// passes n_own = n_stat, Stable32's rule, for comparisons with it.
+// (n_stat), far above the few averaged frequencies the ratio is read from
+// at long tau: random walk's expected B1 (N/2) is then out of reach and
+// random-walk FM is typed flicker or white FM. The 68% intervals still
+// cover 0.60-0.65 for the Allan types, but TOTDEV's cover 0.57-0.59 at
+// N/m = 4 (N = 1024 and 4096; tools/mc-coverage.R), so for the total type
+// random walk is told from flicker FM with the count of averaged
+// frequencies (n_own; NoiseIdRules::b1_rw_own).
 int b1_mu(double b1, double n_stat, double n_own) {
   for (int mu = 2; mu > -2; --mu) {
     const double N = mu >= 1 ? n_own : n_stat;

@@ -6,26 +6,26 @@
 //    "Power law noise identification using the lag 1 autocorrelation") on
 //    the WHOLE decimated series (phase data: every m-th phase point;
 //    frequency data: averages of m samples) while it has at least
-//    acf_min points (64 by default, R/taus.R noise_id_rules(); Stable32 and
-//    allantools: 30). As Stable32: no detrending of phase (removing drift
+//    acf_min points (64; Stable32 and allantools: 30; R/taus.R
+//    noise_id_rules()). As Stable32: no detrending of phase (removing drift
 //    is the user's preprocessing);
 //  * below that, Barnes' B1 ratio (standard / Allan variance of the averaged
 //    frequencies; Barnes 1969, Howe et al. 2000 Tables 3-4) with N the
-//    number of terms of the statistic, as Stable32 (by default random walk
-//    is told from flicker FM with the count of averaged frequencies: see
-//    b1_mu()), and the R(n) ratio MVAR/AVAR where B1 says PM (SP 1065
-//    5.6.1; rn_alpha()).
+//    number of terms of the statistic, as Stable32 (for the total type
+//    random walk is told from flicker FM with the count of averaged
+//    frequencies: see b1_mu()), and the R(n) ratio MVAR/AVAR where B1 says
+//    PM (SP 1065 5.6.1; rn_alpha()).
 // Every m is identified from the data alone, never copied from another m.
 // The choices were checked against 9,582 noise types printed by Stable32 in
 // the allantools and allantoolkit test suites (tools/check-stable32*.R).
 //
-// Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms, pm_only,
-// stable32_n, acf_min) with acf_min the fewest points the ACF is read from,
-// and pm_only for the modified family (R(n) splits PM only),
-// stable32_n for Stable32's N at every B1 boundary (b1_mu()), and x(k) the
-// phase at k = 0 .. L-1 (any constant offset; for frequency data the running
-// sum of the samples, L = N + 1) and an RnCache filled once from the same
-// phase when some m has fewer than acf_min points (needs_b1()).
+// Use: identify_noise(x, L, m, dmax, phase_data, rn, nterms, modified,
+// rules) with x(k) the phase at k = 0 .. L-1 (any constant offset; for
+// frequency data the running sum of the samples, L = N + 1), nterms the
+// statistic's number of terms at m (Stable32's N of B1), modified for the
+// modified family, rules a NoiseIdRules (R/taus.R noise_id_rules()), and an
+// RnCache filled once from the same phase when some m has fewer than
+// rules.acf_min points (needs_b1()).
 #ifndef ALLANVAR_NOISE_ID_H
 #define ALLANVAR_NOISE_ID_H
 
@@ -42,6 +42,14 @@ enum NoiseIdMethod {
   NOISE_ID_B1_RN = 3   // B1 ratio, white/flicker PM told apart by R(n)
 };
 
+// Which of Stable32's rules apply (options(allanvar.noise_id), R/taus.R).
+struct NoiseIdRules {
+  R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
+  bool b1_rw_own = false;    // random walk vs flicker FM: B1 with its own count
+  bool rn_stable32 = false;  // R(n): PM only for the modified family, and
+                             // flicker PM where it cannot be read
+};
+
 struct NoiseId {
   double alpha = NA_REAL;       // continuous estimate (ACF), else = alpha_int
   int alpha_int = NA_INTEGER;   // exponent of the frequency PSD, S_y ~ f^alpha
@@ -50,10 +58,13 @@ struct NoiseId {
 };
 
 // acf_min: Stable32 and allantools use the lag-1 ACF from 30 points on.
-// Between 30 and 63 points it misreads white FM often enough (r1 has
-// standard error 1/sqrt(n)) to push the 68% coverage of overlapping ADEV to
-// 0.645 (tests/testthat/test-edf.R), so by default B1 and R(n) take over
-// below 64 points; options(allanvar.noise_id = "stable32") uses 30.
+// Between 30 and 63 points it misreads (r1 has standard error 1/sqrt(n))
+// flicker PM as white PM often enough that TOTDEV's 68% intervals cover
+// 0.55 (overlapping: 0.58) at N/m = 32, N = 1024, and white FM's 0.645
+// (tools/mc-coverage.R, tests/testthat/test-edf.R); B1 with R(n) over the
+// whole record reads those rows, by default from 64 points; it changes none
+// of the limits compared with Stable32's (tools/check-stable32*.R).
+// options(allanvar.noise_id = "stable32") uses 30.
 
 // Lag-1 ACF method on z[0..n): decimated phase (phase = true) or averaged
 // frequency. dmax: most differences taken (2 for Allan, 3 for Hadamard).
@@ -239,7 +250,8 @@ inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase, R_xlen_t acf_min) {
 // 7,552 instead of 8,652 of 9,582 Stable32 noise types are matched).
 template <class RN>
 NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
-                    double nterms, bool pm_only, bool stable32_n, RN rn) {
+                    double nterms, bool modified, const NoiseIdRules& rules,
+                    RN rn) {
   NoiseId out;
   out.points = n;
   std::vector<double> ybar;
@@ -253,15 +265,17 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
   const double b1 = b1_ratio(ybar.data(), na);
   if (!std::isfinite(b1)) return out;
   const double N = nterms >= 2 ? nterms : static_cast<double>(na);
-  const int mu = b1_mu(b1, N, stable32_n ? N : static_cast<double>(na));
+  const int mu = b1_mu(b1, N, rules.b1_rw_own ? static_cast<double>(na) : N);
   if (mu == -2) {
-    // white or flicker PM: R(n) tells them apart where it can be read,
-    // else flicker PM (Stable32's choice for the unmodified types)
-    // (R(n) unreadable: flicker PM under Stable32's rules, else no type,
-    // the widest interval)
+    // white or flicker PM: R(n) tells the type where it can be read; where
+    // it cannot, flicker PM under Stable32's rules, else no type (the
+    // widest interval)
     const double r = m > 1 ? rn() : NAN;
-    if (!std::isfinite(r) && !stable32_n) return out;
-    out.alpha_int = std::isfinite(r) ? rn_alpha(r, static_cast<double>(m), pm_only && stable32_n) : 1;
+    if (!std::isfinite(r) && !rules.rn_stable32) return out;
+    out.alpha_int = std::isfinite(r)
+                        ? rn_alpha(r, static_cast<double>(m),
+                                   modified && rules.rn_stable32)
+                        : 1;
     out.method = std::isfinite(r) ? NOISE_ID_B1_RN : NOISE_ID_B1;
   } else {
     out.alpha_int = -mu - 1;  // mu -1, 0, 1, 2 -> alpha 0, -1, -2, -3
@@ -274,10 +288,10 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
 // Noise type at m from the phase x(k), k < L.
 template <class X>
 NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
-                       bool phase, RnCache& rn, double nterms,
-                       bool pm_only, bool stable32_n, R_xlen_t acf_min) {
+                       bool phase, RnCache& rn, double nterms, bool modified,
+                       const NoiseIdRules& rules) {
   const R_xlen_t n = acf_points(L, m, phase);
-  if (n >= acf_min) {
+  if (n >= rules.acf_min) {
     if (phase) {
       return acf_noise_id_at([&](R_xlen_t i) { return x(i * m); }, n, true,
                              dmax);
@@ -289,8 +303,7 @@ NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
   for (R_xlen_t i = 0; i < n; ++i) {
     z[i] = phase ? x(i * m) : x((i + 1) * m) - x(i * m);
   }
-  return b1_noise_id(z.data(), n, phase, m, nterms, pm_only, stable32_n,
-                     [&]() {
+  return b1_noise_id(z.data(), n, phase, m, nterms, modified, rules, [&]() {
     if (rn.empty()) rn.build(x, L);  // build it beforehand to share it
     return rn.ratio(m);
   });

@@ -15,8 +15,10 @@ struct AllanOptions {
   bool rate;     // rate samples (else integrated: phase, angle, velocity)
   bool octave;   // standard type at m = 2^j: the pairwise one-pass kernel
   int threads;   // threads the kernel may use (>= 1)
-  bool stable32_b1 = false;  // B1's N as Stable32 for every boundary
+  // noise identification (src/noise_id.h, R/taus.R noise_id_rules()):
   R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
+  bool b1_rw_own = false;    // random walk vs flicker FM by B1 with its own count
+  bool rn_stable32 = false;  // R(n) as Stable32 (modified family: PM only)
   bool sums = true;          // false: noise identification only (no sums)
 };
 
@@ -43,8 +45,10 @@ inline AllanOptions allan_options(const Rcpp::List& o) {
   opts.octave = opt_flag(o, "octave");
   opts.threads = opt_int(o, "threads");
   if (opts.threads < 1) opts.threads = 1;
-  if (o.containsElementNamed("stable32_b1"))
-    opts.stable32_b1 = opt_flag(o, "stable32_b1");
+  if (o.containsElementNamed("b1_rw_own"))
+    opts.b1_rw_own = opt_flag(o, "b1_rw_own");
+  if (o.containsElementNamed("rn_stable32"))
+    opts.rn_stable32 = opt_flag(o, "rn_stable32");
   if (o.containsElementNamed("acf_min")) {
     opts.acf_min = opt_int(o, "acf_min");
     if (opts.acf_min < 4) Rcpp::stop("internal: allan option `acf_min` < 4");

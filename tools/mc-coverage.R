@@ -12,7 +12,7 @@
 # type, `edf_mc` the Monte Carlo EDF 2 E^2 / Var of the uncorrected
 # estimate, `edf_alpha` the formula's at the true type.
 #
-#   Rscript tools/mc-coverage.R [replicates] [N] [types]
+#   [ALLANVAR_NOISE_ID=rule] Rscript tools/mc-coverage.R [replicates] [N] [types]
 #   e.g. Rscript tools/mc-coverage.R 300 1024 overlapping,modified,tdev
 mc_generators <- function(N) {
   flicker <- function(n) {
@@ -109,6 +109,11 @@ if (sys.nframe() == 0L) {
     library(allanvar)
   }
   options(allanvar.threads = 1)
+  # the noise-identification rules (see allan()): "default", "stable32",
+  # "coverage"
+  if (nzchar(Sys.getenv("ALLANVAR_NOISE_ID"))) {
+    options(allanvar.noise_id = Sys.getenv("ALLANVAR_NOISE_ID"))
+  }
   set.seed(8)
   gens <- mc_generators(N)
   alphas <- c(wfm = 0L, ffm = -1L, rwfm = -2L, wpm = 2L, fpm = 1L)

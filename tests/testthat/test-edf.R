@@ -50,10 +50,13 @@ test_that("the exact discrete EDF matches Monte Carlo variances", {
 })
 
 test_that("Riley's lag-1 autocorrelation identifies power-law noise", {
-  # The lag-1 ACF is read wherever the decimated series has >= 30 points;
-  # rows with fewer (the last one or two octaves here) are identified by B1
-  # and R(n) from their own few points (tested below), no longer copied
-  # from a shorter tau, so the assertions hold on the ACF rows.
+  # Under Stable32's rules the lag-1 ACF is read wherever the decimated
+  # series has >= 30 points (by default from 64); rows with fewer (the last
+  # one or two octaves here) are identified by B1 and R(n) from their own
+  # few points (tested below), no longer copied from a shorter tau, so the
+  # assertions hold on the ACF rows.
+  old <- options(allanvar.noise_id = "stable32")
+  on.exit(options(old))
   acf <- function(a, phase = FALSE) {
     N <- attr(a, "N")
     (if (phase) (N - 1) %/% a$m + 1 else N %/% a$m) >= 30
@@ -92,10 +95,15 @@ test_that("the chi-square interval of the deviation (NIST SP 1065 eq. 45)", {
 
 test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
   # 1000 replicates each of white rate noise (AV = 1/m) and random-walk rate
-  # noise y = cumsum(w) (AV = (2m^2 + 1)/(6m)), N = 1024.
-  old <- options(allanvar.threads = 1)
+  # noise y = cumsum(w) (AV = (2m^2 + 1)/(6m)), N = 1024: 65-72%, except
+  # random walk below 64 averaged frequencies, where the default follows
+  # Stable32's B1 (expected ratios for N = the statistic's term count), which
+  # types it flicker or white FM and moves overlapping ADEV to 0.615-0.623 at
+  # N/m = 8-32: there the issue's band 0.60-0.76. The rules before
+  # (options(allanvar.noise_id = "coverage")) keep 65-72% on every row
+  # (0.651-0.671 there).
+  old <- options(allanvar.threads = 1, allanvar.noise_id = NULL)
   on.exit(options(old))
-  set.seed(42)
   N <- 1024
   cover <- function(gen, truth, type) {
     hits <- edfs <- NULL
@@ -106,18 +114,30 @@ test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
       edfs <- rbind(edfs, a$edf)
     }
     keep <- apply(edfs, 2, stats::median) >= 5
-    colMeans(hits)[keep]
+    list(m = a$m[keep], cov = colMeans(hits)[keep])
   }
   white <- function() rnorm(N)
   walk <- function() cumsum(rnorm(N))
   tw <- function(m) 1 / m
   trw <- function(m) (2 * m^2 + 1) / (6 * m)
-  for (type in c("overlapping", "standard")) {
-    cw <- cover(white, tw, type)
-    cr <- cover(walk, trw, type)
-    expect_gte(length(cw), 7)
-    expect_true(all(cw >= 0.65 & cw <= 0.72), info = paste(type, "white:", toString(cw)))
-    expect_true(all(cr >= 0.65 & cr <= 0.72), info = paste(type, "walk:", toString(cr)))
+  for (rule in c("default", "coverage")) {
+    options(allanvar.noise_id = rule)
+    set.seed(42)
+    for (type in c("overlapping", "standard")) {
+      if (rule == "coverage" && type == "standard") next
+      cw <- cover(white, tw, type)
+      cr <- cover(walk, trw, type)
+      expect_gte(length(cw$cov), 7)
+      for (g in c("white", "walk")) {
+        r <- if (g == "white") cw else cr
+        long <- rule == "default" & g == "walk" & N %/% r$m < 64
+        expect_gte(sum(!long), 5)
+        expect_true(all(r$cov[!long] >= 0.65 & r$cov[!long] <= 0.72),
+                    info = paste(rule, type, g, toString(r$cov)))
+        expect_true(all(r$cov[long] >= 0.60 & r$cov[long] <= 0.76),
+                    info = paste(rule, type, g, toString(r$cov)))
+      }
+    }
   }
 })
 
@@ -179,18 +199,34 @@ test_that("an unknown noise-identification rule is refused, naming the option", 
   expect_equal(allan(rnorm(100), 1)$m, 2^(0:5))
 })
 
-test_that("random-walk FM stays random walk at long tau; Stable32's B1 rule does not", {
+test_that("random walk at long tau: Stable32's B1 rule, except for the total type", {
   # B1 with Stable32's N (the statistic's term count, far above the few
   # averaged frequencies at long tau) cannot reach random walk's expected
-  # ratio N/2; the default tells it with the count the ratio was read from.
+  # ratio N/2: the default types such rows flicker or white FM, as Stable32.
+  # For TOTDEV that leaves 68% coverage of random-walk FM at 0.57-0.59 at
+  # N/m = 4 (tools/mc-coverage.R), so the total type, and the "coverage"
+  # rules for every type, tell random walk with the count the ratio was read
+  # from.
+  old <- options(allanvar.noise_id = NULL)
+  on.exit(options(old))
   set.seed(32)
   x <- cumsum(rnorm(2048))
-  a <- allan(x, 1, taus = I(c(256, 512)))
-  expect_equal(a$alpha, c(-2L, -2L))
-  old <- options(allanvar.noise_id = "stable32")
-  on.exit(options(old))
-  b <- allan(x, 1, taus = I(c(256, 512)))
+  for (type in c("overlapping", "modified", "total")) {
+    a <- allan(x, 1, taus = I(c(256, 512)), type = type)
+    if (type == "total") {
+      expect_equal(a$alpha, c(-2L, -2L))
+    } else {
+      expect_true(all(a$alpha > -2L), info = type)
+    }
+  }
+  options(allanvar.noise_id = "stable32")
+  b <- allan(x, 1, taus = I(c(256, 512)), type = "total")
   expect_true(all(b$alpha > -2L))
+  options(allanvar.noise_id = "coverage")
+  for (type in c("overlapping", "total")) {
+    b <- allan(x, 1, taus = I(c(256, 512)), type = type)
+    expect_equal(b$alpha, c(-2L, -2L), info = type)
+  }
 })
 
 test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows), TDEV and TOTDEV", {
@@ -285,4 +321,34 @@ test_that("the further types' noise type (identification without sums) is allan(
       }
     }
   }
+})
+
+test_that("limits agree with Stable32's on >= 95% of its reference rows (issue 10)", {
+  # Both limits within 25% of Stable32's half-width, over every Stable32 run
+  # of allantools' and allantoolkit's test suites (tools/check-stable32.R,
+  # the Allan types, and tools/check-stable32-types.R, the further types),
+  # with the default noise identification. Not shipped: set
+  # ALLANVAR_PEER_DATA to the checkouts (":"-separated).
+  roots <- strsplit(Sys.getenv("ALLANVAR_PEER_DATA"), ":", fixed = TRUE)[[1]]
+  roots <- roots[dir.exists(roots)]
+  skip_if(!length(roots), "ALLANVAR_PEER_DATA does not point at allantools")
+  at <- roots[dir.exists(file.path(roots, "tests", "phasedat"))]
+  skip_if(!length(at), "no allantools checkout under ALLANVAR_PEER_DATA")
+  tools <- file.path("..", "..", "tools")
+  skip_if_not(file.exists(file.path(tools, "check-stable32.R")),
+              "tools/ is not beside the tests")
+  old <- options(allanvar.noise_id = NULL)
+  on.exit(options(old))
+  e1 <- new.env(parent = asNamespace("allanvar"))
+  sys.source(file.path(tools, "check-stable32.R"), envir = e1)
+  e2 <- new.env(parent = asNamespace("allanvar"))
+  sys.source(file.path(tools, "check-stable32-types.R"), envir = e2)
+  r1 <- e1$check_stable32(at[1])
+  ci <- r1$status == "ok" & r1$has_ci
+  d <- e2$check_stable32_types(roots, verbose = FALSE)
+  st <- !d$loose
+  ok <- sum(r1$limits_ok[ci], na.rm = TRUE) + sum(d$lim_ok[st], na.rm = TRUE)
+  of <- sum(ci) + sum(!is.na(d$lim_ok[st]))
+  expect_gt(of, 700)
+  expect_gte(ok / of, 0.95)
 })
