@@ -55,7 +55,8 @@ allan_edf <- function(type, m, n, L, alpha_int, sub = seq_along(m)) {
 # positive finite EDF the number of terms is used (the total type: 1.5
 # (L - 1)/m, NIST SP 1065 Table 7's white-FM value).
 allan_edf_direct <- function(type, m, n, L, alpha) {
-  alpha <- as.integer(alpha)
+  alpha <- rep_len(as.integer(alpha), length(m))
+  n <- rep_len(as.double(n), length(m))
   exact <- alpha %in% c(0L, -2L) & m <= 64
   e <- allan_edf_cpp(allan_type_code(type), as.double(m), as.double(n),
                      as.double(L), alpha, exact)

@@ -247,6 +247,8 @@ Rcpp::NumericVector allan_edf_cpp(int type, const Rcpp::NumericVector& m,
   const int base = total ? static_cast<int>(allanvar::OVERLAPPING) : type;
   const allanvar::EstimatorInfo& info = allanvar::estimator_info(base);
   const R_xlen_t k = m.size();
+  if ((!total && n.size() != k) || alpha.size() != k || exact.size() != k)
+    Rcpp::stop("internal: allan_edf_cpp needs n, alpha and exact per m");
   Rcpp::NumericVector out(k);
   for (R_xlen_t i = 0; i < k; ++i) {
     // the total type: the overlapping EDF where it has terms
