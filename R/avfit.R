@@ -349,7 +349,9 @@ check_dots_empty <- function(...) {
 #'   with lower and upper columns; `fitted()`, `residuals()` and
 #'   `predict()` numeric vectors (a matrix with `by_term = TRUE`);
 #'   `logLik()` a `logLik` object; `summary()` an object of class
-#'   `summary.avfit` with a coefficient table (estimate, SE, CI, unit);
+#'   `summary.avfit` with a coefficient table (estimate, SE, CI, unit,
+#'   meaning, fixed, and hidden: measured values the printed tables leave
+#'   out, such as a measured band's spectrum);
 #'   `print()` and `plot()` return `x` invisibly.
 #' @name avfit-methods
 #' @examples
@@ -460,12 +462,29 @@ print.avfit <- function(x, ...) {
                      previous = "the previous fit's model")))
   tab <- data.frame(estimate = signif(x$coefficients, 4),
                     se = signif(x$se, 3), unit = unit_label(x$layout$unit, x))
-  print(tab)
+  hid <- layout_hidden(x$layout)
+  print(tab[!hid, , drop = FALSE])
+  note_hidden(hid)
   cat(sprintf("chi2/dof = %.3g (dof %d), RMS ADEV error = %.3g %%\n",
               x$chi2, x$df.residual, x$rms))
   if (nrow(x$steps)) cat(nrow(x$steps), "refinement step(s); see $steps\n")
   print_convergence(x$convergence)
   invisible(x)
+}
+
+# Rows of a fit's layout that hold measured values an entry carries for its
+# own use (a measured band's spectrum): left out of the printed tables.
+layout_hidden <- function(lay) {
+  vapply(seq_len(nrow(lay)), function(i) {
+    p <- effect_entry(lay$kind[i], lay$variant[i])$params
+    isTRUE(p$hidden[p$name == lay$param[i]])
+  }, logical(1))
+}
+
+note_hidden <- function(hid) {
+  if (any(hid)) {
+    cat(sum(hid), "measured value(s) of the model not shown; see coef()\n")
+  }
 }
 
 # A fit that did not converge says so (nothing is printed when it did).
@@ -490,7 +509,7 @@ summary.avfit <- function(object, level = 0.95, ...) {
                     lower = ci[, 1], upper = ci[, 2],
                     unit = unit_label(lay$unit, object),
                     meaning = words, fixed = lay$fixed,
-                    stringsAsFactors = FALSE)
+                    hidden = layout_hidden(lay), stringsAsFactors = FALSE)
   rownames(tab) <- lay$name
   structure(list(coefficients = tab, chi2 = object$chi2, rms = object$rms,
                  df.residual = object$df.residual, nobs = object$nobs,
@@ -514,7 +533,9 @@ print.summary.avfit <- function(x, ...) {
                     check.names = FALSE)
   rownames(out) <- rownames(tab)
   names(out)[3:4] <- paste0(c("lower ", "upper "), format(100 * x$level), "%")
-  print(out, right = FALSE)
+  hid <- if (is.null(tab$hidden)) rep(FALSE, nrow(out)) else tab$hidden
+  print(out[!hid, , drop = FALSE], right = FALSE)
+  note_hidden(hid)
   if (is.null(x$rate_unit)) {
     cat("\n\"u\" is the input's rate unit (e.g. deg/s or m/s^2).\n")
   }

@@ -84,8 +84,15 @@ test_that("the loop takes the measured band where the Lorentzian cannot describe
   expect_true(isTRUE(st$confirmed))
   expect_lt(ref$chi2, 2)
   expect_equal(coef(ref)[["N"]], 0.02, tolerance = 0.1)
-  # the hidden spectrum stays out of the step summary
+  # the hidden spectrum stays out of the step summary and the printed tables
   expect_false(grepl("s1=", st$params))
+  hid <- summary(ref)$coefficients$hidden
+  expect_gt(sum(hid), 20)
+  shown <- capture.output(print(ref))
+  expect_false(any(grepl("s1", shown, fixed = TRUE)))
+  expect_true(any(grepl(paste(sum(hid), "measured value"), shown, fixed = TRUE)))
+  expect_false(any(grepl("s1", capture.output(print(summary(ref))), fixed = TRUE)))
+  expect_true(all(grepl("^s[0-9]+$|band", names(coef(ref))[hid])))
 })
 
 test_that("without a band in the raw data the band is never tried", {
