@@ -375,3 +375,316 @@ Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
   }
   return out;
 }
+
+
+// ---- TheoBR's Theo1 values: T_k at many k without double-double. ----
+// With s = (+1, -1, +1, -1) on (x_i, x_{i+L}, x_{i+m}, x_{i+m-L}), the
+// identity (sum s_j x_j)^2 = -sum_{j<l} s_j s_l (x_j - x_l)^2 (sum s = 0)
+// writes each squared term of T_k as six squared increments D(p, q) =
+// (x_q - x_p)^2:
+//   d_i(L)^2 = D(i, i+L) + D(i+m-L, i+m) + D(i, i+m-L) + D(i+L, i+m)
+//            - D(i, i+m) - D(i+L, i+m-L).
+// Summed over i < N - m, each is a full structure function
+// SF(lag) = sum_p D(p, p + lag) minus the pairs within 2k of either end:
+//   T_k = sum_L (1/L) [2 SF(L) + 2 SF(2k-L) - SF(2k) - SF(2k-2L)
+//         - head(L) - tail(L) - head(2k-L) - tail(2k-L)
+//         + triH(k-L) + triT(k-L)],
+// head/tail(lag): pairs within the first/last 2k points; triH/triT(d): the
+// pairs (c-d, c+d) centred below k / at or above N-k (the SF(2k-2L) terms
+// vanish at L = k). Every sum is of positive terms, so nothing cancels
+// inside them; the combination cancels only the global level of the
+// frequency (about N/k for random-walk FM, O(1) for white noise), where the
+// lag-product expansion of theo1_all_cpp cancelled (N/k)^3. A quadratic
+// c (i - i0)^2 is removed first (it adds 2 c L (m - L) to every d_i(L),
+// restored exactly below), so a frequency drift cancels nothing either.
+// The SF come from FFTs of locally detrended blocks (lags in [D, 2D) from
+// blocks of 6D points), the edge sums grow with k by O(k) terms per step
+// (the recurrence of Lewis, arXiv:2106.04542, on squared increments).
+
+namespace {
+
+struct TildePhase {
+  std::vector<double> h, l, rh, rl;  // x~ = h + l; rh, rl reversed
+  R_xlen_t N = 0;
+  double c = 0, i0 = 0;              // x = x~ + c (i - i0)^2 (+ a line)
+  // x~_q - x~_p
+  inline double diff(R_xlen_t p, R_xlen_t q) const {
+    return (h[q] - h[p]) + (l[q] - l[p]);
+  }
+};
+
+void tilde_phase(const allanvar::SplitPhase& X, TildePhase& T) {
+  const R_xlen_t N = X.size();
+  T.N = N;
+  T.h = X.hi;
+  T.l = X.lo;
+  T.c = 0;
+  T.i0 = 0.5 * static_cast<double>(N - 1);
+  const R_xlen_t a = N / 3;
+  if (a >= 2) {
+    // mean frequencies over the first and last thirds: slope 2c between
+    const double f1 = (X.value(a) - X.value(0)) / static_cast<double>(a);
+    const double f2 =
+        (X.value(N - 1) - X.value(N - 1 - a)) / static_cast<double>(a);
+    T.c = (f2 - f1) / (2.0 * static_cast<double>(N - 1 - a));
+  }
+  if (T.c != 0 && std::isfinite(T.c)) {
+    for (R_xlen_t i = 0; i < N; ++i) {
+      const double u = static_cast<double>(i) - T.i0;
+      double s, e;
+      allanvar::dd_two_sum(T.h[i], -T.c * u * u, s, e);
+      T.h[i] = s;
+      T.l[i] += e;
+    }
+  } else {
+    T.c = 0;
+  }
+  T.rh.assign(T.h.rbegin(), T.h.rend());
+  T.rl.assign(T.l.rbegin(), T.l.rend());
+}
+
+// SF(lag) = sum_{p < N - lag} (x~_{p+lag} - x~_p)^2 for lag = 1..lmax
+// (sf[0] = 0). Short lags directly; lags in [D, 2D) from blocks of B = 6D
+// starting points on the block's phase less the chord through its window,
+// z_j = x~(a+j) - x~(a) - s j: with t = x~ increments,
+//   sum_j (t_j)^2 = sum_j (z_{j+lag} - z_j)^2 + 2 s lag sum_j (z_{j+lag}
+//   - z_j) + B s^2 lag^2,
+// the first from one FFT correlation of z; the last window of the record
+// by its own autocorrelation.
+std::vector<double> theo_full_sf(const TildePhase& X, R_xlen_t lmax,
+                                 int threads) {
+  const R_xlen_t N = X.N;
+  std::vector<double> sf(lmax + 1, 0.0);
+  const R_xlen_t L0 = std::min<R_xlen_t>(lmax + 1, 64);
+  struct Job {
+    R_xlen_t lo, hi, a, len;  // lags [lo, hi); points [a, a + len)
+    bool tail;                // autocorrelation of the segment
+    size_t out;               // offset into the results
+    bool direct;              // one short lag over the whole record
+  };
+  std::vector<Job> jobs;
+  size_t tot = 0;
+  for (R_xlen_t lag = 1; lag < L0; ++lag) {
+    jobs.push_back(Job{lag, lag + 1, 0, N, false, tot, true});
+    tot += 1;
+  }
+  for (R_xlen_t D = 64; D <= lmax; D *= 2) {
+    const R_xlen_t lo = D, hi = std::min(2 * D, lmax + 1);
+    const R_xlen_t B = 6 * D, W = B + 2 * D - 1;
+    R_xlen_t a = 0;
+    for (; a + W <= N; a += B) {
+      jobs.push_back(Job{lo, hi, a, W, false, tot, false});
+      tot += static_cast<size_t>(hi - lo);
+    }
+    if (N - a > lo) {
+      jobs.push_back(Job{lo, hi, a, N - a, true, tot, false});
+      tot += static_cast<size_t>(hi - lo);
+    }
+  }
+  std::vector<double> res(tot, 0.0);
+  const int nthr = std::max(1, threads);
+  struct Scratch {
+    allanvar::FFTPlans plans;
+    std::vector<allanvar::cplx> buf, buf2;
+    std::vector<double> z, zs, qz, c;
+  };
+  std::vector<Scratch> scr(nthr);
+  allanvar::parallel_for(static_cast<R_xlen_t>(jobs.size()), nthr,
+                         [&](R_xlen_t it, int worker) {
+    const Job& J = jobs[it];
+    if (J.direct) {
+      // short lag: directly, in blocks for the rounding
+      const R_xlen_t lag = J.lo;
+      double acc = 0;
+      for (R_xlen_t b0 = 0; b0 < N - lag; b0 += 4096) {
+        const R_xlen_t b1 = std::min(N - lag, b0 + 4096);
+        double s0 = 0, s1 = 0;
+        R_xlen_t p = b0;
+        for (; p + 2 <= b1; p += 2) {
+          const double d0 = X.diff(p, p + lag), d1 = X.diff(p + 1, p + 1 + lag);
+          s0 += d0 * d0;
+          s1 += d1 * d1;
+        }
+        for (; p < b1; ++p) {
+          const double d = X.diff(p, p + lag);
+          s0 += d * d;
+        }
+        acc += s0 + s1;
+      }
+      res[J.out] = acc;
+      return;
+    }
+    Scratch& S = scr[worker];
+    const R_xlen_t n = J.len;
+    S.z.resize(n);
+    S.zs.resize(n + 1);
+    S.qz.resize(n + 1);
+    const double s = X.diff(J.a, J.a + n - 1) / static_cast<double>(n - 1);
+    S.zs[0] = S.qz[0] = 0;
+    for (R_xlen_t j = 0; j < n; ++j) {
+      S.z[j] = X.diff(J.a, J.a + j) - s * static_cast<double>(j);
+      S.zs[j + 1] = S.zs[j] + S.z[j];
+      S.qz[j + 1] = S.qz[j] + S.z[j] * S.z[j];
+    }
+    const R_xlen_t hi = std::min(J.hi, J.tail ? n : J.hi);
+    const size_t nt = static_cast<size_t>(hi);
+    S.c.resize(nt);
+    const R_xlen_t B = J.tail ? n : n - 2 * J.lo + 1;  // starting points
+    allanvar::real_correlation(S.z.data(), J.tail ? n : B, S.z.data(), n, nt,
+                               S.c.data(), S.plans, S.buf, S.buf2);
+    for (R_xlen_t lag = J.lo; lag < hi; ++lag) {
+      const R_xlen_t cnt = J.tail ? n - lag : B;
+      const double sfz = (S.qz[lag + cnt] - S.qz[lag]) + S.qz[cnt] - 2 * S.c[lag];
+      const double dz = (S.zs[lag + cnt] - S.zs[lag]) - S.zs[cnt];
+      const double g = s * static_cast<double>(lag);
+      res[J.out + (lag - J.lo)] =
+          sfz + 2 * g * dz + g * g * static_cast<double>(cnt);
+    }
+  });
+  allanvar::TauSums acc(static_cast<size_t>(lmax + 1));
+  for (const Job& J : jobs) {
+    const R_xlen_t hi = std::min(J.hi, J.tail ? J.len : J.hi);
+    for (R_xlen_t lag = J.lo; lag < hi; ++lag)
+      acc.add(static_cast<size_t>(lag), res[J.out + (lag - J.lo)]);
+  }
+  for (R_xlen_t lag = 1; lag <= lmax; ++lag)
+    sf[lag] = acc.any(lag) ? acc.value(lag) : 0.0;
+  return sf;
+}
+
+}  // namespace
+
+// T_k of one channel at the k in `need` (each in [1, (L - 1) / 2]) by the
+// squared-increment recurrence above; O(L log^2 L + kmax^2).
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
+                                   const Rcpp::NumericVector& need,
+                                   int threads) {
+  const allanvar::InterruptScope scope;
+  const allanvar::PhaseInput in{v.begin(), v.size(), rate};
+  allanvar::SplitPhase Xs;
+  allanvar::split_phase(in, Xs);
+  const R_xlen_t N = in.length();
+  Rcpp::NumericVector out(need.size(), NA_REAL);
+  R_xlen_t kmax = 0;
+  for (R_xlen_t i = 0; i < need.size(); ++i) {
+    const double k = need[i];
+    if (k >= 1 && k <= (N - 1) / 2) kmax = std::max(kmax, static_cast<R_xlen_t>(k));
+  }
+  if (kmax < 1) return out;
+  std::vector<std::vector<R_xlen_t>> where(kmax + 1);
+  for (R_xlen_t i = 0; i < need.size(); ++i) {
+    const double k = need[i];
+    if (k >= 1 && k <= kmax) where[static_cast<R_xlen_t>(k)].push_back(i);
+  }
+  TildePhase X;
+  tilde_phase(Xs, X);
+  const std::vector<double> sf = theo_full_sf(X, 2 * kmax, threads);
+  scope.finish();
+  // prefix sums of x~ (double-double) for the quadratic's cross term
+  std::vector<DD> S;
+  if (X.c != 0) {
+    S.resize(N + 1);
+    DD a;
+    for (R_xlen_t j = 0; j < N; ++j) {
+      a += DD(X.h[j]) + DD(X.l[j]);
+      S[j + 1] = a;
+    }
+  }
+  std::vector<double> head(2 * kmax + 2, 0.0), tail(2 * kmax + 2, 0.0),
+      triH(kmax + 1, 0.0), triT(kmax + 1, 0.0);
+  const double* h = X.h.data();
+  const double* l = X.l.data();
+  const double* rh = X.rh.data();
+  const double* rl = X.rl.data();
+  for (R_xlen_t k = 0; k < kmax; ++k) {
+    if (allanvar::interrupted()) scope.finish();
+    // head: pairs within [0, 2k) gain the points q = 2k, 2k + 1;
+    // x(q - lag) = reversed(N - 1 - q + lag)
+    {
+      const R_xlen_t q = 2 * k;
+      const double hq = h[q], lq = l[q], hq1 = h[q + 1], lq1 = l[q + 1];
+      const double* a0 = rh + (N - 1 - q);
+      const double* b0 = rl + (N - 1 - q);
+      const double* a1 = rh + (N - 2 - q);
+      const double* b1 = rl + (N - 2 - q);
+      double* hd = head.data();
+      for (R_xlen_t lag = 1; lag <= q; ++lag) {
+        const double d0 = (hq - a0[lag]) + (lq - b0[lag]);
+        const double d1 = (hq1 - a1[lag]) + (lq1 - b1[lag]);
+        hd[lag] += d0 * d0 + d1 * d1;
+      }
+      const double d = (hq1 - h[0]) + (lq1 - l[0]);
+      hd[q + 1] += d * d;
+    }
+    // tail: pairs within [N - 2k, N) gain p = N - 2k - 1, N - 2k - 2
+    {
+      const R_xlen_t p = N - 2 * k - 1;
+      const double hp = h[p], lp = l[p], hp1 = h[p - 1], lp1 = l[p - 1];
+      const double* a0 = h + p;
+      const double* b0 = l + p;
+      const double* a1 = h + p - 1;
+      const double* b1 = l + p - 1;
+      double* tl = tail.data();
+      for (R_xlen_t lag = 1; lag <= 2 * k; ++lag) {
+        const double d0 = (a0[lag] - hp) + (b0[lag] - lp);
+        const double d1 = (a1[lag] - hp1) + (b1[lag] - lp1);
+        tl[lag] += d0 * d0 + d1 * d1;
+      }
+      const double d = (h[N - 1] - hp1) + (l[N - 1] - lp1);
+      tl[2 * k + 1] += d * d;
+    }
+    // triangles: the centres k and N - 1 - k
+    {
+      const double* ah = h + k;
+      const double* al = l + k;
+      const double* bh = rh + (N - 1 - k);
+      const double* bl = rl + (N - 1 - k);
+      for (R_xlen_t d = 1; d <= k; ++d) {
+        const double e = (ah[d] - bh[d]) + (al[d] - bl[d]);
+        triH[d] += e * e;
+      }
+      const R_xlen_t c = N - 1 - k;
+      const double* ch = h + c;
+      const double* cl = l + c;
+      const double* dh = rh + (N - 1 - c);
+      const double* dl = rl + (N - 1 - c);
+      for (R_xlen_t d = 1; d <= k; ++d) {
+        const double e = (ch[d] - dh[d]) + (cl[d] - dl[d]);
+        triT[d] += e * e;
+      }
+    }
+    const R_xlen_t kk = k + 1;
+    if (where[kk].empty()) continue;
+    // assemble T_kk
+    const R_xlen_t m = 2 * kk, M = N - m;
+    double ts = 0, te = 0;
+    for (R_xlen_t L = 1; L <= kk; ++L) {
+      double b = 2 * sf[L] + 2 * sf[m - L] - sf[m] - head[L] - tail[L] -
+                 head[m - L] - tail[m - L];
+      if (L < kk) b += triH[kk - L] + triT[kk - L] - sf[m - 2 * L];
+      double s, e;
+      allanvar::dd_two_sum(ts, b / static_cast<double>(L), s, e);
+      ts = s;
+      te += e;
+    }
+    DD T = DD(ts) + DD(te);
+    if (X.c != 0) {
+      // x = x~ + c (i - i0)^2 adds delta = 2 c L (m - L) to every d_i(L):
+      // + sum_L (1/L) (2 delta sum_i d~_i(L) + M delta^2)
+      DD corr;
+      for (R_xlen_t L = 1; L <= kk; ++L) {
+        const DD sd = (S[L] - S[0]) - (S[M + L] - S[M]) + (S[N] - S[N - L]) -
+                      (S[m] - S[m - L]);
+        const double delta =
+            2 * X.c * static_cast<double>(L) * static_cast<double>(m - L);
+        const DD t = sd * DD(2 * delta) +
+                     DD(static_cast<double>(M) * delta * delta);
+        corr += DD(t.hi / static_cast<double>(L), t.lo / static_cast<double>(L));
+      }
+      T += corr;
+    }
+    for (R_xlen_t i : where[kk]) out[i] = T.value();
+  }
+  return out;
+}
