@@ -581,109 +581,137 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
   tilde_phase(Xs, X);
   const std::vector<double> sf = theo_full_sf(X, 2 * kmax, threads);
   scope.finish();
-  // prefix sums of x~ (double-double) for the quadratic's cross term
-  std::vector<DD> S;
+  // The quadratic's part, sum_L (1/L) (2 delta_L sum_i d~_i(L) + M delta_L^2)
+  // with delta_L = 2 c L (m - L), in O(1) per k from double-double prefix
+  // sums: sum_i d~_i(L) = A(L) - (S(M+L) - S(M)) - (S(m) - S(m-L)),
+  // A(L) = S(L) + S(N) - S(N-L), S(j) the sum of x~ over [0, j).
+  std::vector<DD> S, PS, PJS, PA, PLA;
   if (X.c != 0) {
     S.resize(N + 1);
-    DD a;
-    for (R_xlen_t j = 0; j < N; ++j) {
-      a += DD(X.h[j]) + DD(X.l[j]);
-      S[j + 1] = a;
+    PS.resize(N + 1);
+    PJS.resize(N + 1);
+    DD a, b, e;
+    for (R_xlen_t j = 0; j <= N; ++j) {
+      if (j > 0) a += DD(X.h[j - 1]) + DD(X.l[j - 1]);
+      S[j] = a;
+      b += a;
+      e += a * static_cast<double>(j);
+      PS[j] = b;
+      PJS[j] = e;
+    }
+    PA.resize(kmax + 1);
+    PLA.resize(kmax + 1);
+    for (R_xlen_t L = 1; L <= kmax; ++L) {
+      const DD A = S[L] + S[N] - S[N - L];
+      PA[L] = PA[L - 1] + A;
+      PLA[L] = PLA[L - 1] + A * static_cast<double>(L);
     }
   }
-  std::vector<double> head(2 * kmax + 2, 0.0), tail(2 * kmax + 2, 0.0),
-      triH(kmax + 1, 0.0), triT(kmax + 1, 0.0);
+  auto quad_part = [&](R_xlen_t k) {
+    const R_xlen_t m = 2 * k, M = N - m;
+    const double kd = static_cast<double>(k), md = static_cast<double>(m);
+    const double W1 = md * kd - 0.5 * kd * (kd + 1);
+    const DD sdw = PA[k] * md - PLA[k] -
+                   (PS[M + k] - PS[M]) * static_cast<double>(N) +
+                   (PJS[M + k] - PJS[M]) + (S[M] - S[m]) * W1 +
+                   (PJS[m - 1] - PJS[k - 1]);
+    const double s1 = 0.5 * kd * (kd + 1), s2 = s1 * (2 * kd + 1) / 3;
+    const double p3 = md * md * s1 - 2 * md * s2 + s1 * s1;
+    return sdw * (4 * X.c) +
+           DD(4 * X.c * X.c * static_cast<double>(M) * p3);
+  };
+  // ht(lag): pairs at lag within the first 2k plus those within the last
+  // 2k points; tri(d): pairs (c - d, c + d) centred below k or at or above
+  // N - k. sfe(d) = SF(2d), inv(L) = 1/L.
+  std::vector<double> ht(2 * kmax + 2, 0.0), tri(kmax + 1, 0.0),
+      sfe(kmax + 1, 0.0), inv(kmax + 1, 0.0);
+  for (R_xlen_t d = 1; d <= kmax; ++d) {
+    sfe[d] = sf[2 * d];
+    inv[d] = 1.0 / static_cast<double>(d);
+  }
   const double* h = X.h.data();
   const double* l = X.l.data();
   const double* rh = X.rh.data();
   const double* rl = X.rl.data();
   for (R_xlen_t k = 0; k < kmax; ++k) {
     if (allanvar::interrupted()) scope.finish();
-    // head: pairs within [0, 2k) gain the points q = 2k, 2k + 1;
-    // x(q - lag) = reversed(N - 1 - q + lag)
+    // the first 2k points gain q = 2k, 2k + 1 (x(q - lag) is reversed
+    // (N - 1 - q + lag)); the last 2k gain p = N - 2k - 1, N - 2k - 2
     {
-      const R_xlen_t q = 2 * k;
+      const R_xlen_t q = 2 * k, p = N - 2 * k - 1;
       const double hq = h[q], lq = l[q], hq1 = h[q + 1], lq1 = l[q + 1];
-      const double* a0 = rh + (N - 1 - q);
-      const double* b0 = rl + (N - 1 - q);
-      const double* a1 = rh + (N - 2 - q);
+      const double hp = h[p], lp = l[p], hp1 = h[p - 1], lp1 = l[p - 1];
+      const double* a1 = rh + (N - 2 - q);  // a1[lag + 1] = x(q - lag)
       const double* b1 = rl + (N - 2 - q);
-      double* hd = head.data();
-      for (R_xlen_t lag = 1; lag <= q; ++lag) {
-        const double d0 = (hq - a0[lag]) + (lq - b0[lag]);
+      const double* c1 = h + p - 1;         // c1[lag + 1] = x(p + lag)
+      const double* e1 = l + p - 1;
+      double* t = ht.data();
+      R_xlen_t lag = 1;
+#if defined(__GNUC__)
+      using allanvar::v2d;
+      using allanvar::ld2;
+      const v2d Hq = {hq, hq}, Lq = {lq, lq}, Hq1 = {hq1, hq1},
+                Lq1 = {lq1, lq1}, Hp = {hp, hp}, Lp = {lp, lp},
+                Hp1 = {hp1, hp1}, Lp1 = {lp1, lp1};
+      for (; lag + 2 <= q + 1; lag += 2) {
+        const v2d d0 = (Hq - ld2(a1 + lag + 1)) + (Lq - ld2(b1 + lag + 1));
+        const v2d d1 = (Hq1 - ld2(a1 + lag)) + (Lq1 - ld2(b1 + lag));
+        const v2d e0 = (ld2(c1 + lag + 1) - Hp) + (ld2(e1 + lag + 1) - Lp);
+        const v2d f1 = (ld2(c1 + lag) - Hp1) + (ld2(e1 + lag) - Lp1);
+        allanvar::st2(t + lag,
+                      ld2(t + lag) + ((d0 * d0 + d1 * d1) + (e0 * e0 + f1 * f1)));
+      }
+#endif
+      for (; lag <= q; ++lag) {
+        const double d0 = (hq - a1[lag + 1]) + (lq - b1[lag + 1]);
         const double d1 = (hq1 - a1[lag]) + (lq1 - b1[lag]);
-        hd[lag] += d0 * d0 + d1 * d1;
+        const double e0 = (c1[lag + 1] - hp) + (e1[lag + 1] - lp);
+        const double f1 = (c1[lag] - hp1) + (e1[lag] - lp1);
+        t[lag] += (d0 * d0 + d1 * d1) + (e0 * e0 + f1 * f1);
       }
       const double d = (hq1 - h[0]) + (lq1 - l[0]);
-      hd[q + 1] += d * d;
+      const double e = (h[N - 1] - hp1) + (l[N - 1] - lp1);
+      t[q + 1] += d * d + e * e;
     }
-    // tail: pairs within [N - 2k, N) gain p = N - 2k - 1, N - 2k - 2
-    {
-      const R_xlen_t p = N - 2 * k - 1;
-      const double hp = h[p], lp = l[p], hp1 = h[p - 1], lp1 = l[p - 1];
-      const double* a0 = h + p;
-      const double* b0 = l + p;
-      const double* a1 = h + p - 1;
-      const double* b1 = l + p - 1;
-      double* tl = tail.data();
-      for (R_xlen_t lag = 1; lag <= 2 * k; ++lag) {
-        const double d0 = (a0[lag] - hp) + (b0[lag] - lp);
-        const double d1 = (a1[lag] - hp1) + (b1[lag] - lp1);
-        tl[lag] += d0 * d0 + d1 * d1;
-      }
-      const double d = (h[N - 1] - hp1) + (l[N - 1] - lp1);
-      tl[2 * k + 1] += d * d;
-    }
-    // triangles: the centres k and N - 1 - k
+    // the centres k and N - 1 - k: x(k + d) - x(k - d) and
+    // x(N - 1 - k + d) - x(N - 1 - k - d)
     {
       const double* ah = h + k;
       const double* al = l + k;
       const double* bh = rh + (N - 1 - k);
       const double* bl = rl + (N - 1 - k);
+      const double* ch = h + (N - 1 - k);
+      const double* cl = l + (N - 1 - k);
+      const double* dh = rh + k;
+      const double* dl = rl + k;
       for (R_xlen_t d = 1; d <= k; ++d) {
         const double e = (ah[d] - bh[d]) + (al[d] - bl[d]);
-        triH[d] += e * e;
-      }
-      const R_xlen_t c = N - 1 - k;
-      const double* ch = h + c;
-      const double* cl = l + c;
-      const double* dh = rh + (N - 1 - c);
-      const double* dl = rl + (N - 1 - c);
-      for (R_xlen_t d = 1; d <= k; ++d) {
-        const double e = (ch[d] - dh[d]) + (cl[d] - dl[d]);
-        triT[d] += e * e;
+        const double f = (ch[d] - dh[d]) + (cl[d] - dl[d]);
+        tri[d] += e * e + f * f;
       }
     }
     const R_xlen_t kk = k + 1;
     if (where[kk].empty()) continue;
-    // assemble T_kk
-    const R_xlen_t m = 2 * kk, M = N - m;
+    // assemble T_kk: blocks of 256 terms summed plainly, the block totals
+    // with compensation
+    const R_xlen_t m = 2 * kk;
+    const double sfm = sf[m];
     double ts = 0, te = 0;
-    for (R_xlen_t L = 1; L <= kk; ++L) {
-      double b = 2 * sf[L] + 2 * sf[m - L] - sf[m] - head[L] - tail[L] -
-                 head[m - L] - tail[m - L];
-      if (L < kk) b += triH[kk - L] + triT[kk - L] - sf[m - 2 * L];
+    for (R_xlen_t L0 = 1; L0 <= kk; L0 += 256) {
+      const R_xlen_t L1 = std::min(kk + 1, L0 + 256);
+      double acc = 0;
+      for (R_xlen_t L = L0; L < L1; ++L) {
+        const double b = (2 * sf[L] - ht[L]) + (2 * sf[m - L] - ht[m - L]) -
+                         sfm + (tri[kk - L] - sfe[kk - L]);
+        acc += b * inv[L];
+      }
       double s, e;
-      allanvar::dd_two_sum(ts, b / static_cast<double>(L), s, e);
+      allanvar::dd_two_sum(ts, acc, s, e);
       ts = s;
       te += e;
     }
     DD T = DD(ts) + DD(te);
-    if (X.c != 0) {
-      // x = x~ + c (i - i0)^2 adds delta = 2 c L (m - L) to every d_i(L):
-      // + sum_L (1/L) (2 delta sum_i d~_i(L) + M delta^2)
-      DD corr;
-      for (R_xlen_t L = 1; L <= kk; ++L) {
-        const DD sd = (S[L] - S[0]) - (S[M + L] - S[M]) + (S[N] - S[N - L]) -
-                      (S[m] - S[m - L]);
-        const double delta =
-            2 * X.c * static_cast<double>(L) * static_cast<double>(m - L);
-        const DD t = sd * DD(2 * delta) +
-                     DD(static_cast<double>(M) * delta * delta);
-        corr += DD(t.hi / static_cast<double>(L), t.lo / static_cast<double>(L));
-      }
-      T += corr;
-    }
+    if (X.c != 0) T += quad_part(kk);
     for (R_xlen_t i : where[kk]) out[i] = T.value();
   }
   return out;
