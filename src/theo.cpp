@@ -620,99 +620,163 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
     return sdw * (4 * X.c) +
            DD(4 * X.c * X.c * static_cast<double>(M) * p3);
   };
-  // ht(lag): pairs at lag within the first 2k plus those within the last
-  // 2k points; tri(d): pairs (c - d, c + d) centred below k or at or above
-  // N - k. sfe(d) = SF(2d), inv(L) = 1/L.
-  std::vector<double> ht(2 * kmax + 2, 0.0), tri(kmax + 1, 0.0),
-      sfe(kmax + 1, 0.0), inv(kmax + 1, 0.0);
+  // ht(lag): the pairs at lag within the first 2k points plus those within
+  // the last 2k; tri(d): the pairs (c - d, c + d) centred below k or at or
+  // above N - k. Each grows by O(k) pairs from k to k + 1. Their weighted
+  // sums at the needed k are formed by items over ranges of lags (of d),
+  // each item stepping k from 0 to kmax on its own range: no item waits for
+  // another, and the partial sums meet in per-worker compensated totals.
+  std::vector<double> sfe(kmax + 1, 0.0), inv(kmax + 1, 0.0);
   for (R_xlen_t d = 1; d <= kmax; ++d) {
     sfe[d] = sf[2 * d];
     inv[d] = 1.0 / static_cast<double>(d);
   }
+  std::vector<R_xlen_t> slot(kmax + 1, -1), ks;
+  for (R_xlen_t kk = 1; kk <= kmax; ++kk) {
+    if (!where[kk].empty()) {
+      slot[kk] = static_cast<R_xlen_t>(ks.size());
+      ks.push_back(kk);
+    }
+  }
+  struct EdgeItem {
+    bool tri;
+    R_xlen_t a, b;  // lags (or d) in [a, b)
+  };
+  std::vector<EdgeItem> items;
+  {
+    // work (squared increments) of lag l: 4 per step from k = (l - 1) / 2
+    // on; of d: 2 per step from k = d on
+    const double kd = static_cast<double>(kmax);
+    const double total = 5.0 * kd * kd;
+    const int nthr = std::max(1, threads);
+    const double pieces = std::max(2.0 * nthr, std::min(512.0, total / 3.3e7));
+    const double per = total / pieces;
+    double w = 0;
+    R_xlen_t a = 1;
+    for (R_xlen_t l = 1; l <= 2 * kmax; ++l) {
+      w += 4.0 * static_cast<double>(kmax - l / 2);
+      if (w >= per || l == 2 * kmax) {
+        items.push_back(EdgeItem{false, a, l + 1});
+        a = l + 1;
+        w = 0;
+      }
+    }
+    a = 1;
+    w = 0;
+    for (R_xlen_t d = 1; d < kmax; ++d) {
+      w += 2.0 * static_cast<double>(kmax - d);
+      if (w >= per || d == kmax - 1) {
+        items.push_back(EdgeItem{true, a, d + 1});
+        a = d + 1;
+        w = 0;
+      }
+    }
+  }
+  const int nthr = std::max(1, threads);
+  std::vector<allanvar::TauSums> edge(nthr, allanvar::TauSums(ks.size()));
   const double* h = X.h.data();
   const double* l = X.l.data();
   const double* rh = X.rh.data();
   const double* rl = X.rl.data();
-  for (R_xlen_t k = 0; k < kmax; ++k) {
-    if (allanvar::interrupted()) scope.finish();
-    // the first 2k points gain q = 2k, 2k + 1 (x(q - lag) is reversed
-    // (N - 1 - q + lag)); the last 2k gain p = N - 2k - 1, N - 2k - 2
-    {
-      const R_xlen_t q = 2 * k, p = N - 2 * k - 1;
-      const double hq = h[q], lq = l[q], hq1 = h[q + 1], lq1 = l[q + 1];
-      const double hp = h[p], lp = l[p], hp1 = h[p - 1], lp1 = l[p - 1];
-      const double* a1 = rh + (N - 2 - q);  // a1[lag + 1] = x(q - lag)
-      const double* b1 = rl + (N - 2 - q);
-      const double* c1 = h + p - 1;         // c1[lag + 1] = x(p + lag)
-      const double* e1 = l + p - 1;
-      double* t = ht.data();
-      R_xlen_t lag = 1;
+  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nthr,
+                         [&](R_xlen_t it, int worker) {
+    const EdgeItem I = items[it];
+    std::vector<double> v(I.b - I.a, 0.0);
+    double* t = v.data() - I.a;  // t[lag]
+    if (!I.tri) {
+      // the first 2k points gain q = 2k, 2k + 1 (x(q - lag) is reversed
+      // (N - 1 - q + lag)); the last 2k gain p = N - 2k - 1, N - 2k - 2
+      for (R_xlen_t k = std::max<R_xlen_t>(0, (I.a - 1) / 2); k < kmax; ++k) {
+        if ((k & 63) == 0 && allanvar::interrupted()) return;
+        const R_xlen_t q = 2 * k, p = N - 2 * k - 1;
+        const double hq = h[q], lq = l[q], hq1 = h[q + 1], lq1 = l[q + 1];
+        const double hp = h[p], lp = l[p], hp1 = h[p - 1], lp1 = l[p - 1];
+        const double* a1 = rh + (N - 2 - q);  // a1[lag + 1] = x(q - lag)
+        const double* b1 = rl + (N - 2 - q);
+        const double* c1 = h + p - 1;         // c1[lag + 1] = x(p + lag)
+        const double* e1 = l + p - 1;
+        R_xlen_t lag = I.a;
+        const R_xlen_t top = std::min(I.b, q + 1);
 #if defined(__GNUC__)
-      using allanvar::v2d;
-      using allanvar::ld2;
-      const v2d Hq = {hq, hq}, Lq = {lq, lq}, Hq1 = {hq1, hq1},
-                Lq1 = {lq1, lq1}, Hp = {hp, hp}, Lp = {lp, lp},
-                Hp1 = {hp1, hp1}, Lp1 = {lp1, lp1};
-      for (; lag + 2 <= q + 1; lag += 2) {
-        const v2d d0 = (Hq - ld2(a1 + lag + 1)) + (Lq - ld2(b1 + lag + 1));
-        const v2d d1 = (Hq1 - ld2(a1 + lag)) + (Lq1 - ld2(b1 + lag));
-        const v2d e0 = (ld2(c1 + lag + 1) - Hp) + (ld2(e1 + lag + 1) - Lp);
-        const v2d f1 = (ld2(c1 + lag) - Hp1) + (ld2(e1 + lag) - Lp1);
-        allanvar::st2(t + lag,
-                      ld2(t + lag) + ((d0 * d0 + d1 * d1) + (e0 * e0 + f1 * f1)));
-      }
+        using allanvar::ld2;
+        using allanvar::v2d;
+        const v2d Hq = {hq, hq}, Lq = {lq, lq}, Hq1 = {hq1, hq1},
+                  Lq1 = {lq1, lq1}, Hp = {hp, hp}, Lp = {lp, lp},
+                  Hp1 = {hp1, hp1}, Lp1 = {lp1, lp1};
+        for (; lag + 2 <= top; lag += 2) {
+          const v2d d0 = (Hq - ld2(a1 + lag + 1)) + (Lq - ld2(b1 + lag + 1));
+          const v2d d1 = (Hq1 - ld2(a1 + lag)) + (Lq1 - ld2(b1 + lag));
+          const v2d e0 = (ld2(c1 + lag + 1) - Hp) + (ld2(e1 + lag + 1) - Lp);
+          const v2d f1 = (ld2(c1 + lag) - Hp1) + (ld2(e1 + lag) - Lp1);
+          allanvar::st2(t + lag, ld2(t + lag) + ((d0 * d0 + d1 * d1) +
+                                                 (e0 * e0 + f1 * f1)));
+        }
 #endif
-      for (; lag <= q; ++lag) {
-        const double d0 = (hq - a1[lag + 1]) + (lq - b1[lag + 1]);
-        const double d1 = (hq1 - a1[lag]) + (lq1 - b1[lag]);
-        const double e0 = (c1[lag + 1] - hp) + (e1[lag + 1] - lp);
-        const double f1 = (c1[lag] - hp1) + (e1[lag] - lp1);
-        t[lag] += (d0 * d0 + d1 * d1) + (e0 * e0 + f1 * f1);
+        for (; lag < top; ++lag) {
+          const double d0 = (hq - a1[lag + 1]) + (lq - b1[lag + 1]);
+          const double d1 = (hq1 - a1[lag]) + (lq1 - b1[lag]);
+          const double e0 = (c1[lag + 1] - hp) + (e1[lag + 1] - lp);
+          const double f1 = (c1[lag] - hp1) + (e1[lag] - lp1);
+          t[lag] += (d0 * d0 + d1 * d1) + (e0 * e0 + f1 * f1);
+        }
+        if (q + 1 >= I.a && q + 1 < I.b) {
+          const double d = (hq1 - h[0]) + (lq1 - l[0]);
+          const double e = (h[N - 1] - hp1) + (l[N - 1] - lp1);
+          t[q + 1] += d * d + e * e;
+        }
+        const R_xlen_t kk = k + 1;
+        if (slot[kk] < 0) continue;
+        // sum_L (2 SF(L) - ht(L) + 2 SF(2kk - L) - ht(2kk - L)) / L over
+        // this item's lags (each SF with the pairs it loses, which cancel
+        // most of it when 2kk nears N)
+        const R_xlen_t hi = std::min(I.b, 2 * kk);
+        double acc = 0;
+        for (R_xlen_t g = I.a; g < std::min(hi, kk + 1); ++g)
+          acc += (2 * sf[g] - t[g]) * inv[g];
+        for (R_xlen_t g = std::max(I.a, kk); g < hi; ++g)
+          acc += (2 * sf[g] - t[g]) * inv[2 * kk - g];
+        edge[worker].add(static_cast<size_t>(slot[kk]), acc);
       }
-      const double d = (hq1 - h[0]) + (lq1 - l[0]);
-      const double e = (h[N - 1] - hp1) + (l[N - 1] - lp1);
-      t[q + 1] += d * d + e * e;
-    }
-    // the centres k and N - 1 - k: x(k + d) - x(k - d) and
-    // x(N - 1 - k + d) - x(N - 1 - k - d)
-    {
-      const double* ah = h + k;
-      const double* al = l + k;
-      const double* bh = rh + (N - 1 - k);
-      const double* bl = rl + (N - 1 - k);
-      const double* ch = h + (N - 1 - k);
-      const double* cl = l + (N - 1 - k);
-      const double* dh = rh + k;
-      const double* dl = rl + k;
-      for (R_xlen_t d = 1; d <= k; ++d) {
-        const double e = (ah[d] - bh[d]) + (al[d] - bl[d]);
-        const double f = (ch[d] - dh[d]) + (cl[d] - dl[d]);
-        tri[d] += e * e + f * f;
+    } else {
+      // the centres k and N - 1 - k: x(k + d) - x(k - d) and
+      // x(N - 1 - k + d) - x(N - 1 - k - d)
+      for (R_xlen_t k = I.a; k < kmax; ++k) {
+        if ((k & 63) == 0 && allanvar::interrupted()) return;
+        const double* ah = h + k;
+        const double* al = l + k;
+        const double* bh = rh + (N - 1 - k);
+        const double* bl = rl + (N - 1 - k);
+        const double* ch = h + (N - 1 - k);
+        const double* cl = l + (N - 1 - k);
+        const double* dh = rh + k;
+        const double* dl = rl + k;
+        const R_xlen_t top = std::min(I.b, k + 1);
+        for (R_xlen_t d = I.a; d < top; ++d) {
+          const double e = (ah[d] - bh[d]) + (al[d] - bl[d]);
+          const double f = (ch[d] - dh[d]) + (cl[d] - dl[d]);
+          t[d] += e * e + f * f;
+        }
+        const R_xlen_t kk = k + 1;
+        if (slot[kk] < 0) continue;
+        // sum_{L < kk} (tri(kk - L) - SF(2kk - 2L)) / L over this item's d
+        double acc = 0;
+        for (R_xlen_t d = I.a; d < std::min(I.b, kk); ++d)
+          acc += (t[d] - sfe[d]) * inv[kk - d];
+        edge[worker].add(static_cast<size_t>(slot[kk]), acc);
       }
     }
-    const R_xlen_t kk = k + 1;
-    if (where[kk].empty()) continue;
-    // assemble T_kk: blocks of 256 terms summed plainly, the block totals
-    // with compensation
-    const R_xlen_t m = 2 * kk;
-    const double sfm = sf[m];
-    double ts = 0, te = 0;
-    for (R_xlen_t L0 = 1; L0 <= kk; L0 += 256) {
-      const R_xlen_t L1 = std::min(kk + 1, L0 + 256);
-      double acc = 0;
-      for (R_xlen_t L = L0; L < L1; ++L) {
-        const double b = (2 * sf[L] - ht[L]) + (2 * sf[m - L] - ht[m - L]) -
-                         sfm + (tri[kk - L] - sfe[kk - L]);
-        acc += b * inv[L];
-      }
-      double s, e;
-      allanvar::dd_two_sum(ts, acc, s, e);
-      ts = s;
-      te += e;
-    }
-    DD T = DD(ts) + DD(te);
-    if (X.c != 0) T += quad_part(kk);
-    for (R_xlen_t i : where[kk]) out[i] = T.value();
+  });
+  scope.finish();
+  for (size_t i = 0; i < ks.size(); ++i) {
+    // - H_k SF(2k), the SF(2k) of every L
+    double Hk = 0;
+    for (R_xlen_t L = ks[i]; L >= 1; --L) Hk += inv[L];
+    double p, e;
+    allanvar::dd_two_prod(-Hk, sf[2 * ks[i]], p, e);
+    DD T(p, e);
+    for (int w = 0; w < nthr; ++w) T += DD(edge[w].value(i));
+    if (X.c != 0) T += quad_part(ks[i]);
+    for (R_xlen_t j : where[ks[i]]) out[j] = T.value();
   }
   return out;
 }
