@@ -591,13 +591,14 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   a$alpha[match(mm, a$m)]
 }
 
-# Theo1's sums T_k (src/theo.cpp) at many even m: the direct stencil below
-# m = 64, where it costs little and the recurrence's cancellation (about
-# L / m for random-walk FM) would be largest; the squared-increment
-# recurrence for the rest.
+# Theo1's sums T_k (src/theo.cpp) at many even m: per m sums below m = 64
+# and above L - 64, where they cost little and the recurrence would cancel
+# most (about L / m for random-walk FM, L / (L - m) near the top); the
+# squared-increment recurrence for the rest.
 theo1_many <- function(v, rate, m, threads) {
   T <- rep(NA_real_, length(m))
-  small <- m < 64
+  L <- length(v) + rate
+  small <- m < 64 | m > L - 64
   if (any(small)) T[small] <- theo1_sums_cpp(v, rate, m[small], threads)
   if (any(!small)) T[!small] <- theo1_incr_cpp(v, rate, m[!small] / 2, threads)
   T
