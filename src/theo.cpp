@@ -166,6 +166,7 @@ double theo_fast_cost(R_xlen_t N, R_xlen_t k) {
 struct Item {
   size_t tau;
   R_xlen_t l0, l1;  // direct: L in [l0, l1); fast: l0 = block start, l1 = -1
+  double cost;      // for the order of the work
 };
 
 }  // namespace
@@ -192,15 +193,22 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
         (method == 0 && theo_fast_cost(N, k) < theo_direct_cost(N, k));
     if (fast) {
       const R_xlen_t B = theo_block_len(N, k);
-      for (R_xlen_t a = 0; a < N - mm; a += B) items.push_back(Item{t, a, -1});
+      const double c = theo_fast_cost(N, k) /
+                       std::ceil(static_cast<double>(N - mm) / static_cast<double>(B));
+      for (R_xlen_t a = 0; a < N - mm; a += B) items.push_back(Item{t, a, -1, c});
       continue;
     }
     // about 2^22 stencil terms per item, for interrupt latency and balance
     const R_xlen_t per =
         std::max<R_xlen_t>(1, (R_xlen_t(1) << 22) / std::max<R_xlen_t>(1, N - mm));
     for (R_xlen_t l0 = 1; l0 <= k; l0 += per)
-      items.push_back(Item{t, l0, std::min(k + 1, l0 + per)});
+      items.push_back(Item{t, l0, std::min(k + 1, l0 + per),
+                           static_cast<double>(N - mm) *
+                               static_cast<double>(std::min(k + 1, l0 + per) - l0)});
   }
+  // the longest items first, so that the last ones to finish are short
+  std::stable_sort(items.begin(), items.end(),
+                   [](const Item& a, const Item& b) { return a.cost > b.cost; });
   std::vector<double> part(items.size(), 0.0);
   const double* h = X.hi.data();
   const double* l = X.lo.data();
