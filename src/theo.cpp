@@ -775,12 +775,12 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
     }
   });
   scope.finish();
+  std::vector<DD> harm(kmax + 1);  // harmonic numbers
+  for (R_xlen_t L = 1; L <= kmax; ++L) harm[L] = harm[L - 1] + DD(inv[L]);
   for (size_t i = 0; i < ks.size(); ++i) {
     // - H_k SF(2k), the SF(2k) of every L
-    double Hk = 0;
-    for (R_xlen_t L = ks[i]; L >= 1; --L) Hk += inv[L];
     double p, e;
-    allanvar::dd_two_prod(-Hk, sf[2 * ks[i]], p, e);
+    allanvar::dd_two_prod(-harm[ks[i]].value(), sf[2 * ks[i]], p, e);
     DD T(p, e);
     for (int w = 0; w < nthr; ++w) T += DD(edge[w].value(i));
     if (X.c != 0) T += quad_part(ks[i]);
