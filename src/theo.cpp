@@ -6,7 +6,7 @@
 //   T_k = sum_{i < N-m} sum_{L=1..k} (1/L) (x(i) - x(i+L) + x(i+m) - x(i+m-L))^2
 // (L = m/2 - delta of SP 1065's inner index).
 //
-// Three evaluations:
+// Four evaluations:
 //  * theo1_sums_cpp: T_k at the requested m, per m the cheaper of
 //    - the definition: for each L one pass of a four-point stencil over the
 //      phase split hi + lo (src/local-phase.h), exact on the hi grid;
@@ -25,7 +25,11 @@
 //    cancels heavily (terms of size N var(x) for a result of size N k
 //    var(dx)), so every product and sum is carried in double-double
 //    (src/dd.h) on the exact hi + lo phase: the result agrees with the
-//    direct evaluation to about 1e-15 whatever the noise type.
+//    direct evaluation to about 1e-15 whatever the noise type. Kept as the
+//    tests' reference; O(N kmax) double-double products.
+//  * theo1_incr_cpp: T_k at many k (TheoBR's factor, Theo1 at many taus)
+//    in O(N log^2 N + kmax^2) plain double operations: the same recurrence
+//    on squared increments, which cancel far less (see its section).
 #include "dd.h"
 #include "fft.h"
 #include "local-phase.h"
