@@ -763,7 +763,17 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
         const double* dh = rh + k;
         const double* dl = rl + k;
         const R_xlen_t top = std::min(I.b, k + 1);
-        for (R_xlen_t d = I.a; d < top; ++d) {
+        R_xlen_t d = I.a;
+#if defined(__GNUC__)
+        using allanvar::ld2;
+        using allanvar::v2d;
+        for (; d + 2 <= top; d += 2) {
+          const v2d e = (ld2(ah + d) - ld2(bh + d)) + (ld2(al + d) - ld2(bl + d));
+          const v2d f = (ld2(ch + d) - ld2(dh + d)) + (ld2(cl + d) - ld2(dl + d));
+          allanvar::st2(t + d, ld2(t + d) + (e * e + f * f));
+        }
+#endif
+        for (; d < top; ++d) {
           const double e = (ah[d] - bh[d]) + (al[d] - bl[d]);
           const double f = (ch[d] - dh[d]) + (cl[d] - dl[d]);
           t[d] += e * e + f * f;
