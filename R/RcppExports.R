@@ -157,6 +157,10 @@ theo1_all_cpp <- function(v, rate, kmax_d, need) {
     .Call(`_allanvar_theo1_all_cpp`, v, rate, kmax_d, need)
 }
 
+theo1_incr_cpp <- function(v, rate, need, threads) {
+    .Call(`_allanvar_theo1_incr_cpp`, v, rate, need, threads)
+}
+
 mtie_cpp <- function(v, rate, m) {
     .Call(`_allanvar_mtie_cpp`, v, rate, m)
 }

@@ -84,10 +84,14 @@
 #' \eqn{4m} windows; directly, \eqn{O(L m)}, below \eqn{m = 8}); Theo1 per
 #' tau the cheaper of its definition (\eqn{O(L m)}) and an expansion into
 #' FFT correlations over blocks of the phase (\eqn{O(L \log^2 m)}, agreeing
-#' with the definition to about \eqn{10^{-12}}), and TheoBR's factor
-#' \eqn{O(L^2)} once (Lewis's recurrence, evaluated in double-double
-#' arithmetic), so `"theobr"` and `"theoh"` stay slow beyond about
-#' \eqn{10^5} samples.
+#' with the definition to about \eqn{10^{-12}}); TheoBR's factor, which
+#' needs Theo1 at about \eqn{L/6} averaging times, and Theo1 at more than
+#' 40 taus by a recurrence over \eqn{m} on squared phase increments
+#' (structure functions by FFT of locally detrended blocks, the pairs near
+#' the ends of the record added as \eqn{m} grows; \eqn{O(L \log^2 L +
+#' m_{max}^2)}, agreeing with the definition to about \eqn{10^{-11}}), so
+#' `"theobr"` and `"theoh"` take seconds at \eqn{10^5} samples and minutes
+#' at \eqn{10^6}.
 #' @param debias For `"mtotdev"`, `"ttotdev"`, `"htotdev"` and `"theo1"`:
 #'   apply NIST SP 1065's noise-dependent bias correction (default `TRUE`);
 #'   see "Further statistics". Ignored by the other types.
@@ -513,9 +517,10 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
       av <- rep(NA_real_, length(m))
       mt <- m[theo_row]
       if (length(mt)) {
-        # many m: the all-k recurrence (O(L kmax)) beats m-by-m sums
+        # many m: the recurrence over k (O(L log^2 L + kmax^2)) beats
+        # m-by-m sums
         T <- if (length(mt) > 40L) {
-          theo1_all_cpp(v, rate, max(mt) / 2, mt / 2)[mt / 2]
+          theo1_many(v, rate, mt, threads)
         } else {
           theo1_sums_cpp(v, rate, mt, threads)
         }
@@ -525,7 +530,7 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
         if (type == "theo1") {
           if (debias) t1 <- t1 * debias_factor("theo1", alpha[theo_row], mt)
         } else {
-          kf <- theobr_factor(v, freq, rate, L)
+          kf <- theobr_factor(v, freq, rate, L, threads)
           if (!is.finite(kf)) {
             abort("TheoBR needs at least 19 phase points (", L, " given).",
                   class = "argument")
@@ -586,12 +591,25 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   a$alpha[match(mm, a$m)]
 }
 
+# Theo1's sums T_k (src/theo.cpp) at many even m: per m sums below m = 64
+# and above L - 64, where they cost little and the recurrence would cancel
+# most (about L / m for random-walk FM, L / (L - m) near the top); the
+# squared-increment recurrence for the rest.
+theo1_many <- function(v, rate, m, threads) {
+  T <- rep(NA_real_, length(m))
+  L <- length(v) + rate
+  small <- m < 64 | m > L - 64
+  if (any(small)) T[small] <- theo1_sums_cpp(v, rate, m[small], threads)
+  if (any(!small)) T[!small] <- theo1_incr_cpp(v, rate, m[!small] / 2, threads)
+  T
+}
+
 # TheoBR's bias-removal factor (NIST SP 1065 eq. 33): the mean over
 # i = 0..n, n = floor(N/6 - 3), of AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),
 # two estimates at the same averaging time. Theo1 at every needed m comes
-# from the all-k recurrence (src/theo.cpp), AVAR from the overlapping
-# estimator. NA when the record is too short (N < 19 phase points).
-theobr_factor <- function(v, freq, rate, L) {
+# from theo1_many(), AVAR from the overlapping estimator. NA when the record
+# is too short (N < 19 phase points).
+theobr_factor <- function(v, freq, rate, L, threads = 1L) {
   n <- floor(L / 6 - 3)
   if (n < 0) return(NA_real_)
   i <- 0:n
@@ -601,9 +619,8 @@ theobr_factor <- function(v, freq, rate, L) {
   if (!any(ok)) return(NA_real_)
   mt <- mt[ok]
   ma <- ma[ok]
-  kmax <- max(mt) / 2
-  T <- theo1_all_cpp(v, rate, kmax, mt / 2)
-  th <- T[mt / 2] / (0.75 * (L - mt) * mt^2)
+  T <- theo1_many(v, rate, mt, threads)
+  th <- T / (0.75 * (L - mt) * mt^2)
   input <- if (rate) "rate" else "integrated"
   a <- allan(v, 1, taus = I(ma), type = "overlapping", input = input)
   mean(a$avar / th)

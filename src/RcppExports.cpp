@@ -490,6 +490,19 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// theo1_incr_cpp
+Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& need, int threads);
+RcppExport SEXP _allanvar_theo1_incr_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP needSEXP, SEXP threadsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type v(vSEXP);
+    Rcpp::traits::input_parameter< bool >::type rate(rateSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type need(needSEXP);
+    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
+    rcpp_result_gen = Rcpp::wrap(theo1_incr_cpp(v, rate, need, threads));
+    return rcpp_result_gen;
+END_RCPP
+}
 // mtie_cpp
 Rcpp::NumericVector mtie_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m);
 RcppExport SEXP _allanvar_mtie_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP) {
@@ -601,6 +614,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_rosbag_imu", (DL_FUNC) &_allanvar_rosbag_imu, 7},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
+    {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},
     {"_allanvar_mtie_cpp", (DL_FUNC) &_allanvar_mtie_cpp, 3},
     {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
     {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 6},

@@ -23,11 +23,18 @@ class FFTPlan {
   size_t size() const { return n_; }
   void reset(size_t n) {
     n_ = n;
-    w_.resize(n / 2);
+    std::vector<cplx> w(n / 2);
     const double pi = 3.14159265358979323846;
     for (size_t j = 0; j < n / 2; ++j) {
       const double a = -2.0 * pi * static_cast<double>(j) / static_cast<double>(n);
-      w_[j] = cplx(std::cos(a), std::sin(a));
+      w[j] = cplx(std::cos(a), std::sin(a));
+    }
+    // the twiddles of each stage contiguous (the stage of half-length h at
+    // offset h - 1), so that a stage reads them in order
+    w_.resize(n > 1 ? n - 1 : 0);
+    for (size_t half = 1; half < n; half <<= 1) {
+      const size_t step = n / (2 * half);
+      for (size_t j = 0; j < half; ++j) w_[half - 1 + j] = w[j * step];
     }
   }
   // In place; inverse without the 1/n factor.
@@ -39,24 +46,35 @@ class FFTPlan {
       j ^= bit;
       if (i < j) std::swap(a[i], a[j]);
     }
-    for (size_t len = 2; len <= n; len <<= 1) {
-      const size_t half = len / 2, step = n / len;
-      for (size_t i = 0; i < n; i += len) {
-        for (size_t j = 0; j < half; ++j) {
-          // written out: std::complex's operator* checks for NaN (slow)
-          const double wr = w_[j * step].real();
-          const double wi = inverse ? -w_[j * step].imag() : w_[j * step].imag();
-          const double br = a[i + j + half].real(), bi = a[i + j + half].imag();
-          const double vr = br * wr - bi * wi, vi = br * wi + bi * wr;
-          const double ur = a[i + j].real(), ui = a[i + j].imag();
-          a[i + j] = cplx(ur + vr, ui + vi);
-          a[i + j + half] = cplx(ur - vr, ui - vi);
-        }
+    // The stages up to len = C run block by block (each block of C points
+    // stays in cache through them); the same butterflies in another order,
+    // so the result is unchanged.
+    const size_t C = std::min(n, static_cast<size_t>(1) << 13);
+    for (size_t b = 0; b < n; b += C) {
+      for (size_t len = 2; len <= C; len <<= 1) stage(a, len, b, b + C, inverse);
+    }
+    for (size_t len = 2 * C; len <= n; len <<= 1) stage(a, len, 0, n, inverse);
+  }
+
+ private:
+  // the butterflies of one stage over the points [from, to)
+  void stage(cplx* a, size_t len, size_t from, size_t to, bool inverse) const {
+    const size_t half = len / 2;
+    const cplx* w = w_.data() + (half - 1);
+    for (size_t i = from; i < to; i += len) {
+      for (size_t j = 0; j < half; ++j) {
+        // written out: std::complex's operator* checks for NaN (slow)
+        const double wr = w[j].real();
+        const double wi = inverse ? -w[j].imag() : w[j].imag();
+        const double br = a[i + j + half].real(), bi = a[i + j + half].imag();
+        const double vr = br * wr - bi * wi, vi = br * wi + bi * wr;
+        const double ur = a[i + j].real(), ui = a[i + j].imag();
+        a[i + j] = cplx(ur + vr, ui + vi);
+        a[i + j + half] = cplx(ur - vr, ui - vi);
       }
     }
   }
 
- private:
   size_t n_;
   std::vector<cplx> w_;
 };

@@ -6,7 +6,7 @@
 //   T_k = sum_{i < N-m} sum_{L=1..k} (1/L) (x(i) - x(i+L) + x(i+m) - x(i+m-L))^2
 // (L = m/2 - delta of SP 1065's inner index).
 //
-// Three evaluations:
+// Four evaluations:
 //  * theo1_sums_cpp: T_k at the requested m, per m the cheaper of
 //    - the definition: for each L one pass of a four-point stencil over the
 //      phase split hi + lo (src/local-phase.h), exact on the hi grid;
@@ -25,7 +25,11 @@
 //    cancels heavily (terms of size N var(x) for a result of size N k
 //    var(dx)), so every product and sum is carried in double-double
 //    (src/dd.h) on the exact hi + lo phase: the result agrees with the
-//    direct evaluation to about 1e-15 whatever the noise type.
+//    direct evaluation to about 1e-15 whatever the noise type. Kept as the
+//    tests' reference; O(N kmax) double-double products.
+//  * theo1_incr_cpp: T_k at many k (TheoBR's factor, Theo1 at many taus)
+//    in O(N log^2 N + kmax^2) plain double operations: the same recurrence
+//    on squared increments, which cancel far less (see its section).
 #include "dd.h"
 #include "fft.h"
 #include "local-phase.h"
@@ -166,6 +170,7 @@ double theo_fast_cost(R_xlen_t N, R_xlen_t k) {
 struct Item {
   size_t tau;
   R_xlen_t l0, l1;  // direct: L in [l0, l1); fast: l0 = block start, l1 = -1
+  double cost;      // for the order of the work
 };
 
 }  // namespace
@@ -192,15 +197,22 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
         (method == 0 && theo_fast_cost(N, k) < theo_direct_cost(N, k));
     if (fast) {
       const R_xlen_t B = theo_block_len(N, k);
-      for (R_xlen_t a = 0; a < N - mm; a += B) items.push_back(Item{t, a, -1});
+      const double c = theo_fast_cost(N, k) /
+                       std::ceil(static_cast<double>(N - mm) / static_cast<double>(B));
+      for (R_xlen_t a = 0; a < N - mm; a += B) items.push_back(Item{t, a, -1, c});
       continue;
     }
     // about 2^22 stencil terms per item, for interrupt latency and balance
     const R_xlen_t per =
         std::max<R_xlen_t>(1, (R_xlen_t(1) << 22) / std::max<R_xlen_t>(1, N - mm));
     for (R_xlen_t l0 = 1; l0 <= k; l0 += per)
-      items.push_back(Item{t, l0, std::min(k + 1, l0 + per)});
+      items.push_back(Item{t, l0, std::min(k + 1, l0 + per),
+                           static_cast<double>(N - mm) *
+                               static_cast<double>(std::min(k + 1, l0 + per) - l0)});
   }
+  // the longest items first, so that the last ones to finish are short
+  std::stable_sort(items.begin(), items.end(),
+                   [](const Item& a, const Item& b) { return a.cost > b.cost; });
   std::vector<double> part(items.size(), 0.0);
   const double* h = X.hi.data();
   const double* l = X.lo.data();
@@ -372,6 +384,421 @@ Rcpp::NumericVector theo1_all_cpp(const Rcpp::NumericVector& v, bool rate,
       T += DD(term.hi / static_cast<double>(L), term.lo / static_cast<double>(L));
     }
     out[k - 1] = T.value();
+  }
+  return out;
+}
+
+
+// ---- TheoBR's Theo1 values: T_k at many k without double-double. ----
+// With s = (+1, -1, +1, -1) on (x_i, x_{i+L}, x_{i+m}, x_{i+m-L}), the
+// identity (sum s_j x_j)^2 = -sum_{j<l} s_j s_l (x_j - x_l)^2 (sum s = 0)
+// writes each squared term of T_k as six squared increments D(p, q) =
+// (x_q - x_p)^2:
+//   d_i(L)^2 = D(i, i+L) + D(i+m-L, i+m) + D(i, i+m-L) + D(i+L, i+m)
+//            - D(i, i+m) - D(i+L, i+m-L).
+// Summed over i < N - m, each is a full structure function
+// SF(lag) = sum_p D(p, p + lag) minus the pairs within 2k of either end:
+//   T_k = sum_L (1/L) [2 SF(L) + 2 SF(2k-L) - SF(2k) - SF(2k-2L)
+//         - head(L) - tail(L) - head(2k-L) - tail(2k-L)
+//         + triH(k-L) + triT(k-L)],
+// head/tail(lag): pairs within the first/last 2k points; triH/triT(d): the
+// pairs (c-d, c+d) centred below k / at or above N-k (the SF(2k-2L) terms
+// vanish at L = k). Every sum is of positive terms, so nothing cancels
+// inside them; the combination cancels only the global level of the
+// frequency (about N/k for random-walk FM, O(1) for white noise), where the
+// lag-product expansion of theo1_all_cpp cancelled (N/k)^3. A quadratic
+// c (i - i0)^2 is removed first (it adds 2 c L (m - L) to every d_i(L),
+// restored exactly below), so a frequency drift cancels nothing either.
+// The SF come from FFTs of locally detrended blocks (lags in [D, 2D) from
+// blocks of 6D points), the edge sums grow with k by O(k) terms per step
+// (the recurrence of Lewis, arXiv:2106.04542, on squared increments).
+
+namespace {
+
+struct TildePhase {
+  std::vector<double> h, l, rh, rl;  // x~ = h + l; rh, rl reversed
+  R_xlen_t N = 0;
+  double c = 0, i0 = 0;              // x = x~ + c (i - i0)^2 (+ a line)
+  // x~_q - x~_p
+  inline double diff(R_xlen_t p, R_xlen_t q) const {
+    return (h[q] - h[p]) + (l[q] - l[p]);
+  }
+};
+
+void tilde_phase(const allanvar::SplitPhase& X, TildePhase& T) {
+  const R_xlen_t N = X.size();
+  T.N = N;
+  T.h = X.hi;
+  T.l = X.lo;
+  T.c = 0;
+  T.i0 = 0.5 * static_cast<double>(N - 1);
+  const R_xlen_t a = N / 3;
+  if (a >= 2) {
+    // mean frequencies over the first and last thirds: slope 2c between
+    const double f1 = (X.value(a) - X.value(0)) / static_cast<double>(a);
+    const double f2 =
+        (X.value(N - 1) - X.value(N - 1 - a)) / static_cast<double>(a);
+    T.c = (f2 - f1) / (2.0 * static_cast<double>(N - 1 - a));
+  }
+  if (T.c != 0 && std::isfinite(T.c)) {
+    for (R_xlen_t i = 0; i < N; ++i) {
+      const double u = static_cast<double>(i) - T.i0;
+      double s, e;
+      allanvar::dd_two_sum(T.h[i], -T.c * u * u, s, e);
+      T.h[i] = s;
+      T.l[i] += e;
+    }
+  } else {
+    T.c = 0;
+  }
+  T.rh.assign(T.h.rbegin(), T.h.rend());
+  T.rl.assign(T.l.rbegin(), T.l.rend());
+}
+
+// SF(lag) = sum_{p < N - lag} (x~_{p+lag} - x~_p)^2 for lag = 1..lmax
+// (sf[0] = 0). Short lags directly; lags in [D, 2D) from blocks of B = 6D
+// starting points on the block's phase less the chord through its window,
+// z_j = x~(a+j) - x~(a) - s j: with t = x~ increments,
+//   sum_j (t_j)^2 = sum_j (z_{j+lag} - z_j)^2 + 2 s lag sum_j (z_{j+lag}
+//   - z_j) + B s^2 lag^2,
+// the first from one FFT correlation of z; the last window of the record
+// by its own autocorrelation.
+std::vector<double> theo_full_sf(const TildePhase& X, R_xlen_t lmax,
+                                 int threads) {
+  const R_xlen_t N = X.N;
+  std::vector<double> sf(lmax + 1, 0.0);
+  const R_xlen_t L0 = std::min<R_xlen_t>(lmax + 1, 64);
+  struct Job {
+    R_xlen_t lo, hi, a, len;  // lags [lo, hi); points [a, a + len)
+    bool tail;                // autocorrelation of the segment
+    size_t out;               // offset into the results
+    bool direct;              // one short lag over the whole record
+  };
+  std::vector<Job> jobs;
+  size_t tot = 0;
+  for (R_xlen_t lag = 1; lag < L0; ++lag) {
+    jobs.push_back(Job{lag, lag + 1, 0, N, false, tot, true});
+    tot += 1;
+  }
+  for (R_xlen_t D = 64; D <= lmax; D *= 2) {
+    const R_xlen_t lo = D, hi = std::min(2 * D, lmax + 1);
+    const R_xlen_t B = 6 * D, W = B + 2 * D - 1;
+    R_xlen_t a = 0;
+    for (; a + W <= N; a += B) {
+      jobs.push_back(Job{lo, hi, a, W, false, tot, false});
+      tot += static_cast<size_t>(hi - lo);
+    }
+    if (N - a > lo) {
+      jobs.push_back(Job{lo, hi, a, N - a, true, tot, false});
+      tot += static_cast<size_t>(hi - lo);
+    }
+  }
+  std::vector<double> res(tot, 0.0);
+  const int nthr = std::max(1, threads);
+  struct Scratch {
+    allanvar::FFTPlans plans;
+    std::vector<allanvar::cplx> buf, buf2;
+    std::vector<double> z, zs, qz, c;
+  };
+  std::vector<Scratch> scr(nthr);
+  allanvar::parallel_for(static_cast<R_xlen_t>(jobs.size()), nthr,
+                         [&](R_xlen_t it, int worker) {
+    const Job& J = jobs[it];
+    if (J.direct) {
+      // short lag: directly, in blocks for the rounding
+      const R_xlen_t lag = J.lo;
+      double acc = 0;
+      for (R_xlen_t b0 = 0; b0 < N - lag; b0 += 4096) {
+        const R_xlen_t b1 = std::min(N - lag, b0 + 4096);
+        double s0 = 0, s1 = 0;
+        R_xlen_t p = b0;
+        for (; p + 2 <= b1; p += 2) {
+          const double d0 = X.diff(p, p + lag), d1 = X.diff(p + 1, p + 1 + lag);
+          s0 += d0 * d0;
+          s1 += d1 * d1;
+        }
+        for (; p < b1; ++p) {
+          const double d = X.diff(p, p + lag);
+          s0 += d * d;
+        }
+        acc += s0 + s1;
+      }
+      res[J.out] = acc;
+      return;
+    }
+    Scratch& S = scr[worker];
+    const R_xlen_t n = J.len;
+    S.z.resize(n);
+    S.zs.resize(n + 1);
+    S.qz.resize(n + 1);
+    const double s = X.diff(J.a, J.a + n - 1) / static_cast<double>(n - 1);
+    S.zs[0] = S.qz[0] = 0;
+    for (R_xlen_t j = 0; j < n; ++j) {
+      S.z[j] = X.diff(J.a, J.a + j) - s * static_cast<double>(j);
+      S.zs[j + 1] = S.zs[j] + S.z[j];
+      S.qz[j + 1] = S.qz[j] + S.z[j] * S.z[j];
+    }
+    const R_xlen_t hi = std::min(J.hi, J.tail ? n : J.hi);
+    const size_t nt = static_cast<size_t>(hi);
+    S.c.resize(nt);
+    const R_xlen_t B = J.tail ? n : n - 2 * J.lo + 1;  // starting points
+    allanvar::real_correlation(S.z.data(), J.tail ? n : B, S.z.data(), n, nt,
+                               S.c.data(), S.plans, S.buf, S.buf2);
+    for (R_xlen_t lag = J.lo; lag < hi; ++lag) {
+      const R_xlen_t cnt = J.tail ? n - lag : B;
+      const double sfz = (S.qz[lag + cnt] - S.qz[lag]) + S.qz[cnt] - 2 * S.c[lag];
+      const double dz = (S.zs[lag + cnt] - S.zs[lag]) - S.zs[cnt];
+      const double g = s * static_cast<double>(lag);
+      res[J.out + (lag - J.lo)] =
+          sfz + 2 * g * dz + g * g * static_cast<double>(cnt);
+    }
+  });
+  allanvar::TauSums acc(static_cast<size_t>(lmax + 1));
+  for (const Job& J : jobs) {
+    const R_xlen_t hi = std::min(J.hi, J.tail ? J.len : J.hi);
+    for (R_xlen_t lag = J.lo; lag < hi; ++lag)
+      acc.add(static_cast<size_t>(lag), res[J.out + (lag - J.lo)]);
+  }
+  for (R_xlen_t lag = 1; lag <= lmax; ++lag)
+    sf[lag] = acc.any(lag) ? acc.value(lag) : 0.0;
+  return sf;
+}
+
+}  // namespace
+
+// T_k of one channel at the k in `need` (each in [1, (L - 1) / 2]) by the
+// squared-increment recurrence above; O(L log^2 L + kmax^2).
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
+                                   const Rcpp::NumericVector& need,
+                                   int threads) {
+  const allanvar::InterruptScope scope;
+  const allanvar::PhaseInput in{v.begin(), v.size(), rate};
+  allanvar::SplitPhase Xs;
+  allanvar::split_phase(in, Xs);
+  const R_xlen_t N = in.length();
+  Rcpp::NumericVector out(need.size(), NA_REAL);
+  R_xlen_t kmax = 0;
+  for (R_xlen_t i = 0; i < need.size(); ++i) {
+    const double k = need[i];
+    if (k >= 1 && k <= (N - 1) / 2) kmax = std::max(kmax, static_cast<R_xlen_t>(k));
+  }
+  if (kmax < 1) return out;
+  std::vector<std::vector<R_xlen_t>> where(kmax + 1);
+  for (R_xlen_t i = 0; i < need.size(); ++i) {
+    const double k = need[i];
+    if (k >= 1 && k <= kmax) where[static_cast<R_xlen_t>(k)].push_back(i);
+  }
+  TildePhase X;
+  tilde_phase(Xs, X);
+  const std::vector<double> sf = theo_full_sf(X, 2 * kmax, threads);
+  scope.finish();
+  // The quadratic's part, sum_L (1/L) (2 delta_L sum_i d~_i(L) + M delta_L^2)
+  // with delta_L = 2 c L (m - L), in O(1) per k from double-double prefix
+  // sums: sum_i d~_i(L) = A(L) - (S(M+L) - S(M)) - (S(m) - S(m-L)),
+  // A(L) = S(L) + S(N) - S(N-L), S(j) the sum of x~ over [0, j).
+  std::vector<DD> S, PS, PJS, PA, PLA;
+  if (X.c != 0) {
+    S.resize(N + 1);
+    PS.resize(N + 1);
+    PJS.resize(N + 1);
+    DD a, b, e;
+    for (R_xlen_t j = 0; j <= N; ++j) {
+      if (j > 0) a += DD(X.h[j - 1]) + DD(X.l[j - 1]);
+      S[j] = a;
+      b += a;
+      e += a * static_cast<double>(j);
+      PS[j] = b;
+      PJS[j] = e;
+    }
+    PA.resize(kmax + 1);
+    PLA.resize(kmax + 1);
+    for (R_xlen_t L = 1; L <= kmax; ++L) {
+      const DD A = S[L] + S[N] - S[N - L];
+      PA[L] = PA[L - 1] + A;
+      PLA[L] = PLA[L - 1] + A * static_cast<double>(L);
+    }
+  }
+  auto quad_part = [&](R_xlen_t k) {
+    const R_xlen_t m = 2 * k, M = N - m;
+    const double kd = static_cast<double>(k), md = static_cast<double>(m);
+    const double W1 = md * kd - 0.5 * kd * (kd + 1);
+    const DD sdw = PA[k] * md - PLA[k] -
+                   (PS[M + k] - PS[M]) * static_cast<double>(N) +
+                   (PJS[M + k] - PJS[M]) + (S[M] - S[m]) * W1 +
+                   (PJS[m - 1] - PJS[k - 1]);
+    const double s1 = 0.5 * kd * (kd + 1), s2 = s1 * (2 * kd + 1) / 3;
+    const double p3 = md * md * s1 - 2 * md * s2 + s1 * s1;
+    return sdw * (4 * X.c) +
+           DD(4 * X.c * X.c * static_cast<double>(M) * p3);
+  };
+  // ht(lag): the pairs at lag within the first 2k points plus those within
+  // the last 2k; tri(d): the pairs (c - d, c + d) centred below k or at or
+  // above N - k. Each grows by O(k) pairs from k to k + 1. Their weighted
+  // sums at the needed k are formed by items over ranges of lags (of d),
+  // each item stepping k from 0 to kmax on its own range: no item waits for
+  // another, and the partial sums meet in per-worker compensated totals.
+  std::vector<double> sfe(kmax + 1, 0.0), inv(kmax + 1, 0.0);
+  for (R_xlen_t d = 1; d <= kmax; ++d) {
+    sfe[d] = sf[2 * d];
+    inv[d] = 1.0 / static_cast<double>(d);
+  }
+  std::vector<R_xlen_t> slot(kmax + 1, -1), ks;
+  for (R_xlen_t kk = 1; kk <= kmax; ++kk) {
+    if (!where[kk].empty()) {
+      slot[kk] = static_cast<R_xlen_t>(ks.size());
+      ks.push_back(kk);
+    }
+  }
+  struct EdgeItem {
+    bool tri;
+    R_xlen_t a, b;  // lags (or d) in [a, b)
+  };
+  std::vector<EdgeItem> items;
+  {
+    // work (squared increments) of lag l: 4 per step from k = (l - 1) / 2
+    // on; of d: 2 per step from k = d on
+    const double kd = static_cast<double>(kmax);
+    const double total = 5.0 * kd * kd;
+    const int nthr = std::max(1, threads);
+    const double pieces = std::max(2.0 * nthr, std::min(512.0, total / 3.3e7));
+    const double per = total / pieces;
+    double w = 0;
+    R_xlen_t a = 1;
+    for (R_xlen_t l = 1; l <= 2 * kmax; ++l) {
+      w += 4.0 * static_cast<double>(kmax - l / 2);
+      if (w >= per || l == 2 * kmax) {
+        items.push_back(EdgeItem{false, a, l + 1});
+        a = l + 1;
+        w = 0;
+      }
+    }
+    a = 1;
+    w = 0;
+    for (R_xlen_t d = 1; d < kmax; ++d) {
+      w += 2.0 * static_cast<double>(kmax - d);
+      if (w >= per || d == kmax - 1) {
+        items.push_back(EdgeItem{true, a, d + 1});
+        a = d + 1;
+        w = 0;
+      }
+    }
+  }
+  const int nthr = std::max(1, threads);
+  std::vector<allanvar::TauSums> edge(nthr, allanvar::TauSums(ks.size()));
+  const double* h = X.h.data();
+  const double* l = X.l.data();
+  const double* rh = X.rh.data();
+  const double* rl = X.rl.data();
+  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nthr,
+                         [&](R_xlen_t it, int worker) {
+    const EdgeItem I = items[it];
+    std::vector<double> v(I.b - I.a, 0.0);
+    double* t = v.data() - I.a;  // t[lag]
+    if (!I.tri) {
+      // the first 2k points gain q = 2k, 2k + 1 (x(q - lag) is reversed
+      // (N - 1 - q + lag)); the last 2k gain p = N - 2k - 1, N - 2k - 2
+      for (R_xlen_t k = std::max<R_xlen_t>(0, (I.a - 1) / 2); k < kmax; ++k) {
+        if ((k & 63) == 0 && allanvar::interrupted()) return;
+        const R_xlen_t q = 2 * k, p = N - 2 * k - 1;
+        const double hq = h[q], lq = l[q], hq1 = h[q + 1], lq1 = l[q + 1];
+        const double hp = h[p], lp = l[p], hp1 = h[p - 1], lp1 = l[p - 1];
+        const double* a1 = rh + (N - 2 - q);  // a1[lag + 1] = x(q - lag)
+        const double* b1 = rl + (N - 2 - q);
+        const double* c1 = h + p - 1;         // c1[lag + 1] = x(p + lag)
+        const double* e1 = l + p - 1;
+        R_xlen_t lag = I.a;
+        const R_xlen_t top = std::min(I.b, q + 1);
+#if defined(__GNUC__)
+        using allanvar::ld2;
+        using allanvar::v2d;
+        const v2d Hq = {hq, hq}, Lq = {lq, lq}, Hq1 = {hq1, hq1},
+                  Lq1 = {lq1, lq1}, Hp = {hp, hp}, Lp = {lp, lp},
+                  Hp1 = {hp1, hp1}, Lp1 = {lp1, lp1};
+        for (; lag + 2 <= top; lag += 2) {
+          const v2d d0 = (Hq - ld2(a1 + lag + 1)) + (Lq - ld2(b1 + lag + 1));
+          const v2d d1 = (Hq1 - ld2(a1 + lag)) + (Lq1 - ld2(b1 + lag));
+          const v2d e0 = (ld2(c1 + lag + 1) - Hp) + (ld2(e1 + lag + 1) - Lp);
+          const v2d f1 = (ld2(c1 + lag) - Hp1) + (ld2(e1 + lag) - Lp1);
+          allanvar::st2(t + lag, ld2(t + lag) + ((d0 * d0 + d1 * d1) +
+                                                 (e0 * e0 + f1 * f1)));
+        }
+#endif
+        for (; lag < top; ++lag) {
+          const double d0 = (hq - a1[lag + 1]) + (lq - b1[lag + 1]);
+          const double d1 = (hq1 - a1[lag]) + (lq1 - b1[lag]);
+          const double e0 = (c1[lag + 1] - hp) + (e1[lag + 1] - lp);
+          const double f1 = (c1[lag] - hp1) + (e1[lag] - lp1);
+          t[lag] += (d0 * d0 + d1 * d1) + (e0 * e0 + f1 * f1);
+        }
+        if (q + 1 >= I.a && q + 1 < I.b) {
+          const double d = (hq1 - h[0]) + (lq1 - l[0]);
+          const double e = (h[N - 1] - hp1) + (l[N - 1] - lp1);
+          t[q + 1] += d * d + e * e;
+        }
+        const R_xlen_t kk = k + 1;
+        if (slot[kk] < 0) continue;
+        // sum_L (2 SF(L) - ht(L) + 2 SF(2kk - L) - ht(2kk - L)) / L over
+        // this item's lags (each SF with the pairs it loses, which cancel
+        // most of it when 2kk nears N)
+        const R_xlen_t hi = std::min(I.b, 2 * kk);
+        double acc = 0;
+        for (R_xlen_t g = I.a; g < std::min(hi, kk + 1); ++g)
+          acc += (2 * sf[g] - t[g]) * inv[g];
+        for (R_xlen_t g = std::max(I.a, kk); g < hi; ++g)
+          acc += (2 * sf[g] - t[g]) * inv[2 * kk - g];
+        edge[worker].add(static_cast<size_t>(slot[kk]), acc);
+      }
+    } else {
+      // the centres k and N - 1 - k: x(k + d) - x(k - d) and
+      // x(N - 1 - k + d) - x(N - 1 - k - d)
+      for (R_xlen_t k = I.a; k < kmax; ++k) {
+        if ((k & 63) == 0 && allanvar::interrupted()) return;
+        const double* ah = h + k;
+        const double* al = l + k;
+        const double* bh = rh + (N - 1 - k);
+        const double* bl = rl + (N - 1 - k);
+        const double* ch = h + (N - 1 - k);
+        const double* cl = l + (N - 1 - k);
+        const double* dh = rh + k;
+        const double* dl = rl + k;
+        const R_xlen_t top = std::min(I.b, k + 1);
+        R_xlen_t d = I.a;
+#if defined(__GNUC__)
+        using allanvar::ld2;
+        using allanvar::v2d;
+        for (; d + 2 <= top; d += 2) {
+          const v2d e = (ld2(ah + d) - ld2(bh + d)) + (ld2(al + d) - ld2(bl + d));
+          const v2d f = (ld2(ch + d) - ld2(dh + d)) + (ld2(cl + d) - ld2(dl + d));
+          allanvar::st2(t + d, ld2(t + d) + (e * e + f * f));
+        }
+#endif
+        for (; d < top; ++d) {
+          const double e = (ah[d] - bh[d]) + (al[d] - bl[d]);
+          const double f = (ch[d] - dh[d]) + (cl[d] - dl[d]);
+          t[d] += e * e + f * f;
+        }
+        const R_xlen_t kk = k + 1;
+        if (slot[kk] < 0) continue;
+        // sum_{L < kk} (tri(kk - L) - SF(2kk - 2L)) / L over this item's d
+        double acc = 0;
+        for (R_xlen_t d = I.a; d < std::min(I.b, kk); ++d)
+          acc += (t[d] - sfe[d]) * inv[kk - d];
+        edge[worker].add(static_cast<size_t>(slot[kk]), acc);
+      }
+    }
+  });
+  scope.finish();
+  std::vector<DD> harm(kmax + 1);  // harmonic numbers
+  for (R_xlen_t L = 1; L <= kmax; ++L) harm[L] = harm[L - 1] + DD(inv[L]);
+  for (size_t i = 0; i < ks.size(); ++i) {
+    // - H_k SF(2k), the SF(2k) of every L
+    double p, e;
+    allanvar::dd_two_prod(-harm[ks[i]].value(), sf[2 * ks[i]], p, e);
+    DD T(p, e);
+    for (int w = 0; w < nthr; ++w) T += DD(edge[w].value(i));
+    if (X.c != 0) T += quad_part(ks[i]);
+    for (R_xlen_t j : where[ks[i]]) out[j] = T.value();
   }
   return out;
 }

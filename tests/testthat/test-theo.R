@@ -52,3 +52,61 @@ test_that("allan() picks the fast path at long records and stays exact", {
     expect_lt(max(abs(a$avar[a$m >= 512] / ref - 1)), 1e-10, label = nm)
   }
 })
+
+# TheoBR's Theo1 values come from the squared-increment recurrence
+# (theo1_incr_cpp); the noise is made here: white PM, white FM, random-walk
+# FM and white FM on a linear frequency drift (quadratic phase).
+theobr_sets <- function(N, seed) {
+  set.seed(seed)
+  w <- rnorm(N)
+  list(wpm = w, wfm = cumsum(w), rwfm = cumsum(cumsum(w)),
+       drift = cumsum(w) + 3e4 + 0.02 * seq_len(N) + 5e-3 * seq_len(N)^2)
+}
+
+test_that("the squared-increment recurrence agrees with the definition", {
+  for (N in c(401L, 1000L, 1501L)) {
+    kmax <- (N - 1) %/% 2
+    k <- sort(unique(c(1:4, 7, 32, 33, kmax %/% 3, kmax %/% 2, kmax - 1, kmax)))
+    for (nm in names(theobr_sets(N, 1))) {
+      x <- theobr_sets(N, N + 7)[[nm]]
+      ref <- vapply(2 * k, function(mm) theo_T_ref(x, mm), 0)
+      got <- theo1_incr_cpp(x, FALSE, k, 1L)
+      expect_lt(max(abs(got / ref - 1)), 1e-10, label = paste(nm, N))
+      # the order of `need` does not matter; k outside the range give NA
+      expect_equal(theo1_incr_cpp(x, FALSE, c(rev(k), 0, kmax + 1), 2L),
+                   c(rev(got), NA, NA))
+    }
+  }
+})
+
+test_that("rate input gives the Theo1 sums of its phase", {
+  set.seed(3)
+  y <- cumsum(rnorm(1200))  # random-walk FM as frequency
+  x <- c(0, cumsum(y))
+  k <- c(1, 40, 300, 600)
+  expect_equal(theo1_incr_cpp(y, TRUE, k, 1L),
+               vapply(2 * k, function(mm) theo_T_ref(x, mm), 0),
+               tolerance = 1e-10)
+})
+
+test_that("TheoBR's factor agrees with its direct evaluation", {
+  for (N in c(301L, 513L, 800L)) {  # the helper keeps every i (N %% 6 != 0)
+    for (nm in names(theobr_sets(N, 1))) {
+      x <- theobr_sets(N, 2 * N)[[nm]]
+      kf <- theobr_factor(x, 1, FALSE, N, 2L)
+      expect_lt(abs(kf / ref_theobr_factor(x) - 1), 1e-10,
+                label = paste(nm, N))
+    }
+  }
+})
+
+test_that("the recurrence keeps its digits on long random-walk FM records", {
+  # against the double-double recurrence (theo1_all_cpp, itself checked
+  # against the definition in test-types.R) over the whole k range
+  N <- 12001L
+  set.seed(11)
+  x <- cumsum(cumsum(rnorm(N)))
+  k <- c(32, 100, 1000, 3000, 5999, 6000)
+  ref <- theo1_all_cpp(x, FALSE, max(k), k)[k]
+  expect_lt(max(abs(theo1_incr_cpp(x, FALSE, k, 2L) / ref - 1)), 1e-10)
+})
