@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <deque>
 #include <vector>
 
 namespace allanvar {
@@ -85,7 +86,8 @@ inline size_t fft_size(size_t need) {
   return n;
 }
 
-// Plans by size, one set per thread of a kernel.
+// Plans by size, one set per thread of a kernel (a deque: a plan handed out
+// stays valid when later sizes are added).
 class FFTPlans {
  public:
   const FFTPlan& get(size_t n) {
@@ -96,7 +98,7 @@ class FFTPlans {
   }
 
  private:
-  std::vector<FFTPlan> plans_;
+  std::deque<FFTPlan> plans_;
 };
 
 // Both c1[t] = sum_j a[j] b[j + t] (t < nt1) and c2[t] = sum_j b[j] b[j + t]
