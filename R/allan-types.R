@@ -572,7 +572,7 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   top <- min(allan_max_m(base, L), max(1, floor((L - 1) / 3)))
   mm <- pmax(1, pmin(m, top))
   u <- sort(unique(mm))
-  mx <- max(abs(range(v)))  # no copy of v (finite here)
+  mx <- max(-min(v), max(v))  # finite here; range() would copy v
   if (length(u) <= 200L && mx > 1e-100 && mx < 1e100) {
     # the kernel's noise identification, as allan() calls it (the term
     # counts are part of the identification), without allan()'s limits:
