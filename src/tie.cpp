@@ -83,49 +83,11 @@ Rcpp::NumericVector mtie_cpp(const Rcpp::NumericVector& v, bool rate,
       ++level;
     }
     const R_xlen_t s = w - (static_cast<R_xlen_t>(1) << level);
-    double* px = mx.data();
-    double* pn = mn.data();
+    const double* px = mx.data();
+    const double* pn = mn.data();
     const R_xlen_t nwin = L - w + 1;
     double best = 0;
     R_xlen_t i = 0;
-    // Octave m (s = 1) followed by a tau that needs the next level: the
-    // query and that level's build share one pass (ascending i reads i,
-    // i + 1 and i + h before i is written).
-    R_xlen_t t2 = t + 1;
-    while (t2 < nt && !(m[t2] + 1 >= 2 && m[t2] + 1 <= L)) ++t2;
-    const R_xlen_t h = static_cast<R_xlen_t>(1) << level;
-    const bool fuse = s == 1 && t2 < nt &&
-                      (static_cast<R_xlen_t>(2) << level) <=
-                          static_cast<R_xlen_t>(m[t2]) + 1;
-    if (fuse) {
-      const R_xlen_t end = L - 2 * h + 1;  // <= nwin
-#if defined(__GNUC__)
-      v2d vb = {0, 0};
-      for (; i + 2 <= end; i += 2) {
-        const v2d a = ld2(px + i), b = ld2(px + i + 1), e = ld2(px + i + h);
-        const v2d c = ld2(pn + i), d = ld2(pn + i + 1), f = ld2(pn + i + h);
-        const v2d r = (a > b ? a : b) - (c < d ? c : d);
-        vb = r > vb ? r : vb;
-        st2(px + i, a > e ? a : e);
-        st2(pn + i, c < f ? c : f);
-      }
-      best = std::max(vb[0], vb[1]);
-#endif
-      for (; i < end; ++i) {
-        best = std::max(best, std::max(px[i], px[i + 1]) -
-                                  std::min(pn[i], pn[i + 1]));
-        px[i] = std::max(px[i], px[i + h]);
-        pn[i] = std::min(pn[i], pn[i + h]);
-      }
-      // the last windows (the next level has no entry there)
-      for (; i < nwin; ++i) {
-        best = std::max(best, std::max(px[i], px[i + 1]) -
-                                  std::min(pn[i], pn[i + 1]));
-      }
-      ++level;
-      out[t] = best;
-      continue;
-    }
 #if defined(__GNUC__)
     v2d vb = {0, 0};
     for (; i + 2 <= nwin; i += 2) {

@@ -179,6 +179,24 @@ test_that("Total family, PDEV, MTIE, TIE rms against their definitions", {
   }
 })
 
+test_that("MTIE at octave taus is the definition's", {
+  set.seed(17)
+  for (L in c(3, 4, 5, 17, 33, 9000)) {
+    x <- cumsum(rnorm(L)) + 50 * (seq_len(L) %% 997 == 0)  # a walk with spikes
+    m <- 2^(0:20)
+    m <- m[m <= L - 1]
+    mi <- allan(x, 1, taus = I(m), type = "mtie", input = "integrated")
+    ref <- vapply(m, function(k) ref_mtie(x, k), 0)
+    expect_equal(mi$adev, ref, tolerance = 1e-13, label = paste("L =", L))
+    # a subset of the octaves (the levels between are built all the same)
+    if (length(m) > 3) {
+      sub <- m[c(2, length(m))]
+      ms <- allan(x, 1, taus = I(sub), type = "mtie", input = "integrated")
+      expect_equal(ms$adev, ref[c(2, length(m))], tolerance = 1e-13)
+    }
+  }
+})
+
 test_that("rate input with a large bias loses nothing", {
   set.seed(13)
   y <- 1e7 + rnorm(5000)  # a bias of 1e7 noise sigmas
