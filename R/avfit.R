@@ -155,6 +155,19 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
             ", not ", format(v), ".", class = "argument")
     }
   }
+  # an entry measured from the raw series (a band's spectrum) cannot be
+  # searched on a curve: its measured values come with it
+  unmeasured <- layout_hidden(lay) & !lay$fixed
+  if (any(unmeasured)) {
+    kinds <- unique(lay$kind[unmeasured])
+    abort("`terms`: ", paste0("\"", kinds, "\"", collapse = ", "),
+          " is measured from the raw series, not fitted to a curve; let ",
+          "`avrefine(fit, data = x)` propose it, or give its measured values (",
+          paste(lay$name[unmeasured][seq_len(min(3, sum(unmeasured)))],
+                collapse = ", "),
+          if (sum(unmeasured) > 3) ", ..." else "", ") in `fixed`.",
+          class = "argument")
+  }
   lay$value <- NA_real_
   lay$value[lay$fixed] <- fixed[lay$name[lay$fixed]]
   keep <- rep(TRUE, nrow(curve$data))

@@ -108,3 +108,12 @@ test_that("without a band in the raw data the band is never tried", {
   expect_false("band" %in% ref$refine$failures$effect)
   expect_true(isTRUE(allanvar:::effect_entry("band")$proposed_only))
 })
+
+test_that("a band is not searched on a curve: its measured values come with it", {
+  set.seed(5)
+  x <- rnorm(2^14, sd = 0.1) + cumsum(rnorm(2^14, sd = 1e-3))
+  av <- allan(x, 100)
+  expect_snapshot(error = TRUE, avfit(av, terms = c("N", "K", "band")))
+  expect_error(avfit(av, terms = c("N", "band")),
+               class = "allanvar_error_argument")
+})
