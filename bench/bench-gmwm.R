@@ -14,6 +14,7 @@
 # most of the compile time: apt-get install -y r-cran-rcpparmadillo
 # r-cran-scales r-cran-broom r-cran-dplyr r-cran-tidyr first.
 library(allanvar)
+source("bench/common.R")
 args <- as.integer(commandArgs(TRUE))
 seeds <- c(if (length(args) >= 1L) args[1L] else 20L,
            if (length(args) >= 2L) args[2L] else 10L)
@@ -39,17 +40,8 @@ scenarios <- list(
   "weak K" = c(N = 0.01, K = 2e-4, sigma = 0.02, tc = 2))
 truth <- scenarios[[1L]]
 
-# Our own generator: white (sd N / sqrt(tau0)), random walk (increments
-# K sqrt(tau0)), AR(1) started from its stationary law.
-gen <- function(n, seed) {
-  set.seed(seed)
-  phi <- exp(-tau0 / truth[["tc"]])
-  w <- rnorm(n, sd = truth[["sigma"]] * sqrt(1 - phi^2))
-  w[1] <- rnorm(1, sd = truth[["sigma"]])
-  rnorm(n, sd = truth[["N"]] / sqrt(tau0)) +
-    cumsum(rnorm(n, sd = truth[["K"]] * sqrt(tau0))) +
-    as.numeric(stats::filter(w, phi, method = "recursive"))
-}
+# Our own generator (bench/common.R), the current scenario's truth.
+gen <- function(n, seed) composite_series(n, seed, truth, tau0)
 
 fit_allanvar <- function(x) {
   f <- avfit(allan(x, freq), terms = c("N", "K", "gm"))

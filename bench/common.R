@@ -35,3 +35,18 @@ timed <- function(expr, reps = 5, warm = TRUE) {
     system.time(eval(f, e))[["elapsed"]]
   }, 0))
 }
+
+# The composite series of the GMWM comparison (bench-gmwm.R and its
+# record gmwm-k-variants.R), our own generator rather than avsim(): white
+# rate noise (sd N / sqrt(tau0)), a rate random walk (increments
+# K sqrt(tau0)) and an AR(1) Gauss-Markov process started from its
+# stationary law; `truth` holds N, K, sigma and tc.
+composite_series <- function(n, seed, truth, tau0) {
+  set.seed(seed)
+  phi <- exp(-tau0 / truth[["tc"]])
+  w <- rnorm(n, sd = truth[["sigma"]] * sqrt(1 - phi^2))
+  w[1] <- rnorm(1, sd = truth[["sigma"]])
+  rnorm(n, sd = truth[["N"]] / sqrt(tau0)) +
+    cumsum(rnorm(n, sd = truth[["K"]] * sqrt(tau0))) +
+    as.numeric(stats::filter(w, phi, method = "recursive"))
+}

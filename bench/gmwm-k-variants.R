@@ -22,6 +22,7 @@
 # The sums over lags are exact on short stretches and trapezoidal (401
 # nodes between the kinks at multiples of m) on long ones.
 library(allanvar)
+source("bench/common.R")
 args <- commandArgs(TRUE)
 S <- if (length(args) >= 1L) as.integer(args[1L]) else 20L
 n <- if (length(args) >= 2L) as.numeric(args[2L]) else 1e5
@@ -31,16 +32,8 @@ freq <- 100
 tau0 <- 1 / freq
 truth <- c(N = 0.01, K = Kt, sigma = 0.02, tc = 2)
 
-# bench-gmwm.R's generator (same seeds: 1000 k + s)
-gen <- function(n, seed) {
-  set.seed(seed)
-  phi <- exp(-tau0 / truth[["tc"]])
-  w <- rnorm(n, sd = truth[["sigma"]] * sqrt(1 - phi^2))
-  w[1] <- rnorm(1, sd = truth[["sigma"]])
-  rnorm(n, sd = truth[["N"]] / sqrt(tau0)) +
-    cumsum(rnorm(n, sd = truth[["K"]] * sqrt(tau0))) +
-    as.numeric(stats::filter(w, phi, method = "recursive"))
-}
+# bench-gmwm.R's generator (bench/common.R; same seeds: 1000 k + s)
+gen <- function(n, seed) composite_series(n, seed, truth, tau0)
 
 # V(l) in rate^2 units (tau0^2 x rate^2 = phase^2)
 Vfun <- function(l, p) {
