@@ -487,7 +487,9 @@ print.avfit <- function(x, ...) {
 
 # Rows of a fit's layout that hold measured values an entry carries for its
 # own use (a measured band's spectrum): left out of the printed tables.
+# coef_layout() records them; layouts saved before it did are looked up.
 layout_hidden <- function(lay) {
+  if (!is.null(lay$hidden)) return(lay$hidden %in% TRUE)
   vapply(seq_len(nrow(lay)), function(i) {
     p <- effect_entry(lay$kind[i], lay$variant[i])$params
     isTRUE(p$hidden[p$name == lay$param[i]])

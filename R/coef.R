@@ -87,7 +87,7 @@ coef_layout <- function(terms) {
     p <- e$params
     data.frame(name = coef_names(e, labs[i]), label = labs[i], kind = sp$kind[i],
                variant = sp$variant[i], param = p$name, role = p$role,
-               unit = p$unit, stringsAsFactors = FALSE)
+               unit = p$unit, hidden = p$hidden, stringsAsFactors = FALSE)
   })
   do.call(rbind, rows)
 }
