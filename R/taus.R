@@ -29,7 +29,8 @@ allan_opts <- function(type, rate, octave = FALSE,
   list(type = allan_type_code(type), rate = isTRUE(rate),
        octave = isTRUE(octave), threads = as.integer(threads),
        acf_min = rules$acf_min, b1_rw_own = rules$b1_rw_own,
-       rn_stable32 = rules$rn_stable32, sums = isTRUE(sums))
+       rn_stable32 = rules$rn_stable32, rn_check_wfm = rules$rn_check_wfm,
+       sums = isTRUE(sums))
 }
 
 # The noise-identification rules (src/noise_id.h) for `type`:
@@ -53,7 +54,9 @@ noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default"),
   }
   list(acf_min = if (rule == "stable32") 30L else 64L,
        b1_rw_own = rule == "coverage" || (rule == "default" && type == "total"),
-       rn_stable32 = rule == "stable32")
+       rn_stable32 = rule == "stable32",
+       rn_check_wfm = rule == "default" && type != "total" &&
+         !nzchar(Sys.getenv("ALLANVAR_EXP_NOCHECK")))
 }
 
 # Largest cluster size with at least one term, for L phase points (L = N + 1
