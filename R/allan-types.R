@@ -498,6 +498,7 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
   }
   alpha <- rep(NA_integer_, length(m))
   edf <- rep(NA_real_, length(m))
+  union <- NULL
   switch(type,
     tdev = {
       a <- allan(v, freq, taus = I(m / freq), type = "modified", input = input,
@@ -553,8 +554,11 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
         alpha[theo_row] <- extra_alpha(v, freq, round(0.75 * mt), "overlapping",
                                        input, L)
         if (type == "theo1") {
-          alpha[theo_row] <- theo1_alpha(v, rate, L, mt, t1 / sc_rate,
-                                         alpha[theo_row], threads)
+          ta <- theo1_alpha(v, rate, L, mt, t1 / sc_rate, alpha[theo_row],
+                            threads)
+          alpha[theo_row] <- as.integer(ta)
+          union <- theo1_union(t1, mt, L, attr(ta, "alts"), n[theo_row],
+                               conf, debias)
         }
         if (type == "theo1") {
           if (debias) t1 <- t1 * debias_factor("theo1", alpha[theo_row], mt)
@@ -585,6 +589,10 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
     ci <- allan_ci(av, edf, conf)
     lower <- ci$lower
     upper <- ci$upper
+    if (type == "theo1" && any(theo_row)) {
+      lower[theo_row] <- union$lower
+      upper[theo_row] <- union$upper
+    }
   }
   list(tau = tau, m = as.integer(m), n = n, avar = av, adev = sqrt(av),
        lower = lower, upper = upper, edf = edf, alpha_ = as.integer(alpha))
@@ -639,7 +647,8 @@ theo1_alpha <- function(v, rate, L, m, t1, alpha0, threads) {
   mp <- 2 * round(m / 4)
   mp[mp < 2] <- 4
   ok <- mp <= L - 1
-  if (!any(ok)) return(alpha0)
+  alts <- as.list(alpha0)
+  if (!any(ok)) return(structure(alpha0, alts = alts))
   need <- sort(unique(mp[ok & !(mp %in% m)]))
   tp <- t1[match(mp, m)]
   if (length(need)) {
@@ -662,8 +671,67 @@ theo1_alpha <- function(v, rate, L, m, t1, alpha0, threads) {
                                    debias_factor_known("theo1", a, mp))
   }, numeric(length(m)))
   ex <- matrix(ex, nrow = length(m))
-  a <- apply(abs(ex - lr), 1, which.min) - 3L
-  ifelse(ok & is.finite(lr), as.integer(a), alpha0)
+  dist <- abs(ex - lr)
+  a <- alpha0
+  # white against flicker PM: the slopes differ by a slowly varying log
+  # factor only; R(n) = MVAR/AVAR at k = 0.75 m (SP 1065 5.6.1: 1/k against
+  # flicker PM's ~0.2) tells them apart where MVAR has >= 4 cluster spans
+  # and the two ratios differ by 1.3 or more (k >= 3)
+  k <- round(0.75 * m)
+  rn <- rep(NA_real_, length(m))
+  kk <- sort(unique(k[4 * k <= L - 1 & k >= 3]))
+  if (length(kk)) {
+    input <- if (rate) "rate" else "integrated"
+    r <- allan(v, 1, taus = I(kk), type = "modified", input = input)$avar /
+      allan(v, 1, taus = I(kk), type = "overlapping", input = input)$avar
+    rn <- r[match(k, kk)]
+  }
+  fpm_rn <- 3 * log(256 / 27) / (2 * (1.038 + 3 * log(pi * k)))
+  rn_pm <- ifelse(rn < sqrt(fpm_rn / k), 2L, 1L)
+  for (i in which(ok & is.finite(lr))) {
+    s <- which.min(dist[i, ]) - 3L
+    # types within one standard error of the slope (from the EDF at m and
+    # m' of the type read, correlation ignored) of the nearest
+    e <- extra_edf("theo1", c(m[i], mp[i]), L, rep(s, 2), c(1, 1))
+    near <- which(dist[i, ] <= min(dist[i, ]) + sqrt(sum(2 / e))) - 3L
+    a0 <- alpha0[i]
+    if (is.na(a0)) {
+      a[i] <- s
+      alts[[i]] <- near
+    } else if (a0 <= 0L && s <= 0L) {
+      # both FM: the slope's type (the Allan variance's misreads flicker FM
+      # in up to 79% of records), its FM neighbours within reach
+      a[i] <- s
+      alts[[i]] <- near[near <= 0L]
+    } else if (a0 >= 1L && s >= 1L) {
+      # both PM: R(n) where read, else the Allan variance's
+      a[i] <- if (is.finite(rn[i])) rn_pm[i] else a0
+      alts[[i]] <- sort(unique(c(a[i], near[near <= 0L])))
+    } else {
+      # the two methods disagree on phase against frequency noise: the
+      # Allan variance's type (Stable32's reading), the interval spanning
+      # both
+      a[i] <- a0
+      alts[[i]] <- sort(unique(c(a0, s, near)))
+    }
+  }
+  structure(as.integer(a), alts = alts)
+}
+
+# Theo1 limits when its noise type is ambiguous (theo1_alpha()): the union
+# of the chi-square intervals of the candidate types, each with its bias
+# correction and EDF. raw: uncorrected Theo1; n: terms.
+theo1_union <- function(raw, m, L, alts, n, conf, debias) {
+  lo <- hi <- rep(NA_real_, length(m))
+  for (i in seq_along(m)) {
+    al <- alts[[i]]
+    e <- extra_edf("theo1", rep(m[i], length(al)), L, al, rep(n[i], length(al)))
+    f <- if (debias) debias_factor("theo1", al, rep(m[i], length(al))) else 1
+    ci <- allan_ci(raw[i] * f, e, conf)
+    lo[i] <- min(ci$lower)
+    hi[i] <- max(ci$upper)
+  }
+  list(lower = lo, upper = hi)
 }
 
 # Theo1's sums T_k (src/theo.cpp) at many even m: per m sums below m = 64
