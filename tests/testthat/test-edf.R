@@ -372,6 +372,39 @@ test_that("MTOT/TTOT at m = 1, 2 and HTOT at m = 1: the EDF of the estimator the
   }
 })
 
+test_that("bias-corrected Theo1 covers 0.60-0.76 at N/m 8-64 for the five noise types", {
+  # The correction AVAR/Theo1 changes up to 2.7-fold between adjacent
+  # types; with the Allan variance's type at 0.75 m (misreading flicker FM
+  # in up to 79% of records, random walk in 93-100% from m = 32) coverage
+  # was 0.15-0.57 on 25 of 50 rows (N = 1024). Now the type comes from
+  # Theo1's own octave slope (R(n) for white against flicker PM) and the
+  # limits span the types within a standard error of it (theo1_alpha()).
+  # The truth is the mean uncorrected Theo1 times the true type's
+  # correction. 400 replicates (a row at 0.68 leaves the band with
+  # probability 6e-4), N = 256, m = 4-32.
+  old <- options(allanvar.threads = 1, allanvar.noise_id = NULL)
+  on.exit(options(old))
+  set.seed(38)
+  N <- 256
+  gens <- mc_gens(N)
+  alphas <- c(wfm = 0L, ffm = -1L, rwfm = -2L, wpm = 2L, fpm = 1L)
+  for (g in names(gens)) {
+    res <- lapply(1:400, function(i) allan(gens[[g]](), 1, type = "theo1"))
+    ms <- res[[1]]$m
+    get <- function(col) sapply(res, function(a) a[[col]])
+    raw <- get("avar") / matrix(debias_factor("theo1", get("alpha"), ms),
+                                nrow = length(ms))
+    truth <- sqrt(rowMeans(raw) *
+                    debias_factor("theo1", rep(alphas[[g]], length(ms)), ms))
+    hits <- get("lower") <= truth & truth <= get("upper")
+    keep <- N / ms >= 8 & N / ms <= 64
+    cov <- rowMeans(hits)[keep]
+    expect_length(cov, 4)
+    expect_true(all(cov >= 0.60 & cov <= 0.76),
+                info = paste(g, toString(round(cov, 3))))
+  }
+})
+
 test_that("Theo1's EDF (Howe & Peppler, SP 1065) matches Monte Carlo at a known noise type", {
   # The uncorrected Theo1 with the EDF of the generator's noise type: the
   # formula alone, apart from noise identification (whose misreadings at
