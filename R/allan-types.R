@@ -701,12 +701,19 @@ theo1_alpha <- function(v, rate, L, m, t1, alpha0, threads) {
   }
   fpm_rn <- 3 * log(256 / 27) / (2 * (1.038 + 3 * log(pi * k)))
   rn_pm <- ifelse(rn < sqrt(fpm_rn / k), 2L, 1L)
-  for (i in which(ok & is.finite(lr))) {
-    s <- which.min(dist[i, ]) - 3L
-    # types within one standard error of the slope (from the EDF at m and
-    # m' of the type read, correlation ignored) of the nearest
-    e <- extra_edf("theo1", c(m[i], mp[i]), L, rep(s, 2), c(1, 1))
-    near <- which(dist[i, ] <= min(dist[i, ]) + sqrt(sum(2 / e))) - 3L
+  rows <- which(ok & is.finite(lr))
+  sl <- apply(dist, 1, which.min) - 3L
+  # types within one standard error of the slope (from the EDF at m and m'
+  # of the type read, correlation ignored) of the nearest
+  se <- rep(NA_real_, length(m))
+  if (length(rows)) {
+    one <- rep(1, length(rows))
+    se[rows] <- sqrt(2 / extra_edf("theo1", m[rows], L, sl[rows], one) +
+                       2 / extra_edf("theo1", mp[rows], L, sl[rows], one))
+  }
+  for (i in rows) {
+    s <- sl[i]
+    near <- which(dist[i, ] <= dist[i, s + 3L] + se[i]) - 3L
     a0 <- alpha0[i]
     if (is.na(a0)) {
       a[i] <- s
@@ -735,8 +742,13 @@ theo1_alpha <- function(v, rate, L, m, t1, alpha0, threads) {
 # of the chi-square intervals of the candidate types, each with its bias
 # correction and EDF. raw: uncorrected Theo1; n: terms.
 theo1_union <- function(raw, m, L, alts, n, conf, debias) {
-  lo <- hi <- rep(NA_real_, length(m))
-  for (i in seq_along(m)) {
+  a <- vapply(alts, function(x) x[1L], 1L)
+  e <- extra_edf("theo1", m, L, a, n)
+  f <- if (debias) debias_factor("theo1", a, m) else 1
+  ci <- allan_ci(raw * f, e, conf)
+  lo <- ci$lower
+  hi <- ci$upper
+  for (i in which(lengths(alts) > 1L)) {
     al <- alts[[i]]
     e <- extra_edf("theo1", rep(m[i], length(al)), L, al, rep(n[i], length(al)))
     f <- if (debias) debias_factor("theo1", al, rep(m[i], length(al))) else 1
