@@ -748,13 +748,16 @@ theo1_union <- function(raw, m, L, alts, n, conf, debias) {
   ci <- allan_ci(raw * f, e, conf)
   lo <- ci$lower
   hi <- ci$upper
-  for (i in which(lengths(alts) > 1L)) {
-    al <- alts[[i]]
-    e <- extra_edf("theo1", rep(m[i], length(al)), L, al, rep(n[i], length(al)))
-    f <- if (debias) debias_factor("theo1", al, rep(m[i], length(al))) else 1
-    ci <- allan_ci(raw[i] * f, e, conf)
-    lo[i] <- min(ci$lower)
-    hi[i] <- max(ci$upper)
+  amb <- which(lengths(alts) > 1L)
+  if (length(amb)) {
+    # every (row, candidate type) pair at once
+    row <- rep(amb, lengths(alts[amb]))
+    al <- unlist(alts[amb], use.names = FALSE)
+    e <- extra_edf("theo1", m[row], L, al, n[row])
+    f <- if (debias) debias_factor("theo1", al, m[row]) else 1
+    ci <- allan_ci(raw[row] * f, e, conf)
+    lo[amb] <- vapply(split(ci$lower, row), min, 0)
+    hi[amb] <- vapply(split(ci$upper, row), max, 0)
   }
   list(lower = lo, upper = hi)
 }
