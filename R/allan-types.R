@@ -68,13 +68,27 @@
 #' `"theoh"` are bias-removed by construction.
 #'
 #' **Intervals** use the EDF approximations published for each statistic:
-#' MTOT and TTOT \eqn{b L/m - c} (SP 1065 Table 11), HTOT
+#' MTOT and TTOT \eqn{b L/m - c} (SP 1065 Table 11; at \eqn{m = 1, 2},
+#' where it overstates the EDF up to fourfold, the modified Allan EDF), HTOT
 #' \eqn{(L/m)/(b_0 + b_1 m/L)} for FM noise from \eqn{m = 16} (Howe et al.
-#' 2000) and the overlapping Allan EDF otherwise, Theo1 and TheoBR Howe and
+#' 2000) and the overlapping Allan EDF otherwise (at \eqn{m = 1}, where HTOT
+#' is the overlapping Hadamard variance, its EDF), Theo1 and TheoBR Howe and
 #' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV the modified Allan
-#' EDF. The noise type of a Theo1 row is the overlapping Allan variance's at
+#' EDF. The noise type of a TheoBR row is the overlapping Allan variance's at
 #' \eqn{0.75 m}, or at \eqn{(L - 1)/3} beyond it (no fewer than three
-#' cluster averages).
+#' cluster averages). A Theo1 row's type, which picks its bias correction
+#' (up to 2.7-fold apart between adjacent types), also uses Theo1's own
+#' slope from \eqn{m' = 2\,\mathrm{round}(m/4)} (\eqn{m = 2}: 4) to
+#' \eqn{m}, against each type's expected slope with its correction: among
+#' the FM types the slope's type; between white and flicker PM, R(n) at
+#' \eqn{0.75 m} where it can be read, else the Allan variance's type; where
+#' the slope and the Allan variance disagree on phase against frequency
+#' noise, the Allan variance's type. The interval is the union of the
+#' corrected chi-square intervals of the types whose expected slope lies
+#' within one standard error of the nearest (wider where the type is
+#' ambiguous). With the Allan variance's type alone 25 of 50 Monte Carlo
+#' rows (N = 1024, five noise types) covered 0.60-0.76; now 40 of 48 (the
+#' misses at N/m <= 4, covering 0.78-0.90).
 #'
 #' **Cost**: MTIE builds a table of window extremes level by level
 #' (\eqn{O(L \log L)} for a whole grid); TIE rms, TDEV and PDEV cost
@@ -302,7 +316,8 @@ debias_factor_known <- function(type, alpha, m) {
 # EDF of the further types from their published approximations (NIST SP
 # 1065 sec. 5.3.3; W.J. Riley, "Confidence intervals and bias corrections
 # for the Stable32 variance functions", 2000):
-#  * MTOT and TTOT: b N/m - c (Table 11);
+#  * MTOT and TTOT: b N/m - c (Table 11) from m = 4, the modified Allan
+#    EDF at m = 1, 2;
 #  * HTOT: (N/m) / (b0 + b1 m/N) for the FM noises from m = 16 (Howe et
 #    al. 2000, Table 1, rows alpha = 0, -1, ..., -4: the mapping Stable32's
 #    limits confirm), else the overlapping Allan EDF as Stable32 does;
@@ -337,7 +352,20 @@ extra_edf_known <- function(type, m, L, alpha, n) {
       a <- pmin(2L, pmax(-2L, a))
       b <- c(0.75, 0.85, 1.10, 1.20, 1.90)[a + 3L]
       cc <- c(0.31, 0.50, 1.20, 1.40, 2.10)[a + 3L]
-      b * N / m - cc
+      out <- b * N / m - cc
+      # At m = 1 and 2 Table 11 overstates the EDF (N = 1024, Monte Carlo
+      # 2 E^2/Var: white PM 510 and 620 where it gives 1950 and 972,
+      # flicker PM 600 for 1230, white FM 600-760 for 1130: coverage
+      # 0.40-0.60); the windows of 3 and 6 points are (nearly) MVAR's terms,
+      # and the modified Allan EDF (526, 651, 682 at m = 1) fits, as it does
+      # Stable32's printed limits (implied EDF 485, 243, 120 at m = 2, 4, 8
+      # of PHASE.DAT, white FM; MVAR's 504, 247, 120)
+      small <- m < 4
+      if (any(small)) {
+        out[small] <- allan_edf_direct("modified", m[small],
+                                       L - 3 * m[small] + 1, L, a[small])
+      }
+      out
     },
     htotdev = {
       # Howe et al. (2000) Table 1 covers the FM noises (alpha 0 .. -4)
@@ -350,6 +378,16 @@ extra_edf_known <- function(type, m, L, alpha, n) {
       if (any(!fm)) {
         out[!fm] <- allan_edf_direct("overlapping", m[!fm], L - 2 * m[!fm], L,
                                      pmin(2L, pmax(-2L, a[!fm])))
+      }
+      # at m = 1 HTOT is the overlapping Hadamard variance (SP 1065 5.2.14),
+      # and so is its EDF (Monte Carlo, N = 1024: 537, 601, 691, 416, 453
+      # for white, flicker, random-walk FM, white, flicker PM; overlapping
+      # Hadamard 526, 733, 682, 443, 521; overlapping Allan 682, 917, 1020,
+      # 526, 651: coverage 0.57-0.60 under flicker and random-walk FM)
+      one <- m == 1
+      if (any(one)) {
+        out[one] <- allan_edf_direct("ohadamard", 1, L - 3, L,
+                                     pmin(2L, pmax(-4L, a[one])))
       }
       out
     },
@@ -473,6 +511,7 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
   }
   alpha <- rep(NA_integer_, length(m))
   edf <- rep(NA_real_, length(m))
+  union <- NULL
   switch(type,
     tdev = {
       a <- allan(v, freq, taus = I(m / freq), type = "modified", input = input,
@@ -528,6 +567,13 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
         alpha[theo_row] <- extra_alpha(v, freq, round(0.75 * mt), "overlapping",
                                        input, L)
         if (type == "theo1") {
+          ta <- theo1_alpha(v, rate, L, mt, t1 / sc_rate, alpha[theo_row],
+                            threads)
+          alpha[theo_row] <- as.integer(ta)
+          union <- theo1_union(t1, mt, L, attr(ta, "alts"), n[theo_row],
+                               conf, debias)
+        }
+        if (type == "theo1") {
           if (debias) t1 <- t1 * debias_factor("theo1", alpha[theo_row], mt)
         } else {
           kf <- theobr_factor(v, freq, rate, L, threads)
@@ -556,6 +602,10 @@ extra_channel <- function(v, freq, m, theo_row, type, rate, L, conf, debias) {
     ci <- allan_ci(av, edf, conf)
     lower <- ci$lower
     upper <- ci$upper
+    if (type == "theo1" && any(theo_row)) {
+      lower[theo_row] <- union$lower
+      upper[theo_row] <- union$upper
+    }
   }
   list(tau = tau, m = as.integer(m), n = n, avar = av, adev = sqrt(av),
        lower = lower, upper = upper, edf = edf, alpha_ = as.integer(alpha))
@@ -589,6 +639,127 @@ extra_alpha <- function(v, freq, m, base, input, L) {
   }
   a <- allan(v, freq, taus = I(u / freq), type = base, input = input)
   a$alpha[match(mm, a$m)]
+}
+
+# The noise type of Theo1 rows, for its bias correction: from Theo1's own
+# slope over an octave. The correction AVAR/Theo1 changes up to 2.7-fold
+# between adjacent types (SP 1065 Table; Howe & Tasset 2004), so a type
+# misread in one record of three (the Allan variance's identification at
+# 0.75 m reads flicker FM right in 21-69% of records at m = 8-256, N =
+# 1024, random walk in 0-7% from m = 32) moves the corrected value out of
+# its interval: 68% coverage 0.15-0.57 there. Theo1 itself, with EDF in the
+# hundreds at mid tau, tells the types by its slope: E Theo1(m) =
+# AVAR(0.75 m) / F(alpha, m), AVAR ~ tau^mu (mu = -alpha - 1 for FM, -2
+# for white PM, -2 times SP 1065's log factor for flicker PM), compared
+# between m and m' = m/2 (m = 2: m' = 4) rounded to even, a function of m
+# alone. The type whose expected log ratio is nearest is taken (Monte
+# Carlo, N = 1024, 300 records: flicker FM read right in 86-100% of
+# records up to m = 128, random walk 91-100%); NA where Theo1 is not
+# positive: then the Allan variance's type (`alpha0`).
+theo1_alpha <- function(v, rate, L, m, t1, alpha0, threads) {
+  mp <- 2 * round(m / 4)
+  mp[mp < 2] <- 4
+  ok <- mp <= L - 1
+  alts <- as.list(alpha0)
+  if (!any(ok)) return(structure(alpha0, alts = alts))
+  need <- sort(unique(mp[ok & !(mp %in% m)]))
+  tp <- t1[match(mp, m)]
+  if (length(need)) {
+    Tn <- if (length(need) > 40L) {
+      theo1_many(v, rate, need, threads)
+    } else {
+      theo1_sums_cpp(v, rate, need, threads)
+    }
+    tn <- Tn / (0.75 * (L - need) * need^2)
+    tp[is.na(tp)] <- tn[match(mp[is.na(tp)], need)]
+  }
+  lr <- log(t1 / tp)
+  mu <- function(a, k) {
+    if (a <= 0) return((-a - 1) * log(k))
+    if (a == 2) return(-2 * log(k))
+    -2 * log(k) + log(1.038 + 3 * log(pi * k))
+  }
+  ex <- vapply(-2:2, function(a) {
+    (mu(a, m) - mu(a, mp)) - log(debias_factor_known("theo1", a, m) /
+                                   debias_factor_known("theo1", a, mp))
+  }, numeric(length(m)))
+  ex <- matrix(ex, nrow = length(m))
+  dist <- abs(ex - lr)
+  a <- alpha0
+  # white against flicker PM: the slopes differ by a slowly varying log
+  # factor only; R(n) = MVAR/AVAR at k = 0.75 m (SP 1065 5.6.1: 1/k against
+  # flicker PM's ~0.2) tells them apart where MVAR has >= 4 cluster spans
+  # and the two ratios differ by 1.3 or more (k >= 3)
+  k <- round(0.75 * m)
+  rn <- rep(NA_real_, length(m))
+  kk <- sort(unique(k[4 * k <= L - 1 & k >= 3]))
+  if (length(kk)) {
+    input <- if (rate) "rate" else "integrated"
+    r <- allan(v, 1, taus = I(kk), type = "modified", input = input)$avar /
+      allan(v, 1, taus = I(kk), type = "overlapping", input = input)$avar
+    rn <- r[match(k, kk)]
+  }
+  fpm_rn <- 3 * log(256 / 27) / (2 * (1.038 + 3 * log(pi * k)))
+  rn_pm <- ifelse(rn < sqrt(fpm_rn / k), 2L, 1L)
+  rows <- which(ok & is.finite(lr))
+  sl <- apply(dist, 1, which.min) - 3L
+  # types within one standard error of the slope (from the EDF at m and m'
+  # of the type read, correlation ignored) of the nearest
+  se <- rep(NA_real_, length(m))
+  if (length(rows)) {
+    one <- rep(1, length(rows))
+    se[rows] <- sqrt(2 / extra_edf("theo1", m[rows], L, sl[rows], one) +
+                       2 / extra_edf("theo1", mp[rows], L, sl[rows], one))
+  }
+  for (i in rows) {
+    s <- sl[i]
+    near <- which(dist[i, ] <= dist[i, s + 3L] + se[i]) - 3L
+    a0 <- alpha0[i]
+    if (is.na(a0)) {
+      a[i] <- s
+      alts[[i]] <- near
+    } else if (a0 <= 0L && s <= 0L) {
+      # both FM: the slope's type (the Allan variance's misreads flicker FM
+      # in up to 79% of records), its FM neighbours within reach
+      a[i] <- s
+      alts[[i]] <- near[near <= 0L]
+    } else if (a0 >= 1L && s >= 1L) {
+      # both PM: R(n) where read, else the Allan variance's
+      a[i] <- if (is.finite(rn[i])) rn_pm[i] else a0
+      alts[[i]] <- sort(unique(c(a[i], near[near <= 0L])))
+    } else {
+      # the two methods disagree on phase against frequency noise: the
+      # Allan variance's type (Stable32's reading), the interval spanning
+      # both
+      a[i] <- a0
+      alts[[i]] <- sort(unique(c(a0, s, near)))
+    }
+  }
+  structure(as.integer(a), alts = alts)
+}
+
+# Theo1 limits when its noise type is ambiguous (theo1_alpha()): the union
+# of the chi-square intervals of the candidate types, each with its bias
+# correction and EDF. raw: uncorrected Theo1; n: terms.
+theo1_union <- function(raw, m, L, alts, n, conf, debias) {
+  a <- vapply(alts, function(x) x[1L], 1L)
+  e <- extra_edf("theo1", m, L, a, n)
+  f <- if (debias) debias_factor("theo1", a, m) else 1
+  ci <- allan_ci(raw * f, e, conf)
+  lo <- ci$lower
+  hi <- ci$upper
+  amb <- which(lengths(alts) > 1L)
+  if (length(amb)) {
+    # every (row, candidate type) pair at once
+    row <- rep(amb, lengths(alts[amb]))
+    al <- unlist(alts[amb], use.names = FALSE)
+    e <- extra_edf("theo1", m[row], L, al, n[row])
+    f <- if (debias) debias_factor("theo1", al, m[row]) else 1
+    ci <- allan_ci(raw[row] * f, e, conf)
+    lo[amb] <- vapply(split(ci$lower, row), min, 0)
+    hi[amb] <- vapply(split(ci$upper, row), max, 0)
+  }
+  list(lower = lo, upper = hi)
 }
 
 # Theo1's sums T_k (src/theo.cpp) at many even m: per m sums below m = 64

@@ -63,7 +63,14 @@
 #'   flicker PM and the three FM types (Stable32 asks it only between white
 #'   and flicker PM for the modified family, which types NIST SP 1065's
 #'   white-FM NBS14 set flicker PM at m = 100 where SP 1065 corrects MTOT's
-#'   bias as white FM's);
+#'   bias as white FM's). Where B1 says white FM, R(n) may still say white
+#'   PM (from 4 cluster averages: its ratio \eqn{1/m} is far below every
+#'   FM type's) or flicker PM (from 8): B1 from so few averages reads PM as
+#'   white FM in 21-60% of records, and the 68% intervals of overlapping
+#'   ADEV covered 0.77-0.89 of white and flicker PM at N/m = 4-16 (now
+#'   0.68-0.75; Monte Carlo, N = 1024). Not for `"total"`, whose EDF for
+#'   white PM at long tau (Stable32's, NIST SP 1065 Table 5) is itself
+#'   2-12 times too high;
 #' * with fewer than three cluster averages (or phase noise that R(n) cannot
 #'   check), the type is unknown: `alpha` is `NA` and the EDF is the
 #'   smallest over the admissible types (the widest interval).

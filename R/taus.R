@@ -29,7 +29,8 @@ allan_opts <- function(type, rate, octave = FALSE,
   list(type = allan_type_code(type), rate = isTRUE(rate),
        octave = isTRUE(octave), threads = as.integer(threads),
        acf_min = rules$acf_min, b1_rw_own = rules$b1_rw_own,
-       rn_stable32 = rules$rn_stable32, sums = isTRUE(sums))
+       rn_stable32 = rules$rn_stable32, rn_check_wfm = rules$rn_check_wfm,
+       sums = isTRUE(sums))
 }
 
 # The noise-identification rules (src/noise_id.h) for `type`:
@@ -38,8 +39,12 @@ allan_opts <- function(type, rate, octave = FALSE,
 #    them: the lag-1 ACF from 64 points, not 30 (from 30, flicker PM's 68%
 #    coverage falls to 0.55 for TOTDEV at N/m = 32); for the total type
 #    random walk told from flicker FM by B1 with its own count (b1_rw_own);
-#    R(n) over all five types (rn_stable32 FALSE). The ACF threshold moves
-#    none of the limits compared with Stable32 (tools/check-stable32*.R);
+#    R(n) over all five types (rn_stable32 FALSE); R(n) may turn B1's white
+#    FM into white PM (from 4 averaged frequencies) or flicker PM (from 8),
+#    except for the total type (rn_check_wfm; src/noise_id.h). The ACF
+#    threshold moves none of the limits compared with Stable32
+#    (tools/check-stable32*.R); the R(n) check moves 2 of 753 (GPS OADEV and
+#    OHDEV at AF 8192, where Stable32 reads white FM and R(n) flicker PM);
 #  * "stable32": Stable32's rules throughout, for comparisons with it;
 #  * "coverage": allanvar's rules before (random walk told by B1's own count
 #    for every type).
@@ -53,7 +58,8 @@ noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default"),
   }
   list(acf_min = if (rule == "stable32") 30L else 64L,
        b1_rw_own = rule == "coverage" || (rule == "default" && type == "total"),
-       rn_stable32 = rule == "stable32")
+       rn_stable32 = rule == "stable32",
+       rn_check_wfm = rule == "default" && type != "total")
 }
 
 # Largest cluster size with at least one term, for L phase points (L = N + 1

@@ -625,6 +625,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   rules.acf_min = opts.acf_min;
   rules.b1_rw_own = opts.b1_rw_own;
   rules.rn_stable32 = opts.rn_stable32;
+  rules.rn_check_wfm = opts.rn_check_wfm;
   // the statistic's number of terms at each noise-id row (B1's N)
   std::vector<double> mid_n(ni, 0.0);
   for (size_t j = 0; j < ni; ++j) {

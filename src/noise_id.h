@@ -48,6 +48,8 @@ struct NoiseIdRules {
   bool b1_rw_own = false;    // random walk vs flicker FM: B1 with its own count
   bool rn_stable32 = false;  // R(n): PM only for the modified family, and
                              // flicker PM where it cannot be read
+  bool rn_check_wfm = false; // R(n) may turn B1's white-FM verdict into PM
+                             // (from 8 averaged frequencies; b1_noise_id())
 };
 
 struct NoiseId {
@@ -244,6 +246,13 @@ inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase, R_xlen_t acf_min) {
   return acf_points(L, m, phase) < acf_min;
 }
 
+// Fewest averaged frequencies at which R(n) may turn B1's white FM into
+// white PM (ratio ~1/m, far below every FM type's), and into flicker PM
+// (NoiseIdRules::rn_check_wfm). From 4 to 7 averaged frequencies flicker
+// PM's ratio is too close to the FM ones' (random-walk and flicker FM
+// would be read as PM in enough replicates to cover 0.57-0.59 at N/m = 4).
+constexpr R_xlen_t kRnCheckWpm = 4, kRnCheckFpm = 8;
+
 // B1 (and R(n)) from the decimated series z (phase or averaged frequency);
 // nterms: the statistic's number of terms at m, Stable32's N of the
 // expected B1 (SP 1065 5.6; with the count of averaged frequencies instead,
@@ -280,6 +289,21 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
   } else {
     out.alpha_int = -mu - 1;  // mu -1, 0, 1, 2 -> alpha 0, -1, -2, -3
     out.method = NOISE_ID_B1;
+    // B1 from a handful of averaged frequencies reads white or flicker PM
+    // as white FM in 21-60% of replicates at N/m <= 16 (N = 1024), and
+    // white FM's EDF is far below PM's there: the 68% intervals of
+    // overlapping PM covered 0.77-0.89. R(n) reads the whole record and
+    // tells PM (ratio ~1/m or less) from white FM (0.5) with a wide margin.
+    if (mu == -1 && rules.rn_check_wfm && na >= kRnCheckWpm && m > 1) {
+      const double r = rn();
+      if (std::isfinite(r)) {
+        const int a = rn_alpha(r, static_cast<double>(m), false);
+        if (a == 2 || (a == 1 && na >= kRnCheckFpm)) {
+          out.alpha_int = a;
+          out.method = NOISE_ID_B1_RN;
+        }
+      }
+    }
   }
   out.alpha = out.alpha_int;
   return out;

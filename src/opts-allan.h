@@ -19,6 +19,7 @@ struct AllanOptions {
   R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
   bool b1_rw_own = false;    // random walk vs flicker FM by B1 with its own count
   bool rn_stable32 = false;  // R(n) as Stable32 (modified family: PM only)
+  bool rn_check_wfm = false; // R(n) may turn B1's white FM into PM
   bool sums = true;          // false: noise identification only (no sums)
 };
 
@@ -49,6 +50,8 @@ inline AllanOptions allan_options(const Rcpp::List& o) {
     opts.b1_rw_own = opt_flag(o, "b1_rw_own");
   if (o.containsElementNamed("rn_stable32"))
     opts.rn_stable32 = opt_flag(o, "rn_stable32");
+  if (o.containsElementNamed("rn_check_wfm"))
+    opts.rn_check_wfm = opt_flag(o, "rn_check_wfm");
   if (o.containsElementNamed("acf_min")) {
     opts.acf_min = opt_int(o, "acf_min");
     if (opts.acf_min < 4) Rcpp::stop("internal: allan option `acf_min` < 4");

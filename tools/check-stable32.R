@@ -5,7 +5,7 @@
 #
 # ALLANVAR_NOISE_ID=stable32 (or coverage) sets options(allanvar.noise_id)
 # (R/taus.R noise_id_rules(), src/noise_id.h). Counts on allantools' suite:
-# 385 of 402 rows' limits by default, 387 with "stable32", 384 "coverage".
+# 383 of 402 rows' limits by default, 387 with "stable32", 384 "coverage".
 #
 # The reference files (tests/*/...txt) are Stable32 tables: AF, tau, number of
 # terms, alpha, min sigma, sigma, max sigma. They are fetched, never

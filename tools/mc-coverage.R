@@ -101,8 +101,8 @@ if (sys.nframe() == 0L) {
   reps <- if (length(args) >= 1) as.integer(args[1]) else 300L
   N <- if (length(args) >= 2) as.integer(args[2]) else 1024L
   types <- if (length(args) >= 3) strsplit(args[3], ",")[[1]] else
-    c("overlapping", "standard", "modified", "total", "tdev", "mtotdev",
-      "theo1")
+    c("overlapping", "standard", "modified", "hadamard", "ohadamard", "tdev",
+      "total", "mtotdev", "ttotdev", "htotdev", "theo1")
   if (file.exists("DESCRIPTION") && requireNamespace("pkgload", quietly = TRUE)) {
     pkgload::load_all(".", quiet = TRUE)
   } else {
