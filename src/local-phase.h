@@ -10,6 +10,7 @@
 #define ALLANVAR_LOCAL_PHASE_H
 
 #include <Rcpp.h>
+#include "scratch.h"
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -114,7 +115,7 @@ inline double local_phase(const PhaseInput& in, R_xlen_t a, R_xlen_t len,
 // |hi| <= 2^50 q, so integer combinations of hi with total weight <= 8 are
 // exact in double; lo (|lo| <= q/2) carries the rest. One compensated pass.
 struct SplitPhase {
-  std::vector<double> hi, lo;
+  Scratch hi, lo;  // 2 x 8 MB at 1e6: huge pages where granted
   double c = 0;  // removed slope per sample
   R_xlen_t size() const { return static_cast<R_xlen_t>(hi.size()); }
   double value(R_xlen_t j) const { return hi[j] + lo[j]; }
@@ -122,8 +123,10 @@ struct SplitPhase {
 
 inline void split_phase(const PhaseInput& in, SplitPhase& out) {
   const R_xlen_t L = in.length();
-  out.hi.assign(L, 0.0);
-  out.lo.assign(L, 0.0);
+  out.hi.resize(L);
+  out.lo.resize(L);
+  if (L < 1) return;
+  out.hi[0] = out.lo[0] = 0.0;
   if (L < 2) return;
   double s = 0, e = 0, bmin = 0, bmax = 0;
   for (R_xlen_t l = 0; l < L - 1; ++l) {

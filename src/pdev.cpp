@@ -311,13 +311,20 @@ void octave_top(const allanvar::PhaseInput& in, double c,
       const R_xlen_t t = std::min(end[0], F[0] + kStep);
       level0(in, c, F[0], t, E + (F[0] - a));
       // level 0 at F[0] - 1 is still there: level 1 trails by 2
-      double s = 0;
+      double s0 = 0, s1 = 0;
       const R_xlen_t i1 = std::min(t - 1, q0);
-      for (R_xlen_t i = std::max(a, F[0] - 1); i < i1; ++i) {
-        const double d = E[i - a] - E[i + 1 - a];
-        s += d * d;
+      R_xlen_t i = std::max(a, F[0] - 1);
+      for (; i + 2 <= i1; i += 2) {
+        const double d0 = E[i - a] - E[i + 1 - a];
+        const double d1 = E[i + 1 - a] - E[i + 2 - a];
+        s0 += d0 * d0;
+        s1 += d1 * d1;
       }
-      sq[0] += s;
+      if (i < i1) {
+        const double d = E[i - a] - E[i + 1 - a];
+        s0 += d * d;
+      }
+      sq[0] += s0 + s1;
       F[0] = t;
       moved = true;
     }
@@ -417,7 +424,8 @@ std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
   std::vector<R_xlen_t> a(P + 1);
   for (int p = 0; p <= P; ++p) a[p] = n0 * p / P;
   const R_xlen_t margin = (R_xlen_t(2) << O.J) + 1;
-  std::vector<std::vector<double> > S(P), E(P), sq(P);
+  std::vector<allanvar::Scratch> S(P), E(P);
+  std::vector<std::vector<double> > sq(P);
   for (int p = 0; p < P; ++p) {
     const R_xlen_t len = std::min(n0, a[p + 1] + margin) - a[p];
     S[p].resize(len);
@@ -437,11 +445,11 @@ std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
     const R_xlen_t B = D / nb;
     std::vector<double> tsq(static_cast<size_t>(nb) * (K + 1), 0.0);
     const R_xlen_t tlen = tile_count(nJ, 0, B, D);
-    std::vector<std::vector<double> > ts(nw), te(nw);
+    std::vector<allanvar::Scratch> ts(nw), te(nw);
     allanvar::parallel_for(nb, nw, [&](R_xlen_t k, int w) {
       const R_xlen_t r0 = k * B;
-      std::vector<double>& ST = ts[w];
-      std::vector<double>& ET = te[w];
+      allanvar::Scratch& ST = ts[w];
+      allanvar::Scratch& ET = te[w];
       if (static_cast<R_xlen_t>(ST.size()) < tlen) {
         ST.resize(tlen);
         ET.resize(tlen);

@@ -277,7 +277,8 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
 struct PhaseProducts {
   std::vector<double> h, h1, h2, l;
   explicit PhaseProducts(const allanvar::SplitPhase& X)
-      : h(X.hi), h1(X.hi.size()), h2(X.hi.size()), l(X.lo) {
+      : h(X.hi.begin(), X.hi.end()), h1(X.hi.size()), h2(X.hi.size()),
+        l(X.lo.begin(), X.lo.end()) {
     for (size_t j = 0; j < h.size(); ++j) allanvar::dd_split(h[j], h1[j], h2[j]);
   }
   // s + c += x_a x_b, compensated (Ogita, Rump & Oishi's Dot2 step)
@@ -428,8 +429,8 @@ struct TildePhase {
 void tilde_phase(const allanvar::SplitPhase& X, TildePhase& T) {
   const R_xlen_t N = X.size();
   T.N = N;
-  T.h = X.hi;
-  T.l = X.lo;
+  T.h.assign(X.hi.begin(), X.hi.end());
+  T.l.assign(X.lo.begin(), X.lo.end());
   T.c = 0;
   T.i0 = 0.5 * static_cast<double>(N - 1);
   const R_xlen_t a = N / 3;

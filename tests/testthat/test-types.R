@@ -334,6 +334,10 @@ test_that("PDEV's doubling recursion (octave m) equals the other kernels", {
     # the same sums whatever the number of threads, and chosen by default
     expect_identical(pdev_sums_cpp(x, FALSE, m, 1L, 3L), octave, label = nm)
     expect_identical(pdev_sums_cpp(x, FALSE, m, 2L, 0L), octave, label = nm)
+    # tiles of 64 values (many residue blocks, short records): the same
+    # values, the squares summed in another order
+    expect_lt(max(abs(pdev_sums_cpp(x, FALSE, m, 1L, 4L) / octave - 1)),
+              1e-13, label = nm)
     y <- diff(x)
     expect_lt(max(abs(pdev_sums_cpp(y, TRUE, m, 2L, 3L) / blocked - 1)),
               1e-10, label = nm)
