@@ -121,13 +121,13 @@ struct SplitPhase {
   double value(R_xlen_t j) const { return hi[j] + lo[j]; }
 };
 
-inline void split_phase(const PhaseInput& in, SplitPhase& out) {
+// The two passes of split_phase(): f(j, hi, lo, c) for j = 1..L-1 (X(0) =
+// 0); returns c. Kernels that need X(j) once take it from here without the
+// arrays.
+template <class F>
+inline double split_phase_each(const PhaseInput& in, F f) {
   const R_xlen_t L = in.length();
-  out.hi.resize(L);
-  out.lo.resize(L);
-  if (L < 1) return;
-  out.hi[0] = out.lo[0] = 0.0;
-  if (L < 2) return;
+  if (L < 2) return 0.0;
   double s = 0, e = 0, bmin = 0, bmax = 0;
   for (R_xlen_t l = 0; l < L - 1; ++l) {
     double h, lo, t, te;
@@ -139,7 +139,6 @@ inline void split_phase(const PhaseInput& in, SplitPhase& out) {
     e += te + lo;
   }
   const double c = (s + e) / static_cast<double>(L - 1);
-  out.c = c;
   double bound = std::max(std::fabs(bmax - c), std::fabs(bmin - c)) + 1e-300;
   bound *= static_cast<double>(L) * (1 + 1e-9);
   int ex;
@@ -156,9 +155,25 @@ inline void split_phase(const PhaseInput& in, SplitPhase& out) {
     s = t;
     e += te + re + lo;
     const double g = (s + C) - C;
-    out.hi[l + 1] = g;
-    out.lo[l + 1] = (s - g) + e;
+    f(l + 1, g, (s - g) + e, c);
   }
+  return c;
+}
+
+inline void split_phase(const PhaseInput& in, SplitPhase& out) {
+  const R_xlen_t L = in.length();
+  out.hi.resize(L);
+  out.lo.resize(L);
+  out.c = 0;
+  if (L < 1) return;
+  out.hi[0] = out.lo[0] = 0.0;
+  double* hi = out.hi.data();
+  double* lo = out.lo.data();
+  out.c = split_phase_each(in, [hi, lo](R_xlen_t j, double h, double l,
+                                         double) {
+    hi[j] = h;
+    lo[j] = l;
+  });
 }
 
 }  // namespace allanvar
