@@ -337,8 +337,87 @@ Plan make_plan(R_xlen_t m) {
   return P;
 }
 
+#if defined(__GNUC__)
+using allanvar::v2d;
+using allanvar::ld2;
+inline double hsum(v2d v) { return v[0] + v[1]; }
+#endif
+
+// d = sums over n < nb of T T, T Z, T B, Z Z, Z B, B B
+inline void dots6(const double* T, const double* Z, const double* B,
+                  R_xlen_t nb, double* d) {
+  for (int k = 0; k < 6; ++k) d[k] = 0;
+  R_xlen_t n = 0;
+#if defined(__GNUC__)
+  v2d a[6] = {};
+  for (; n + 2 <= nb; n += 2) {
+    const v2d t = ld2(T + n), z = ld2(Z + n), b = ld2(B + n);
+    a[0] += t * t;
+    a[1] += t * z;
+    a[2] += t * b;
+    a[3] += z * z;
+    a[4] += z * b;
+    a[5] += b * b;
+  }
+  for (int k = 0; k < 6; ++k) d[k] = hsum(a[k]);
+#endif
+  for (; n < nb; ++n) {
+    d[0] += T[n] * T[n];
+    d[1] += T[n] * Z[n];
+    d[2] += T[n] * B[n];
+    d[3] += Z[n] * Z[n];
+    d[4] += Z[n] * B[n];
+    d[5] += B[n] * B[n];
+  }
+}
+
+// d = sums over n < nb of Z zz, B zz, B1 zz, B2 zz, B m1, B1 m1, B m2
+inline void dots7(const double* Z, const double* B, const double* B1,
+                  const double* B2, const double* zz, const double* m1,
+                  const double* m2, R_xlen_t nb, double* d) {
+  for (int k = 0; k < 7; ++k) d[k] = 0;
+  R_xlen_t n = 0;
+#if defined(__GNUC__)
+  v2d a[7] = {};
+  for (; n + 2 <= nb; n += 2) {
+    const v2d q = ld2(zz + n), p = ld2(m1 + n), b = ld2(B + n),
+              b1 = ld2(B1 + n);
+    a[0] += ld2(Z + n) * q;
+    a[1] += b * q;
+    a[2] += b1 * q;
+    a[3] += ld2(B2 + n) * q;
+    a[4] += b * p;
+    a[5] += b1 * p;
+    a[6] += b * ld2(m2 + n);
+  }
+  for (int k = 0; k < 7; ++k) d[k] = hsum(a[k]);
+#endif
+  for (; n < nb; ++n) {
+    d[0] += Z[n] * zz[n];
+    d[1] += B[n] * zz[n];
+    d[2] += B1[n] * zz[n];
+    d[3] += B2[n] * zz[n];
+    d[4] += B[n] * m1[n];
+    d[5] += B1[n] * m1[n];
+    d[6] += B[n] * m2[n];
+  }
+}
+
+inline double dot(const double* x, const double* y, R_xlen_t n) {
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  R_xlen_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += x[i] * y[i];
+    s1 += x[i + 1] * y[i + 1];
+    s2 += x[i + 2] * y[i + 2];
+    s3 += x[i + 3] * y[i + 3];
+  }
+  for (; i < n; ++i) s0 += x[i] * y[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
 struct FastScratch {
-  std::vector<double> Z, ZZ, M1, M2, PE;
+  std::vector<double> Z, ZZ, M1, M2, PE, T, B, B1, B2;
   std::vector<std::vector<double> > LP;  // lags 0, m, 2m
 };
 
@@ -376,39 +455,60 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
   const double* M1 = w.M1.data();
   const double* M2 = w.M2.data();
   const double bden = static_cast<double>(h) * static_cast<double>(n3 - h);
-  // per window: Z(n), the slope beta_n and T_n, and the merged plan (a
-  // few dozen places of ZZ, M1, M2 and the lag products, at about seven
-  // distinct offsets)
-  double total = 0;
-  const size_t nts = P.ts_off.size();
-  const R_xlen_t* tso = P.ts_off.data();
-  const double* tsw = P.ts_w.data();
-  const size_t no = P.off.size(), nl = P.l_off.size();
-  const R_xlen_t* off = P.off.data();
-  const double *zz = P.zn_z.data(), *z0 = P.b_z0.data(), *z1 = P.b_z1.data(),
-               *z2 = P.b_z2.data(), *m10 = P.b_m10.data(),
-               *m11 = P.b_m11.data(), *m2 = P.b_m2.data();
-  const double* Lp[3] = {w.LP[0].data(), w.LP[1].data(), w.LP[2].data()};
+  // per window: Z(n), the slope beta_n and T_n; the merged plan is a sum
+  // over windows of these (and of beta_n n, beta_n n^2) times a few dozen
+  // places of ZZ, M1, M2 and the lag products at about seven distinct
+  // offsets, so it is summed as dot products over the windows, one pass per
+  // offset (vectorised), and combined with the plan's weights once
+  w.T.resize(nb);
+  w.B.resize(nb);
+  w.B1.resize(nb);
+  w.B2.resize(nb);
+  double* Tn = w.T.data();
+  double* Bn = w.B.data();
+  double* B1 = w.B1.data();
+  double* B2 = w.B2.data();
+  const double q3 = qk(n3 - 1);
   for (R_xlen_t n = 0; n < nb; ++n) {
-    const double zn = Z[n];
     const double beta =
         ((Z[n + n3] - Z[n + n3 - h]) - (Z[n + h] - Z[n])) / bden;
-    const double T = (Z[n + n3] - zn) - beta * qk(n3 - 1);
-    double v = 0;
-    for (size_t k = 0; k < nts; ++k) v += tsw[k] * ZZ[n + tso[k]];
-    double vz = 0, s0 = 0, s1 = 0, s2 = 0, vl = 0;
-    for (size_t k = 0; k < no; ++k) {
-      const double zk = ZZ[n + off[k]], m1k = M1[n + off[k]];
-      vz += zz[k] * zk;
-      s0 += m2[k] * M2[n + off[k]] + m10[k] * m1k + z0[k] * zk;
-      s1 += m11[k] * m1k + z1[k] * zk;
-      s2 += z2[k] * zk;
-    }
-    for (size_t k = 0; k < nl; ++k) vl += P.l_w[k] * Lp[P.l_lag[k]][n + P.l_off[k]];
     const double dn = static_cast<double>(n);
-    total += T * (P.tt * T + (v - P.ts_c1 * zn - P.ts_c2 * beta)) + vl +
-             zn * (vz + P.czz * zn + P.cbz * beta) +
-             beta * ((s0 + dn * (s1 + dn * s2)) + P.cbb * beta);
+    Bn[n] = beta;
+    B1[n] = beta * dn;
+    B2[n] = B1[n] * dn;
+    Tn[n] = (Z[n + n3] - Z[n]) - beta * q3;
+  }
+  const double* Zn = Z.data();
+  double total = 0;
+  {
+    // the per-window quadratic terms
+    double d[6];
+    dots6(Tn, Zn, Bn, nb, d);
+    total += P.tt * d[0] - P.ts_c1 * d[1] - P.ts_c2 * d[2] + P.czz * d[3] +
+             P.cbz * d[4] + P.cbb * d[5];
+  }
+  for (size_t k = 0; k < P.ts_off.size(); ++k)
+    total += P.ts_w[k] * dot(Tn, ZZ + P.ts_off[k], nb);
+  for (size_t k = 0; k < P.off.size(); ++k) {
+    const double* zo = ZZ + P.off[k];
+    const double* m1o = M1 + P.off[k];
+    const double* m2o = M2 + P.off[k];
+    double d[7];
+    dots7(Zn, Bn, B1, B2, zo, m1o, m2o, nb, d);
+    total += P.zn_z[k] * d[0] + P.b_z0[k] * d[1] + P.b_z1[k] * d[2] +
+             P.b_z2[k] * d[3] + P.b_m10[k] * d[4] + P.b_m11[k] * d[5] +
+             P.b_m2[k] * d[6];
+  }
+  for (size_t k = 0; k < P.l_off.size(); ++k) {
+    const double* lp = w.LP[P.l_lag[k]].data() + P.l_off[k];
+    double s0 = 0, s1 = 0;
+    R_xlen_t n = 0;
+    for (; n + 2 <= nb; n += 2) {
+      s0 += lp[n];
+      s1 += lp[n + 1];
+    }
+    if (n < nb) s0 += lp[n];
+    total += P.l_w[k] * (s0 + s1);
   }
   // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t)
   const double* PE = w.PE.data();
