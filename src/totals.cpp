@@ -427,30 +427,41 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
                     FastScratch& w) {
   const R_xlen_t n3 = 3 * m, Lz = nb + n3 - 1;
   const R_xlen_t h = n3 / 2;
-  std::vector<double>& Z = w.Z;
-  Z.resize(Lz + 1);
-  Z[0] = 0;
-  for (R_xlen_t i = 0; i < Lz; ++i) Z[i + 1] = Z[i] + z[i];
+  // every prefix array in one pass (independent chains side by side):
+  // Z, and over u <= Lz: ZZ, M1, M2 (sums of u^j Z(u)), PE (every other
+  // index, two zeros first: PE[v + 2] = Z(v) + Z(v - 2) + ...) and the lag
+  // products Z(u) Z(u - c), c = 0, m, 2m
+  w.Z.resize(Lz + 1);
   w.ZZ.resize(Lz + 2);
   w.M1.resize(Lz + 2);
   w.M2.resize(Lz + 2);
-  w.PE.resize(Lz + 1);
-  w.ZZ[0] = w.M1[0] = w.M2[0] = 0;
-  for (R_xlen_t u = 0; u <= Lz; ++u) {
-    const double du = static_cast<double>(u);
-    w.ZZ[u + 1] = w.ZZ[u] + Z[u];
-    w.M1[u + 1] = w.M1[u] + du * Z[u];
-    w.M2[u + 1] = w.M2[u] + du * du * Z[u];
-    w.PE[u] = Z[u] + (u >= 2 ? w.PE[u - 2] : 0.0);
-  }
+  w.PE.resize(Lz + 3);
   w.LP.resize(3);
-  for (int i = 0; i < 3; ++i) {
-    const R_xlen_t c = i * m;
-    std::vector<double>& L = w.LP[i];
-    L.assign(Lz + 2, 0.0);
-    for (R_xlen_t u = 0; u <= Lz; ++u)
-      L[u + 1] = L[u] + (u >= c ? Z[u] * Z[u - c] : 0.0);
+  for (int i = 0; i < 3; ++i) w.LP[i].resize(Lz + 2);
+  {
+    double* Zp = w.Z.data();
+    double* zz = w.ZZ.data();
+    double* m1 = w.M1.data();
+    double* m2 = w.M2.data();
+    double* pe = w.PE.data();
+    double* l0 = w.LP[0].data();
+    double* l1 = w.LP[1].data();
+    double* l2 = w.LP[2].data();
+    Zp[0] = zz[0] = m1[0] = m2[0] = pe[0] = pe[1] = 0;
+    l0[0] = l1[0] = l2[0] = 0;
+    for (R_xlen_t u = 0; u <= Lz; ++u) {
+      if (u < Lz) Zp[u + 1] = Zp[u] + z[u];
+      const double zu = Zp[u], du = static_cast<double>(u);
+      zz[u + 1] = zz[u] + zu;
+      m1[u + 1] = m1[u] + du * zu;
+      m2[u + 1] = m2[u] + du * du * zu;
+      pe[u + 2] = zu + pe[u];
+      l0[u + 1] = l0[u] + zu * zu;
+      l1[u + 1] = l1[u] + (u >= m ? zu * Zp[u - m] : 0.0);
+      l2[u + 1] = l2[u] + (u >= 2 * m ? zu * Zp[u - 2 * m] : 0.0);
+    }
   }
+  const std::vector<double>& Z = w.Z;
   const double* ZZ = w.ZZ.data();
   const double* M1 = w.M1.data();
   const double* M2 = w.M2.data();
@@ -510,18 +521,36 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
     if (n < nb) s0 += lp[n];
     total += P.l_w[k] * (s0 + s1);
   }
-  // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t)
+  // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t) =
+  // sum_u Z(u) (Z(v0) + Z(v0 + 2) + ... + Z(v1)), n = u - 1 - t in
+  // [lo, hi] = [max(0, u - 1 - b), min(nb - 1, u - 1 - a)], v = 2n + e + 2 - u:
+  // both ends linear in u between the cuts u = b + 1 and u = nb + a + 1
   const double* PE = w.PE.data();
+  const double* Zd = Z.data();
   for (const PlanItem& it : P.items) {
     if (it.kind != ITEM_ANTI) continue;
     const R_xlen_t a = it.a, b = it.b, e = it.c;
+    const R_xlen_t u_end = nb + b + 1;
+    R_xlen_t cuts[4] = {a + 1, std::min(b + 1, u_end), std::min(nb + a + 1, u_end),
+                        u_end};
+    if (cuts[1] > cuts[2]) std::swap(cuts[1], cuts[2]);
     double s = 0;
-    for (R_xlen_t u = a + 1; u <= nb + b; ++u) {
-      const R_xlen_t lo = std::max<R_xlen_t>(0, u - 1 - b);
-      const R_xlen_t hi = std::min<R_xlen_t>(nb - 1, u - 1 - a);
-      if (lo > hi) continue;
-      const R_xlen_t v0 = 2 * lo + e + 2 - u, v1 = 2 * hi + e + 2 - u;
-      s += Z[u] * (PE[v1] - (v0 >= 2 ? PE[v0 - 2] : 0.0));
+    for (int g = 0; g < 3; ++g) {
+      const R_xlen_t u0 = std::max(cuts[g], a + 1), u1 = cuts[g + 1];
+      if (u0 >= u1) continue;
+      // lo = 0 below u = b + 1, hi = u - 1 - a up to u = nb + a
+      const bool lo0 = u0 <= b, hil = u0 <= nb + a;
+      // PE[v1 + 2] - PE[v0] with v0 = k0 + d0 u, v1 + 2 = k1 + d1 u
+      const R_xlen_t k0 = lo0 ? e + 2 : e - 2 * b, d0 = lo0 ? -1 : 1;
+      const R_xlen_t k1 = hil ? e - 2 * a + 2 : 2 * nb + e + 2, d1 = hil ? 1 : -1;
+      double s0 = 0, s1 = 0;
+      R_xlen_t u = u0;
+      for (; u + 2 <= u1; u += 2) {
+        s0 += Zd[u] * (PE[k1 + d1 * u] - PE[k0 + d0 * u]);
+        s1 += Zd[u + 1] * (PE[k1 + d1 * (u + 1)] - PE[k0 + d0 * (u + 1)]);
+      }
+      if (u < u1) s0 += Zd[u] * (PE[k1 + d1 * u] - PE[k0 + d0 * u]);
+      s += s0 + s1;
     }
     total += it.coef * s;
   }
