@@ -597,6 +597,11 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     if (allanvar::interrupted()) scope.finish();
     if (fast[t] && mm >= 1) plans[t] = make_plan(mm);
   }
+  // the phase once, split hi + lo, for the closed form's sub-blocks
+  allanvar::SplitPhase X;
+  bool any_fast = false;
+  for (const Item& I : items) any_fast = any_fast || fast[I.tau];
+  if (any_fast) allanvar::split_phase(in, X);
   allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nw,
                          [&](R_xlen_t it, int w) {
     const Item& I = items[it];
@@ -610,7 +615,7 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
         const R_xlen_t nsub = std::min(I.n1 - b0, 4 * mm);
         const R_xlen_t len = nsub + 3 * mm - (hadamard ? 0 : 1);
         sc.r.resize(len);
-        allanvar::local_phase(in, b0, len, sc.r.data());
+        allanvar::local_from_split(X, b0, len, sc.r.data());
         if (hadamard) {
           // frequency, with its least-squares line removed: each window's
           // own line absorbs it (HTOT ignores a linear frequency term), and
