@@ -8,6 +8,7 @@
 #define ALLANVAR_FFT_H
 
 #include <Rcpp.h>
+#include "scratch.h"
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -17,6 +18,8 @@
 namespace allanvar {
 
 using cplx = std::complex<double>;
+// transform buffers: 32 MB each at 2^21 points, huge pages (src/scratch.h)
+using cvec = std::vector<cplx, BigAllocator<cplx> >;
 
 class FFTPlan {
  public:
@@ -54,7 +57,12 @@ class FFTPlan {
     for (size_t b = 0; b < n; b += C) {
       for (size_t len = 2; len <= C; len <<= 1) stage(a, len, b, b + C, inverse);
     }
-    for (size_t len = 2 * C; len <= n; len <<= 1) stage(a, len, 0, n, inverse);
+    // the stages above C over the whole array, two at a time (radix-4
+    // order: each pass reads and writes the points once for two stages;
+    // the same butterflies with the same twiddles, so the same result)
+    size_t len = 2 * C;
+    for (; 2 * len <= n; len <<= 2) stage2(a, len, inverse);
+    if (len <= n) stage(a, len, 0, n, inverse);
   }
 
  private:
@@ -72,6 +80,44 @@ class FFTPlan {
         const double ur = a[i + j].real(), ui = a[i + j].imag();
         a[i + j] = cplx(ur + vr, ui + vi);
         a[i + j + half] = cplx(ur - vr, ui - vi);
+      }
+    }
+  }
+
+  // the stages of length len and 2 len: on each block of 2 len points,
+  // points j, j + h, j + 2h, j + 3h (h = len / 2) go through both
+  void stage2(cplx* a, size_t len, bool inverse) const {
+    const size_t h = len / 2;
+    const cplx* w1 = w_.data() + (h - 1);    // stage len
+    const cplx* w2 = w_.data() + (len - 1);  // stage 2 len
+    const double sg = inverse ? -1.0 : 1.0;
+    for (size_t i = 0; i < n_; i += 2 * len) {
+      for (size_t j = 0; j < h; ++j) {
+        cplx* p = a + i + j;
+        // stage len: (p0, p1) and (p2, p3) with twiddle w1[j]
+        const double wr = w1[j].real(), wi = sg * w1[j].imag();
+        double x0r = p[0].real(), x0i = p[0].imag();
+        double x1r = p[h].real(), x1i = p[h].imag();
+        double x2r = p[2 * h].real(), x2i = p[2 * h].imag();
+        double x3r = p[3 * h].real(), x3i = p[3 * h].imag();
+        double vr = x1r * wr - x1i * wi, vi = x1r * wi + x1i * wr;
+        const double b0r = x0r + vr, b0i = x0i + vi;
+        const double b1r = x0r - vr, b1i = x0i - vi;
+        vr = x3r * wr - x3i * wi;
+        vi = x3r * wi + x3i * wr;
+        const double b2r = x2r + vr, b2i = x2i + vi;
+        const double b3r = x2r - vr, b3i = x2i - vi;
+        // stage 2 len: (b0, b2) with w2[j], (b1, b3) with w2[j + h]
+        const double ur = w2[j].real(), ui = sg * w2[j].imag();
+        vr = b2r * ur - b2i * ui;
+        vi = b2r * ui + b2i * ur;
+        p[0] = cplx(b0r + vr, b0i + vi);
+        p[2 * h] = cplx(b0r - vr, b0i - vi);
+        const double tr = w2[j + h].real(), ti = sg * w2[j + h].imag();
+        vr = b3r * tr - b3i * ti;
+        vi = b3r * ti + b3i * tr;
+        p[h] = cplx(b1r + vr, b1i + vi);
+        p[3 * h] = cplx(b1r - vr, b1i - vi);
       }
     }
   }
@@ -108,7 +154,7 @@ class FFTPlans {
 inline void real_correlation2(const double* a, size_t na, const double* b,
                               size_t nb, size_t nt1, double* c1, size_t nt2,
                               double* c2, FFTPlans& plans,
-                              std::vector<cplx>& buf, std::vector<cplx>& C) {
+                              cvec& buf, cvec& C) {
   size_t need = std::max(nb, na + nt1 - 1);
   if (nt2 > 0) need = std::max(need, nb + nt2 - 1);
   const FFTPlan& P = plans.get(fft_size(need));
@@ -139,7 +185,7 @@ inline void real_correlation2(const double* a, size_t na, const double* b,
 // then j + t < n for every needed term (no wrap) and b fits.
 inline void real_correlation(const double* a, size_t na, const double* b,
                              size_t nb, size_t nt, double* c, FFTPlans& plans,
-                             std::vector<cplx>& buf, std::vector<cplx>& C) {
+                             cvec& buf, cvec& C) {
   real_correlation2(a, na, b, nb, nt, c, 0, nullptr, plans, buf, C);
 }
 

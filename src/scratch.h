@@ -7,8 +7,9 @@
 // (madvise(MADV_HUGEPAGE); taken
 // where the system grants them on request, its "madvise" mode): one fault
 // per 2 MiB, 8 MB in about 1 ms. Elsewhere, or when the advice is refused,
-// it is plain memory. The contents are not initialised unless assign() is
-// used.
+// it is plain memory. Scratch: an array of doubles whose contents are not
+// initialised unless assign() is used; BigAllocator: the same memory for a
+// std::vector (the FFT buffers of src/fft.h).
 #ifndef ALLANVAR_SCRATCH_H
 #define ALLANVAR_SCRATCH_H
 
@@ -22,6 +23,65 @@
 
 namespace allanvar {
 
+// Memory of `bytes` for a kernel: large blocks in a mapping of their own,
+// 2 MiB aligned and advised as huge pages (Linux), others from malloc.
+// Release with big_free(p, bytes) (the same bytes).
+inline void* big_alloc(std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  const std::size_t huge = std::size_t(2) << 20;
+  if (bytes >= huge) {
+    const std::size_t len = (bytes + huge - 1) / huge * huge;
+    void* m = mmap(nullptr, len + huge, PROT_READ | PROT_WRITE,
+                   MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED) throw std::bad_alloc();
+    // keep the aligned len bytes, unmap the rest
+    const std::size_t a = reinterpret_cast<std::size_t>(m);
+    const std::size_t start = (a + huge - 1) / huge * huge;
+    if (start > a) munmap(m, start - a);
+    if (a + huge > start) {
+      munmap(reinterpret_cast<void*>(start + len), a + huge - start);
+    }
+    void* p = reinterpret_cast<void*>(start);
+    madvise(p, len, MADV_HUGEPAGE);  // advice only
+    return p;
+  }
+#endif
+  void* p = std::malloc(bytes > 0 ? bytes : 1);
+  if (p == nullptr) throw std::bad_alloc();
+  return p;
+}
+
+inline void big_free(void* p, std::size_t bytes) {
+  if (p == nullptr) return;
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  const std::size_t huge = std::size_t(2) << 20;
+  if (bytes >= huge) {
+    munmap(p, (bytes + huge - 1) / huge * huge);
+    return;
+  }
+#endif
+  (void)bytes;
+  std::free(p);
+}
+
+// An allocator for std::vector on big_alloc (FFT buffers).
+template <class T>
+struct BigAllocator {
+  typedef T value_type;
+  BigAllocator() = default;
+  template <class U>
+  BigAllocator(const BigAllocator<U>&) {}
+  T* allocate(std::size_t n) {
+    if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_alloc();
+    return static_cast<T*>(big_alloc(n * sizeof(T)));
+  }
+  void deallocate(T* p, std::size_t n) { big_free(p, n * sizeof(T)); }
+  template <class U>
+  bool operator==(const BigAllocator<U>&) const { return true; }
+  template <class U>
+  bool operator!=(const BigAllocator<U>&) const { return false; }
+};
+
 class Scratch {
  public:
   Scratch() = default;
@@ -29,11 +89,9 @@ class Scratch {
   ~Scratch() { release(); }
   Scratch(const Scratch&) = delete;
   Scratch& operator=(const Scratch&) = delete;
-  Scratch(Scratch&& o) noexcept
-      : p_(o.p_), n_(o.n_), cap_(o.cap_), map_(o.map_), map_len_(o.map_len_) {
+  Scratch(Scratch&& o) noexcept : p_(o.p_), n_(o.n_), cap_(o.cap_) {
     o.p_ = nullptr;
-    o.map_ = nullptr;
-    o.n_ = o.cap_ = o.map_len_ = 0;
+    o.n_ = o.cap_ = 0;
   }
   Scratch& operator=(Scratch&& o) noexcept {
     if (this != &o) {
@@ -41,11 +99,8 @@ class Scratch {
       p_ = o.p_;
       n_ = o.n_;
       cap_ = o.cap_;
-      map_ = o.map_;
-      map_len_ = o.map_len_;
       o.p_ = nullptr;
-      o.map_ = nullptr;
-      o.n_ = o.cap_ = o.map_len_ = 0;
+      o.n_ = o.cap_ = 0;
     }
     return *this;
   }
@@ -75,51 +130,18 @@ class Scratch {
   const double* end() const { return p_ + n_; }
 
  private:
-  // large arrays: their own mapping, 2 MiB aligned, advised as huge pages
-  // (from malloc, the advice was not taken inside R); the rest: malloc
   double* allocate(std::size_t n) {
     if (n == 0) return nullptr;
-    if (n > static_cast<std::size_t>(-1) / sizeof(double) / 2) throw std::bad_alloc();
-    const std::size_t bytes = n * sizeof(double);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    const std::size_t huge = std::size_t(2) << 20;
-    if (bytes >= huge) {
-      const std::size_t len = (bytes + huge - 1) / huge * huge + huge;
-      void* m = mmap(nullptr, len, PROT_READ | PROT_WRITE,
-                     MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-      if (m != MAP_FAILED) {
-        const std::size_t a = reinterpret_cast<std::size_t>(m);
-        const std::size_t start = (a + huge - 1) / huge * huge;
-        madvise(reinterpret_cast<void*>(start), len - (start - a) - (len - (start - a)) % huge,
-                MADV_HUGEPAGE);  // advice only
-        map_ = m;
-        map_len_ = len;
-        return reinterpret_cast<double*>(start);
-      }
-    }
-#endif
-    void* p = std::malloc(bytes);
-    if (p == nullptr) throw std::bad_alloc();
-    return static_cast<double*>(p);
+    if (n > static_cast<std::size_t>(-1) / sizeof(double)) throw std::bad_alloc();
+    return static_cast<double*>(big_alloc(n * sizeof(double)));
   }
   void release() {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    if (map_ != nullptr) {
-      munmap(map_, map_len_);
-      map_ = nullptr;
-      map_len_ = 0;
-      p_ = nullptr;
-      return;
-    }
-#endif
-    std::free(p_);
+    big_free(p_, cap_ * sizeof(double));
     p_ = nullptr;
   }
 
   double* p_ = nullptr;
   std::size_t n_ = 0, cap_ = 0;
-  void* map_ = nullptr;  // the mapping of a large array
-  std::size_t map_len_ = 0;
 };
 
 }  // namespace allanvar
