@@ -4,6 +4,9 @@
 // the rounding error grows only as log n), and correlation of two real
 // sequences by packing them into one complex transform (Press et al.,
 // Numerical Recipes, sec. 12.3 "FFT of two real functions simultaneously").
+// A correlation runs the forward transform by decimation in frequency
+// (Gentleman & Sande 1966), leaving the spectrum in bit-reversed order, and
+// the inverse by decimation in time from that order: no permutation.
 #ifndef ALLANVAR_FFT_H
 #define ALLANVAR_FFT_H
 
@@ -41,7 +44,7 @@ class FFTPlan {
       for (size_t j = 0; j < half; ++j) w_[half - 1 + j] = w[j * step];
     }
   }
-  // In place; inverse without the 1/n factor.
+  // In place, natural order in and out; inverse without the 1/n factor.
   void run(cplx* a, bool inverse) const {
     const size_t n = n_;
     for (size_t i = 1, j = 0; i < n; ++i) {
@@ -50,6 +53,29 @@ class FFTPlan {
       j ^= bit;
       if (i < j) std::swap(a[i], a[j]);
     }
+    dit(a, inverse);
+  }
+  // Forward transform, natural order in, bit-reversed order out
+  // (decimation in frequency: the stages of run() in reverse, each
+  // butterfly (u, v) -> (u + v, (u - v) w)); with inverse_from_br() a
+  // correlation needs no permutation (the swaps of the bit reversal were
+  // a tenth of Theo1's time at 2^21 points).
+  void forward_to_br(cplx* a) const {
+    const size_t n = n_;
+    const size_t C = std::min(n, static_cast<size_t>(1) << 13);
+    // the stages above C over the whole array, then blocks of C in cache
+    for (size_t len = n; len > C; len >>= 1) dif_stage(a, len, 0, n);
+    for (size_t b = 0; b < n; b += C) {
+      for (size_t len = C; len >= 2; len >>= 1) dif_stage(a, len, b, b + C);
+    }
+  }
+  // Inverse transform (without 1/n), bit-reversed order in, natural out.
+  void inverse_from_br(cplx* a) const { dit(a, true); }
+
+ private:
+  // the stages of the decimation in time, the input bit-reversed
+  void dit(cplx* a, bool inverse) const {
+    const size_t n = n_;
     // The stages up to len = C run block by block (each block of C points
     // stays in cache through them); the same butterflies in another order,
     // so the result is unchanged.
@@ -64,7 +90,21 @@ class FFTPlan {
     for (; 2 * len <= n; len <<= 2) stage2(a, len, inverse);
     if (len <= n) stage(a, len, 0, n, inverse);
   }
-
+  // one forward stage of the decimation in frequency over [from, to)
+  void dif_stage(cplx* a, size_t len, size_t from, size_t to) const {
+    const size_t half = len / 2;
+    const cplx* w = w_.data() + (half - 1);
+    for (size_t i = from; i < to; i += len) {
+      for (size_t j = 0; j < half; ++j) {
+        const double ur = a[i + j].real(), ui = a[i + j].imag();
+        const double br = a[i + j + half].real(), bi = a[i + j + half].imag();
+        const double dr = ur - br, di = ui - bi;
+        const double wr = w[j].real(), wi = w[j].imag();
+        a[i + j] = cplx(ur + br, ui + bi);
+        a[i + j + half] = cplx(dr * wr - di * wi, dr * wi + di * wr);
+      }
+    }
+  }
  private:
   // the butterflies of one stage over the points [from, to)
   void stage(cplx* a, size_t len, size_t from, size_t to, bool inverse) const {
@@ -162,17 +202,23 @@ inline void real_correlation2(const double* a, size_t na, const double* b,
   buf.assign(n, cplx(0, 0));
   for (size_t j = 0; j < na; ++j) buf[j].real(a[j]);
   for (size_t j = 0; j < nb; ++j) buf[j].imag(b[j]);
-  P.run(buf.data(), false);
+  P.forward_to_br(buf.data());
   C.resize(n);
-  for (size_t f = 0; f < n; ++f) {
-    const cplx z = buf[f], zr = std::conj(buf[(n - f) & (n - 1)]);
+  // in bit-reversed order the partner of frequency f, n - f, of the
+  // position p in [2^k, 2^(k+1)) sits at 3 2^k - 1 - p (and 0 at 0)
+  auto one = [&](size_t p, size_t q) {
+    const cplx z = buf[p], zr = std::conj(buf[q]);
     const double ar = 0.5 * (z.real() + zr.real()), ai = 0.5 * (z.imag() + zr.imag());
     const double br = 0.5 * (z.imag() - zr.imag()), bi = -0.5 * (z.real() - zr.real());
     // conj(A) B (+ i |B|^2 when c2 is wanted)
     const double b2 = c2 ? br * br + bi * bi : 0.0;
-    C[f] = cplx(ar * br + ai * bi, ar * bi - ai * br + b2);
+    C[p] = cplx(ar * br + ai * bi, ar * bi - ai * br + b2);
+  };
+  one(0, 0);
+  for (size_t g = 1; g < n; g <<= 1) {
+    for (size_t p = g; p < 2 * g; ++p) one(p, 3 * g - 1 - p);
   }
-  P.run(C.data(), true);
+  P.inverse_from_br(C.data());
   const double s = 1.0 / static_cast<double>(n);
   for (size_t t = 0; t < nt1; ++t) c1[t] = C[t].real() * s;
   if (c2) {
