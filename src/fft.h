@@ -64,9 +64,14 @@ class FFTPlan {
     const size_t n = n_;
     const size_t C = std::min(n, static_cast<size_t>(1) << 13);
     // the stages above C over the whole array, then blocks of C in cache
-    for (size_t len = n; len > C; len >>= 1) dif_stage(a, len, 0, n);
+    // (two stages at a time where two remain, as in dit())
+    size_t len = n;
+    for (; len / 2 > C; len >>= 2) dif_stage2(a, len, 0, n);
+    if (len > C) dif_stage(a, len, 0, n);
     for (size_t b = 0; b < n; b += C) {
-      for (size_t len = C; len >= 2; len >>= 1) dif_stage(a, len, b, b + C);
+      size_t l = C;
+      for (; l >= 4; l >>= 2) dif_stage2(a, l, b, b + C);
+      if (l == 2) dif_stage(a, l, b, b + C);
     }
   }
   // Inverse transform (without 1/n), bit-reversed order in, natural out.
@@ -79,16 +84,57 @@ class FFTPlan {
     // The stages up to len = C run block by block (each block of C points
     // stays in cache through them); the same butterflies in another order,
     // so the result is unchanged.
+    // Stages go two at a time (radix-4 order: the points are read and
+    // written once for two stages; the same butterflies with the same
+    // twiddles, so the same result).
     const size_t C = std::min(n, static_cast<size_t>(1) << 13);
     for (size_t b = 0; b < n; b += C) {
-      for (size_t len = 2; len <= C; len <<= 1) stage(a, len, b, b + C, inverse);
+      size_t len = 2;
+      for (; 2 * len <= C; len <<= 2) stage2(a, len, b, b + C, inverse);
+      if (len <= C) stage(a, len, b, b + C, inverse);
     }
-    // the stages above C over the whole array, two at a time (radix-4
-    // order: each pass reads and writes the points once for two stages;
-    // the same butterflies with the same twiddles, so the same result)
+    // the stages above C over the whole array
     size_t len = 2 * C;
-    for (; 2 * len <= n; len <<= 2) stage2(a, len, inverse);
+    for (; 2 * len <= n; len <<= 2) stage2(a, len, 0, n, inverse);
     if (len <= n) stage(a, len, 0, n, inverse);
+  }
+  // the stages len and len / 2 of the decimation in frequency: on each
+  // block of len points, points j, j + q, j + 2q, j + 3q (q = len / 4)
+  void dif_stage2(cplx* a, size_t len, size_t from, size_t to) const {
+    const size_t q = len / 4;
+    const cplx* wl = w_.data() + (2 * q - 1);  // stage len
+    const cplx* wh = w_.data() + (q - 1);      // stage len / 2
+    for (size_t i = from; i < to; i += len) {
+      for (size_t j = 0; j < q; ++j) {
+        cplx* p = a + i + j;
+        const double x0r = p[0].real(), x0i = p[0].imag();
+        const double x1r = p[q].real(), x1i = p[q].imag();
+        const double x2r = p[2 * q].real(), x2i = p[2 * q].imag();
+        const double x3r = p[3 * q].real(), x3i = p[3 * q].imag();
+        // stage len: (x0, x2) with wl[j], (x1, x3) with wl[j + q]
+        const double a0r = x0r + x2r, a0i = x0i + x2i;
+        double dr = x0r - x2r, di = x0i - x2i;
+        double wr = wl[j].real(), wi = wl[j].imag();
+        const double a2r = dr * wr - di * wi, a2i = dr * wi + di * wr;
+        const double a1r = x1r + x3r, a1i = x1i + x3i;
+        dr = x1r - x3r;
+        di = x1i - x3i;
+        wr = wl[j + q].real();
+        wi = wl[j + q].imag();
+        const double a3r = dr * wr - di * wi, a3i = dr * wi + di * wr;
+        // stage len / 2: (a0, a1) and (a2, a3) with wh[j]
+        wr = wh[j].real();
+        wi = wh[j].imag();
+        p[0] = cplx(a0r + a1r, a0i + a1i);
+        dr = a0r - a1r;
+        di = a0i - a1i;
+        p[q] = cplx(dr * wr - di * wi, dr * wi + di * wr);
+        p[2 * q] = cplx(a2r + a3r, a2i + a3i);
+        dr = a2r - a3r;
+        di = a2i - a3i;
+        p[3 * q] = cplx(dr * wr - di * wi, dr * wi + di * wr);
+      }
+    }
   }
   // one forward stage of the decimation in frequency over [from, to)
   void dif_stage(cplx* a, size_t len, size_t from, size_t to) const {
@@ -126,12 +172,12 @@ class FFTPlan {
 
   // the stages of length len and 2 len: on each block of 2 len points,
   // points j, j + h, j + 2h, j + 3h (h = len / 2) go through both
-  void stage2(cplx* a, size_t len, bool inverse) const {
+  void stage2(cplx* a, size_t len, size_t from, size_t to, bool inverse) const {
     const size_t h = len / 2;
     const cplx* w1 = w_.data() + (h - 1);    // stage len
     const cplx* w2 = w_.data() + (len - 1);  // stage 2 len
     const double sg = inverse ? -1.0 : 1.0;
-    for (size_t i = 0; i < n_; i += 2 * len) {
+    for (size_t i = from; i < to; i += 2 * len) {
       for (size_t j = 0; j < h; ++j) {
         cplx* p = a + i + j;
         // stage len: (p0, p1) and (p2, p3) with twiddle w1[j]
