@@ -1,15 +1,14 @@
-// Large scratch arrays of doubles for the kernels. The first touch of fresh
-// memory costs a page fault per 4 KiB page: on the development machine,
-// writing 8 MB of fresh memory took 4.5 ms against 0.55 ms for rewriting it
-// (sum(x) at 1e6 takes about 2 ms), a large share of the kernels' time at
-// 1e6 samples. On Linux an array of 2 MiB or more is therefore aligned to
-// 2 MiB in a mapping of its own and advised as transparent huge pages
-// (madvise(MADV_HUGEPAGE); taken
-// where the system grants them on request, its "madvise" mode): one fault
-// per 2 MiB, 8 MB in about 1 ms. Elsewhere, or when the advice is refused,
-// it is plain memory. Scratch: an array of doubles whose contents are not
-// initialised unless assign() is used; BigAllocator: the same memory for a
-// std::vector (the FFT buffers of src/fft.h).
+// Large scratch memory for the kernels. The first touch of fresh memory
+// costs a page fault per 4 KiB page: on the development machine, writing
+// 8 MB of fresh memory took 4.5 ms against 0.55 ms for rewriting it (sum(x)
+// at 1e6 takes about 2 ms), a large share of the kernels' time at 1e6
+// samples. On Linux a block of 2 MiB or more therefore gets a mapping of
+// its own, 2 MiB aligned and advised as transparent huge pages
+// (madvise(MADV_HUGEPAGE), granted where the system allows them on
+// request, its "madvise" mode): one fault per 2 MiB, 8 MB in 1-1.5 ms.
+// Elsewhere, or when the advice is refused, it is plain memory.
+// Scratch: an array of doubles, not initialised unless assign() is used;
+// BigAllocator: the same memory for a std::vector (src/fft.h's buffers).
 #ifndef ALLANVAR_SCRATCH_H
 #define ALLANVAR_SCRATCH_H
 
@@ -21,13 +20,27 @@
 #include <sys/mman.h>
 #endif
 
+// Own mappings on Linux, but not under AddressSanitizer: its bounds checks
+// cover malloc's blocks only
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define ALLANVAR_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define ALLANVAR_ASAN 1
+#endif
+#if defined(__linux__) && defined(MADV_HUGEPAGE) && !defined(ALLANVAR_ASAN)
+#define ALLANVAR_BIG_MAP 1
+#endif
+
 namespace allanvar {
 
 // Memory of `bytes` for a kernel: large blocks in a mapping of their own,
 // 2 MiB aligned and advised as huge pages (Linux), others from malloc.
 // Release with big_free(p, bytes) (the same bytes).
 inline void* big_alloc(std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+#if defined(ALLANVAR_BIG_MAP)
   const std::size_t huge = std::size_t(2) << 20;
   if (bytes >= huge) {
     const std::size_t len = (bytes + huge - 1) / huge * huge;
@@ -53,7 +66,7 @@ inline void* big_alloc(std::size_t bytes) {
 
 inline void big_free(void* p, std::size_t bytes) {
   if (p == nullptr) return;
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+#if defined(ALLANVAR_BIG_MAP)
   const std::size_t huge = std::size_t(2) << 20;
   if (bytes >= huge) {
     munmap(p, (bytes + huge - 1) / huge * huge);
