@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <deque>
 #include <vector>
 
@@ -23,6 +24,34 @@ namespace allanvar {
 using cplx = std::complex<double>;
 // transform buffers: 32 MB each at 2^21 points, huge pages (src/scratch.h)
 using cvec = std::vector<cplx, BigAllocator<cplx> >;
+
+#if defined(__GNUC__)
+// A complex number as two doubles of an SSE2 vector; x w computed as
+// x (wr, wr) + swap(x) (-wi, wi): the scalar code's products and sums
+// (the same values, bit for bit).
+typedef double fft_v2 __attribute__((vector_size(16)));
+// (std::complex<double> is laid out as an array of two doubles)
+inline fft_v2 fft_ld(const cplx* p) {
+  fft_v2 v;
+  std::memcpy(&v, reinterpret_cast<const double*>(p), sizeof v);
+  return v;
+}
+inline void fft_st(cplx* p, fft_v2 v) {
+  std::memcpy(reinterpret_cast<double*>(p), &v, sizeof v);
+}
+inline fft_v2 fft_swap(fft_v2 x) {
+#if defined(__clang__)
+  return __builtin_shufflevector(x, x, 1, 0);
+#else
+  typedef long long v2i __attribute__((vector_size(16)));
+  return __builtin_shuffle(x, v2i{1, 0});
+#endif
+}
+inline fft_v2 fft_mul(fft_v2 x, double wr, double wi) {
+  const fft_v2 a = {wr, wr}, b = {-wi, wi};
+  return x * a + fft_swap(x) * b;
+}
+#endif
 
 class FFTPlan {
  public:
@@ -105,6 +134,22 @@ class FFTPlan {
     const cplx* wl = w_.data() + (2 * q - 1);  // stage len
     const cplx* wh = w_.data() + (q - 1);      // stage len / 2
     for (size_t i = from; i < to; i += len) {
+#if defined(__GNUC__)
+      for (size_t j = 0; j < q; ++j) {
+        cplx* p = a + i + j;
+        const fft_v2 x0 = fft_ld(p), x1 = fft_ld(p + q), x2 = fft_ld(p + 2 * q),
+                     x3 = fft_ld(p + 3 * q);
+        const fft_v2 a0 = x0 + x2, a1 = x1 + x3;
+        const fft_v2 a2 = fft_mul(x0 - x2, wl[j].real(), wl[j].imag());
+        const fft_v2 a3 = fft_mul(x1 - x3, wl[j + q].real(), wl[j + q].imag());
+        const double wr = wh[j].real(), wi = wh[j].imag();
+        fft_st(p, a0 + a1);
+        fft_st(p + q, fft_mul(a0 - a1, wr, wi));
+        fft_st(p + 2 * q, a2 + a3);
+        fft_st(p + 3 * q, fft_mul(a2 - a3, wr, wi));
+      }
+      continue;
+#endif
       for (size_t j = 0; j < q; ++j) {
         cplx* p = a + i + j;
         const double x0r = p[0].real(), x0i = p[0].imag();
@@ -141,6 +186,14 @@ class FFTPlan {
     const size_t half = len / 2;
     const cplx* w = w_.data() + (half - 1);
     for (size_t i = from; i < to; i += len) {
+#if defined(__GNUC__)
+      for (size_t j = 0; j < half; ++j) {
+        const fft_v2 u = fft_ld(a + i + j), b = fft_ld(a + i + j + half);
+        fft_st(a + i + j, u + b);
+        fft_st(a + i + j + half, fft_mul(u - b, w[j].real(), w[j].imag()));
+      }
+      continue;
+#endif
       for (size_t j = 0; j < half; ++j) {
         const double ur = a[i + j].real(), ui = a[i + j].imag();
         const double br = a[i + j + half].real(), bi = a[i + j + half].imag();
@@ -157,6 +210,17 @@ class FFTPlan {
     const size_t half = len / 2;
     const cplx* w = w_.data() + (half - 1);
     for (size_t i = from; i < to; i += len) {
+#if defined(__GNUC__)
+      const double sg = inverse ? -1.0 : 1.0;
+      for (size_t j = 0; j < half; ++j) {
+        const fft_v2 u = fft_ld(a + i + j);
+        const fft_v2 v = fft_mul(fft_ld(a + i + j + half), w[j].real(),
+                                 sg * w[j].imag());
+        fft_st(a + i + j, u + v);
+        fft_st(a + i + j + half, u - v);
+      }
+      continue;
+#endif
       for (size_t j = 0; j < half; ++j) {
         // written out: std::complex's operator* checks for NaN (slow)
         const double wr = w[j].real();
@@ -178,6 +242,23 @@ class FFTPlan {
     const cplx* w2 = w_.data() + (len - 1);  // stage 2 len
     const double sg = inverse ? -1.0 : 1.0;
     for (size_t i = from; i < to; i += 2 * len) {
+#if defined(__GNUC__)
+      for (size_t j = 0; j < h; ++j) {
+        cplx* p = a + i + j;
+        const double wr = w1[j].real(), wi = sg * w1[j].imag();
+        const fft_v2 x0 = fft_ld(p), x2 = fft_ld(p + 2 * h);
+        const fft_v2 v1 = fft_mul(fft_ld(p + h), wr, wi);
+        const fft_v2 v3 = fft_mul(fft_ld(p + 3 * h), wr, wi);
+        const fft_v2 b0 = x0 + v1, b1 = x0 - v1, b2 = x2 + v3, b3 = x2 - v3;
+        const fft_v2 u = fft_mul(b2, w2[j].real(), sg * w2[j].imag());
+        const fft_v2 t = fft_mul(b3, w2[j + h].real(), sg * w2[j + h].imag());
+        fft_st(p, b0 + u);
+        fft_st(p + 2 * h, b0 - u);
+        fft_st(p + h, b1 + t);
+        fft_st(p + 3 * h, b1 - t);
+      }
+      continue;
+#endif
       for (size_t j = 0; j < h; ++j) {
         cplx* p = a + i + j;
         // stage len: (p0, p1) and (p2, p3) with twiddle w1[j]
