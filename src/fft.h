@@ -61,7 +61,7 @@ class FFTPlan {
   size_t size() const { return n_; }
   void reset(size_t n) {
     n_ = n;
-    std::vector<cplx> w(n / 2);
+    cvec w(n / 2);
     const double pi = 3.14159265358979323846;
     for (size_t j = 0; j < n / 2; ++j) {
       const double a = -2.0 * pi * static_cast<double>(j) / static_cast<double>(n);
@@ -292,7 +292,7 @@ class FFTPlan {
   }
 
   size_t n_;
-  std::vector<cplx> w_;
+  cvec w_;  // 32 MB at 2^21 points: huge pages too
 };
 
 inline size_t fft_size(size_t need) {
@@ -352,6 +352,56 @@ inline void real_correlation2(const double* a, size_t na, const double* b,
   for (size_t t = 0; t < nt1; ++t) c1[t] = C[t].real() * s;
   if (c2) {
     for (size_t t = 0; t < nt2; ++t) c2[t] = C[t].imag() * s;
+  }
+}
+
+// Two correlations of real sequences at once, c1[t] = sum_j a1[j] b1[j + t]
+// and c2[t] = sum_j a2[j] b2[j + t] for t < nt (na points of a1 and a2, nb
+// of b1 and b2): the transforms of a1 + i a2 and b1 + i b2 hold all four
+// spectra, and one inverse returns c1 + i c2 (three transforms instead of
+// four).
+inline void real_correlation_pair(const double* a1, const double* a2,
+                                  size_t na, const double* b1,
+                                  const double* b2, size_t nb, size_t nt,
+                                  double* c1, double* c2, FFTPlans& plans,
+                                  cvec& buf, cvec& C) {
+  const FFTPlan& P = plans.get(fft_size(std::max(nb, na + nt - 1)));
+  const size_t n = P.size();
+  buf.assign(n, cplx(0, 0));
+  for (size_t j = 0; j < na; ++j) buf[j] = cplx(a1[j], a2[j]);
+  C.assign(n, cplx(0, 0));
+  for (size_t j = 0; j < nb; ++j) C[j] = cplx(b1[j], b2[j]);
+  P.forward_to_br(buf.data());
+  P.forward_to_br(C.data());
+  // at position p (partner q, as in real_correlation2): A1 = (X + conj Xq)
+  // / 2, A2 = (X - conj Xq) / 2i, likewise B1, B2 from C; the product
+  // conj(A1) B1 + i conj(A2) B2
+  auto prod = [&](size_t p, size_t q) {
+    const cplx x = buf[p], xq = std::conj(buf[q]);
+    const cplx y = C[p], yq = std::conj(C[q]);
+    const double a1r = 0.5 * (x.real() + xq.real()), a1i = 0.5 * (x.imag() + xq.imag());
+    const double a2r = 0.5 * (x.imag() - xq.imag()), a2i = -0.5 * (x.real() - xq.real());
+    const double b1r = 0.5 * (y.real() + yq.real()), b1i = 0.5 * (y.imag() + yq.imag());
+    const double b2r = 0.5 * (y.imag() - yq.imag()), b2i = -0.5 * (y.real() - yq.real());
+    const double s1r = a1r * b1r + a1i * b1i, s1i = a1r * b1i - a1i * b1r;
+    const double s2r = a2r * b2r + a2i * b2i, s2i = a2r * b2i - a2i * b2r;
+    return cplx(s1r - s2i, s1i + s2r);
+  };
+  C[0] = prod(0, 0);
+  for (size_t g = 1; g < n; g <<= 1) {
+    for (size_t p = g; p < 2 * g; ++p) {
+      const size_t q = 3 * g - 1 - p;
+      if (q < p) continue;  // done with its partner
+      const cplx rp = prod(p, q), rq = prod(q, p);
+      C[p] = rp;
+      C[q] = rq;
+    }
+  }
+  P.inverse_from_br(C.data());
+  const double s = 1.0 / static_cast<double>(n);
+  for (size_t t = 0; t < nt; ++t) {
+    c1[t] = C[t].real() * s;
+    c2[t] = C[t].imag() * s;
   }
 }
 

@@ -37,44 +37,56 @@
 namespace allanvar {
 
 // Memory of `bytes` for a kernel: large blocks in a mapping of their own,
-// 2 MiB aligned and advised as huge pages (Linux), others from malloc.
-// Release with big_free(p, bytes) (the same bytes).
+// 2 MiB aligned and advised as huge pages (Linux), others (and any block
+// when no mapping is to be had) from malloc. Each block starts with a
+// header saying which, so big_free() releases it the right way.
+const std::size_t kBigHeader = 64;
+struct BigHeader {
+  std::size_t mapped;  // length of the mapping, or 0: from malloc
+};
+
 inline void* big_alloc(std::size_t bytes) {
+  if (bytes > static_cast<std::size_t>(-1) / 2) throw std::bad_alloc();
+  const std::size_t total = bytes + kBigHeader;
 #if defined(ALLANVAR_BIG_MAP)
   const std::size_t huge = std::size_t(2) << 20;
-  if (bytes >= huge) {
-    const std::size_t len = (bytes + huge - 1) / huge * huge;
+  if (total >= huge) {
+    const std::size_t len = (total + huge - 1) / huge * huge;
     void* m = mmap(nullptr, len + huge, PROT_READ | PROT_WRITE,
                    MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (m == MAP_FAILED) throw std::bad_alloc();
-    // keep the aligned len bytes, unmap the rest
-    const std::size_t a = reinterpret_cast<std::size_t>(m);
-    const std::size_t start = (a + huge - 1) / huge * huge;
-    if (start > a) munmap(m, start - a);
-    if (a + huge > start) {
-      munmap(reinterpret_cast<void*>(start + len), a + huge - start);
+    if (m != MAP_FAILED) {  // else: malloc below
+      // keep the aligned len bytes, unmap the rest
+      const std::size_t a = reinterpret_cast<std::size_t>(m);
+      const std::size_t start = (a + huge - 1) / huge * huge;
+      if (start > a) munmap(m, start - a);
+      if (a + huge > start) {
+        munmap(reinterpret_cast<void*>(start + len), a + huge - start);
+      }
+      char* base = reinterpret_cast<char*>(start);
+      madvise(base, len, MADV_HUGEPAGE);  // advice only
+      reinterpret_cast<BigHeader*>(base)->mapped = len;
+      return base + kBigHeader;
     }
-    void* p = reinterpret_cast<void*>(start);
-    madvise(p, len, MADV_HUGEPAGE);  // advice only
-    return p;
   }
 #endif
-  void* p = std::malloc(bytes > 0 ? bytes : 1);
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
+  char* base = static_cast<char*>(std::malloc(total));
+  if (base == nullptr) throw std::bad_alloc();
+  reinterpret_cast<BigHeader*>(base)->mapped = 0;
+  return base + kBigHeader;
 }
 
-inline void big_free(void* p, std::size_t bytes) {
+inline void big_free(void* p) {
   if (p == nullptr) return;
+  char* base = static_cast<char*>(p) - kBigHeader;
+  const std::size_t mapped = reinterpret_cast<BigHeader*>(base)->mapped;
 #if defined(ALLANVAR_BIG_MAP)
-  const std::size_t huge = std::size_t(2) << 20;
-  if (bytes >= huge) {
-    munmap(p, (bytes + huge - 1) / huge * huge);
+  if (mapped > 0) {
+    munmap(base, mapped);
     return;
   }
 #endif
-  (void)bytes;
-  std::free(p);
+  (void)mapped;
+  std::free(base);
 }
 
 // An allocator for std::vector on big_alloc (FFT buffers).
@@ -88,7 +100,7 @@ struct BigAllocator {
     if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_alloc();
     return static_cast<T*>(big_alloc(n * sizeof(T)));
   }
-  void deallocate(T* p, std::size_t n) { big_free(p, n * sizeof(T)); }
+  void deallocate(T* p, std::size_t) { big_free(p); }
   template <class U>
   bool operator==(const BigAllocator<U>&) const { return true; }
   template <class U>
@@ -149,7 +161,7 @@ class Scratch {
     return static_cast<double*>(big_alloc(n * sizeof(double)));
   }
   void release() {
-    big_free(p_, cap_ * sizeof(double));
+    big_free(p_);
     p_ = nullptr;
   }
 

@@ -108,6 +108,38 @@ double theo_triangle(const double* z, R_xlen_t k, R_xlen_t p0, R_xlen_t d0,
          theo_triangle(z, k, p0, d0 + q, h, S);
 }
 
+// theo_triangle() of two series at once (the block and its reverse): the
+// same recursion, each square's two correlations from one set of three
+// transforms (real_correlation_pair); out[0], out[1] get the two sums.
+void theo_triangle2(const double* z, const double* zr, R_xlen_t k,
+                    R_xlen_t p0, R_xlen_t d0, R_xlen_t n, FastScratch& S,
+                    double* out) {
+  if (n <= 0) return;
+  const R_xlen_t h = (n + 1) / 2, q = n - h;
+  if (n <= 48 || h * q <= kTriDirect) {
+    out[0] += theo_triangle(z, k, p0, d0, n, S);
+    out[1] += theo_triangle(zr, k, p0, d0, n, S);
+    return;
+  }
+  const size_t nt = static_cast<size_t>(2 * q - 1);
+  S.c.resize(nt);
+  S.c2.resize(nt);
+  allanvar::real_correlation_pair(z + p0, zr + p0, h, z + p0 + 2 * d0,
+                                  zr + p0 + 2 * d0, h + nt - 1, nt,
+                                  S.c.data(), S.c2.data(), S.plans, S.buf,
+                                  S.buf2);
+  double sq0 = 0, sq1 = 0;
+  for (R_xlen_t d = 0; d < q; ++d) {
+    sq0 += S.c[2 * d] / static_cast<double>(k - d0 - d);
+    sq1 += S.c2[2 * d] / static_cast<double>(k - d0 - d);
+  }
+  out[0] += sq0;
+  out[1] += sq1;
+  if (allanvar::interrupted()) return;  // the result is thrown away
+  theo_triangle2(z, zr, k, p0 + h, d0, q, S, out);
+  theo_triangle2(z, zr, k, p0, d0 + q, h, S, out);
+}
+
 // The block's part of T_k (see above); z has W = Mb + 2k points.
 double theo_block(const double* z, R_xlen_t W, R_xlen_t k, FastScratch& S) {
   const R_xlen_t m = 2 * k, Mb = W - m;
@@ -142,10 +174,12 @@ double theo_block(const double* z, R_xlen_t W, R_xlen_t k, FastScratch& S) {
   double pd = 0;
   for (R_xlen_t d = 0; d < k; ++d)
     pd += S.c2[2 * d] / static_cast<double>(k - d);
-  pd -= theo_triangle(z, k, 0, 0, k, S);
   S.zr.assign(z, z + W);
   std::reverse(S.zr.begin(), S.zr.end());
-  pd -= theo_triangle(S.zr.data(), k, 0, 0, k, S);
+  double tri[2] = {0, 0};
+  theo_triangle2(z, S.zr.data(), k, 0, 0, k, S, tri);
+  pd -= tri[0];
+  pd -= tri[1];
   return H * ss - 2 * cross + sq + 2 * pd;
 }
 
