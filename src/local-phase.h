@@ -10,6 +10,7 @@
 #define ALLANVAR_LOCAL_PHASE_H
 
 #include <Rcpp.h>
+#include "scratch.h"
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -114,17 +115,19 @@ inline double local_phase(const PhaseInput& in, R_xlen_t a, R_xlen_t len,
 // |hi| <= 2^50 q, so integer combinations of hi with total weight <= 8 are
 // exact in double; lo (|lo| <= q/2) carries the rest. One compensated pass.
 struct SplitPhase {
-  std::vector<double> hi, lo;
+  Scratch hi, lo;  // 2 x 8 MB at 1e6: huge pages where granted
   double c = 0;  // removed slope per sample
   R_xlen_t size() const { return static_cast<R_xlen_t>(hi.size()); }
   double value(R_xlen_t j) const { return hi[j] + lo[j]; }
 };
 
-inline void split_phase(const PhaseInput& in, SplitPhase& out) {
+// The two passes of split_phase(): f(j, hi, lo, c) for j = 1..L-1 (X(0) =
+// 0); returns c. Kernels that need X(j) once take it from here without the
+// arrays.
+template <class F>
+inline double split_phase_each(const PhaseInput& in, F f) {
   const R_xlen_t L = in.length();
-  out.hi.assign(L, 0.0);
-  out.lo.assign(L, 0.0);
-  if (L < 2) return;
+  if (L < 2) return 0.0;
   double s = 0, e = 0, bmin = 0, bmax = 0;
   for (R_xlen_t l = 0; l < L - 1; ++l) {
     double h, lo, t, te;
@@ -136,7 +139,6 @@ inline void split_phase(const PhaseInput& in, SplitPhase& out) {
     e += te + lo;
   }
   const double c = (s + e) / static_cast<double>(L - 1);
-  out.c = c;
   double bound = std::max(std::fabs(bmax - c), std::fabs(bmin - c)) + 1e-300;
   bound *= static_cast<double>(L) * (1 + 1e-9);
   int ex;
@@ -153,9 +155,43 @@ inline void split_phase(const PhaseInput& in, SplitPhase& out) {
     s = t;
     e += te + re + lo;
     const double g = (s + C) - C;
-    out.hi[l + 1] = g;
-    out.lo[l + 1] = (s - g) + e;
+    f(l + 1, g, (s - g) + e, c);
   }
+  return c;
+}
+
+inline void split_phase(const PhaseInput& in, SplitPhase& out) {
+  const R_xlen_t L = in.length();
+  out.hi.resize(L);
+  out.lo.resize(L);
+  out.c = 0;
+  if (L < 1) return;
+  out.hi[0] = out.lo[0] = 0.0;
+  double* hi = out.hi.data();
+  double* lo = out.lo.data();
+  out.c = split_phase_each(in, [hi, lo](R_xlen_t j, double h, double l,
+                                         double) {
+    hi[j] = h;
+    lo[j] = l;
+  });
+}
+
+// out[j] = X(a + j) - X(a) - d j, j < len, from the split phase, d the
+// chord's slope: local_phase()'s values (a line apart, which the
+// statistics ignore; rounded alike) in one vectorisable pass, the
+// differences of hi being exact.
+inline void local_from_split(const SplitPhase& X, R_xlen_t a, R_xlen_t len,
+                             double* out) {
+  if (len <= 0) return;
+  const double* h = X.hi.data() + a;
+  const double* l = X.lo.data() + a;
+  const double h0 = h[0], l0 = l[0];
+  const double d =
+      len > 1 ? ((h[len - 1] - h0) + (l[len - 1] - l0)) /
+                    static_cast<double>(len - 1)
+              : 0.0;
+  for (R_xlen_t j = 0; j < len; ++j)
+    out[j] = ((h[j] - h0) + (l[j] - l0)) - d * static_cast<double>(j);
 }
 
 }  // namespace allanvar

@@ -14,8 +14,6 @@
 #include "parallel.h"
 #include <algorithm>
 #include <cmath>
-#include <memory>
-#include <stdexcept>
 #include <vector>
 
 namespace {
@@ -190,27 +188,14 @@ double local_terms(const double* hx, const double* lx, R_xlen_t mm,
 // increment (PVAR ignores a linear phase term; any constant would do). Every
 // value is of the size of the statistic itself (no running sum of the
 // phase), each level costs a few operations per term, and the levels run
-// as a wavefront over tiles so that they meet in cache. Level j (m = 2^j)
+// over tiles that stay in cache (below). Level j (m = 2^j)
 // holds indices [0, L - 2^(j+1) + 1); its terms are i < L - 2^(j+1).
-
-const R_xlen_t kTile = 2048;
-const int kRanges = 2;
-
-// One level's values: global index i at ring position i % R (or, for the
-// whole arrays a group starts from, at i: R = 0).
-struct Level {
-  double* S = nullptr;  // nullptr: S is zero (level 0)
-  double* E = nullptr;
-  std::unique_ptr<double[]> own_s, own_e;
-  R_xlen_t R = 0, prod = 0, hi = 0;
-  R_xlen_t pos(R_xlen_t i) const { return R ? i % R : i; }
-  // contiguous run from i without wrapping
-  R_xlen_t run(R_xlen_t i) const { return R ? R - i % R : R_xlen_t(1) << 62; }
-};
 
 // Level j + 1 at [0, len) from level j (m = 2^j) read at i, i + m, i + 2m
 // (pointers s0, s1, s2 and e0, e1, e2; Z: S_m = 0, s* unused); returns the
-// sum of squares of os[0, nsq), nsq <= len.
+// sum of squares of os[0, nsq), nsq <= len. In place (os == s0, oe == e0)
+// is allowed: the position i is written after its three reads, and the
+// reads lie at or after i.
 template <bool Z>
 inline double double_level(const double* s0, const double* s1,
                            const double* s2, const double* e0,
@@ -267,187 +252,237 @@ inline double double_level(const double* s0, const double* s1,
   return acc;
 }
 
-// Levels j0 + 1 .. j1 from level j0 (whole arrays S0, E0; S0 == nullptr:
-// zero) for the indices [a, b) of every level and the margin the higher
-// levels of this call need: adds the sum of S_m^2 over the terms in
-// [a, b) to sq[j]; writes level j1 on [a, b) into S1, E1 when given.
-// Level j's ring holds the 2^(j+1) + 2 tiles its reader needs; a level
-// waits while its reader has not consumed the oldest values.
-void octave_wave(const double* S0, const double* E0, int j0, int j1,
-                 R_xlen_t a, R_xlen_t b, R_xlen_t L, double* sq, double* S1,
-                 double* E1) {
-  const int nl = j1 - j0;
-  std::vector<Level> lv(nl + 1);
-  auto npts = [L](int j) { return L - (R_xlen_t(2) << j) + 1; };
-  lv[0].S = const_cast<double*>(S0);
-  lv[0].E = const_cast<double*>(E0);
-  lv[0].R = 0;
-  lv[0].prod = npts(j0);
-  for (int k = 1; k <= nl; ++k) {
-    const int j = j0 + k;
-    const R_xlen_t margin = (R_xlen_t(2) << j1) - (R_xlen_t(2) << j);
-    Level& v = lv[k];
-    v.prod = a;
-    v.hi = std::min(npts(j), b + margin);
-    v.R = k < nl ? (R_xlen_t(2) << j) + 2 * kTile : kTile;
-    v.own_s.reset(new double[v.R]);
-    v.own_e.reset(new double[v.R]);
-    v.S = v.own_s.get();
-    v.E = v.own_e.get();
+// Two stages, both in place (level j + 1 at i overwrites level j at i: its
+// reads lie at i, i + m, i + 2m):
+//  * levels 0..J as a wavefront over steps of kStep indices, level j + 1
+//    trailing level j by 2m, so that every level meets the values in cache;
+//    the record is cut in two parts (threads), each computing the margin
+//    past its end that its upper levels read;
+//  * from level J on, the indices congruent modulo D = 2^J never mix with
+//    the others, so blocks of B residues (a tile: i = r0 + g + p D, g < B,
+//    at position p B + g) are gathered and carried through the remaining
+//    levels alone, within a core's cache (position q then reads q, q + G,
+//    q + 2G, G = B m / D).
+// The values are those of the flat recursion (the same operations on the
+// same operands); only the order of the sums of squares differs, and it is
+// fixed (it depends neither on the threads nor on the machine).
+
+const R_xlen_t kStep = 2048;
+
+// Level 0 (E_1 less the centre c) at [i0, i1) into out.
+void level0(const allanvar::PhaseInput& in, double c, R_xlen_t i0,
+            R_xlen_t i1, double* out) {
+  if (in.rate) {
+    for (R_xlen_t i = i0; i < i1; ++i) out[i - i0] = c - in.v[i];
+  } else {
+    for (R_xlen_t i = i0; i < i1; ++i) {
+      double h, lo, r, re;
+      in.increment(i, h, lo);
+      allanvar::phase_two_sum(h, -c, r, re);
+      out[i - i0] = -(r + (re + lo));
+    }
   }
+}
+
+struct OctaveLayout {
+  R_xlen_t L = 0;
+  int K = 0, J = 0;  // levels asked; levels of the first stage
+  R_xlen_t n(int j) const { return L - (R_xlen_t(2) << j) + 1; }
+};
+
+// Levels 0..J of the indices [a, b) and the margin above b that they need,
+// in place in S, E (index i at i - a); adds the squares of the terms in
+// [a, b) to sq[j] (sq[0]: squared differences of level 0).
+void octave_top(const allanvar::PhaseInput& in, double c,
+                const OctaveLayout& O, R_xlen_t a, R_xlen_t b, double* S,
+                double* E, double* sq) {
+  const int J = O.J;
+  std::vector<R_xlen_t> F(J + 1, a), end(J + 1);
+  for (int j = 0; j <= J; ++j) {
+    end[j] = std::min(O.n(j), b + (R_xlen_t(2) << J) - (R_xlen_t(2) << j) +
+                                   (j == 0 ? 1 : 0));
+  }
+  const R_xlen_t q0 = std::min(b, O.n(0) - 1);  // level 0's terms end
   long sweeps = 0;
   for (;;) {
     if ((++sweeps & 63) == 0 && allanvar::interrupted()) return;
     bool moved = false;
-    for (int k = 1; k <= nl; ++k) {
-      Level& v = lv[k];
-      const R_xlen_t p = v.prod;
-      if (p >= v.hi) continue;
-      const R_xlen_t len = std::min(kTile, v.hi - p);
-      const R_xlen_t m = R_xlen_t(1) << (j0 + k - 1);
-      const Level& u = lv[k - 1];
-      if (k > 1 && u.prod < p + len + 2 * m) continue;  // input not ready
-      if (k < nl && lv[k + 1].prod < lv[k + 1].hi &&
-          p + len - lv[k + 1].prod > v.R)
-        continue;  // its reader still needs the values this tile would replace
-      const int j = j0 + k;
-      const R_xlen_t q1 = std::min(b, npts(j) - 1);  // terms end
-      const double h = 0.5 * static_cast<double>(m);
-      for (R_xlen_t i = p; i < p + len;) {
-        R_xlen_t l = std::min(p + len - i, v.run(i));
-        l = std::min(l, u.run(i));
-        l = std::min(l, u.run(i + m));
-        l = std::min(l, u.run(i + 2 * m));
-        const R_xlen_t i0 = u.pos(i), i1 = u.pos(i + m), i2 = u.pos(i + 2 * m);
-        double* os = v.S + v.pos(i);
-        double* oe = v.E + v.pos(i);
-        const R_xlen_t nsq = std::max<R_xlen_t>(0, std::min(l, q1 - i));
-        sq[j] += u.S == nullptr
-                     ? double_level<true>(nullptr, nullptr, nullptr, u.E + i0,
-                                          u.E + i1, u.E + i2, h, l, nsq, os, oe)
-                     : double_level<false>(u.S + i0, u.S + i1, u.S + i2,
-                                           u.E + i0, u.E + i1, u.E + i2, h, l,
-                                           nsq, os, oe);
-        if (k == nl && S1 != nullptr) {
-          const R_xlen_t w1 = std::min(i + l, b);
-          if (w1 > i) {
-            std::copy(os, os + (w1 - i), S1 + i);
-            std::copy(oe, oe + (w1 - i), E1 + i);
-          }
-        }
-        i += l;
+    if (F[0] < end[0]) {
+      const R_xlen_t t = std::min(end[0], F[0] + kStep);
+      level0(in, c, F[0], t, E + (F[0] - a));
+      // level 0 at F[0] - 1 is still there: level 1 trails by 2
+      double s0 = 0, s1 = 0;
+      const R_xlen_t i1 = std::min(t - 1, q0);
+      R_xlen_t i = std::max(a, F[0] - 1);
+      for (; i + 2 <= i1; i += 2) {
+        const double d0 = E[i - a] - E[i + 1 - a];
+        const double d1 = E[i + 1 - a] - E[i + 2 - a];
+        s0 += d0 * d0;
+        s1 += d1 * d1;
       }
-      v.prod = p + len;
+      if (i < i1) {
+        const double d = E[i - a] - E[i + 1 - a];
+        s0 += d * d;
+      }
+      sq[0] += s0 + s1;
+      F[0] = t;
+      moved = true;
+    }
+    for (int j = 0; j < J; ++j) {
+      const R_xlen_t m = R_xlen_t(1) << j;
+      const R_xlen_t t = std::min(end[j + 1], F[j] - 2 * m);
+      const R_xlen_t f = F[j + 1];
+      if (t <= f) continue;
+      const R_xlen_t p = f - a;
+      const R_xlen_t nsq =
+          std::max<R_xlen_t>(0, std::min(t, std::min(b, O.n(j + 1) - 1)) - f);
+      const double h = 0.5 * static_cast<double>(m);
+      sq[j + 1] +=
+          j == 0 ? double_level<true>(nullptr, nullptr, nullptr, E + p,
+                                      E + p + m, E + p + 2 * m, h, t - f, nsq,
+                                      S + p, E + p)
+                 : double_level<false>(S + p, S + p + m, S + p + 2 * m, E + p,
+                                       E + p + m, E + p + 2 * m, h, t - f,
+                                       nsq, S + p, E + p);
+      F[j + 1] = t;
       moved = true;
     }
     if (!moved) break;
   }
-  for (int k = 1; k <= nl; ++k)
-    if (lv[k].prod < lv[k].hi) throw std::logic_error("pdev: octave levels stalled");
+}
+
+// #{q : r0 + (q mod B) + (q div B) D < n}: the positions of a tile below
+// index n (a prefix, the index growing with q).
+inline R_xlen_t tile_count(R_xlen_t n, R_xlen_t r0, R_xlen_t B, R_xlen_t D) {
+  const R_xlen_t k = n - r0;
+  if (k <= 0) return 0;
+  const R_xlen_t p = k / D;
+  return p * B + std::min(B, k - p * D);
+}
+
+// Levels J + 1 .. K of the tile of residues [r0, r0 + B) (level J in S, E),
+// in place; adds the squares of the terms to sq[j].
+void octave_tile(double* S, double* E, R_xlen_t r0, R_xlen_t B,
+                 const OctaveLayout& O, double* sq) {
+  const R_xlen_t D = R_xlen_t(1) << O.J;
+  for (int j = O.J; j < O.K; ++j) {
+    const R_xlen_t n1 = O.n(j + 1);
+    const R_xlen_t cnt = tile_count(n1, r0, B, D);
+    if (cnt == 0) return;
+    const R_xlen_t nsq = tile_count(n1 - 1, r0, B, D);
+    const R_xlen_t G = B << (j - O.J);
+    const double h = 0.5 * static_cast<double>(R_xlen_t(1) << j);
+    sq[j + 1] += double_level<false>(S, S + G, S + 2 * G, E, E + G, E + 2 * G,
+                                     h, cnt, nsq, S, E);
+  }
 }
 
 // Sums of (2 S_i)^2 for m = 2^j, j = 1..K (sums[j]) and of squared second
-// differences (sums[0]); every level is needed up to K.
+// differences (sums[0]); every level is needed up to K. cap: values per
+// tile of the second stage.
 std::vector<double> octave_sums(const allanvar::PhaseInput& in, int K,
-                                int nw) {
-  const R_xlen_t L = in.length();
+                                int nw, R_xlen_t cap) {
+  OctaveLayout O;
+  O.L = in.length();
+  O.K = K;
+  const R_xlen_t n0 = O.n(0);
   std::vector<double> sums(K + 1, 0.0);
-  const R_xlen_t n0 = L - 1;  // level 0: E_1(i), i < L - 1
-  std::unique_ptr<double[]> Sa, Ea(new double[n0]), Sb, Eb;
   // E_1 centred by the mean increment: any constant would do (S ignores
   // it exactly), so a plain sum is enough; each E_1 is then the rounded
   // exact increment less c
-  double* E = Ea.get();
-  if (in.rate) {
+  double c = 0;
+  {
     double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
     R_xlen_t i = 0;
-    for (; i + 4 <= n0; i += 4) {
-      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
-      a0 += in.v[i];
-      a1 += in.v[i + 1];
-      a2 += in.v[i + 2];
-      a3 += in.v[i + 3];
+    if (in.rate) {
+      for (; i + 4 <= n0; i += 4) {
+        if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
+        a0 += in.v[i];
+        a1 += in.v[i + 1];
+        a2 += in.v[i + 2];
+        a3 += in.v[i + 3];
+      }
     }
-    for (; i < n0; ++i) a0 += in.v[i];
-    const double c = ((a0 + a1) + (a2 + a3)) / static_cast<double>(n0);
-    for (i = 0; i < n0; ++i) {
-      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
-      E[i] = c - in.v[i];
-    }
-  } else {
-    double a0 = 0;
-    for (R_xlen_t i = 0; i < n0; ++i) {
+    for (; i < n0; ++i) {
       if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
       double h, lo;
       in.increment(i, h, lo);
       a0 += h;
     }
-    const double c = a0 / static_cast<double>(n0);
-    for (R_xlen_t i = 0; i < n0; ++i) {
-      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
-      double h, lo, r, re;
-      in.increment(i, h, lo);
-      allanvar::phase_two_sum(h, -c, r, re);
-      E[i] = -(r + (re + lo));
-    }
+    c = ((a0 + a1) + (a2 + a3)) / static_cast<double>(n0);
   }
-  {
-    double s0 = 0, s1 = 0;
-    R_xlen_t i = 0;
-    for (; i + 2 < L - 1; i += 2) {
-      if ((i & 0xFFFFF) == 0 && allanvar::interrupted()) return sums;
-      const double d0 = E[i] - E[i + 1], d1 = E[i + 1] - E[i + 2];
-      s0 += d0 * d0;
-      s1 += d1 * d1;
-    }
-    for (; i < L - 2; ++i) {
-      const double d = E[i] - E[i + 1];
-      s0 += d * d;
-    }
-    sums[0] = s0 + s1;
+  // the second stage: 2^tb tiles of B = 8 residues modulo D = 2^J
+  const R_xlen_t ntile = (n0 + cap - 1) / cap;
+  int tb = 0;
+  while ((R_xlen_t(1) << tb) < ntile) ++tb;
+  O.J = ntile > 1 ? std::min(K, tb + 3) : K;
+  const bool tiles = O.J < K;
+  // the first stage in two parts when long enough (fixed: the sums do not
+  // depend on the number of threads)
+  const int P = n0 >= (R_xlen_t(1) << 16) ? 2 : 1;
+  const R_xlen_t nJ = std::max<R_xlen_t>(0, O.n(O.J));
+  std::vector<R_xlen_t> a(P + 1);
+  for (int p = 0; p <= P; ++p) a[p] = n0 * p / P;
+  const R_xlen_t margin = (R_xlen_t(2) << O.J) + 1;
+  std::vector<allanvar::Scratch> S(P), E(P);
+  std::vector<std::vector<double> > sq(P);
+  for (int p = 0; p < P; ++p) {
+    const R_xlen_t len = std::min(n0, a[p + 1] + margin) - a[p];
+    S[p].resize(len);
+    E[p].resize(len);
+    sq[p].assign(K + 1, 0.0);
   }
-  // groups of levels: kRanges ranges of indices (for threads; fixed, so
-  // that the sums do not depend on the number of threads) while the margin
-  // the group's top level needs (2^(j1+1)) stays small beside each range
-  int j0 = 0;
-  while (j0 < K) {
-    const R_xlen_t n = L - (R_xlen_t(2) << j0) + 1;
-    int j1 = j0 + 1;
-    while (j1 < K && (R_xlen_t(2) << (j1 + 1)) * 8 * kRanges <= n) ++j1;
-    const bool split = (R_xlen_t(2) << j1) * 8 * kRanges <= n;
-    if (!split) j1 = K;
-    const int nr = split ? kRanges : 1;
-    const bool last = j1 == K;
-    if (!last && !Sb) {
-      const R_xlen_t n1 = L - (R_xlen_t(2) << j1) + 1;
-      Sb.reset(new double[n1]);
-      Eb.reset(new double[n1]);
-    }
-    std::vector<std::vector<double> > sq(nr, std::vector<double>(K + 1, 0.0));
-    const R_xlen_t nj = L - (R_xlen_t(2) << (j0 + 1)) + 1;  // level j0 + 1
-    allanvar::parallel_for(nr, nw, [&](R_xlen_t r, int) {
-      const R_xlen_t a = nj * r / nr, b = nj * (r + 1) / nr;
-      octave_wave(Sa.get(), Ea.get(), j0, j1, a, b, L, sq[r].data(),
-                  last ? nullptr : Sb.get(), last ? nullptr : Eb.get());
+  allanvar::parallel_for(P, nw, [&](R_xlen_t p, int) {
+    octave_top(in, c, O, a[p], a[p + 1], S[p].data(), E[p].data(),
+               sq[p].data());
+  });
+  if (allanvar::interrupted()) return sums;
+  for (int p = 0; p < P; ++p)
+    for (int j = 0; j <= O.J; ++j) sums[j] += sq[p][j];
+  if (tiles) {
+    const R_xlen_t D = R_xlen_t(1) << O.J;
+    const R_xlen_t nb = R_xlen_t(1) << tb;
+    const R_xlen_t B = D / nb;
+    std::vector<double> tsq(static_cast<size_t>(nb) * (K + 1), 0.0);
+    const R_xlen_t tlen = tile_count(nJ, 0, B, D);
+    std::vector<allanvar::Scratch> ts(nw), te(nw);
+    allanvar::parallel_for(nb, nw, [&](R_xlen_t k, int w) {
+      const R_xlen_t r0 = k * B;
+      allanvar::Scratch& ST = ts[w];
+      allanvar::Scratch& ET = te[w];
+      if (static_cast<R_xlen_t>(ST.size()) < tlen) {
+        ST.resize(tlen);
+        ET.resize(tlen);
+      }
+      // gather level J's residues [r0, r0 + B) from the parts
+      R_xlen_t q = 0;
+      int p = 0;
+      for (R_xlen_t i = r0; i < nJ; i += D) {
+        for (R_xlen_t g = 0; g < B && i + g < nJ;) {
+          const R_xlen_t x = i + g;
+          while (x >= a[p + 1]) ++p;
+          const R_xlen_t run =
+              std::min(std::min(B - g, nJ - x), a[p + 1] - x);
+          const double* ss = S[p].data() + (x - a[p]);
+          const double* se = E[p].data() + (x - a[p]);
+          std::copy(ss, ss + run, ST.data() + q);
+          std::copy(se, se + run, ET.data() + q);
+          q += run;
+          g += run;
+        }
+      }
+      octave_tile(ST.data(), ET.data(), r0, B, O, tsq.data() + k * (K + 1));
     });
     if (allanvar::interrupted()) return sums;
-    for (int r = 0; r < nr; ++r)
-      for (int j = j0 + 1; j <= j1; ++j) sums[j] += sq[r][j];
-    if (!last) {
-      // the next group reads these; the old arrays take its output (they
-      // are longer than it)
-      Sa.swap(Sb);
-      Ea.swap(Eb);
-      if (!Sb) {
-        Sb.reset(new double[n0]);
-      }
-    }
-    j0 = j1;
+    for (R_xlen_t k = 0; k < nb; ++k)
+      for (int j = O.J + 1; j <= K; ++j) sums[j] += tsq[k * (K + 1) + j];
   }
   for (int j = 1; j <= K; ++j) sums[j] *= 4.0;
   return sums;
 }
 
+// values per tile of the second stage: S and E, 256 KiB, within a core's L2
+const R_xlen_t kTileCap = 16384;
 const R_xlen_t kChunk = 1 << 16;  // terms per parallel item (global kernel)
 const R_xlen_t kBlock = 4096;     // terms per cache block, every tau in turn
 
@@ -459,7 +494,8 @@ const R_xlen_t kBlock = 4096;     // terms per cache block, every tau in turn
 // bound exceeds 1e-13 relative; the doubling recursion for the powers of
 // two when most levels up to the largest are asked for), 1 the blocked
 // kernel, 2 the global one, 3 the doubling recursion for the powers of two
-// (the global kernel for the other m).
+// (the global kernel for the other m), 4 as 3 with tiles of 64 values (to
+// test the splitting on short records).
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
                                   const Rcpp::NumericVector& m, int threads,
@@ -486,7 +522,7 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   // are asked for (method 3: always)
   std::vector<bool> oct(nt, false);
   int K = -1, nask = 0;
-  if (method == 0 || method == 3) {
+  if (method == 0 || method == 3 || method == 4) {
     for (size_t t = 0; t < nt; ++t) {
       const R_xlen_t mm = mv[t];
       if (mm < 1 || (mm & (mm - 1)) != 0) continue;
@@ -495,8 +531,9 @@ Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate,
       K = std::max(K, j);
       ++nask;
     }
-    if (K >= 0 && (method == 3 || 2 * nask >= K + 1)) {
-      const std::vector<double> os = octave_sums(in, K, nw);
+    if (K >= 0 && (method >= 3 || 2 * nask >= K + 1)) {
+      const std::vector<double> os =
+          octave_sums(in, K, nw, method == 4 ? 64 : kTileCap);
       if (allanvar::interrupted()) scope.finish();
       for (size_t t = 0; t < nt; ++t) {
         const R_xlen_t mm = mv[t];

@@ -45,12 +45,17 @@ Rcpp::NumericVector mtie_cpp(const Rcpp::NumericVector& v, bool rate,
                              const Rcpp::NumericVector& m) {
   const allanvar::InterruptScope scope;
   const allanvar::PhaseInput in{v.begin(), v.size(), rate};
-  allanvar::SplitPhase X;
-  allanvar::split_phase(in, X);
   const R_xlen_t L = in.length();
-  std::vector<double> mx(L), mn(L);
-  for (R_xlen_t j = 0; j < L; ++j) {
-    mx[j] = mn[j] = X.value(j) + X.c * static_cast<double>(j);
+  // the phase X(j) + c j (src/local-phase.h), straight into the two tables
+  allanvar::Scratch mx(L), mn(L);
+  if (L > 0) mx[0] = mn[0] = 0.0;
+  {
+    double* px = mx.data();
+    double* pn = mn.data();
+    allanvar::split_phase_each(
+        in, [px, pn](R_xlen_t j, double h, double l, double c) {
+          px[j] = pn[j] = (h + l) + c * static_cast<double>(j);
+        });
   }
   const R_xlen_t nt = m.size();
   Rcpp::NumericVector out(nt, NA_REAL);

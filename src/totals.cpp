@@ -337,8 +337,87 @@ Plan make_plan(R_xlen_t m) {
   return P;
 }
 
+#if defined(__GNUC__)
+using allanvar::v2d;
+using allanvar::ld2;
+inline double hsum(v2d v) { return v[0] + v[1]; }
+#endif
+
+// d = sums over n < nb of T T, T Z, T B, Z Z, Z B, B B
+inline void dots6(const double* T, const double* Z, const double* B,
+                  R_xlen_t nb, double* d) {
+  for (int k = 0; k < 6; ++k) d[k] = 0;
+  R_xlen_t n = 0;
+#if defined(__GNUC__)
+  v2d a[6] = {};
+  for (; n + 2 <= nb; n += 2) {
+    const v2d t = ld2(T + n), z = ld2(Z + n), b = ld2(B + n);
+    a[0] += t * t;
+    a[1] += t * z;
+    a[2] += t * b;
+    a[3] += z * z;
+    a[4] += z * b;
+    a[5] += b * b;
+  }
+  for (int k = 0; k < 6; ++k) d[k] = hsum(a[k]);
+#endif
+  for (; n < nb; ++n) {
+    d[0] += T[n] * T[n];
+    d[1] += T[n] * Z[n];
+    d[2] += T[n] * B[n];
+    d[3] += Z[n] * Z[n];
+    d[4] += Z[n] * B[n];
+    d[5] += B[n] * B[n];
+  }
+}
+
+// d = sums over n < nb of Z zz, B zz, B1 zz, B2 zz, B m1, B1 m1, B m2
+inline void dots7(const double* Z, const double* B, const double* B1,
+                  const double* B2, const double* zz, const double* m1,
+                  const double* m2, R_xlen_t nb, double* d) {
+  for (int k = 0; k < 7; ++k) d[k] = 0;
+  R_xlen_t n = 0;
+#if defined(__GNUC__)
+  v2d a[7] = {};
+  for (; n + 2 <= nb; n += 2) {
+    const v2d q = ld2(zz + n), p = ld2(m1 + n), b = ld2(B + n),
+              b1 = ld2(B1 + n);
+    a[0] += ld2(Z + n) * q;
+    a[1] += b * q;
+    a[2] += b1 * q;
+    a[3] += ld2(B2 + n) * q;
+    a[4] += b * p;
+    a[5] += b1 * p;
+    a[6] += b * ld2(m2 + n);
+  }
+  for (int k = 0; k < 7; ++k) d[k] = hsum(a[k]);
+#endif
+  for (; n < nb; ++n) {
+    d[0] += Z[n] * zz[n];
+    d[1] += B[n] * zz[n];
+    d[2] += B1[n] * zz[n];
+    d[3] += B2[n] * zz[n];
+    d[4] += B[n] * m1[n];
+    d[5] += B1[n] * m1[n];
+    d[6] += B[n] * m2[n];
+  }
+}
+
+inline double dot(const double* x, const double* y, R_xlen_t n) {
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  R_xlen_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += x[i] * y[i];
+    s1 += x[i + 1] * y[i + 1];
+    s2 += x[i + 2] * y[i + 2];
+    s3 += x[i + 3] * y[i + 3];
+  }
+  for (; i < n; ++i) s0 += x[i] * y[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
 struct FastScratch {
-  std::vector<double> Z, ZZ, M1, M2, PE;
+  std::vector<double> Z, ZZ, M1, M2, PE, T, B, B1, B2;
   std::vector<std::vector<double> > LP;  // lags 0, m, 2m
 };
 
@@ -348,80 +427,130 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
                     FastScratch& w) {
   const R_xlen_t n3 = 3 * m, Lz = nb + n3 - 1;
   const R_xlen_t h = n3 / 2;
-  std::vector<double>& Z = w.Z;
-  Z.resize(Lz + 1);
-  Z[0] = 0;
-  for (R_xlen_t i = 0; i < Lz; ++i) Z[i + 1] = Z[i] + z[i];
+  // every prefix array in one pass (independent chains side by side):
+  // Z, and over u <= Lz: ZZ, M1, M2 (sums of u^j Z(u)), PE (every other
+  // index, two zeros first: PE[v + 2] = Z(v) + Z(v - 2) + ...) and the lag
+  // products Z(u) Z(u - c), c = 0, m, 2m
+  w.Z.resize(Lz + 1);
   w.ZZ.resize(Lz + 2);
   w.M1.resize(Lz + 2);
   w.M2.resize(Lz + 2);
-  w.PE.resize(Lz + 1);
-  w.ZZ[0] = w.M1[0] = w.M2[0] = 0;
-  for (R_xlen_t u = 0; u <= Lz; ++u) {
-    const double du = static_cast<double>(u);
-    w.ZZ[u + 1] = w.ZZ[u] + Z[u];
-    w.M1[u + 1] = w.M1[u] + du * Z[u];
-    w.M2[u + 1] = w.M2[u] + du * du * Z[u];
-    w.PE[u] = Z[u] + (u >= 2 ? w.PE[u - 2] : 0.0);
-  }
+  w.PE.resize(Lz + 3);
   w.LP.resize(3);
-  for (int i = 0; i < 3; ++i) {
-    const R_xlen_t c = i * m;
-    std::vector<double>& L = w.LP[i];
-    L.assign(Lz + 2, 0.0);
-    for (R_xlen_t u = 0; u <= Lz; ++u)
-      L[u + 1] = L[u] + (u >= c ? Z[u] * Z[u - c] : 0.0);
+  for (int i = 0; i < 3; ++i) w.LP[i].resize(Lz + 2);
+  {
+    double* Zp = w.Z.data();
+    double* zz = w.ZZ.data();
+    double* m1 = w.M1.data();
+    double* m2 = w.M2.data();
+    double* pe = w.PE.data();
+    double* l0 = w.LP[0].data();
+    double* l1 = w.LP[1].data();
+    double* l2 = w.LP[2].data();
+    Zp[0] = zz[0] = m1[0] = m2[0] = pe[0] = pe[1] = 0;
+    l0[0] = l1[0] = l2[0] = 0;
+    for (R_xlen_t u = 0; u <= Lz; ++u) {
+      if (u < Lz) Zp[u + 1] = Zp[u] + z[u];
+      const double zu = Zp[u], du = static_cast<double>(u);
+      zz[u + 1] = zz[u] + zu;
+      m1[u + 1] = m1[u] + du * zu;
+      m2[u + 1] = m2[u] + du * du * zu;
+      pe[u + 2] = zu + pe[u];
+      l0[u + 1] = l0[u] + zu * zu;
+      l1[u + 1] = l1[u] + (u >= m ? zu * Zp[u - m] : 0.0);
+      l2[u + 1] = l2[u] + (u >= 2 * m ? zu * Zp[u - 2 * m] : 0.0);
+    }
   }
+  const std::vector<double>& Z = w.Z;
   const double* ZZ = w.ZZ.data();
   const double* M1 = w.M1.data();
   const double* M2 = w.M2.data();
   const double bden = static_cast<double>(h) * static_cast<double>(n3 - h);
-  // per window: Z(n), the slope beta_n and T_n, and the merged plan (a
-  // few dozen places of ZZ, M1, M2 and the lag products, at about seven
-  // distinct offsets)
-  double total = 0;
-  const size_t nts = P.ts_off.size();
-  const R_xlen_t* tso = P.ts_off.data();
-  const double* tsw = P.ts_w.data();
-  const size_t no = P.off.size(), nl = P.l_off.size();
-  const R_xlen_t* off = P.off.data();
-  const double *zz = P.zn_z.data(), *z0 = P.b_z0.data(), *z1 = P.b_z1.data(),
-               *z2 = P.b_z2.data(), *m10 = P.b_m10.data(),
-               *m11 = P.b_m11.data(), *m2 = P.b_m2.data();
-  const double* Lp[3] = {w.LP[0].data(), w.LP[1].data(), w.LP[2].data()};
+  // per window: Z(n), the slope beta_n and T_n; the merged plan is a sum
+  // over windows of these (and of beta_n n, beta_n n^2) times a few dozen
+  // places of ZZ, M1, M2 and the lag products at about seven distinct
+  // offsets, so it is summed as dot products over the windows, one pass per
+  // offset (vectorised), and combined with the plan's weights once
+  w.T.resize(nb);
+  w.B.resize(nb);
+  w.B1.resize(nb);
+  w.B2.resize(nb);
+  double* Tn = w.T.data();
+  double* Bn = w.B.data();
+  double* B1 = w.B1.data();
+  double* B2 = w.B2.data();
+  const double q3 = qk(n3 - 1);
   for (R_xlen_t n = 0; n < nb; ++n) {
-    const double zn = Z[n];
     const double beta =
         ((Z[n + n3] - Z[n + n3 - h]) - (Z[n + h] - Z[n])) / bden;
-    const double T = (Z[n + n3] - zn) - beta * qk(n3 - 1);
-    double v = 0;
-    for (size_t k = 0; k < nts; ++k) v += tsw[k] * ZZ[n + tso[k]];
-    double vz = 0, s0 = 0, s1 = 0, s2 = 0, vl = 0;
-    for (size_t k = 0; k < no; ++k) {
-      const double zk = ZZ[n + off[k]], m1k = M1[n + off[k]];
-      vz += zz[k] * zk;
-      s0 += m2[k] * M2[n + off[k]] + m10[k] * m1k + z0[k] * zk;
-      s1 += m11[k] * m1k + z1[k] * zk;
-      s2 += z2[k] * zk;
-    }
-    for (size_t k = 0; k < nl; ++k) vl += P.l_w[k] * Lp[P.l_lag[k]][n + P.l_off[k]];
     const double dn = static_cast<double>(n);
-    total += T * (P.tt * T + (v - P.ts_c1 * zn - P.ts_c2 * beta)) + vl +
-             zn * (vz + P.czz * zn + P.cbz * beta) +
-             beta * ((s0 + dn * (s1 + dn * s2)) + P.cbb * beta);
+    Bn[n] = beta;
+    B1[n] = beta * dn;
+    B2[n] = B1[n] * dn;
+    Tn[n] = (Z[n + n3] - Z[n]) - beta * q3;
   }
-  // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t)
+  const double* Zn = Z.data();
+  double total = 0;
+  {
+    // the per-window quadratic terms
+    double d[6];
+    dots6(Tn, Zn, Bn, nb, d);
+    total += P.tt * d[0] - P.ts_c1 * d[1] - P.ts_c2 * d[2] + P.czz * d[3] +
+             P.cbz * d[4] + P.cbb * d[5];
+  }
+  for (size_t k = 0; k < P.ts_off.size(); ++k)
+    total += P.ts_w[k] * dot(Tn, ZZ + P.ts_off[k], nb);
+  for (size_t k = 0; k < P.off.size(); ++k) {
+    const double* zo = ZZ + P.off[k];
+    const double* m1o = M1 + P.off[k];
+    const double* m2o = M2 + P.off[k];
+    double d[7];
+    dots7(Zn, Bn, B1, B2, zo, m1o, m2o, nb, d);
+    total += P.zn_z[k] * d[0] + P.b_z0[k] * d[1] + P.b_z1[k] * d[2] +
+             P.b_z2[k] * d[3] + P.b_m10[k] * d[4] + P.b_m11[k] * d[5] +
+             P.b_m2[k] * d[6];
+  }
+  for (size_t k = 0; k < P.l_off.size(); ++k) {
+    const double* lp = w.LP[P.l_lag[k]].data() + P.l_off[k];
+    double s0 = 0, s1 = 0;
+    R_xlen_t n = 0;
+    for (; n + 2 <= nb; n += 2) {
+      s0 += lp[n];
+      s1 += lp[n + 1];
+    }
+    if (n < nb) s0 += lp[n];
+    total += P.l_w[k] * (s0 + s1);
+  }
+  // anti-diagonal sums: sum_n sum_{t in [a,b]} Z(n+t+1) Z(n+e+1-t) =
+  // sum_u Z(u) (Z(v0) + Z(v0 + 2) + ... + Z(v1)), n = u - 1 - t in
+  // [lo, hi] = [max(0, u - 1 - b), min(nb - 1, u - 1 - a)], v = 2n + e + 2 - u:
+  // both ends linear in u between the cuts u = b + 1 and u = nb + a + 1
   const double* PE = w.PE.data();
+  const double* Zd = Z.data();
   for (const PlanItem& it : P.items) {
     if (it.kind != ITEM_ANTI) continue;
     const R_xlen_t a = it.a, b = it.b, e = it.c;
+    const R_xlen_t u_end = nb + b + 1;
+    R_xlen_t cuts[4] = {a + 1, std::min(b + 1, u_end), std::min(nb + a + 1, u_end),
+                        u_end};
+    if (cuts[1] > cuts[2]) std::swap(cuts[1], cuts[2]);
     double s = 0;
-    for (R_xlen_t u = a + 1; u <= nb + b; ++u) {
-      const R_xlen_t lo = std::max<R_xlen_t>(0, u - 1 - b);
-      const R_xlen_t hi = std::min<R_xlen_t>(nb - 1, u - 1 - a);
-      if (lo > hi) continue;
-      const R_xlen_t v0 = 2 * lo + e + 2 - u, v1 = 2 * hi + e + 2 - u;
-      s += Z[u] * (PE[v1] - (v0 >= 2 ? PE[v0 - 2] : 0.0));
+    for (int g = 0; g < 3; ++g) {
+      const R_xlen_t u0 = std::max(cuts[g], a + 1), u1 = cuts[g + 1];
+      if (u0 >= u1) continue;
+      // lo = 0 below u = b + 1, hi = u - 1 - a up to u = nb + a
+      const bool lo0 = u0 <= b, hil = u0 <= nb + a;
+      // PE[v1 + 2] - PE[v0] with v0 = k0 + d0 u, v1 + 2 = k1 + d1 u
+      const R_xlen_t k0 = lo0 ? e + 2 : e - 2 * b, d0 = lo0 ? -1 : 1;
+      const R_xlen_t k1 = hil ? e - 2 * a + 2 : 2 * nb + e + 2, d1 = hil ? 1 : -1;
+      double s0 = 0, s1 = 0;
+      R_xlen_t u = u0;
+      for (; u + 2 <= u1; u += 2) {
+        s0 += Zd[u] * (PE[k1 + d1 * u] - PE[k0 + d0 * u]);
+        s1 += Zd[u + 1] * (PE[k1 + d1 * (u + 1)] - PE[k0 + d0 * (u + 1)]);
+      }
+      if (u < u1) s0 += Zd[u] * (PE[k1 + d1 * u] - PE[k0 + d0 * u]);
+      s += s0 + s1;
     }
     total += it.coef * s;
   }
@@ -468,6 +597,11 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     if (allanvar::interrupted()) scope.finish();
     if (fast[t] && mm >= 1) plans[t] = make_plan(mm);
   }
+  // the phase once, split hi + lo, for the closed form's sub-blocks
+  allanvar::SplitPhase X;
+  bool any_fast = false;
+  for (const Item& I : items) any_fast = any_fast || fast[I.tau];
+  if (any_fast) allanvar::split_phase(in, X);
   allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nw,
                          [&](R_xlen_t it, int w) {
     const Item& I = items[it];
@@ -481,7 +615,7 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
         const R_xlen_t nsub = std::min(I.n1 - b0, 4 * mm);
         const R_xlen_t len = nsub + 3 * mm - (hadamard ? 0 : 1);
         sc.r.resize(len);
-        allanvar::local_phase(in, b0, len, sc.r.data());
+        allanvar::local_from_split(X, b0, len, sc.r.data());
         if (hadamard) {
           // frequency, with its least-squares line removed: each window's
           // own line absorbs it (HTOT ignores a linear frequency term), and

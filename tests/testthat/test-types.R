@@ -334,6 +334,10 @@ test_that("PDEV's doubling recursion (octave m) equals the other kernels", {
     # the same sums whatever the number of threads, and chosen by default
     expect_identical(pdev_sums_cpp(x, FALSE, m, 1L, 3L), octave, label = nm)
     expect_identical(pdev_sums_cpp(x, FALSE, m, 2L, 0L), octave, label = nm)
+    # tiles of 64 values (many residue blocks, short records): the same
+    # values, the squares summed in another order
+    expect_lt(max(abs(pdev_sums_cpp(x, FALSE, m, 1L, 4L) / octave - 1)),
+              1e-13, label = nm)
     y <- diff(x)
     expect_lt(max(abs(pdev_sums_cpp(y, TRUE, m, 2L, 3L) / blocked - 1)),
               1e-10, label = nm)
@@ -343,6 +347,22 @@ test_that("PDEV's doubling recursion (octave m) equals the other kernels", {
   mm <- c(2, 64, 4096, 8192)
   ref <- vapply(mm, function(k) ref_pvar(x, k) * (N - 2 * k) * k^6 / 18, 0)
   expect_lt(max(abs(pdev_sums_cpp(x, FALSE, mm, 2L, 3L) / ref - 1)), 1e-12)
+})
+
+test_that("PDEV's octave kernel in two parts (long records) equals the others", {
+  # from 2^16 points the first levels run in two parts, each with the
+  # margin past its end that its upper levels read (src/pdev.cpp)
+  set.seed(19)
+  N <- 70001
+  m <- 2^(0:14)
+  for (x in list(cumsum(rnorm(N)), rnorm(N) + 1e-4 * (1:N))) {
+    blocked <- pdev_sums_cpp(x, FALSE, m, 2L, 1L)
+    octave <- pdev_sums_cpp(x, FALSE, m, 2L, 3L)
+    expect_lt(max(abs(octave / blocked - 1)), 1e-10)
+    expect_identical(pdev_sums_cpp(x, FALSE, m, 1L, 3L), octave)
+    expect_lt(max(abs(pdev_sums_cpp(x, FALSE, m, 1L, 4L) / octave - 1)),
+              1e-13)
+  }
 })
 
 test_that("PDEV keeps its digits on long random-walk records", {
