@@ -2,11 +2,13 @@
 # rate random walk K + Gauss-Markov sigma, tc; 100 Hz; 1e5 and 1e6
 # samples)? Prints, from one run:
 #  1. the Cramer-Rao bound of each parameter (relative SD of an unbiased
-#     estimator, = SD of the log-parameter), (a) Whittle's approximation on
-#     the first differences with the exact discrete-time PSDs and (b) exact:
-#     the covariance of the score of the exact Gaussian likelihood at the
-#     true parameters, by Monte Carlo (E[score score'] = Fisher information),
-#     with a bootstrap 95% range;
+#     estimator, = SD of the log-parameter): (a) Whittle's approximation on
+#     the first differences with the exact discrete-time PSDs, (b) exact:
+#     the expected Fisher information of the exact Gaussian likelihood,
+#     computed through the Kalman filter, and (c) a Monte Carlo check of
+#     (b): the covariance of the score at the true parameters over
+#     simulated series (E[score score'] = Fisher information), with a
+#     bootstrap 95% range;
 #  2. the exact Gaussian maximum-likelihood estimator of the rate series
 #     (Kalman filter, bench/gmwm-mle.cpp) next to allanvar's avfit(allan())
 #     and GMWM (CRAN simts) on bench-gmwm.R's generator and seeds: relative
@@ -112,8 +114,73 @@ crb_whittle <- function(p, n) {
   }, numeric(length(w)))
   100 * sqrt(diag(solve(0.5 * crossprod(G))))
 }
-# exact: Monte Carlo of the score (central differences in log parameters)
-crb_exact <- function(p, n, S) {
+# Exact expected information of the likelihood of y_2..y_n given y_1
+# (Harvey 1989, sec. 3.4.6):
+#   I_ij = sum_t [ dF_i dF_j / (2 F_t^2) + E(dv_i dv_j) / F_t ],
+# F_t, v_t the innovation variance and innovation, d the derivative in the
+# log parameters. F_t and the gain are deterministic (derivatives by central
+# differences of the covariance recursion run at +-h); dv = -Z da, and the
+# predicted state's derivatives da_t are linear in the noise, so E(dv dv')
+# comes from the covariance of the stacked linear system
+#   x_t = (filter error e_t (2), GM state g_t, da_t for 4 parameters (8)),
+#   e_{t+1} = (T - G Z) e_t + eta_t - G eps_t,  g_{t+1} = phi g_t + eta_g,
+#   da_{t+1} = dT (g_t - e_g,t) + (T - G Z) da_t + dG (Z e_t + eps_t),
+# started after y_1 (da = 0, e = (-g_1 - eps_1, g_1) predicted one step).
+# Once the filter and the stacked covariance are stationary the remaining
+# steps add the same increment. Cov(e_t) = P_t is checked on the way.
+crb_kalman <- function(p, n, h = 1e-5) {
+  L <- matrix(log(p), 9L, 4L, byrow = TRUE)
+  for (j in 1:4) L[2 * j, j] <- L[2 * j, j] + h; for (j in 1:4) L[2 * j + 1, j] <- L[2 * j + 1, j] - h
+  P <- exp(L)  # row 1: p; rows 2j, 2j+1: parameter j at +-h
+  R <- P[, 1]^2 / tau0; qr <- P[, 2]^2 * tau0; s2 <- P[, 3]^2
+  phi <- exp(-tau0 / P[, 4]); qg <- s2 * (1 - phi^2); ph <- phi[1]
+  Prr <- s2 + R + qr; Prg <- -phi * s2; Pgg <- s2  # predicted P_2
+  dphi <- c(0, 0, 0, ph * tau0 / p[[4]])
+  Sig <- matrix(0, 11, 11)
+  Sig[1:3, 1:3] <- matrix(c(Prr[1], Prg[1], Prg[1], Prg[1], s2[1], s2[1], Prg[1], s2[1], s2[1]), 3)
+  W <- diag(c(qr[1], qg[1], R[1]))
+  rows <- lapply(1:4, function(j) 3 + 2 * j - 1:0)
+  up <- 2 * (1:4); dn <- up + 1
+  I <- matrix(0, 4, 4); inc_old <- NULL; dev <- 0
+  for (t in 2:n) {
+    kr <- Prr + Prg; kg <- Prg + Pgg
+    F <- kr + kg + R
+    Gr <- kr / F; Gg <- phi * kg / F
+    dF <- (F[up] - F[dn]) / (2 * h)
+    dGr <- (Gr[up] - Gr[dn]) / (2 * h); dGg <- (Gg[up] - Gg[dn]) / (2 * h)
+    ZS <- matrix(0, 4, 4)
+    for (i in 1:4) for (j in i:4) ZS[i, j] <- ZS[j, i] <- sum(Sig[rows[[i]], rows[[j]]])
+    inc <- outer(dF, dF) / (2 * F[1]^2) + ZS / F[1]
+    I <- I + inc
+    if (t %% 1000 == 0) {
+      dev <- max(dev, abs(Sig[1, 1] / Prr[1] - 1), abs(Sig[2, 2] / Pgg[1] - 1))
+      if (!is.null(inc_old) && max(abs(inc - inc_old) / sqrt(outer(diag(inc), diag(inc)))) < 1e-10) {
+        I <- I + inc * (n - t)
+        break
+      }
+      inc_old <- inc
+    }
+    TGZ <- matrix(c(1 - Gr[1], -Gg[1], -Gr[1], ph - Gg[1]), 2)
+    A <- matrix(0, 11, 11); B <- matrix(0, 11, 3)
+    A[1:2, 1:2] <- TGZ; A[3, 3] <- ph
+    B[1, 1] <- 1; B[2, 2] <- 1; B[3, 2] <- 1; B[1:2, 3] <- -c(Gr[1], Gg[1])
+    for (j in 1:4) {
+      r <- rows[[j]]
+      A[r, 1:2] <- c(dGr[j], dGg[j])
+      A[r[2], 3] <- dphi[j]; A[r[2], 2] <- A[r[2], 2] - dphi[j]
+      A[r, r] <- TGZ
+      B[r, 3] <- c(dGr[j], dGg[j])
+    }
+    Sig <- A %*% Sig %*% t(A) + B %*% W %*% t(B)
+    fr <- Prr - kr^2 / F; fg <- Prg - kr * kg / F; fgg <- Pgg - kg^2 / F
+    Prr <- fr + qr; Prg <- phi * fg; Pgg <- phi^2 * fgg + qg
+  }
+  stopifnot(dev < 1e-8)  # the stacked system reproduces the filter's P
+  100 * sqrt(diag(solve(I)))
+}
+
+# Monte Carlo check of the exact bound: covariance of the score (central differences in log parameters)
+crb_score <- function(p, n, S) {
   sc <- t(vapply(seq_len(S), function(s) {
     y <- composite_series(n, 500000L + s, p, tau0)
     vapply(1:4, function(j) {
@@ -136,13 +203,14 @@ for (sc in names(scenarios)) {
   for (k in 1:2) {
     n <- c(1e5, 1e6)[k]
     w <- crb_whittle(truth, n)
-    ex <- crb_exact(truth, n, score_seeds[k])
+    kb <- crb_kalman(truth, n)
+    ex <- crb_score(truth, n, score_seeds[k])
+    cell <- function(j) c(signif(w[j], 3), signif(kb[j], 3), signif(ex["est", j], 3),
+                          sprintf("%.3g-%.3g", ex["lo", j], ex["hi", j]))
     crb[[length(crb) + 1L]] <- data.frame(
-      scenario = sc, n = n, bound = c("whittle", sprintf("exact (%d seeds)", score_seeds[k]), "exact 95% range"),
-      N = c(signif(w[1], 3), signif(ex["est", 1], 3), sprintf("%.3g-%.3g", ex["lo", 1], ex["hi", 1])),
-      K = c(signif(w[2], 3), signif(ex["est", 2], 3), sprintf("%.3g-%.3g", ex["lo", 2], ex["hi", 2])),
-      sigma = c(signif(w[3], 3), signif(ex["est", 3], 3), sprintf("%.3g-%.3g", ex["lo", 3], ex["hi", 3])),
-      tc = c(signif(w[4], 3), signif(ex["est", 4], 3), sprintf("%.3g-%.3g", ex["lo", 4], ex["hi", 4])))
+      scenario = sc, n = n,
+      bound = c("whittle", "exact", sprintf("score MC (%d seeds)", score_seeds[k]), "score MC 95% range"),
+      N = cell(1), K = cell(2), sigma = cell(3), tc = cell(4))
     E <- array(NA_real_, c(seeds[k], 4L, 3L), list(NULL, pn, c("allanvar", "mle", "gmwm")))
     tm <- matrix(NA_real_, seeds[k], 3L)
     for (s in seq_len(seeds[k])) {
