@@ -238,6 +238,7 @@ for (sc in names(scenarios)) {
   cat(sprintf("%s: N = %g, K = %g, GM sigma = %g, tc = %g s; %g Hz\n", sc,
               tr[["N"]], tr[["K"]], tr[["sigma"]], tr[["tc"]], freq))
 }
+options(width = 200)
 cat("\nCramer-Rao bound: relative SD of an unbiased estimator, percent\n")
 print(do.call(rbind, crb), row.names = FALSE)
 out <- do.call(rbind, err)
@@ -245,6 +246,5 @@ out[pn] <- lapply(out[pn], function(v) signif(v, 3))
 out$median_s <- signif(out$median_s, 3)
 out <- out[order(out$scenario, out$n, match(out$stat, unique(out$stat)),
                  match(out$method, c("allanvar", "mle", "gmwm"))), ]
-options(width = 200)
 cat("\nEstimates against truth (K_lt_1pct: fits with K below 1% of the truth, i.e. at 0)\n")
 print(out, row.names = FALSE)
