@@ -101,6 +101,10 @@ mcap_imu <- function(buf, op, off, len, ids, enc) {
     .Call(`_allanvar_mcap_imu`, buf, op, off, len, ids, enc)
 }
 
+mle_kalman_sums <- function(y, R, T, Q, P0, diffuse) {
+    .Call(`_allanvar_mle_kalman_sums`, y, R, T, Q, P0, diffuse)
+}
+
 pdev_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads, method)
 }

@@ -65,6 +65,12 @@
 #   proposed_only  TRUE when the loop tries the entry only where the raw
 #                 data propose it (its parameters are measured, not
 #                 searched: a tabulated band spectrum)
+#   statespace(amp, nl, tau0)  the term's part of a linear Gaussian
+#                 state-space model of the sampled rate (avmle()): a list
+#                 with any of R (measurement-noise variance), and per state
+#                 T (transition coefficient), Q (innovation variance), P0
+#                 (start variance, Inf for a diffuse start); NULL when the
+#                 term has none
 #   admissible(par, tau, freq)  NULL when a fitted instance is a valid
 #                 instance of this effect on this curve, else the reason it
 #                 is not (a sub-sample GM is a filter; a sinusoid outside
@@ -144,7 +150,8 @@ new_effect <- function(name, title, params, component = "av",
                        peak_tau = NULL, reading = NULL, fold = NULL,
                        discrete = NULL, describe = NULL, detect = NULL,
                        remove = NULL, replaces = character(),
-                       admissible = NULL, proposed_only = FALSE) {
+                       admissible = NULL, proposed_only = FALSE,
+                       statespace = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -155,7 +162,7 @@ new_effect <- function(name, title, params, component = "av",
        reading = reading, fold = fold, discrete = discrete,
        describe = describe, detect = detect, remove = remove,
        replaces = replaces, admissible = admissible,
-       proposed_only = proposed_only)
+       proposed_only = proposed_only, statespace = statespace)
 }
 
 validate_effect <- function(e) {
@@ -189,7 +196,8 @@ validate_effect <- function(e) {
   fun_ok <- function(f) is.null(f) || is.function(f)
   for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
               "nl_range", "nl_bounds", "trace", "propose", "evidence", "peak_tau",
-              "discrete", "describe", "detect", "remove", "admissible")) {
+              "discrete", "describe", "detect", "remove", "admissible",
+              "statespace")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
   if (!is.null(e$variants) && !is.function(e$variants)) {

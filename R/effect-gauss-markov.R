@@ -112,6 +112,11 @@ effect_gauss_markov <- function() {
     psd = function(f, nl) 2 * nl[["tc"]] / (1 + (2 * pi * f * nl[["tc"]])^2),
     acf = function(h, tau0, nl) exp(-abs(h) * tau0 / nl[["tc"]]),
     sim = function(n, tau0, amp, nl) sim_gm(n, tau0, amp[[1L]], nl[["tc"]]),
+    # AR(1) from its stationary law
+    statespace = function(amp, nl, tau0) {
+      phi <- exp(-tau0 / nl[["tc"]])
+      list(T = phi, Q = amp[[1L]]^2 * (1 - phi^2), P0 = amp[[1L]]^2)
+    },
     # random-walk-like well below Tc, flicker-like around it, white above
     edf_alpha = function(tau, tau0, nl) {
       tc <- nl[["tc"]]

@@ -67,6 +67,7 @@ effect_white <- function() {
     psd = function(f, nl) rep(1, length(f)),
     acf = function(h, tau0, nl) ifelse(h == 0, 1 / tau0, 0),
     sim = function(n, tau0, amp, nl) stats::rnorm(n, sd = amp[[1L]] / sqrt(tau0)),
+    statespace = function(amp, nl, tau0) list(R = amp[[1L]]^2 / tau0),
     edf_alpha = function(tau, tau0, nl) rep(0, length(tau)),
     trace = trace_edge("short", -0.5, "N", basis),
     evidence = evidence_noise_id(0),
@@ -193,6 +194,8 @@ effect_random_walk <- function() {
     basis = basis,
     psd = function(f, nl) 1 / (2 * pi * f)^2,
     sim = function(n, tau0, amp, nl) cumsum(stats::rnorm(n, sd = amp[[1L]] * sqrt(tau0))),
+    # the walk's level (the sensor's bias) is unknown: a diffuse start
+    statespace = function(amp, nl, tau0) list(T = 1, Q = amp[[1L]]^2 * tau0, P0 = Inf),
     edf_alpha = function(tau, tau0, nl) rep(-2, length(tau)),
     trace = trace_edge("long", 0.5, "K", basis),
     evidence = evidence_noise_id(-2),

@@ -48,6 +48,12 @@ fit_allanvar <- function(x) {
   cf <- coef(f)
   c(N = cf[["N"]], K = cf[["K"]], sigma = cf[["gm1.sigma"]], tc = cf[["gm1.tc"]])
 }
+# the exact likelihood of the raw series (avmle(); its Cramer-Rao bounds in
+# bench/gmwm-mle.R)
+fit_mle <- function(x) {
+  cf <- coef(avmle(x, freq, terms = c("N", "K", "gm")))
+  c(N = cf[["N"]], K = cf[["K"]], sigma = cf[["gm1.sigma"]], tc = cf[["gm1.tc"]])
+}
 
 # simts works per sample: WN sigma2 = N^2 / tau0; RW gamma2 = K^2 tau0;
 # AR1 (phi, innovation variance s2): sigma^2 = s2 / (1 - phi^2),
@@ -88,25 +94,27 @@ for (sc in names(scenarios)) {
 truth <- scenarios[[sc]]
 for (k in 1:2) {
   n <- c(1e5, 1e6)[k]
-  ea <- eg <- matrix(NA_real_, seeds[k], 4L, dimnames = list(NULL, names(truth)))
-  ta <- tg <- numeric(seeds[k])
+  ea <- eg <- em <- matrix(NA_real_, seeds[k], 4L, dimnames = list(NULL, names(truth)))
+  ta <- tg <- tm <- numeric(seeds[k])
   for (s in seq_len(seeds[k])) {
     x <- gen(n, 1000L * k + s)
     ta[s] <- system.time(ea[s, ] <- fit_allanvar(x))[["elapsed"]]
+    tm[s] <- system.time(em[s, ] <- fit_mle(x))[["elapsed"]]
     tg[s] <- system.time(eg[s, ] <- tryCatch(fit_gmwm(x),
                                              error = function(e) rep(NA_real_, 4L)))[["elapsed"]]
   }
   ok <- stats::complete.cases(eg)
   rows[[length(rows) + 1L]] <- data.frame(
-    scenario = sc, n = n, method = c("allanvar", "gmwm"), seeds = c(seeds[k], sum(ok)),
-    rbind(rel_rmse(ea), rel_rmse(eg[ok, , drop = FALSE])),
-    median_s = c(median(ta), median(tg)), check.names = FALSE)
+    scenario = sc, n = n, method = c("allanvar", "allanvar mle", "gmwm"),
+    seeds = c(seeds[k], seeds[k], sum(ok)),
+    rbind(rel_rmse(ea), rel_rmse(em), rel_rmse(eg[ok, , drop = FALSE])),
+    median_s = c(median(ta), median(tm), median(tg)), check.names = FALSE)
   mdae[[length(mdae) + 1L]] <- data.frame(
-    scenario = sc, n = n, method = c("allanvar", "gmwm"),
-    rbind(rel_mdae(ea), rel_mdae(eg[ok, , drop = FALSE])), check.names = FALSE)
+    scenario = sc, n = n, method = c("allanvar", "allanvar mle", "gmwm"),
+    rbind(rel_mdae(ea), rel_mdae(em), rel_mdae(eg[ok, , drop = FALSE])), check.names = FALSE)
   bias[[length(bias) + 1L]] <- data.frame(
-    scenario = sc, n = n, method = c("allanvar", "gmwm"),
-    rbind(rel_mean(ea), rel_mean(eg[ok, , drop = FALSE])), check.names = FALSE)
+    scenario = sc, n = n, method = c("allanvar", "allanvar mle", "gmwm"),
+    rbind(rel_mean(ea), rel_mean(em), rel_mean(eg[ok, , drop = FALSE])), check.names = FALSE)
 }
 }
 out <- do.call(rbind, rows)

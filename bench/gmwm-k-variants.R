@@ -3,7 +3,9 @@
 # the same generator and seeds. A record of what does and does not move the
 # relative RMSE of K (issue 9), not package code: the alternatives are
 # written here, on the exact second-moment structure of the overlapping AV
-# estimator for the N + K + GM model.
+# estimator for the N + K + GM model. The Cramer-Rao bounds of the same
+# cases and the exact maximum-likelihood estimator of the raw series (the
+# best an unbiased estimator can do) are in bench/gmwm-mle.R.
 #
 #   R CMD INSTALL --preclean . && Rscript bench/gmwm-k-variants.R [seeds] [n] [K] [extend]
 #

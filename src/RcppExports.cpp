@@ -321,6 +321,22 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// mle_kalman_sums
+Rcpp::NumericVector mle_kalman_sums(Rcpp::NumericVector y, double R, Rcpp::NumericVector T, Rcpp::NumericVector Q, Rcpp::NumericVector P0, int diffuse);
+RcppExport SEXP _allanvar_mle_kalman_sums(SEXP ySEXP, SEXP RSEXP, SEXP TSEXP, SEXP QSEXP, SEXP P0SEXP, SEXP diffuseSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::RNGScope rcpp_rngScope_gen;
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type y(ySEXP);
+    Rcpp::traits::input_parameter< double >::type R(RSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type T(TSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type Q(QSEXP);
+    Rcpp::traits::input_parameter< Rcpp::NumericVector >::type P0(P0SEXP);
+    Rcpp::traits::input_parameter< int >::type diffuse(diffuseSEXP);
+    rcpp_result_gen = Rcpp::wrap(mle_kalman_sums(y, R, T, Q, P0, diffuse));
+    return rcpp_result_gen;
+END_RCPP
+}
 // pdev_sums_cpp
 Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -600,6 +616,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
     {"_allanvar_mcap_chunk_raw", (DL_FUNC) &_allanvar_mcap_chunk_raw, 3},
     {"_allanvar_mcap_imu", (DL_FUNC) &_allanvar_mcap_imu, 6},
+    {"_allanvar_mle_kalman_sums", (DL_FUNC) &_allanvar_mle_kalman_sums, 6},
     {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 5},
     {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
     {"_allanvar_int64_rel_seconds", (DL_FUNC) &_allanvar_int64_rel_seconds, 3},

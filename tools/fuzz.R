@@ -275,6 +275,10 @@ fuzz_cases <- function(quick = FALSE) {
   add("avfit", "constant series", q(avfit(allan(rep(1, 1000), 100))))
   add("avfit", "dup channel names", q(avfit(allan(cbind(a = x, a = rev(x)), 100))))
   add("avfit", "unknown term", q(avfit(av, terms = "Z")))
+  sub_arg("avmle", q(avmle(x = x, freq = 100, terms = c("N", "K"))),
+          c("x", "freq", "terms", "start"))
+  add("avmle", "term without a state-space form", q(avmle(x, 100, terms = c("N", "B"))))
+  add("avmle", "constant series", q(avmle(rep(1, 1000), 100, terms = c("N", "K"))))
   sub_arg("avfit_control", q(avfit_control()), c("tol", "maxit", "cycles"))
   sub_arg("as_av_curve", q(as_av_curve(av = av)), c("av", "n", "freq", "type", "channel"))
   add("as_av_curve", "df negative avar", q(as_av_curve(data.frame(tau = 1:3, avar = c(1, -1, 1)), n = 100, freq = 1)))
