@@ -10,7 +10,7 @@
 #     simulated series (E[score score'] = Fisher information), with a
 #     bootstrap 95% range;
 #  2. the exact Gaussian maximum-likelihood estimator of the rate series
-#     (Kalman filter, bench/gmwm-mle.cpp) next to allanvar's avfit(allan())
+#     (Kalman filter: the package's kernel, src/mle.cpp) next to allanvar's avfit(allan())
 #     and GMWM (CRAN simts) on bench-gmwm.R's generator and seeds: relative
 #     RMSE, median |error| and mean estimate / truth of every parameter.
 # A record for issue 9 (is GMWM's K error at 1e5 "weak K" reachable by an
@@ -34,7 +34,12 @@ if (!requireNamespace("simts", quietly = TRUE)) {
                           Ncpus = 2L, quiet = TRUE)
 }
 stopifnot(requireNamespace("simts", quietly = TRUE))
-Rcpp::sourceCpp("bench/gmwm-mle.cpp")
+# random walk (diffuse start) + GM (stationary start), white noise R:
+# c(sum log F, sum v^2 / F, count) from the package's Kalman kernel
+kf_sums <- function(y, R, qr, qg, phi) {
+  allanvar:::mle_kalman_sums(y, R, c(1, phi), c(qr, qg),
+                             c(0, qg / (1 - phi^2)), 0L)
+}
 cat(sprintf("simts %s, allanvar %s\n", utils::packageVersion("simts"),
             utils::packageVersion("allanvar")))
 
