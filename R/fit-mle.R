@@ -5,7 +5,8 @@
 #' Kalman filter over the linear state-space form of each term (catalogue
 #' field `statespace`: white noise `N` is measurement noise, the rate random
 #' walk `K` a state with a diffuse start, the sensor's unknown bias, and a
-#' Gauss-Markov term `gm` an AR(1) state started from its stationary law).
+#' Gauss-Markov term `gm` an AR(1) state started from its stationary law;
+#' without `K` a constant level with a diffuse start carries the bias).
 #' One likelihood costs O(n) and a fit a few hundred of them (about a second
 #' at 1e5 samples).
 #'
@@ -38,8 +39,9 @@
 #'   `se` and `vcov` are the maximum-likelihood ones; its curve parts
 #'   (`data`, `chi2`, `components`) compare that model with [allan()]'s
 #'   overlapping curve of `x`. Extra elements: `method = "mle"`, `loglik`
-#'   (the exact log-likelihood of `x[-1]` given `x[1]` when there is a `K`
-#'   term, else of `x`) and `avfit` (the curve fit it started from).
+#'   (the exact log-likelihood of `x[-1]` given `x[1]`: the sensor's bias is
+#'   unknown, a diffuse level, or the random walk's start when there is a
+#'   `K` term) and `avfit` (the curve fit it started from).
 #' @seealso [avfit()], [avsim()]
 #' @export
 #' @examples
@@ -109,6 +111,14 @@ mle_model <- function(p, lay, entries, tau0) {
     T <- c(T, ss$T); Q <- c(Q, ss$Q); P0 <- c(P0, ss$P0)
   }
   diffuse <- which(is.infinite(P0))
+  if (!length(diffuse)) {
+    # the sensor's constant bias, unknown: a diffuse level that never moves
+    # (without it a bias is read as a slow Gauss-Markov process)
+    T <- c(T, 1)
+    Q <- c(Q, 0)
+    P0 <- c(P0, Inf)
+    diffuse <- length(P0)
+  }
   if (length(diffuse) > 1L) {
     abort("`terms`: avmle() takes at most one term with an unknown level ",
           "(a diffuse state such as K).", class = "argument")

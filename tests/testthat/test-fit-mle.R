@@ -35,15 +35,24 @@ test_that("the Kalman likelihood equals the dense Gaussian likelihood of the dif
   m <- allanvar:::mle_model(p, lay, entries, tau0)
   expect_equal(allanvar:::mle_loglik(y, m),
                dense_loglik(y, tau0, 0.012, 2e-3, 0.015, 0.08), tolerance = 1e-10)
-  # without a walk: the plain Gaussian likelihood of y (stationary start)
+  # without a walk the sensor's constant bias is still unknown: a diffuse
+  # level, so again the likelihood of the differences
   lay2 <- allanvar:::coef_layout(c("N", "gm"))
   m2 <- allanvar:::mle_model(p[c("N", "gm1.sigma", "gm1.tc")], lay2, entries[c(1, 3)], tau0)
-  S <- diag(0.012^2 / tau0, 300) + 0.015^2 * exp(-tau0 / 0.08)^abs(outer(1:300, 1:300, "-"))
-  ch <- chol(S)
-  z <- backsolve(ch, y, transpose = TRUE)
   expect_equal(allanvar:::mle_loglik(y, m2),
-               -0.5 * (300 * log(2 * pi) + 2 * sum(log(diag(ch))) + sum(z^2)),
+               dense_loglik(y, tau0, 0.012, 0, 0.015, 0.08), tolerance = 1e-10)
+  expect_equal(allanvar:::mle_loglik(y + 3, m2), allanvar:::mle_loglik(y, m2),
                tolerance = 1e-10)
+})
+
+test_that("a constant bias does not move the fit", {
+  # without the level a bias of 25 sigma was read as a Gauss-Markov term
+  # (sigma 0.50, tc 379 s instead of 0.045, 2.5 s)
+  y <- gen_series(2e4, 0.01, 0.01, 0, 0.02, 0.5, seed = 7)
+  a <- avmle(y, 100, c("N", "gm"))
+  b <- avmle(y + 0.5, 100, c("N", "gm"))
+  expect_equal(coef(b), coef(a), tolerance = 1e-4)
+  expect_lt(abs(coef(a)[["gm1.tc"]] / 0.5 - 1), 0.5)
 })
 
 test_that("avmle() recovers N, K, sigma and tc within 3 Cramer-Rao SDs", {
