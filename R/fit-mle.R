@@ -73,6 +73,12 @@ avmle <- function(x, freq, terms = c("N", "K", "gm"), start = NULL) {
   if (!is.null(start)) p0[names(start)] <- start
   p0 <- mle_start(p0, lay, fit0, tau0, entries)
   model <- function(p) mle_model(p, lay, entries, tau0)
+  if (!is.finite(mle_loglik(x, model(p0)))) {
+    abort("`freq` (", format(freq), " Hz) puts the terms' variances per sample ",
+          "outside double precision; the likelihood cannot be evaluated ",
+          "(give the rate in other units or the sampling frequency in Hz).",
+          class = "argument")
+  }
   est <- mle_optimise(x, p0, lay, model)
   # steps relative to each parameter (an amplitude at 0: to its start)
   H <- tryCatch(stats::optimHess(est$par, function(p) -mle_loglik(x, model(p)),
@@ -161,8 +167,9 @@ mle_optimise <- function(x, p0, lay, model) {
   prof <- function(th) {
     m <- model(unpack(th))
     s <- mle_kalman_sums(x, m$R, m$T, m$Q, m$P0, m$diffuse)
-    list(scale = s[[2]] / s[[3]],
-         ll = -0.5 * (s[[3]] * (log(2 * pi * s[[2]] / s[[3]]) + 1) + s[[1]]))
+    ll <- -0.5 * (s[[3]] * (log(2 * pi * s[[2]] / s[[3]]) + 1) + s[[1]])
+    # a trial point whose variances overflow: worse than any finite one
+    list(scale = s[[2]] / s[[3]], ll = if (is.finite(ll)) ll else -.Machine$double.xmax)
   }
   lower <- lp0[free] - ifelse(lay$role[free] == "amp", log(1e12), log(1e3))
   upper <- lp0[free] + ifelse(lay$role[free] == "amp", log(1e6), log(1e3))

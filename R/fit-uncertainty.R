@@ -52,6 +52,9 @@ pinv <- function(A) {
 pinv_raw <- function(A) {
   # no free parameter (every coefficient fixed): nothing to invert
   if (!length(A)) return(A)
+  # a Jacobian that overflowed (taus or AVs near the limits of double,
+  # e.g. freq = 1e300): no covariance rather than an error from eigen()
+  if (!all(is.finite(A))) return(matrix(NA_real_, nrow(A), ncol(A)))
   e <- eigen((A + t(A)) / 2, symmetric = TRUE)
   d <- e$values
   keep <- d > max(d) * 1e-12

@@ -91,6 +91,11 @@ test_that("avmle() rejects terms without a state-space form and bad input", {
   y <- gen_series(1000, 0.01, 0.01, 1e-3, 0, 1, seed = 1)
   expect_snapshot(error = TRUE, avmle(y, 100, c("N", "B")))
   expect_error(avmle(y, 100, c("N", "B")), class = "allanvar_error_argument")
+  # variances per sample beyond double precision: a clear error, and at the
+  # other extreme no error from the covariance (found by tools/fuzz.R)
+  expect_snapshot(error = TRUE, avmle(y, 1e-300, c("N", "K")))
+  f <- avmle(y, 1e300, c("N", "K"))
+  expect_true(all(coef(f) >= 0 & is.finite(coef(f))))
   expect_error(avmle(y, -1), class = "allanvar_error")
   expect_error(avmle(c(y, NA), 100), class = "allanvar_error")
 })
