@@ -1,5 +1,47 @@
 # EDF, noise identification and confidence intervals of allan().
 
+# Own generators for the Monte Carlo tests of this file: Kasdin & Walter's
+# fractional integration for flicker (applied by FFT), cumsum for random
+# walk, first differences of white or flicker phase for PM.
+mc_gens <- function(N) {
+  flicker <- function(n) {
+    h <- numeric(n)
+    h[1] <- 1
+    for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
+    Re(stats::fft(stats::fft(c(h, rep(0, n))) * stats::fft(c(rnorm(n), rep(0, n))),
+                  inverse = TRUE))[1:n] / (2 * n)
+  }
+  list(wfm = function() rnorm(N), ffm = function() flicker(N),
+       rwfm = function() cumsum(rnorm(N)),
+       wpm = function() diff(rnorm(N + 1)),
+       fpm = function() diff(flicker(N + 1)))
+}
+
+# Coverage of allan()'s intervals by row: the truth is the ensemble mean of
+# the estimate; `keep` selects rows by m, `min_edf` by their median EDF.
+# `alpha`: also the coverage with the EDF of that noise type (Allan types).
+mc_cover <- function(type, gen, reps, keep, alpha = NULL, min_edf = NULL, ...) {
+  res <- lapply(seq_len(reps), function(i) allan(gen(), 1, type = type, ...))
+  ms <- Reduce(intersect, lapply(res, function(a) a$m))
+  get <- function(col) sapply(res, function(a) a[[col]][match(ms, a$m)])
+  av <- get("avar")
+  truth <- sqrt(rowMeans(av))
+  hits <- get("lower") <= truth & truth <= get("upper")
+  k <- keep(ms)
+  if (!is.null(min_edf)) k <- k & apply(get("edf"), 1, stats::median) >= min_edf
+  out <- list(m = ms[k], cov = rowMeans(hits)[k])
+  if (!is.null(alpha)) {
+    L <- attr(res[[1]], "N") + 1
+    e <- allan_edf_direct(type, ms, res[[1]]$n[match(ms, res[[1]]$m)], L,
+                          alpha)
+    ci <- lapply(seq_len(ncol(av)), function(j) allan_ci(av[, j], e, 0.683))
+    h <- sapply(ci, function(c) c$lower) <= truth &
+      truth <= sapply(ci, function(c) c$upper)
+    out$cov_alpha <- rowMeans(h)[k]
+  }
+  out
+}
+
 test_that("Greenhall's EDF and the exact discrete EDF for white rate noise", {
   # NIST SP 1065 / noise-models.md: overlapping AV, m = 1, 1001 phase points:
   # Greenhall gives 782, the exact Gaussian value is 666.
@@ -151,17 +193,7 @@ test_that("68% coverage 0.60-0.76 for white/flicker/RW FM and white/flicker PM",
   on.exit(options(old))
   set.seed(8)
   N <- 1024
-  flicker <- function(n) {
-    h <- numeric(n)
-    h[1] <- 1
-    for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
-    Re(stats::fft(stats::fft(c(h, rep(0, n))) * stats::fft(c(rnorm(n), rep(0, n))),
-                  inverse = TRUE))[1:n] / (2 * n)
-  }
-  gens <- list(wfm = function() rnorm(N), ffm = function() flicker(N),
-               rwfm = function() cumsum(rnorm(N)),
-               wpm = function() diff(rnorm(N + 1)),
-               fpm = function() diff(flicker(N + 1)))
+  gens <- mc_gens(N)
   for (g in names(gens)) {
     res <- lapply(1:300, function(i) allan(gens[[g]](), 1))
     av <- sapply(res, function(a) a$avar)
@@ -238,20 +270,12 @@ test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows), TDEV and TOTDE
   old <- options(allanvar.threads = 1)
   on.exit(options(old))
   set.seed(34)
-  cover <- function(type, gen, reps) {
-    res <- lapply(seq_len(reps), function(i) allan(gen(), 1, type = type))
-    ms <- Reduce(intersect, lapply(res, function(a) a$m))
-    get <- function(col) sapply(res, function(a) a[[col]][match(ms, a$m)])
-    truth <- sqrt(rowMeans(get("avar")))
-    hits <- get("lower") <= truth & truth <= get("upper")
-    keep <- apply(get("edf"), 1, stats::median) >= 3
-    list(m = ms[keep], cov = rowMeans(hits)[keep])
-  }
+  all_m <- function(m) rep(TRUE, length(m))
   for (N in c(512, 256)) {
     gens <- list(wfm = function() rnorm(N), rwfm = function() cumsum(rnorm(N)))
     for (g in names(gens)) {
       if (N == 512) {
-        r <- cover("overlapping", gens[[g]], 400)
+        r <- mc_cover("overlapping", gens[[g]], 400, all_m, min_edf = 3)
         long <- N / r$m < 64
         expect_gte(sum(long), 3)
         expect_true(all(r$cov[long] >= 0.60 & r$cov[long] <= 0.76),
@@ -259,7 +283,7 @@ test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows), TDEV and TOTDE
         next
       }
       for (type in c("tdev", "total")) {
-        r <- cover(type, gens[[g]], 400)
+        r <- mc_cover(type, gens[[g]], 400, all_m, min_edf = 3)
         expect_gte(length(r$cov), 3)
         expect_true(all(r$cov >= 0.60 & r$cov <= 0.76),
                     info = paste(type, g, toString(round(r$cov, 3))))
@@ -267,47 +291,6 @@ test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows), TDEV and TOTDE
     }
   }
 })
-
-# Own generators for the Monte Carlo tests below: Kasdin & Walter's
-# fractional integration for flicker (applied by FFT), cumsum for random
-# walk, first differences of white or flicker phase for PM.
-mc_gens <- function(N) {
-  flicker <- function(n) {
-    h <- numeric(n)
-    h[1] <- 1
-    for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
-    Re(stats::fft(stats::fft(c(h, rep(0, n))) * stats::fft(c(rnorm(n), rep(0, n))),
-                  inverse = TRUE))[1:n] / (2 * n)
-  }
-  list(wfm = function() rnorm(N), ffm = function() flicker(N),
-       rwfm = function() cumsum(rnorm(N)),
-       wpm = function() diff(rnorm(N + 1)),
-       fpm = function() diff(flicker(N + 1)))
-}
-
-# Coverage of allan()'s intervals by row: the truth is the ensemble mean of
-# the estimate; `keep` selects rows by m.
-# `alpha`: also the coverage with the EDF of that noise type (Allan types).
-mc_cover <- function(type, gen, reps, keep, alpha = NULL, ...) {
-  res <- lapply(seq_len(reps), function(i) allan(gen(), 1, type = type, ...))
-  ms <- Reduce(intersect, lapply(res, function(a) a$m))
-  get <- function(col) sapply(res, function(a) a[[col]][match(ms, a$m)])
-  av <- get("avar")
-  truth <- sqrt(rowMeans(av))
-  hits <- get("lower") <= truth & truth <= get("upper")
-  k <- keep(ms)
-  out <- list(m = ms[k], cov = rowMeans(hits)[k])
-  if (!is.null(alpha)) {
-    L <- attr(res[[1]], "N") + 1
-    e <- allan_edf_direct(type, ms, res[[1]]$n[match(ms, res[[1]]$m)], L,
-                          alpha)
-    ci <- lapply(seq_len(ncol(av)), function(j) allan_ci(av[, j], e, 0.683))
-    h <- sapply(ci, function(c) c$lower) <= truth &
-      truth <= sapply(ci, function(c) c$upper)
-    out$cov_alpha <- rowMeans(h)[k]
-  }
-  out
-}
 
 test_that("68% coverage of white and flicker PM where B1 reads a few averaged frequencies", {
   # B1 from <= 16 averaged frequencies reads PM as white FM in 21-60% of
