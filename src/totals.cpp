@@ -17,6 +17,7 @@
 #include "dd.h"
 #include "local-phase.h"
 #include "parallel.h"
+#include "scratch.h"
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -416,9 +417,18 @@ inline double dot(const double* x, const double* y, R_xlen_t n) {
   return (s0 + s1) + (s2 + s3);
 }
 
+// Uninitialised, huge-page backed (src/scratch.h), sized once per call for
+// the largest sub-block: growing std::vectors tau by tau cost as much in
+// copies, zero fills and page faults as the sums themselves at 1e6.
 struct FastScratch {
-  std::vector<double> Z, ZZ, M1, M2, PE, T, B, B1, B2;
-  std::vector<std::vector<double> > LP;  // lags 0, m, 2m
+  allanvar::Scratch r, Z, ZZ, M1, M2, PE, T, B, B1, B2;
+  allanvar::Scratch LP[3];  // lags 0, m, 2m
+  void reserve(R_xlen_t len) {  // a sub-block of len local phase points
+    const std::size_t n = static_cast<std::size_t>(len) + 3;
+    for (allanvar::Scratch* v : {&r, &Z, &ZZ, &M1, &M2, &PE, &T, &B, &B1, &B2,
+                                 &LP[0], &LP[1], &LP[2]})
+      v->resize(n);
+  }
 };
 
 // Sum of Q over windows n in [0, nb) of the local series z (3m values per
@@ -436,7 +446,6 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
   w.M1.resize(Lz + 2);
   w.M2.resize(Lz + 2);
   w.PE.resize(Lz + 3);
-  w.LP.resize(3);
   for (int i = 0; i < 3; ++i) w.LP[i].resize(Lz + 2);
   {
     double* Zp = w.Z.data();
@@ -461,7 +470,7 @@ double block_q_fast(const double* z, R_xlen_t nb, R_xlen_t m, const Plan& P,
       l2[u + 1] = l2[u] + (u >= 2 * m ? zu * Zp[u - 2 * m] : 0.0);
     }
   }
-  const std::vector<double>& Z = w.Z;
+  const allanvar::Scratch& Z = w.Z;
   const double* ZZ = w.ZZ.data();
   const double* M1 = w.M1.data();
   const double* M2 = w.M2.data();
@@ -602,6 +611,14 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   bool any_fast = false;
   for (const Item& I : items) any_fast = any_fast || fast[I.tau];
   if (any_fast) allanvar::split_phase(in, X);
+  R_xlen_t fast_len = 0;  // the longest sub-block's local phase
+  for (const Item& I : items) {
+    if (!fast[I.tau]) continue;
+    const R_xlen_t mm = static_cast<R_xlen_t>(ms[I.tau]);
+    fast_len = std::max(fast_len, std::min(I.n1 - I.n0, 4 * mm) + 3 * mm);
+  }
+  if (fast_len > 0)
+    for (FastScratch& fs : fscratch) fs.reserve(fast_len);
   allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nw,
                          [&](R_xlen_t it, int w) {
     const Item& I = items[it];
@@ -610,31 +627,32 @@ Rcpp::NumericVector total_sums_cpp(const Rcpp::NumericVector& v, bool rate,
     Scratch& sc = scratch[w];
     if (fast[I.tau]) {
       // sub-blocks of 4m windows, each on its own local phase
+      FastScratch& fs = fscratch[w];
       double acc = 0;
       for (R_xlen_t b0 = I.n0; b0 < I.n1; b0 += 4 * mm) {
         const R_xlen_t nsub = std::min(I.n1 - b0, 4 * mm);
         const R_xlen_t len = nsub + 3 * mm - (hadamard ? 0 : 1);
-        sc.r.resize(len);
-        allanvar::local_from_split(X, b0, len, sc.r.data());
+        fs.r.resize(len);
+        allanvar::local_from_split(X, b0, len, fs.r.data());
         if (hadamard) {
           // frequency, with its least-squares line removed: each window's
           // own line absorbs it (HTOT ignores a linear frequency term), and
           // a drift then leaves no large offsets to cancel
           const R_xlen_t nz = len - 1;
-          for (R_xlen_t i = 0; i < nz; ++i) sc.r[i] = sc.r[i + 1] - sc.r[i];
+          for (R_xlen_t i = 0; i < nz; ++i) fs.r[i] = fs.r[i + 1] - fs.r[i];
           const double mid = 0.5 * static_cast<double>(nz - 1);
           double s0 = 0, s1 = 0, s2 = 0;
           for (R_xlen_t i = 0; i < nz; ++i) {
             const double t = static_cast<double>(i) - mid;
-            s0 += sc.r[i];
-            s1 += t * sc.r[i];
+            s0 += fs.r[i];
+            s1 += t * fs.r[i];
             s2 += t * t;
           }
           const double a = s0 / static_cast<double>(nz), b = s2 > 0 ? s1 / s2 : 0;
           for (R_xlen_t i = 0; i < nz; ++i)
-            sc.r[i] -= a + b * (static_cast<double>(i) - mid);
+            fs.r[i] -= a + b * (static_cast<double>(i) - mid);
         }
-        acc += block_q_fast(sc.r.data(), nsub, mm, plans[I.tau], fscratch[w]);
+        acc += block_q_fast(fs.r.data(), nsub, mm, plans[I.tau], fs);
       }
       part[it] = acc;
       return;
