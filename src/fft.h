@@ -19,13 +19,15 @@
 #include <complex>
 #include <cstring>
 #include <deque>
+#include <mutex>
 #include <vector>
 
 namespace allanvar {
 
 using cplx = std::complex<double>;
-// transform buffers: 32 MB each at 2^21 points, huge pages (src/scratch.h)
-using cvec = std::vector<cplx, BigAllocator<cplx> >;
+// transform buffers: 32 MB each at 2^21 points, huge pages and not
+// initialised (src/scratch.h): every user writes all n values it reads
+using cvec = BasicScratch<cplx>;
 
 #if defined(__GNUC__)
 // A complex number as two doubles of an SSE2 vector; x w computed as
@@ -61,16 +63,18 @@ class FFTPlan {
   size_t size() const { return n_; }
   void reset(size_t n) {
     n_ = n;
-    cvec w(n / 2);
+    // the twiddles of each stage contiguous (the stage of half-length h at
+    // offset h - 1), so that a stage reads them in order; the last stage's
+    // are every twiddle, the others every step-th of those
+    w_.resize(n > 1 ? n - 1 : 0);
+    if (n < 2) return;
     const double pi = 3.14159265358979323846;
+    cplx* w = w_.data() + (n / 2 - 1);
     for (size_t j = 0; j < n / 2; ++j) {
       const double a = -2.0 * pi * static_cast<double>(j) / static_cast<double>(n);
       w[j] = cplx(std::cos(a), std::sin(a));
     }
-    // the twiddles of each stage contiguous (the stage of half-length h at
-    // offset h - 1), so that a stage reads them in order
-    w_.resize(n > 1 ? n - 1 : 0);
-    for (size_t half = 1; half < n; half <<= 1) {
+    for (size_t half = 1; half < n / 2; half <<= 1) {
       const size_t step = n / (2 * half);
       for (size_t j = 0; j < half; ++j) w_[half - 1 + j] = w[j * step];
     }
@@ -301,11 +305,13 @@ inline size_t fft_size(size_t need) {
   return n;
 }
 
-// Plans by size, one set per thread of a kernel (a deque: a plan handed out
-// stays valid when later sizes are added).
+// Plans by size, shared by the workers of a kernel: each size's twiddles
+// are computed once per call (a deque: a plan handed out stays valid when
+// later sizes are added; plans are read only once made).
 class FFTPlans {
  public:
   const FFTPlan& get(size_t n) {
+    std::lock_guard<std::mutex> lock(mu_);
     for (const FFTPlan& p : plans_)
       if (p.size() == n) return p;
     plans_.emplace_back(n);
@@ -313,6 +319,7 @@ class FFTPlans {
   }
 
  private:
+  std::mutex mu_;
   std::deque<FFTPlan> plans_;
 };
 
@@ -328,11 +335,11 @@ inline void real_correlation2(const double* a, size_t na, const double* b,
   if (nt2 > 0) need = std::max(need, nb + nt2 - 1);
   const FFTPlan& P = plans.get(fft_size(need));
   const size_t n = P.size();
-  buf.assign(n, cplx(0, 0));
-  for (size_t j = 0; j < na; ++j) buf[j].real(a[j]);
-  for (size_t j = 0; j < nb; ++j) buf[j].imag(b[j]);
+  buf.resize(n);
+  for (size_t j = 0; j < n; ++j)
+    buf[j] = cplx(j < na ? a[j] : 0.0, j < nb ? b[j] : 0.0);
   P.forward_to_br(buf.data());
-  C.resize(n);
+  C.resize(n);  // every value written below
   // in bit-reversed order the partner of frequency f, n - f, of the
   // position p in [2^k, 2^(k+1)) sits at 3 2^k - 1 - p (and 0 at 0)
   auto one = [&](size_t p, size_t q) {
@@ -367,10 +374,12 @@ inline void real_correlation_pair(const double* a1, const double* a2,
                                   cvec& buf, cvec& C) {
   const FFTPlan& P = plans.get(fft_size(std::max(nb, na + nt - 1)));
   const size_t n = P.size();
-  buf.assign(n, cplx(0, 0));
+  buf.resize(n);
   for (size_t j = 0; j < na; ++j) buf[j] = cplx(a1[j], a2[j]);
-  C.assign(n, cplx(0, 0));
+  std::fill(buf.data() + na, buf.data() + n, cplx(0, 0));
+  C.resize(n);
   for (size_t j = 0; j < nb; ++j) C[j] = cplx(b1[j], b2[j]);
+  std::fill(C.data() + nb, C.data() + n, cplx(0, 0));
   P.forward_to_br(buf.data());
   P.forward_to_br(C.data());
   // at position p (partner q, as in real_correlation2): A1 = (X + conj Xq)

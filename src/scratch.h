@@ -7,8 +7,9 @@
 // (madvise(MADV_HUGEPAGE), granted where the system allows them on
 // request, its "madvise" mode): one fault per 2 MiB, 8 MB in 1-1.5 ms.
 // Elsewhere, or when the advice is refused, it is plain memory.
-// Scratch: an array of doubles, not initialised unless assign() is used;
-// BigAllocator: the same memory for a std::vector (src/fft.h's buffers).
+// BasicScratch: an array (Scratch: of doubles), not initialised unless
+// assign() is used, its values not kept when it grows; BigAllocator: the
+// same memory for a std::vector.
 #ifndef ALLANVAR_SCRATCH_H
 #define ALLANVAR_SCRATCH_H
 
@@ -107,18 +108,19 @@ struct BigAllocator {
   bool operator!=(const BigAllocator<U>&) const { return false; }
 };
 
-class Scratch {
+template <class T>
+class BasicScratch {
  public:
-  Scratch() = default;
-  explicit Scratch(std::size_t n) { resize(n); }
-  ~Scratch() { release(); }
-  Scratch(const Scratch&) = delete;
-  Scratch& operator=(const Scratch&) = delete;
-  Scratch(Scratch&& o) noexcept : p_(o.p_), n_(o.n_), cap_(o.cap_) {
+  BasicScratch() = default;
+  explicit BasicScratch(std::size_t n) { resize(n); }
+  ~BasicScratch() { release(); }
+  BasicScratch(const BasicScratch&) = delete;
+  BasicScratch& operator=(const BasicScratch&) = delete;
+  BasicScratch(BasicScratch&& o) noexcept : p_(o.p_), n_(o.n_), cap_(o.cap_) {
     o.p_ = nullptr;
     o.n_ = o.cap_ = 0;
   }
-  Scratch& operator=(Scratch&& o) noexcept {
+  BasicScratch& operator=(BasicScratch&& o) noexcept {
     if (this != &o) {
       release();
       p_ = o.p_;
@@ -140,34 +142,37 @@ class Scratch {
     }
     n_ = n;
   }
-  void assign(std::size_t n, double v) {
+  void assign(std::size_t n, const T& v) {
     resize(n);
     std::fill(p_, p_ + n, v);
   }
-  double* data() { return p_; }
-  const double* data() const { return p_; }
+  T* data() { return p_; }
+  const T* data() const { return p_; }
   std::size_t size() const { return n_; }
-  double& operator[](std::size_t i) { return p_[i]; }
-  const double& operator[](std::size_t i) const { return p_[i]; }
-  double* begin() { return p_; }
-  double* end() { return p_ + n_; }
-  const double* begin() const { return p_; }
-  const double* end() const { return p_ + n_; }
+  T& operator[](std::size_t i) { return p_[i]; }
+  const T& operator[](std::size_t i) const { return p_[i]; }
+  T* begin() { return p_; }
+  T* end() { return p_ + n_; }
+  const T* begin() const { return p_; }
+  const T* end() const { return p_ + n_; }
 
  private:
-  double* allocate(std::size_t n) {
+  T* allocate(std::size_t n) {
     if (n == 0) return nullptr;
-    if (n > static_cast<std::size_t>(-1) / sizeof(double)) throw std::bad_alloc();
-    return static_cast<double*>(big_alloc(n * sizeof(double)));
+    if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_alloc();
+    return static_cast<T*>(big_alloc(n * sizeof(T)));
   }
   void release() {
     big_free(p_);
     p_ = nullptr;
   }
 
-  double* p_ = nullptr;
+  T* p_ = nullptr;
   std::size_t n_ = 0, cap_ = 0;
 };
+
+// doubles (most kernels); src/fft.h holds complex transform buffers
+using Scratch = BasicScratch<double>;
 
 }  // namespace allanvar
 

@@ -62,9 +62,9 @@ using allanvar::DD;
 // triangles recursively.
 
 struct FastScratch {
-  allanvar::FFTPlans plans;
+  allanvar::FFTPlans* plans = nullptr;  // the call's, shared by the workers
   allanvar::cvec buf, buf2;
-  std::vector<double> z, zr, s, c, c2, p2;
+  allanvar::Scratch z, zr, s, c, c2, p2;
 };
 
 // The squares of the triangles below this many products are summed
@@ -99,7 +99,7 @@ double theo_triangle(const double* z, R_xlen_t k, R_xlen_t p0, R_xlen_t d0,
     const size_t nt = static_cast<size_t>(2 * q - 1);
     S.c.resize(nt);
     allanvar::real_correlation(z + p0, h, z + p0 + 2 * d0, h + nt - 1, nt,
-                               S.c.data(), S.plans, S.buf, S.buf2);
+                               S.c.data(), *S.plans, S.buf, S.buf2);
     for (R_xlen_t d = 0; d < q; ++d)
       sq += S.c[2 * d] / static_cast<double>(k - d0 - d);
   }
@@ -126,7 +126,7 @@ void theo_triangle2(const double* z, const double* zr, R_xlen_t k,
   S.c2.resize(nt);
   allanvar::real_correlation_pair(z + p0, zr + p0, h, z + p0 + 2 * d0,
                                   zr + p0 + 2 * d0, h + nt - 1, nt,
-                                  S.c.data(), S.c2.data(), S.plans, S.buf,
+                                  S.c.data(), S.c2.data(), *S.plans, S.buf,
                                   S.buf2);
   double sq0 = 0, sq1 = 0;
   for (R_xlen_t d = 0; d < q; ++d) {
@@ -164,7 +164,7 @@ double theo_block(const double* z, R_xlen_t W, R_xlen_t k, FastScratch& S) {
   S.c.resize(m);
   S.c2.resize(m - 1);
   allanvar::real_correlation2(S.s.data(), Mb, z, W, m, S.c.data(), m - 1,
-                              S.c2.data(), S.plans, S.buf, S.buf2);
+                              S.c2.data(), *S.plans, S.buf, S.buf2);
   double cross = 0, sq = 0;
   for (R_xlen_t t = 1; t < m; ++t) {
     cross += g(t) * S.c[t];
@@ -174,8 +174,8 @@ double theo_block(const double* z, R_xlen_t W, R_xlen_t k, FastScratch& S) {
   double pd = 0;
   for (R_xlen_t d = 0; d < k; ++d)
     pd += S.c2[2 * d] / static_cast<double>(k - d);
-  S.zr.assign(z, z + W);
-  std::reverse(S.zr.begin(), S.zr.end());
+  S.zr.resize(W);
+  std::reverse_copy(z, z + W, S.zr.begin());
   double tri[2] = {0, 0};
   theo_triangle2(z, S.zr.data(), k, 0, 0, k, S, tri);
   pd -= tri[0];
@@ -255,7 +255,9 @@ Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate,
   const double* h = X.hi.data();
   const double* l = X.lo.data();
   const int nthr = std::max(1, threads);
+  allanvar::FFTPlans plans;
   std::vector<FastScratch> scratch(nthr);
+  for (FastScratch& S : scratch) S.plans = &plans;
   allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nthr,
                          [&](R_xlen_t it, int worker) {
     const Item& I = items[it];
@@ -534,12 +536,12 @@ std::vector<double> theo_full_sf(const TildePhase& X, R_xlen_t lmax,
   }
   std::vector<double> res(tot, 0.0);
   const int nthr = std::max(1, threads);
-  struct Scratch {
-    allanvar::FFTPlans plans;
+  struct SfScratch {
     allanvar::cvec buf, buf2;
-    std::vector<double> z, zs, qz, c;
+    allanvar::Scratch z, zs, qz, c;
   };
-  std::vector<Scratch> scr(nthr);
+  allanvar::FFTPlans plans;  // shared by the workers
+  std::vector<SfScratch> scr(nthr);
   allanvar::parallel_for(static_cast<R_xlen_t>(jobs.size()), nthr,
                          [&](R_xlen_t it, int worker) {
     const Job& J = jobs[it];
@@ -565,7 +567,7 @@ std::vector<double> theo_full_sf(const TildePhase& X, R_xlen_t lmax,
       res[J.out] = acc;
       return;
     }
-    Scratch& S = scr[worker];
+    SfScratch& S = scr[worker];
     const R_xlen_t n = J.len;
     S.z.resize(n);
     S.zs.resize(n + 1);
@@ -582,7 +584,7 @@ std::vector<double> theo_full_sf(const TildePhase& X, R_xlen_t lmax,
     S.c.resize(nt);
     const R_xlen_t B = J.tail ? n : n - 2 * J.lo + 1;  // starting points
     allanvar::real_correlation(S.z.data(), J.tail ? n : B, S.z.data(), n, nt,
-                               S.c.data(), S.plans, S.buf, S.buf2);
+                               S.c.data(), plans, S.buf, S.buf2);
     for (R_xlen_t lag = J.lo; lag < hi; ++lag) {
       const R_xlen_t cnt = J.tail ? n - lag : B;
       const double sfz = (S.qz[lag + cnt] - S.qz[lag]) + S.qz[cnt] - 2 * S.c[lag];
