@@ -13,8 +13,11 @@
 #   Rscript tools/htot-pm-edf.R [reps] [sizes] [seed] [fit|check]
 #   fit   (default 4000 512,2048,4096,8192 1065): the Monte Carlo EDFs and
 #         the least-squares fit (in log EDF) of the forms below;
-#   check (e.g. 1000 256,1024 7 check): the Monte Carlo EDFs against the
-#         installed package's extra_edf("htotdev", ..., alpha = 2, 1).
+#   check (e.g. 4000 256,1024 7 check): the Monte Carlo EDFs against the
+#         installed package's extra_edf("htotdev", ..., alpha = 2, 1);
+#   tail  (2000 512,2048 1066 tail): the same at the last taus (m from N/4
+#         to (N - 1)/3) and the fit of the factor there (see below); `tail
+#         check` (2000 256,1024 12 tailcheck) compares them with the package.
 # Run with the package installed (library(allanvar)); one thread.
 
 htot_pm_generators <- function(N) {
@@ -76,6 +79,62 @@ htot_pm_fit <- function(d) {
   })
 }
 
+# The last taus, m up to (N - 1)/3: as the number of terms n = N + 1 - 3m
+# falls to a few, nearly the same data enter every window and the EDF drops
+# below the forms (at n = 2, N = 1024: 53 for white PM where they give 595,
+# 16 for flicker PM for 34). The ratio of the Monte Carlo EDF to the form is
+# close to a function of x = n/N alone (N = 256 and 1024 agree): white PM
+# 1 - exp(-x/x0), flicker PM min(1, (x/x1)^p). `tail` mode fits x0, x1, p
+# at n = 2, 4, 8, ... up to N/4, against the forms with the coefficients of
+# `fit` mode (htot_pm_main).
+htot_pm_main <- function(noise, N, m) {
+  if (noise == "wpm") {
+    N / (1.337 + 0.621 / m + 1.152 * m / N)
+  } else {
+    N / m * (0.713 + 0.5725 * log(m))^2 / (1 + 1.344 * m / N)
+  }
+}
+
+htot_pm_tail_mc <- function(reps, sizes) {
+  out <- list()
+  for (N in sizes) {
+    gens <- htot_pm_generators(N)
+    n <- 2^(1:floor(log2(N / 4)))
+    m <- sort(unique(floor((N + 1 - n) / 3)))
+    m <- m[m >= N / 4]
+    for (noise in names(gens)) {
+      v <- vapply(seq_len(reps), function(i) {
+        allanvar::allan(gens[[noise]](), 1, taus = I(m), type = "htotdev",
+                        debias = FALSE)$avar
+      }, numeric(length(m)))
+      edf <- 2 * rowMeans(v)^2 / apply(v, 1, stats::var)
+      out[[length(out) + 1L]] <- data.frame(noise = noise, N = N, m = m,
+                                            N_over_m = N / m, edf = edf)
+    }
+  }
+  do.call(rbind, out)
+}
+
+htot_pm_tail_fit <- function(d) {
+  d$x <- (d$N + 1 - 3 * d$m) / d$N
+  d$r <- log(d$edf / vapply(seq_len(nrow(d)), function(i) {
+    htot_pm_main(d$noise[i], d$N[i], d$m[i])
+  }, 0))
+  w <- d[d$noise == "wpm", ]
+  f <- d[d$noise == "fpm", ]
+  fw <- stats::nls(r ~ log(1 - exp(-x / x0)), w, start = list(x0 = 0.02))
+  # flicker PM: a line in log x below x = 0.1 (where the ratio is below 1)
+  ff <- stats::lm(r ~ log(x), f[f$x < 0.1, ])
+  p <- unname(stats::coef(ff)[2])
+  x1 <- exp(-unname(stats::coef(ff)[1]) / p)
+  rf <- f$r - log(pmin(1, (f$x / x1)^p))
+  rw <- stats::residuals(fw)
+  list(wpm = list(coef = stats::coef(fw), rms = sqrt(mean(rw^2)),
+                  max = max(abs(rw))),
+       fpm = list(coef = c(x1 = x1, p = p), rms = sqrt(mean(rf^2)),
+                  max = max(abs(rf))))
+}
+
 if (sys.nframe() == 0L) {
   args <- commandArgs(TRUE)
   reps <- if (length(args) >= 1) as.integer(args[1]) else 4000L
@@ -90,6 +149,8 @@ if (sys.nframe() == 0L) {
   # without simulating again
   d <- if (nzchar(Sys.getenv("HTOT_PM_DATA"))) {
     readRDS(Sys.getenv("HTOT_PM_DATA"))
+  } else if (mode %in% c("tail", "tailcheck")) {
+    htot_pm_tail_mc(reps, sizes)
   } else {
     htot_pm_mc(reps, sizes)
   }
@@ -105,6 +166,14 @@ if (sys.nframe() == 0L) {
     r <- log(d$ratio[d$noise == noise])
     cat(sprintf("%s: package EDF / Monte Carlo EDF %.3f-%.3f, rms log ratio %.3f\n",
                 noise, exp(min(r)), exp(max(r)), sqrt(mean(r^2))))
+  }
+  if (mode == "tail") {
+    for (nm in c("wpm", "fpm")) {
+      f <- htot_pm_tail_fit(d)[[nm]]
+      cat(sprintf("%s tail fit: %s; rms log error %.3f, max %.3f\n", nm,
+                  paste(names(f$coef), signif(f$coef, 3), sep = " = ",
+                        collapse = ", "), f$rms, f$max))
+    }
   }
   if (mode == "fit") {
     for (f in htot_pm_fit(d)) {
