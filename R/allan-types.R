@@ -71,8 +71,14 @@
 #' MTOT and TTOT \eqn{b L/m - c} (SP 1065 Table 11; at \eqn{m = 1, 2},
 #' where it overstates the EDF up to fourfold, the modified Allan EDF), HTOT
 #' \eqn{(L/m)/(b_0 + b_1 m/L)} for FM noise from \eqn{m = 16} (Howe et al.
-#' 2000) and the overlapping Allan EDF otherwise (at \eqn{m = 1}, where HTOT
-#' is the overlapping Hadamard variance, its EDF), Theo1 and TheoBR Howe and
+#' 2000) and the overlapping Allan EDF below it; for white and flicker PM,
+#' where none is published (Stable32 uses the overlapping Allan EDF, 0.47-0.89
+#' of the true one), fits to Monte Carlo EDFs in \eqn{N = L - 1}:
+#' \eqn{N/(1.337 + 0.621/m + 1.152 m/N)} and
+#' \eqn{(N/m)(0.713 + 0.5725 \ln m)^2/(1 + 1.344 m/N)} (within 11% of
+#' Monte Carlo up to \eqn{m = N/4}; beyond, where the terms fall to a few,
+#' times a factor in their number); at \eqn{m = 1}, where HTOT is the
+#' overlapping Hadamard variance, its EDF. Theo1 and TheoBR use Howe and
 #' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV the modified Allan
 #' EDF. The noise type of a TheoBR row is the overlapping Allan variance's at
 #' \eqn{0.75 m}, or at \eqn{(L - 1)/3} beyond it (no fewer than three
