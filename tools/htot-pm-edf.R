@@ -10,15 +10,18 @@
 # (h_k = h_{k-1} (k - 1.5)/(k - 1), applied by FFT). N is the number of
 # frequency values, m = 2, 4, ..., N/4.
 #
-#   Rscript tools/htot-pm-edf.R [reps] [sizes] [seed] [fit|check]
+#   Rscript tools/htot-pm-edf.R [reps] [sizes] [seed] [fit|check|tail|tailcheck]
 #   fit   (default 4000 512,2048,4096,8192 1065): the Monte Carlo EDFs and
 #         the least-squares fit (in log EDF) of the forms below;
 #   check (e.g. 4000 256,1024 7 check): the Monte Carlo EDFs against the
 #         installed package's extra_edf("htotdev", ..., alpha = 2, 1);
 #   tail  (2000 512,2048 1066 tail): the same at the last taus (m from N/4
-#         to (N - 1)/3) and the fit of the factor there (see below); `tail
-#         check` (2000 256,1024 12 tailcheck) compares them with the package.
-# Run with the package installed (library(allanvar)); one thread.
+#         to (N - 1)/3) and the fit of the factor there (see below);
+#   tailcheck (2000 256,1024 12 tailcheck): those taus against the package.
+# Run with the package installed (library(allanvar)); one thread. The
+# coefficients, their fit errors and the checks' ratios are quoted where
+# they are used, in extra_edf_known(). A few minutes for `fit` at 4000
+# replicates.
 
 htot_pm_generators <- function(N) {
   n <- N + 1
