@@ -71,8 +71,14 @@
 #' MTOT and TTOT \eqn{b L/m - c} (SP 1065 Table 11; at \eqn{m = 1, 2},
 #' where it overstates the EDF up to fourfold, the modified Allan EDF), HTOT
 #' \eqn{(L/m)/(b_0 + b_1 m/L)} for FM noise from \eqn{m = 16} (Howe et al.
-#' 2000) and the overlapping Allan EDF otherwise (at \eqn{m = 1}, where HTOT
-#' is the overlapping Hadamard variance, its EDF), Theo1 and TheoBR Howe and
+#' 2000) and the overlapping Allan EDF below it; for white and flicker PM,
+#' where none is published (Stable32 uses the overlapping Allan EDF, 0.47-0.89
+#' of the true one), fits to Monte Carlo EDFs in \eqn{N = L - 1}:
+#' \eqn{N/(1.337 + 0.621/m + 1.152 m/N)} and
+#' \eqn{(N/m)(0.713 + 0.5725 \ln m)^2/(1 + 1.344 m/N)} (within 11% of
+#' Monte Carlo up to \eqn{m = N/4}; beyond, where the terms fall to a few,
+#' times a factor in their number); at \eqn{m = 1}, where HTOT is the
+#' overlapping Hadamard variance, its EDF. Theo1 and TheoBR use Howe and
 #' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV the modified Allan
 #' EDF. The noise type of a TheoBR row is the overlapping Allan variance's at
 #' \eqn{0.75 m}, or at \eqn{(L - 1)/3} beyond it (no fewer than three
@@ -320,7 +326,8 @@ debias_factor_known <- function(type, alpha, m) {
 #    EDF at m = 1, 2;
 #  * HTOT: (N/m) / (b0 + b1 m/N) for the FM noises from m = 16 (Howe et
 #    al. 2000, Table 1, rows alpha = 0, -1, ..., -4: the mapping Stable32's
-#    limits confirm), else the overlapping Allan EDF as Stable32 does;
+#    limits confirm), the overlapping Allan EDF below (as Stable32), fits
+#    to Monte Carlo EDFs for white and flicker PM (tools/htot-pm-edf.R);
 #  * Theo1 (and TheoBR): Howe & Peppler's formulas in tau = 0.75 m;
 #  * PDEV: the modified Allan EDF (the estimators share their overlapping
 #    structure; Vernotte et al. 2016 give no closed form).
@@ -369,15 +376,43 @@ extra_edf_known <- function(type, m, L, alpha, n) {
     },
     htotdev = {
       # Howe et al. (2000) Table 1 covers the FM noises (alpha 0 .. -4)
-      # from m = 16; elsewhere Stable32 uses the overlapping Allan EDF
+      # from m = 16; below it Stable32 uses the overlapping Allan EDF
       fm <- a <= 0L & m >= 16
       k <- 1L - pmax(-4L, pmin(0L, a))
       b0 <- c(0.559, 0.868, 0.938, 2.554, 3.149)[k]
       b1 <- c(1.004, 1.140, 1.696, 0.974, 1.276)[k]
       out <- (N / m) / (b0 + b1 * m / N)
-      if (any(!fm)) {
-        out[!fm] <- allan_edf_direct("overlapping", m[!fm], L - 2 * m[!fm], L,
-                                     pmin(2L, pmax(-2L, a[!fm])))
+      pm <- a >= 1L
+      o <- !fm & !pm
+      if (any(o)) {
+        out[o] <- allan_edf_direct("overlapping", m[o], L - 2 * m[o], L,
+                                   pmin(2L, pmax(-2L, a[o])))
+      }
+      # White and flicker PM: no published EDF; Stable32's overlapping Allan
+      # one is 0.47-0.89 of the Monte Carlo EDF (N = 1024: coverage up to 0.89).
+      # Fitted, in Nf = L - 1 frequency values, to Monte Carlo EDFs 2 E^2/Var
+      # of the uncorrected HTOT (tools/htot-pm-edf.R: own generators, 4000
+      # replicates, seed 1065, Nf = 512, 2048, 4096, 8192, m = 2 .. Nf/4
+      # octave; least squares in log EDF): white PM
+      # Nf / (1.337 + 0.621/m + 1.152 m/Nf), rms error 4.4%, max 11%;
+      # flicker PM (Nf/m) (0.713 + 0.5725 ln m)^2 / (1 + 1.344 m/Nf),
+      # rms 3.4%, max 7.8% (at Nf = 256, 1024, seed 7: 0.91-1.09 and
+      # 0.95-1.06 of Monte Carlo). Beyond m = Nf/4, as the n = L - 3m terms fall
+      # to a few, the EDF drops (white PM, n = 2, Nf = 1024: 53, not 595)
+      # by a factor in x = n/Nf: white PM 1 - exp(-x/0.021), flicker PM
+      # min(1, (x/0.138)^0.137) (`tail` mode of the script, 2000 replicates,
+      # seed 1066, Nf = 512, 2048, m = Nf/4 .. Nf/3: rms error 4.4% and
+      # 6.8%, max 7.2% and 11%; at Nf = 256, 1024, seed 12, 0.88-1.14 and
+      # 0.96-1.18 of Monte Carlo; a factor of 1 - 3e-5 or 1 at m = Nf/4).
+      if (any(pm)) {
+        nf <- L - 1
+        mp <- m[pm]
+        x <- (L - 3 * mp) / nf
+        out[pm] <- ifelse(a[pm] >= 2L,
+                          nf / (1.337 + 0.621 / mp + 1.152 * mp / nf) *
+                            (1 - exp(-x / 0.021)),
+                          nf / mp * (0.713 + 0.5725 * log(mp))^2 /
+                            (1 + 1.344 * mp / nf) * pmin(1, (x / 0.138)^0.137))
       }
       # at m = 1 HTOT is the overlapping Hadamard variance (SP 1065 5.2.14),
       # and so is its EDF (Monte Carlo, N = 1024: 537, 601, 691, 416, 453
