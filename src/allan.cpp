@@ -11,6 +11,7 @@
 #include "checks.h"
 #include "local-phase.h"
 #include "noise_id.h"
+#include "scratch.h"
 #include "opts-allan.h"
 #include "parallel.h"
 #include "types.h"
@@ -437,7 +438,14 @@ struct Level {
   double s = 0;
   R_xlen_t cnt = 0;
   bool keep = false;     // keep every cluster sum (a noise id is asked here)
-  std::vector<double> z;  // the cluster sums, for noise id
+  // the cluster sums, for noise id: zn of them written at z, which points
+  // into `store` of the joined level (a part writes at its own offset, so
+  // the halves need no joining copy; uninitialised, huge pages: zero fills,
+  // growth copies and page faults of vectors took most of an octave call
+  // at 1e7)
+  double* z = nullptr;
+  R_xlen_t zn = 0;
+  allanvar::Scratch store;
 };
 
 // Consume n dd values at level j: accumulate squared differences, keep the
@@ -464,12 +472,9 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
   L.pl = pl;
   L.acc.add(s);
   if (L.keep) {
-    // one resize and a plain loop (per-element push_back cost 8% of an
-    // octave call at 1e7; the capacity is reserved by the caller)
-    const size_t o = L.z.size();
-    L.z.resize(o + static_cast<size_t>(n));
-    double* z = L.z.data() + o;
+    double* z = L.z + L.zn;
     for (R_xlen_t k = 0; k < n; ++k) z[k] = h[k] + l[k];
+    L.zn += n;
   }
   if (!pair) return 0;
   const R_xlen_t n2 = n / 2;
@@ -517,22 +522,38 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
   const R_xlen_t nblocks = (N + B - 1) / B;
   const int P = (threads > 1 && nblocks >= 8) ? 2 : 1;
   const R_xlen_t cut[3] = {0, P == 2 ? (nblocks / 2) * B : N, N};
-  std::vector<std::vector<Level> > part(P, std::vector<Level>(jin + 1));
+  // each kept level's sums in one array, floor(N / 2^j) of them; part p
+  // writes from (its first sample) / 2^j, a whole number (cut at a block)
+  lev.clear();
+  lev.resize(J + 1);
+  for (int j = 0; j <= J; ++j) lev[j].keep = keep[j];
+  std::vector<std::vector<Level> > part(P);
   for (int p = 0; p < P; ++p) {
+    part[p].resize(jin + 1);
     for (int j = 0; j <= jin; ++j) {
       part[p][j].keep = keep[j];
-      if (keep[j]) part[p][j].z.reserve((cut[p + 1] - cut[p]) >> j);
+      if (!keep[j]) continue;
+      if (p == 0) lev[j].store.resize(static_cast<size_t>(N >> j));
+      part[p][j].z = lev[j].store.data() + (cut[p] >> j);
     }
   }
   std::vector<std::vector<double> > th(P), tl(P);
   run_items(P, threads, main, [&](R_xlen_t p) {
     octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p]);
   });
-  lev.assign(J + 1, Level());
-  for (int j = 0; j <= J; ++j) lev[j].keep = keep[j];
   for (int j = 0; j <= jin; ++j) {
     Level& L = lev[j];
-    L = std::move(part[0][j]);
+    const Level& A = part[0][j];
+    L.ph = A.ph;
+    L.pl = A.pl;
+    L.fh = A.fh;
+    L.fl = A.fl;
+    L.has = A.has;
+    L.acc = A.acc;
+    L.s = A.s;
+    L.cnt = A.cnt;
+    L.z = L.store.data();
+    L.zn = A.zn;
     if (P == 2) {
       const Level& R = part[1][j];
       L.acc.add(R.acc.value());
@@ -540,7 +561,7 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
         const double d = (R.fh - L.ph) + (R.fl - L.pl);
         L.acc.add(d * d);
       }
-      L.z.insert(L.z.end(), R.z.begin(), R.z.end());
+      L.zn += R.zn;
       if (R.has) {
         L.ph = R.ph;
         L.pl = R.pl;
@@ -555,8 +576,13 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
       l.insert(l.end(), tl[1].begin(), tl[1].end());
     }
     R_xlen_t cur = static_cast<R_xlen_t>(h.size());
-    for (int j = b; j <= J; ++j)
+    for (int j = b; j <= J; ++j) {
+      if (lev[j].keep) {
+        lev[j].store.resize(static_cast<size_t>(cur));
+        lev[j].z = lev[j].store.data();
+      }
       cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
+    }
   }
 }
 
@@ -595,8 +621,8 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const R_xlen_t m = mid[j];
     int lj = 0;
     while ((static_cast<R_xlen_t>(1) << lj) < m) ++lj;
-    const double* z = lj == 0 ? v : lev[lj].z.data();
-    const R_xlen_t n = lj == 0 ? N : static_cast<R_xlen_t>(lev[lj].z.size());
+    const double* z = lj == 0 ? v : lev[lj].z;
+    const R_xlen_t n = lj == 0 ? N : lev[lj].zn;
     allanvar::NoiseId id;
     if (n >= rules.acf_min) {
       id = allanvar::acf_noise_id(z, n, false, dmax);
