@@ -37,12 +37,13 @@ htot_pm_generators <- function(N) {
        fpm = function() diff(flicker()))
 }
 
-# Monte Carlo EDF of the uncorrected HTOT variance by noise, N and m.
-htot_pm_mc <- function(reps, sizes) {
+# Monte Carlo EDF of the uncorrected HTOT variance by noise, N and m, at
+# the m that grid(N) gives.
+htot_pm_run <- function(reps, sizes, grid) {
   out <- list()
   for (N in sizes) {
     gens <- htot_pm_generators(N)
-    m <- 2^(1:floor(log2(N / 4)))
+    m <- grid(N)
     for (noise in names(gens)) {
       v <- vapply(seq_len(reps), function(i) {
         allanvar::allan(gens[[noise]](), 1, taus = I(m), type = "htotdev",
@@ -54,6 +55,11 @@ htot_pm_mc <- function(reps, sizes) {
     }
   }
   do.call(rbind, out)
+}
+
+# octave m up to N/4
+htot_pm_mc <- function(reps, sizes) {
+  htot_pm_run(reps, sizes, function(N) 2^(1:floor(log2(N / 4))))
 }
 
 # The forms, in N (frequency values) and m; both fall as (1 + b m/N) at
@@ -98,24 +104,13 @@ htot_pm_main <- function(noise, N, m) {
   }
 }
 
+# m from N/4 up, where n = N + 1 - 3m is 2, 4, 8, ...
 htot_pm_tail_mc <- function(reps, sizes) {
-  out <- list()
-  for (N in sizes) {
-    gens <- htot_pm_generators(N)
+  htot_pm_run(reps, sizes, function(N) {
     n <- 2^(1:floor(log2(N / 4)))
     m <- sort(unique(floor((N + 1 - n) / 3)))
-    m <- m[m >= N / 4]
-    for (noise in names(gens)) {
-      v <- vapply(seq_len(reps), function(i) {
-        allanvar::allan(gens[[noise]](), 1, taus = I(m), type = "htotdev",
-                        debias = FALSE)$avar
-      }, numeric(length(m)))
-      edf <- 2 * rowMeans(v)^2 / apply(v, 1, stats::var)
-      out[[length(out) + 1L]] <- data.frame(noise = noise, N = N, m = m,
-                                            N_over_m = N / m, edf = edf)
-    }
-  }
-  do.call(rbind, out)
+    m[m >= N / 4]
+  })
 }
 
 htot_pm_tail_fit <- function(d) {
