@@ -522,38 +522,29 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
   const R_xlen_t nblocks = (N + B - 1) / B;
   const int P = (threads > 1 && nblocks >= 8) ? 2 : 1;
   const R_xlen_t cut[3] = {0, P == 2 ? (nblocks / 2) * B : N, N};
-  // each kept level's sums in one array, floor(N / 2^j) of them; part p
-  // writes from (its first sample) / 2^j, a whole number (cut at a block)
-  lev.clear();
-  lev.resize(J + 1);
-  for (int j = 0; j <= J; ++j) lev[j].keep = keep[j];
+  // each kept level's sums in one array, floor(N / 2^j) of them, owned by
+  // part 0's level; part p writes from (its first sample) / 2^j, a whole
+  // number (cut at a block)
   std::vector<std::vector<Level> > part(P);
-  for (int p = 0; p < P; ++p) {
-    part[p].resize(jin + 1);
-    for (int j = 0; j <= jin; ++j) {
-      part[p][j].keep = keep[j];
-      if (!keep[j]) continue;
-      if (p == 0) lev[j].store.resize(static_cast<size_t>(N >> j));
-      part[p][j].z = lev[j].store.data() + (cut[p] >> j);
+  for (int p = 0; p < P; ++p) part[p].resize(jin + 1);
+  for (int j = 0; j <= jin; ++j) {
+    if (!keep[j]) continue;
+    part[0][j].store.resize(static_cast<size_t>(N >> j));
+    for (int p = 0; p < P; ++p) {
+      part[p][j].keep = true;
+      part[p][j].z = part[0][j].store.data() + (cut[p] >> j);
     }
   }
   std::vector<std::vector<double> > th(P), tl(P);
   run_items(P, threads, main, [&](R_xlen_t p) {
     octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p]);
   });
+  lev.clear();
+  lev.resize(J + 1);
+  for (int j = 0; j <= J; ++j) lev[j].keep = keep[j];
   for (int j = 0; j <= jin; ++j) {
     Level& L = lev[j];
-    const Level& A = part[0][j];
-    L.ph = A.ph;
-    L.pl = A.pl;
-    L.fh = A.fh;
-    L.fl = A.fl;
-    L.has = A.has;
-    L.acc = A.acc;
-    L.s = A.s;
-    L.cnt = A.cnt;
-    L.z = L.store.data();
-    L.zn = A.zn;
+    L = std::move(part[0][j]);  // z stays valid: the store moves with it
     if (P == 2) {
       const Level& R = part[1][j];
       L.acc.add(R.acc.value());
