@@ -215,9 +215,6 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
           "\" with ", N, " samples (largest cluster size: ", maxm, ").")
   }
   nterms <- allan_nterms(type, m, L)
-  if (gaps == "skip" && anyNA(ch$values)) {
-    return(allan_gaps(ch, freq, m, type, input, conf))
-  }
   octave <- type == "standard" && rate && length(m) <= 64L &&
     all(m == 2^round(log2(m)))
   sub <- allan_subset(m)
@@ -225,6 +222,11 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
                                           allan_opts(type, rate, octave)),
                            N, ch$nc)
   if (any(res$bad > 0)) {
+    # the kernel finds NA/NaN in the pass it makes anyway (no anyNA() pass
+    # over every call's data)
+    if (gaps == "skip" && anyNA(ch$values)) {
+      return(allan_gaps(ch, freq, m, type, input, conf))
+    }
     col <- which(res$bad > 0)[1L]
     row <- res$bad[col]
     bad <- ch$values[[(col - 1) * N + row]]
@@ -401,6 +403,9 @@ range_exponent <- function(x) {
 # non-zero variance below the smallest double); `nonzero`: where the
 # variance is known to be positive.
 check_representable <- function(av, nonzero = FALSE, what = "`x`") {
+  # variances are >= 0: the range settles long curves without temporaries
+  r <- suppressWarnings(range(av))
+  if (is.finite(r[2]) && r[1] >= .Machine$double.xmin) return(av)
   if (any(!is.finite(av))) {
     abort("The variance of ", what, " exceeds the largest double (",
           format(.Machine$double.xmax, digits = 3), "); divide the data by ",

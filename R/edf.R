@@ -14,10 +14,10 @@
 # and a log-log interpolation of the EDF.
 allan_subset <- function(m) {
   if (length(m) <= 200L) return(seq_along(m))
-  big <- m > 64
-  if (!any(big)) return(seq_along(m))
-  t <- 10^seq(log10(min(m[big])), log10(max(m)), by = 1 / 40)
-  sort(unique(c(which(!big), findInterval(t, m), which(big)[1L], length(m))))
+  first <- findInterval(64, m) + 1L  # m is sorted: the first m > 64
+  if (first > length(m)) return(seq_along(m))
+  t <- 10^seq(log10(m[first]), log10(m[length(m)]), by = 1 / 40)
+  sort(unique(c(seq_len(first - 1L), findInterval(t, m), first, length(m))))
 }
 
 # EDF for every row of a curve. alpha_int: identified noise exponent at the
@@ -75,13 +75,15 @@ allan_ci <- function(avar, edf, conf) {
     lo <- edf / stats::qchisq(1 - p, edf)
     hi <- edf / stats::qchisq(p, edf)
   } else {
-    g <- exp(seq(log(min(edf)), log(max(edf)), length.out = 2000L))
+    # half the log factor is splined: one exp() per limit gives its sqrt
+    g <- exp(seq(log(r[1]), log(r[2]), length.out = 2000L))
     lg <- log(g)
     le <- log(edf)
-    lo <- exp(stats::splinefun(lg, log(g / stats::qchisq(1 - p, g)),
-                               method = "fmm")(le))
-    hi <- exp(stats::splinefun(lg, log(g / stats::qchisq(p, g)),
-                               method = "fmm")(le))
+    adev <- sqrt(avar)
+    half_log <- function(q) 0.5 * log(g / stats::qchisq(q, g))
+    return(list(
+      lower = adev * exp(stats::splinefun(lg, half_log(1 - p), "fmm")(le)),
+      upper = adev * exp(stats::splinefun(lg, half_log(p), "fmm")(le))))
   }
   # sqrt of each factor: avar * hi may overflow where the limit does not
   list(lower = sqrt(avar) * sqrt(lo), upper = sqrt(avar) * sqrt(hi))

@@ -103,9 +103,9 @@ allan_taus <- function(taus, freq, maxm) {
         k <- 0:floor(log10(maxm) + 1e-9)
         sort(as.vector(outer(c(1, 2, 4), 10^k)))
       },
-      all = seq_len(maxm)
+      all = as.double(seq_len(maxm))
     )
-    return(as.double(m[m <= maxm]))
+    return(if (taus == "all") m else as.double(m[m <= maxm]))
   }
   if (!is.numeric(taus) || is.factor(taus) || length(taus) == 0L ||
       anyNA(taus) || any(!is.finite(taus)) || any(taus <= 0)) {

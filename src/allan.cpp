@@ -446,6 +446,12 @@ struct Level {
   double* z = nullptr;
   R_xlen_t zn = 0;
   allanvar::Scratch store;
+  // the lag-1 ACF's line (noise_id.h, acf_line_from()) read in the same
+  // pass, so the ACF needs one more pass, not three: s0 = sum z and
+  // sp = sum (i - cc) z over this level's values (centred cluster sums),
+  // i counted over the whole level from i0, cc its centre
+  bool line = false;
+  double s0 = 0, sp = 0, i0 = 0, cc = 0;
 };
 
 // Consume n dd values at level j: accumulate squared differences, keep the
@@ -453,28 +459,58 @@ struct Level {
 // place.
 inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
                            bool pair) {
-  double s = 0;
-  R_xlen_t i = 0;
-  if (!L.has && n > 0) {
-    L.ph = L.fh = h[0];
-    L.pl = L.fl = l[0];
-    L.has = true;
-    i = 1;
+  double s = 0, s1 = 0;  // two chains: the add latency bounds one
+  if (n > 0) {
+    if (!L.has) {
+      L.fh = h[0];
+      L.fl = l[0];
+      L.has = true;
+    } else {
+      const double d = (h[0] - L.ph) + (l[0] - L.pl);
+      s = d * d;
+    }
+    R_xlen_t i = 1;
+    for (; i + 2 <= n; i += 2) {
+      const double d0 = (h[i] - h[i - 1]) + (l[i] - l[i - 1]);
+      const double d1 = (h[i + 1] - h[i]) + (l[i + 1] - l[i]);
+      s += d0 * d0;
+      s1 += d1 * d1;
+    }
+    if (i < n) {
+      const double d = (h[i] - h[i - 1]) + (l[i] - l[i - 1]);
+      s += d * d;
+    }
+    L.ph = h[n - 1];
+    L.pl = l[n - 1];
   }
-  double ph = L.ph, pl = L.pl;
-  for (; i < n; ++i) {
-    const double d = (h[i] - ph) + (l[i] - pl);
-    s += d * d;
-    ph = h[i];
-    pl = l[i];
-  }
-  L.ph = ph;
-  L.pl = pl;
-  L.acc.add(s);
-  if (L.keep) {
+  L.acc.add(s + s1);
+  if (L.line) {
     double* z = L.z + L.zn;
-    for (R_xlen_t k = 0; k < n; ++k) z[k] = h[k] + l[k];
-    L.zn += n;
+    const double t = L.i0 - L.cc;
+    double a0 = 0, a1 = 0, q0 = 0, q1 = 0;
+    R_xlen_t k = 0;
+    for (; k + 2 <= n; k += 2) {
+      const double z0 = h[k] + l[k], z1 = h[k + 1] + l[k + 1];
+      if (L.keep) {
+        z[k] = z0;
+        z[k + 1] = z1;
+      }
+      const double tk = t + static_cast<double>(k);
+      a0 += z0;
+      a1 += z1;
+      q0 += tk * z0;
+      q1 += (tk + 1) * z1;
+    }
+    if (k < n) {
+      const double z0 = h[k] + l[k];
+      if (L.keep) z[k] = z0;
+      a0 += z0;
+      q0 += (t + static_cast<double>(k)) * z0;
+    }
+    L.s0 += a0 + a1;
+    L.sp += q0 + q1;
+    L.i0 += static_cast<double>(n);
+    if (L.keep) L.zn += n;
   }
   if (!pair) return 0;
   const R_xlen_t n2 = n / 2;
@@ -514,8 +550,8 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
 // at a block boundary (one per thread), whose per-level sums are then
 // joined with the one difference that straddles the cut.
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
-                     const std::vector<bool>& keep, std::vector<Level>& lev,
-                     int threads, bool main) {
+                     const std::vector<bool>& keep, bool line0,
+                     std::vector<Level>& lev, int threads, bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -527,12 +563,22 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
   // number (cut at a block)
   std::vector<std::vector<Level> > part(P);
   for (int p = 0; p < P; ++p) part[p].resize(jin + 1);
+  // level j holds floor(N / 2^j) values (blocks are powers of two)
+  auto set_line = [N](Level& L, int j, R_xlen_t first) {
+    L.line = true;
+    L.i0 = static_cast<double>(first >> j);
+    L.cc = (static_cast<double>(N >> j) - 1) / 2;
+  };
+  if (line0) {
+    for (int p = 0; p < P; ++p) set_line(part[p][0], 0, cut[p]);
+  }
   for (int j = 0; j <= jin; ++j) {
     if (!keep[j]) continue;
     part[0][j].store.resize(static_cast<size_t>(N >> j));
     for (int p = 0; p < P; ++p) {
       part[p][j].keep = true;
       part[p][j].z = part[0][j].store.data() + (cut[p] >> j);
+      set_line(part[p][j], j, cut[p]);
     }
   }
   std::vector<std::vector<double> > th(P), tl(P);
@@ -553,6 +599,8 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
         L.acc.add(d * d);
       }
       L.zn += R.zn;
+      L.s0 += R.s0;
+      L.sp += R.sp;
       if (R.has) {
         L.ph = R.ph;
         L.pl = R.pl;
@@ -571,6 +619,7 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
       if (lev[j].keep) {
         lev[j].store.resize(static_cast<size_t>(cur));
         lev[j].z = lev[j].store.data();
+        set_line(lev[j], j, 0);
       }
       cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
     }
@@ -599,13 +648,8 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<double>& mid_n, int dmax,
                      bool modified, const allanvar::NoiseIdRules& rules,
                      int threads, bool main, Channel& out) {
-  allanvar::RnCache rn;
-  for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(N + 1, m, false, rules.acf_min)) {
-      rn.build_from_rate(v, N, c);
-      break;
-    }
-  }
+  auto build = [=](allanvar::RnCache& r) { r.build_from_rate(v, N, c); };
+  allanvar::LazyRn<decltype(build)> rn(build);
   // taus are independent: shared between the threads
   run_items(static_cast<R_xlen_t>(mid.size()), threads, main, [&](R_xlen_t j) {
     if (allanvar::interrupted()) return;
@@ -616,7 +660,12 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const R_xlen_t n = lj == 0 ? N : lev[lj].zn;
     allanvar::NoiseId id;
     if (n >= rules.acf_min) {
-      id = allanvar::acf_noise_id(z, n, false, dmax);
+      // the line read in the octave pass: level 0's sums are of v - c
+      const Level& L = lev[lj];
+      const allanvar::AcfLine ln =
+          allanvar::acf_line_from(L.s0, L.sp, lj == 0 ? c : 0.0, n, false);
+      id = allanvar::acf_noise_id_line([z](R_xlen_t i) { return z[i]; }, n,
+                                       false, dmax, ln);
     } else {
       id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], modified, rules,
                                  [&]() { return rn.ratio(m); });
@@ -655,33 +704,38 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       }
     }
   }
-  // Identification alone at octave m of frequency data (another
-  // statistic's noise type) reads the same cluster sums, whatever the type.
-  bool octave_id = !opts.sums && rate && ni > 0;
+  // Noise id at octave m of frequency data, whatever the type, reads the
+  // cluster sums of the standard octave kernel: one pass over the samples
+  // (two threads) and one more per level for the ACF, where reading every
+  // m-th point of the phase took three passes over it per m.
+  bool octave_id = rate && ni > 0;
   for (R_xlen_t m : mid) {
     if (m < 1 || m > N || (m & (m - 1)) != 0) octave_id = false;
   }
-  if ((type == STANDARD && rate && octave) || octave_id) {
+  const bool std_octave = type == STANDARD && rate && octave;
+  if (std_octave || octave_id) {
     // Any constant works as the centre here (cluster sums are double-double
     // and constants cancel); NaN or Inf shows up in the sums.
     R_xlen_t top = 1;
-    for (R_xlen_t m : ms) top = std::max(top, m);
+    if (std_octave) for (R_xlen_t m : ms) top = std::max(top, m);
     for (R_xlen_t m : mid) top = std::max(top, m);
     int J = 0;
     while ((static_cast<R_xlen_t>(1) << (J + 1)) <= top) ++J;
     std::vector<bool> keep(J + 1, false);
+    bool line0 = false;
     for (R_xlen_t m : mid) {
       int lj = 0;
       while ((static_cast<R_xlen_t>(1) << lj) < m) ++lj;
       if (lj > 0 && lj <= J) keep[lj] = true;
+      if (lj == 0) line0 = true;
     }
     std::vector<Level> lev;
-    standard_octave(v, N, v[0], J, keep, lev, threads, main);
+    standard_octave(v, N, v[0], J, keep, line0, lev, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
     }
-    if (opts.sums) {
+    if (std_octave && opts.sums) {
       for (size_t j = 0; j < nt; ++j) {
         int lj = 0;
         while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
@@ -690,7 +744,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     }
     octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, type == MODIFIED,
                     rules, threads, main, out);
-    return;
+    if (std_octave || !opts.sums) return;
   }
 
   // centre (mid-range) and bound of the data; NaN/Inf poison z
@@ -727,6 +781,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     case OHADAMARD: overlapped<3>(X, ms, nterms, threads, main, o); break;
     case TOTAL: total(X, ms, threads, main, o); break;
   }
+  if (octave_id) return;  // identified above
   // Noise id from the phase: X itself, or its first differences when
   // MODIFIED's sums built one more level. Frequency data at m = 1 are the
   // samples.
@@ -736,13 +791,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     return two ? (h[k + 1] - h[k]) + (l[k + 1] - l[k]) : h[k] + l[k];
   };
   const R_xlen_t Lp = rate ? N + 1 : N;
-  allanvar::RnCache rn;
-  for (R_xlen_t m : mid) {
-    if (allanvar::needs_b1(Lp, m, !rate, rules.acf_min)) {
-      rn.build(phase, Lp);
-      break;
-    }
-  }
+  auto build = [&phase, Lp](allanvar::RnCache& r) { r.build(phase, Lp); };
+  allanvar::LazyRn<decltype(build)> rn(build);
   // taus are independent: shared between the threads
   run_items(static_cast<R_xlen_t>(ni), threads, main, [&](R_xlen_t j) {
     if (allanvar::interrupted()) return;

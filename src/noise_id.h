@@ -23,14 +23,15 @@
 // rules) with x(k) the phase at k = 0 .. L-1 (any constant offset; for
 // frequency data the running sum of the samples, L = N + 1), nterms the
 // statistic's number of terms at m (Stable32's N of B1), modified for the
-// modified family, rules a NoiseIdRules (R/taus.R noise_id_rules()), and an
-// RnCache filled once from the same phase when some m has fewer than
-// rules.acf_min points (needs_b1()).
+// modified family, rules a NoiseIdRules (R/taus.R noise_id_rules()), and rn
+// whose ratio(m) gives R(n) (a LazyRn over the same phase, shared by the
+// threads).
 #ifndef ALLANVAR_NOISE_ID_H
 #define ALLANVAR_NOISE_ID_H
 
 #include <Rcpp.h>
 #include <cmath>
+#include <mutex>
 #include <vector>
 
 namespace allanvar {
@@ -101,48 +102,92 @@ inline double lag1_delta(const double* e, R_xlen_t n) {
 
 }  // namespace noise_id_detail
 
-// The lag-1 ACF of z(0..n), differencing while delta >= 0.25 and d < dmax
-// (Riley & Greenhall 2004, eq. 2-4). The first step reads z(i) twice
-// (mean, then sums about it) and stores nothing (most series stop there);
+// The mean and (frequency data) the slope about the centre (n - 1)/2 that
+// the lag-1 ACF removes first.
+struct AcfLine {
+  double mu = 0, b = 0;
+};
+
+// The line from the sums s0 = sum (z - ref) and sp = sum (i - c)(z - ref),
+// c = (n - 1)/2, about any reference `ref` near the data (sum (i - c) = 0,
+// so sp needs no mean).
+inline AcfLine acf_line_from(double s0, double sp, double ref, R_xlen_t n,
+                             bool phase) {
+  const double nn = static_cast<double>(n);
+  AcfLine out;
+  out.mu = s0 / nn + ref;
+  if (!phase) out.b = sp / (nn * (nn * nn - 1) / 12);
+  return out;
+}
+
+// The line of z(0..n) in one pass (about z(0), which keeps the sums small).
+template <class Z>
+AcfLine acf_line(const Z& z, R_xlen_t n, bool phase) {
+  const double z0 = z(0);
+  const double c = (static_cast<double>(n) - 1) / 2;
+  double s0 = 0, s1 = 0, p0 = 0, p1 = 0;
+  R_xlen_t i = 0;
+  if (phase) {
+    for (; i + 2 <= n; i += 2) {
+      s0 += z(i) - z0;
+      s1 += z(i + 1) - z0;
+    }
+    if (i < n) s0 += z(i) - z0;
+  } else {
+    for (; i + 2 <= n; i += 2) {
+      const double a = z(i) - z0, b = z(i + 1) - z0;
+      const double t = static_cast<double>(i) - c;
+      s0 += a;
+      s1 += b;
+      p0 += t * a;
+      p1 += (t + 1) * b;
+    }
+    if (i < n) {
+      const double a = z(i) - z0;
+      s0 += a;
+      p0 += (static_cast<double>(i) - c) * a;
+    }
+  }
+  return acf_line_from(s0 + s1, p0 + p1, z0, n, phase);
+}
+
+// The lag-1 ACF of z(0..n) about the line `ln` (acf_line()), differencing
+// while delta >= 0.25 and d < dmax (Riley & Greenhall 2004, eq. 2-4). The
+// first step reads z(i) once and stores nothing (most series stop there);
 // differencing works on a copy.
 template <class Z>
-NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
+NoiseId acf_noise_id_line(const Z& z, R_xlen_t n, bool phase, int dmax,
+                          const AcfLine& ln) {
   using namespace noise_id_detail;
   NoiseId out;
   out.points = n;
   if (n < 4) return out;
-  const double nn = static_cast<double>(n);
-  const double z0 = z(0);
-  double s0 = 0, s1 = 0;
-  R_xlen_t i = 0;
-  for (; i + 2 <= n; i += 2) {
-    s0 += z(i) - z0;
-    s1 += z(i + 1) - z0;
-  }
-  if (i < n) s0 += z(i) - z0;
-  const double mu = (s0 + s1) / nn + z0;
-  // averaged frequencies: a linear drift removed (its slope b about the
-  // centre c); phase is read as it is, as Stable32 does
-  const double c = (nn - 1) / 2;
-  double b = 0;
-  if (!phase) {
-    double sp = 0;
-    for (i = 0; i < n; ++i) sp += (static_cast<double>(i) - c) * (z(i) - mu);
-    b = sp / (nn * (nn * nn - 1) / 12);
-  }
+  const double c = (static_cast<double>(n) - 1) / 2;
+  const double mu = ln.mu, b = ln.b;
+  // averaged frequencies: a linear drift removed; phase is read as it is,
+  // as Stable32 does
   auto res = [&](R_xlen_t k) {
     return z(k) - mu - b * (static_cast<double>(k) - c);
   };
-  double S2 = 0, Sc = 0;
+  // two chains per sum: the add latency bounds one
+  double S2 = 0, Sc = 0, S2b = 0, Scb = 0;
   double prev = res(0);
   S2 = prev * prev;
-  for (i = 1; i < n; ++i) {
+  R_xlen_t i = 1;
+  for (; i + 2 <= n; i += 2) {
+    const double e0 = res(i), e1 = res(i + 1);
+    S2 += e0 * e0;
+    S2b += e1 * e1;
+    Sc += prev * e0;
+    Scb += e0 * e1;
+    prev = e1;
+  }
+  if (i < n) {
     const double e = res(i);
     S2 += e * e;
     Sc += prev * e;
-    prev = e;
   }
-  double rho = delta_of(Sc, S2, n);
+  double rho = delta_of(Sc + Scb, S2 + S2b, n);
   int d = 0;
   std::vector<double> e;
   R_xlen_t len = n;
@@ -164,6 +209,17 @@ NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
     ++d;
     rho = lag1_delta(e.data(), len);
   }
+}
+
+// The lag-1 ACF method on z(0..n): two passes (line, then the sums about it).
+template <class Z>
+NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
+  if (n < 4) {
+    NoiseId out;
+    out.points = n;
+    return out;
+  }
+  return acf_noise_id_line(z, n, phase, dmax, acf_line(z, n, phase));
 }
 
 // B1 ratio of the averaged frequencies ybar[0..n); rn() gives MVAR/AVAR at
@@ -237,13 +293,34 @@ class RnCache {
   std::vector<double> X_, P_;
 };
 
+// An RnCache built on first use by whichever thread asks first (the others
+// wait): the build is a pass over the whole record, needed only where B1
+// reads PM or white FM, and it overlaps the other threads' ACF passes.
+template <class Build>
+class LazyRn {
+ public:
+  explicit LazyRn(Build build) : build_(build) {}
+  double ratio(R_xlen_t m) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!built_) {
+        build_(rn_);
+        built_ = true;
+      }
+    }
+    return rn_.ratio(m);
+  }
+
+ private:
+  Build build_;
+  RnCache rn_;
+  std::mutex mutex_;
+  bool built_ = false;
+};
+
 // The decimated series for the ACF has this many points at m.
 inline R_xlen_t acf_points(R_xlen_t L, R_xlen_t m, bool phase) {
   return phase ? (L - 1) / m + 1 : (L - 1) / m;
-}
-
-inline bool needs_b1(R_xlen_t L, R_xlen_t m, bool phase, R_xlen_t acf_min) {
-  return acf_points(L, m, phase) < acf_min;
 }
 
 // Fewest averaged frequencies at which R(n) may turn B1's white FM into
@@ -310,9 +387,9 @@ NoiseId b1_noise_id(const double* z, R_xlen_t n, bool phase, R_xlen_t m,
 }
 
 // Noise type at m from the phase x(k), k < L.
-template <class X>
+template <class X, class RN>
 NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
-                       bool phase, RnCache& rn, double nterms, bool modified,
+                       bool phase, RN& rn, double nterms, bool modified,
                        const NoiseIdRules& rules) {
   const R_xlen_t n = acf_points(L, m, phase);
   if (n >= rules.acf_min) {
@@ -327,10 +404,8 @@ NoiseId identify_noise(const X& x, R_xlen_t L, R_xlen_t m, int dmax,
   for (R_xlen_t i = 0; i < n; ++i) {
     z[i] = phase ? x(i * m) : x((i + 1) * m) - x(i * m);
   }
-  return b1_noise_id(z.data(), n, phase, m, nterms, modified, rules, [&]() {
-    if (rn.empty()) rn.build(x, L);  // build it beforehand to share it
-    return rn.ratio(m);
-  });
+  return b1_noise_id(z.data(), n, phase, m, nterms, modified, rules,
+                     [&]() { return rn.ratio(m); });
 }
 
 }  // namespace allanvar
