@@ -61,6 +61,10 @@ edf_interpolate_cpp <- function(m, sub, es, alpha) {
     .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
 }
 
+ci_long_cpp <- function(avar, edf, lg0, h, flo, fhi) {
+    .Call(`_allanvar_ci_long_cpp`, avar, edf, lg0, h, flo, fhi)
+}
+
 acf_sums <- function(x, max_lag) {
     .Call(`_allanvar_acf_sums`, x, max_lag)
 }

@@ -65,9 +65,9 @@ allan_edf_direct <- function(type, m, n, L, alpha) {
 }
 
 # Chi-square confidence limits of the deviation (NIST SP 1065 eq. 45). For
-# long curves the quantile factors come from a cubic spline through 2000
-# exact values in log(edf) (qchisq() with fractional df is slow); the
-# interpolation error is below 1e-6 relative.
+# long curves the quantile factors come from cubic interpolation between
+# 2000 exact values uniform in log(edf) (qchisq() with fractional df is
+# slow); the interpolation error is below 1e-6 relative.
 allan_ci <- function(avar, edf, conf) {
   p <- (1 - conf) / 2
   r <- range(edf)
@@ -75,15 +75,22 @@ allan_ci <- function(avar, edf, conf) {
     lo <- edf / stats::qchisq(1 - p, edf)
     hi <- edf / stats::qchisq(p, edf)
   } else {
-    # half the log factor is splined: one exp() per limit gives its sqrt
-    g <- exp(seq(log(r[1]), log(r[2]), length.out = 2000L))
-    lg <- log(g)
-    le <- log(edf)
-    adev <- sqrt(avar)
+    # half the log factor on a grid uniform in log(edf), interpolated in
+    # one C++ pass (src/edf.cpp): one exp() per limit gives the deviation's
+    lg <- seq(log(r[1]), log(r[2]), length.out = 2000L)
+    g <- exp(lg)
     half_log <- function(q) 0.5 * log(g / stats::qchisq(q, g))
-    return(list(
-      lower = adev * exp(stats::splinefun(lg, half_log(1 - p), "fmm")(le)),
-      upper = adev * exp(stats::splinefun(lg, half_log(p), "fmm")(le))))
+    ci <- ci_long_cpp(avar, edf, lg[1L], lg[2L] - lg[1L], half_log(1 - p),
+                      half_log(p))
+    # below 0.05 degrees of freedom the factors change too fast to
+    # interpolate (and qchisq(p, edf) underflows)
+    few <- which(edf < 0.05)
+    if (length(few) > 0L) {
+      e <- edf[few]
+      ci$lower[few] <- sqrt(avar[few]) * sqrt(e / stats::qchisq(1 - p, e))
+      ci$upper[few] <- sqrt(avar[few]) * sqrt(e / stats::qchisq(p, e))
+    }
+    return(ci)
   }
   # sqrt of each factor: avar * hi may overflow where the limit does not
   list(lower = sqrt(avar) * sqrt(lo), upper = sqrt(avar) * sqrt(hi))

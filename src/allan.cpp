@@ -527,15 +527,30 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
 
 // Levels 0..jin of the samples [s0, s1) (s0 a multiple of the block), and
 // the level-b sums of its full blocks appended to th/tl.
+// Also the range of the samples when `range` is given (NaN left out; the
+// sums carry it), which spares the other kernels their own pass.
 void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
                  int jin, int b, std::vector<Level>& lev,
-                 std::vector<double>& th, std::vector<double>& tl) {
+                 std::vector<double>& th, std::vector<double>& tl,
+                 double* range) {
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   std::vector<double> h(B), l(B);
+  double lo = y[s0], hi = y[s0];
   for (R_xlen_t k0 = s0; k0 < s1; k0 += B) {
     if (((k0 / B) & 511) == 511 && allanvar::interrupted()) return;
     const R_xlen_t n = std::min(B, s1 - k0);
-    for (R_xlen_t i = 0; i < n; ++i) two_sum(y[k0 + i], -c, h[i], l[i]);
+    if (range) {  // a separate loop: the plain one vectorises
+      for (R_xlen_t i = 0; i < n; ++i) {
+        const double yi = y[k0 + i];
+        two_sum(yi, -c, h[i], l[i]);
+        lo = yi < lo ? yi : lo;
+        hi = yi > hi ? yi : hi;
+      }
+      range[0] = lo;
+      range[1] = hi;
+    } else {
+      for (R_xlen_t i = 0; i < n; ++i) two_sum(y[k0 + i], -c, h[i], l[i]);
+    }
     R_xlen_t cur = n;
     for (int j = 0; j <= jin; ++j)
       cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
@@ -551,7 +566,8 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
 // joined with the one difference that straddles the cut.
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
                      const std::vector<bool>& keep, bool line0,
-                     std::vector<Level>& lev, int threads, bool main) {
+                     std::vector<Level>& lev, double* range, int threads,
+                     bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -582,9 +598,15 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
     }
   }
   std::vector<std::vector<double> > th(P), tl(P);
+  double pr[2][2] = {{y[0], y[0]}, {y[0], y[0]}};
   run_items(P, threads, main, [&](R_xlen_t p) {
-    octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p]);
+    octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p],
+                range ? pr[p] : nullptr);
   });
+  if (range) {
+    range[0] = std::min(pr[0][0], pr[P - 1][0]);
+    range[1] = std::max(pr[0][1], pr[P - 1][1]);
+  }
   lev.clear();
   lev.resize(J + 1);
   for (int j = 0; j <= J; ++j) lev[j].keep = keep[j];
@@ -713,6 +735,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     if (m < 1 || m > N || (m & (m - 1)) != 0) octave_id = false;
   }
   const bool std_octave = type == STANDARD && rate && octave;
+  double range[2] = {v[0], v[0]};
+  bool have_range = false;
   if (std_octave || octave_id) {
     // Any constant works as the centre here (cluster sums are double-double
     // and constants cancel); NaN or Inf shows up in the sums.
@@ -730,7 +754,10 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       if (lj == 0) line0 = true;
     }
     std::vector<Level> lev;
-    standard_octave(v, N, v[0], J, keep, line0, lev, threads, main);
+    // the range only where the sums' kernel below needs it
+    have_range = !std_octave && opts.sums;
+    standard_octave(v, N, v[0], J, keep, line0, lev,
+                    have_range ? range : nullptr, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
@@ -747,17 +774,21 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     if (std_octave || !opts.sums) return;
   }
 
-  // centre (mid-range) and bound of the data; NaN/Inf poison z
-  double vmin = v[0], vmax = v[0], z = 0;
-  for (R_xlen_t i = 0; i < N; ++i) {
-    vmin = std::min(vmin, v[i]);
-    vmax = std::max(vmax, v[i]);
-    z += v[i] * 0.0;
+  // centre (mid-range) and bound of the data; NaN/Inf poison z (the octave
+  // pass above has both already)
+  if (!have_range) {
+    double z = 0;
+    for (R_xlen_t i = 0; i < N; ++i) {
+      range[0] = std::min(range[0], v[i]);
+      range[1] = std::max(range[1], v[i]);
+      z += v[i] * 0.0;
+    }
+    if (z != 0) {
+      out.bad = allanvar::first_nonfinite(v, N);
+      return;
+    }
   }
-  if (z != 0) {
-    out.bad = allanvar::first_nonfinite(v, N);
-    return;
-  }
+  const double vmin = range[0], vmax = range[1];
   const double c = 0.5 * vmin + 0.5 * vmax;
   const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
 

@@ -135,6 +135,15 @@ test_that("the chi-square interval of the deviation (NIST SP 1065 eq. 45)", {
   p <- (1 - 0.683) / 2
   expect_equal(ci$lower, sqrt(edf / qchisq(1 - p, edf)), tolerance = 1e-6)
   expect_equal(ci$upper, sqrt(edf / qchisq(p, edf)), tolerance = 1e-6)
+  # down to allan_edf()'s floor of 1e-3: exact where the factors are too
+  # steep to interpolate, Inf where qchisq() underflows, never NaN or 0
+  edf <- exp(seq(log(1e-3), log(1e9), length.out = 5000))
+  ci <- allan_ci(rep(4, 5000), edf, 0.9)
+  up <- 2 * sqrt(edf / qchisq(0.05, edf))
+  expect_equal(ci$lower, 2 * sqrt(edf / qchisq(0.95, edf)), tolerance = 1e-6)
+  expect_equal(ci$upper[is.finite(up)], up[is.finite(up)], tolerance = 1e-6)
+  expect_true(all(ci$upper[!is.finite(up)] == Inf))
+  expect_true(all(ci$lower > 0 & ci$upper > ci$lower))
 })
 
 test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
