@@ -457,6 +457,9 @@ struct Level {
 // Consume n dd values at level j: accumulate squared differences, keep the
 // cluster sums for noise id when asked, and pair them into level j+1 in
 // place.
+// Exact = false (noise id alone): plain double sums in h, l unused; their
+// rounding (1e-16 of a sum) is far below what a noise type can feel.
+template <bool Exact>
 inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
                            bool pair) {
   double s = 0, s1 = 0;  // two chains: the add latency bounds one
@@ -466,22 +469,25 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
       L.fl = l[0];
       L.has = true;
     } else {
-      const double d = (h[0] - L.ph) + (l[0] - L.pl);
+      const double d = Exact ? (h[0] - L.ph) + (l[0] - L.pl) : h[0] - L.ph;
       s = d * d;
     }
     R_xlen_t i = 1;
     for (; i + 2 <= n; i += 2) {
-      const double d0 = (h[i] - h[i - 1]) + (l[i] - l[i - 1]);
-      const double d1 = (h[i + 1] - h[i]) + (l[i + 1] - l[i]);
+      const double d0 = Exact ? (h[i] - h[i - 1]) + (l[i] - l[i - 1])
+                              : h[i] - h[i - 1];
+      const double d1 = Exact ? (h[i + 1] - h[i]) + (l[i + 1] - l[i])
+                              : h[i + 1] - h[i];
       s += d0 * d0;
       s1 += d1 * d1;
     }
     if (i < n) {
-      const double d = (h[i] - h[i - 1]) + (l[i] - l[i - 1]);
+      const double d = Exact ? (h[i] - h[i - 1]) + (l[i] - l[i - 1])
+                             : h[i] - h[i - 1];
       s += d * d;
     }
     L.ph = h[n - 1];
-    L.pl = l[n - 1];
+    L.pl = Exact ? l[n - 1] : 0.0;
   }
   L.acc.add(s + s1);
   if (L.line) {
@@ -490,7 +496,8 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
     double a0 = 0, a1 = 0, q0 = 0, q1 = 0;
     R_xlen_t k = 0;
     for (; k + 2 <= n; k += 2) {
-      const double z0 = h[k] + l[k], z1 = h[k + 1] + l[k + 1];
+      const double z0 = Exact ? h[k] + l[k] : h[k];
+      const double z1 = Exact ? h[k + 1] + l[k + 1] : h[k + 1];
       if (L.keep) {
         z[k] = z0;
         z[k + 1] = z1;
@@ -502,7 +509,7 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
       q1 += (tk + 1) * z1;
     }
     if (k < n) {
-      const double z0 = h[k] + l[k];
+      const double z0 = Exact ? h[k] + l[k] : h[k];
       if (L.keep) z[k] = z0;
       a0 += z0;
       q0 += (t + static_cast<double>(k)) * z0;
@@ -514,6 +521,10 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
   }
   if (!pair) return 0;
   const R_xlen_t n2 = n / 2;
+  if (!Exact) {
+    for (R_xlen_t k = 0; k < n2; ++k) h[k] = h[2 * k] + h[2 * k + 1];
+    return n2;
+  }
   for (R_xlen_t k = 0; k < n2; ++k) {
     double t, e;
     two_sum(h[2 * k], h[2 * k + 1], t, e);
@@ -529,6 +540,7 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
 // the level-b sums of its full blocks appended to th/tl.
 // Also the range of the samples when `range` is given (NaN left out; the
 // sums carry it), which spares the other kernels their own pass.
+template <bool Exact>
 void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
                  int jin, int b, std::vector<Level>& lev,
                  std::vector<double>& th, std::vector<double>& tl,
@@ -542,21 +554,27 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
     if (range) {  // a separate loop: the plain one vectorises
       for (R_xlen_t i = 0; i < n; ++i) {
         const double yi = y[k0 + i];
-        two_sum(yi, -c, h[i], l[i]);
+        if (Exact) {
+          two_sum(yi, -c, h[i], l[i]);
+        } else {
+          h[i] = yi - c;
+        }
         lo = yi < lo ? yi : lo;
         hi = yi > hi ? yi : hi;
       }
       range[0] = lo;
       range[1] = hi;
-    } else {
+    } else if (Exact) {
       for (R_xlen_t i = 0; i < n; ++i) two_sum(y[k0 + i], -c, h[i], l[i]);
+    } else {
+      for (R_xlen_t i = 0; i < n; ++i) h[i] = y[k0 + i] - c;
     }
     R_xlen_t cur = n;
     for (int j = 0; j <= jin; ++j)
-      cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
+      cur = level_step<Exact>(h.data(), l.data(), cur, lev[j], j < J);
     if (J >= b && cur == 1) {
       th.push_back(h[0]);
-      tl.push_back(l[0]);
+      tl.push_back(Exact ? l[0] : 0.0);
     }
   }
 }
@@ -564,10 +582,12 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
 // Non-overlapping AV at m = 2^j, j = 0..J: the record is cut in two halves
 // at a block boundary (one per thread), whose per-level sums are then
 // joined with the one difference that straddles the cut.
+// exact = false: noise id alone (no sums reported; plain double cluster
+// sums, about a third of the work).
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
                      const std::vector<bool>& keep, bool line0,
-                     std::vector<Level>& lev, double* range, int threads,
-                     bool main) {
+                     std::vector<Level>& lev, double* range, bool exact,
+                     int threads, bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -600,8 +620,14 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
   std::vector<std::vector<double> > th(P), tl(P);
   double pr[2][2] = {{y[0], y[0]}, {y[0], y[0]}};
   run_items(P, threads, main, [&](R_xlen_t p) {
-    octave_part(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p], tl[p],
-                range ? pr[p] : nullptr);
+    double* rp = range ? pr[p] : nullptr;
+    if (exact) {
+      octave_part<true>(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p],
+                        tl[p], rp);
+    } else {
+      octave_part<false>(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p],
+                         tl[p], rp);
+    }
   });
   if (range) {
     range[0] = std::min(pr[0][0], pr[P - 1][0]);
@@ -643,7 +669,8 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
         lev[j].z = lev[j].store.data();
         set_line(lev[j], j, 0);
       }
-      cur = level_step(h.data(), l.data(), cur, lev[j], j < J);
+      cur = exact ? level_step<true>(h.data(), l.data(), cur, lev[j], j < J)
+                  : level_step<false>(h.data(), l.data(), cur, lev[j], j < J);
     }
   }
 }
@@ -757,7 +784,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     // the range only where the sums' kernel below needs it
     have_range = !std_octave && opts.sums;
     standard_octave(v, N, v[0], J, keep, line0, lev,
-                    have_range ? range : nullptr, threads, main);
+                    have_range ? range : nullptr, std_octave, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
