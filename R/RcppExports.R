@@ -61,8 +61,8 @@ edf_interpolate_cpp <- function(m, sub, es, alpha) {
     .Call(`_allanvar_edf_interpolate_cpp`, m, sub, es, alpha)
 }
 
-ci_long_cpp <- function(avar, edf, lg0, h, flo, fhi) {
-    .Call(`_allanvar_ci_long_cpp`, avar, edf, lg0, h, flo, fhi)
+ci_long_cpp <- function(avar, edf, lg0, h, flo, fhi, p) {
+    .Call(`_allanvar_ci_long_cpp`, avar, edf, lg0, h, flo, fhi, p)
 }
 
 acf_sums <- function(x, max_lag) {

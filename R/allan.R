@@ -271,7 +271,7 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
     ci <- allan_ci(av, e$edf, conf)
     d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
-              adev = sqrt(av), lower = ci$lower, upper = ci$upper,
+              adev = ci$adev, lower = ci$lower, upper = ci$upper,
               edf = e$edf)
     if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
     d$alpha <- e$alpha

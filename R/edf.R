@@ -80,18 +80,12 @@ allan_ci <- function(avar, edf, conf) {
     lg <- seq(log(r[1]), log(r[2]), length.out = 2000L)
     g <- exp(lg)
     half_log <- function(q) 0.5 * log(g / stats::qchisq(q, g))
-    ci <- ci_long_cpp(avar, edf, lg[1L], lg[2L] - lg[1L], half_log(1 - p),
-                      half_log(p))
-    # below 0.05 degrees of freedom the factors change too fast to
-    # interpolate (and qchisq(p, edf) underflows)
-    few <- which(edf < 0.05)
-    if (length(few) > 0L) {
-      e <- edf[few]
-      ci$lower[few] <- sqrt(avar[few]) * sqrt(e / stats::qchisq(1 - p, e))
-      ci$upper[few] <- sqrt(avar[few]) * sqrt(e / stats::qchisq(p, e))
-    }
-    return(ci)
+    # half_log() is Inf where qchisq() underflows (edf ~0.01): those grid
+    # points lie below 0.05, where the C++ pass calls qchisq() itself
+    return(ci_long_cpp(avar, edf, lg[1L], lg[2L] - lg[1L], half_log(1 - p),
+                       half_log(p), p))
   }
   # sqrt of each factor: avar * hi may overflow where the limit does not
-  list(lower = sqrt(avar) * sqrt(lo), upper = sqrt(avar) * sqrt(hi))
+  adev <- sqrt(avar)
+  list(lower = adev * sqrt(lo), upper = adev * sqrt(hi), adev = adev)
 }

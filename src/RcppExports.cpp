@@ -205,8 +205,8 @@ BEGIN_RCPP
 END_RCPP
 }
 // ci_long_cpp
-Rcpp::List ci_long_cpp(const Rcpp::NumericVector& avar, const Rcpp::NumericVector& edf, double lg0, double h, const Rcpp::NumericVector& flo, const Rcpp::NumericVector& fhi);
-RcppExport SEXP _allanvar_ci_long_cpp(SEXP avarSEXP, SEXP edfSEXP, SEXP lg0SEXP, SEXP hSEXP, SEXP floSEXP, SEXP fhiSEXP) {
+Rcpp::List ci_long_cpp(const Rcpp::NumericVector& avar, const Rcpp::NumericVector& edf, double lg0, double h, const Rcpp::NumericVector& flo, const Rcpp::NumericVector& fhi, double p);
+RcppExport SEXP _allanvar_ci_long_cpp(SEXP avarSEXP, SEXP edfSEXP, SEXP lg0SEXP, SEXP hSEXP, SEXP floSEXP, SEXP fhiSEXP, SEXP pSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type avar(avarSEXP);
@@ -215,7 +215,8 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< double >::type h(hSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type flo(floSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type fhi(fhiSEXP);
-    rcpp_result_gen = Rcpp::wrap(ci_long_cpp(avar, edf, lg0, h, flo, fhi));
+    Rcpp::traits::input_parameter< double >::type p(pSEXP);
+    rcpp_result_gen = Rcpp::wrap(ci_long_cpp(avar, edf, lg0, h, flo, fhi, p));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -621,7 +622,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
-    {"_allanvar_ci_long_cpp", (DL_FUNC) &_allanvar_ci_long_cpp, 6},
+    {"_allanvar_ci_long_cpp", (DL_FUNC) &_allanvar_ci_long_cpp, 7},
     {"_allanvar_acf_sums", (DL_FUNC) &_allanvar_acf_sums, 2},
     {"_allanvar_detrend_line", (DL_FUNC) &_allanvar_detrend_line, 1},
     {"_allanvar_welch_segments", (DL_FUNC) &_allanvar_welch_segments, 3},

@@ -678,7 +678,8 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
 // ---- noise identification (src/noise_id.h) at the rows `mid` ----
 
 struct Channel {
-  std::vector<double> sums, alpha;
+  double* sums = nullptr;  // nt values: the result matrix's column
+  std::vector<double> alpha;
   std::vector<int> alpha_int, id_method;
   R_xlen_t bad = 0;  // 1-based position of the first NA/NaN/Inf, or 0
 };
@@ -731,7 +732,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   const int type = opts.type;
   const bool rate = opts.rate, octave = opts.octave;
   const size_t nt = ms.size(), ni = mid.size();
-  out.sums.assign(nt, 0.0);
+  std::fill(out.sums, out.sums + nt, 0.0);
   out.alpha.assign(ni, NA_REAL);
   out.alpha_int.assign(ni, NA_INTEGER);
   out.id_method.assign(ni, allanvar::NOISE_ID_NONE);
@@ -829,7 +830,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   } else {
     build_prefix(v, N, c, bound, level, X, threads, main);
   }
-  double* o = out.sums.data();
+  double* o = out.sums;
   // identification alone (other statistics' noise type) needs no sums
   if (opts.sums) switch (type) {
     case STANDARD: strided<2>(X, ms, nterms, threads, main, o); break;
@@ -884,16 +885,16 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
   const R_xlen_t nc = x.size() / N;
   const size_t nt = m.size();
   const size_t ni = mid.size();
-  std::vector<R_xlen_t> ms(nt), nts(nt), mids(ni);
-  for (size_t j = 0; j < nt; ++j) {
-    ms[j] = static_cast<R_xlen_t>(m[j]);
-    nts[j] = static_cast<R_xlen_t>(nterms[j]);
-  }
-  for (size_t j = 0; j < ni; ++j) mids[j] = static_cast<R_xlen_t>(mid[j]);
+  // converted as they are copied (no zero fill first: pages of a long grid)
+  const std::vector<R_xlen_t> ms(m.begin(), m.end()),
+      nts(nterms.begin(), nterms.end()), mids(mid.begin(), mid.end());
   std::vector<Channel> ch;
   const double* p = x.begin();
+  // the sums go straight into the result (no copy of a 500,000-row curve)
+  Rcpp::NumericMatrix sums(Rcpp::no_init(nt, nc));
   try {
     ch.resize(nc);
+    for (R_xlen_t i = 0; i < nc; ++i) ch[i].sums = sums.begin() + i * nt;
     if (nc == 1) {
       one_channel(p, N, ms, nts, mids, opts, threads, true, ch[0]);
     } else {
@@ -906,10 +907,9 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
     Rcpp::stop("allanvar_out_of_memory");
   }
   scope.finish();
-  Rcpp::NumericMatrix sums(nt, nc), alpha(ni, nc);
+  Rcpp::NumericMatrix alpha(ni, nc);
   Rcpp::IntegerMatrix alpha_int(ni, nc), id_method(ni, nc);
   for (R_xlen_t i = 0; i < nc; ++i) {
-    for (size_t j = 0; j < nt; ++j) sums(j, i) = ch[i].sums[j];
     for (size_t j = 0; j < ni; ++j) {
       alpha(j, i) = ch[i].alpha[j];
       alpha_int(j, i) = ch[i].alpha_int[j];

@@ -305,17 +305,28 @@ Rcpp::List edf_interpolate_cpp(const Rcpp::NumericVector& m,
 // Chi-square limits of the deviation for long curves (R/edf.R allan_ci()):
 // adev * exp(f(log edf)), f the half log quantile factor given on a grid
 // uniform in log edf (start lg0, step h; flo and fhi), read by four-point
-// Lagrange interpolation (error ~h^4, below 1e-9 relative at 2000 points).
-// One pass and two result vectors: the R version's temporaries of 500,000
+// Lagrange interpolation (error ~h^4, below 1e-9 relative at 2000 points);
+// below 0.05 degrees of freedom, where the factors are too steep for it,
+// from qchisq() itself (p: the lower tail of the upper limit). One pass and
+// three result vectors (adev too): the R version's temporaries of 500,000
 // rows cost more in page faults than its arithmetic.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List ci_long_cpp(const Rcpp::NumericVector& avar,
                        const Rcpp::NumericVector& edf, double lg0, double h,
                        const Rcpp::NumericVector& flo,
-                       const Rcpp::NumericVector& fhi) {
+                       const Rcpp::NumericVector& fhi, double p) {
   const R_xlen_t n = avar.size(), g = flo.size();
-  Rcpp::NumericVector lower(n), upper(n);
+  Rcpp::NumericVector lower(Rcpp::no_init(n)), upper(Rcpp::no_init(n)),
+      adev(Rcpp::no_init(n));
   for (R_xlen_t i = 0; i < n; ++i) {
+    const double a = std::sqrt(avar[i]);
+    adev[i] = a;
+    if (edf[i] < 0.05) {
+      // qchisq(p, edf) underflows to 0 near 0.01: an unbounded limit
+      lower[i] = a * std::sqrt(edf[i] / R::qchisq(1 - p, edf[i], 1, 0));
+      upper[i] = a * std::sqrt(edf[i] / R::qchisq(p, edf[i], 1, 0));
+      continue;
+    }
     const double u = (std::log(edf[i]) - lg0) / h;
     // points j..j+3 around u (u clamped first: no cast of NaN or huge u)
     const double uc = u > 1 ? (u < static_cast<double>(g) ? u : g) : 1;
@@ -326,14 +337,12 @@ Rcpp::List ci_long_cpp(const Rcpp::NumericVector& avar,
     const double w1 = t * (t - 2) * (t - 3) / 2;
     const double w2 = -t * (t - 1) * (t - 3) / 2;
     const double w3 = t * (t - 1) * (t - 2) / 6;
-    const double a = std::sqrt(avar[i]);
     lower[i] = a * std::exp(w0 * flo[j] + w1 * flo[j + 1] + w2 * flo[j + 2] +
                             w3 * flo[j + 3]);
-    const double fu = w0 * fhi[j] + w1 * fhi[j + 1] + w2 * fhi[j + 2] +
-                      w3 * fhi[j + 3];
-    // at edf ~0.01 and below qchisq() underflows to 0: an unbounded limit
-    upper[i] = std::isnan(fu) ? R_PosInf : a * std::exp(fu);
+    upper[i] = a * std::exp(w0 * fhi[j] + w1 * fhi[j + 1] + w2 * fhi[j + 2] +
+                            w3 * fhi[j + 3]);
   }
   return Rcpp::List::create(Rcpp::Named("lower") = lower,
-                            Rcpp::Named("upper") = upper);
+                            Rcpp::Named("upper") = upper,
+                            Rcpp::Named("adev") = adev);
 }
