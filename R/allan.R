@@ -242,8 +242,10 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   # finite numbers: that channel again on x 2^-e (exact), scaled back.
   sc <- rep(0, ch$nc)
   for (j in seq_len(ch$nc)) {
+    # min() and max() of the column: no copies of a long curve
+    sj <- if (ch$nc == 1L) res$sums else res$sums[, j]
+    if (is.finite(max(sj)) && min(sj) >= 2^-900) next
     sj <- res$sums[, j]
-    if (all(is.finite(sj)) && !any(sj < 2^-900)) next
     xj <- if (ch$nc == 1L) ch$values else ch$values[(j - 1) * N + seq_len(N)]
     e <- range_exponent(xj)
     # zero sums of a constant channel are right as they are
@@ -403,9 +405,11 @@ range_exponent <- function(x) {
 # non-zero variance below the smallest double); `nonzero`: where the
 # variance is known to be positive.
 check_representable <- function(av, nonzero = FALSE, what = "`x`") {
-  # variances are >= 0: the range settles long curves without temporaries
-  r <- suppressWarnings(range(av))
-  if (is.finite(r[2]) && r[1] >= .Machine$double.xmin) return(av)
+  # variances are >= 0: min() and max() settle long curves without
+  # temporaries (range() copies its argument)
+  if (length(av) > 0L && is.finite(max(av)) && min(av) >= .Machine$double.xmin) {
+    return(av)
+  }
   if (any(!is.finite(av))) {
     abort("The variance of ", what, " exceeds the largest double (",
           format(.Machine$double.xmax, digits = 3), "); divide the data by ",

@@ -70,7 +70,7 @@ allan_edf_direct <- function(type, m, n, L, alpha) {
 # slow); the interpolation error is below 1e-6 relative.
 allan_ci <- function(avar, edf, conf) {
   p <- (1 - conf) / 2
-  r <- range(edf)
+  r <- c(min(edf), max(edf))  # range() would copy a long curve's edf
   if (length(edf) <= 2000L || r[2] <= r[1] * (1 + 1e-12)) {
     lo <- edf / stats::qchisq(1 - p, edf)
     hi <- edf / stats::qchisq(p, edf)
