@@ -449,7 +449,8 @@ struct Level {
   // the lag-1 ACF's line (noise_id.h, acf_line_from()) read in the same
   // pass, so the ACF needs one more pass, not three: s0 = sum z and
   // sp = sum (i - cc) z over this level's values (centred cluster sums),
-  // i counted over the whole level from i0, cc its centre
+  // i counted over the whole level from i0, cc its centre; `keep` levels
+  // are stored in that loop, so they need `line` too
   bool line = false;
   double s0 = 0, sp = 0, i0 = 0, cc = 0;
 };
@@ -585,9 +586,9 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
 // exact = false: noise id alone (no sums reported; plain double cluster
 // sums, about a third of the work).
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
-                     const std::vector<bool>& keep, bool line0,
-                     std::vector<Level>& lev, double* range, bool exact,
-                     int threads, bool main) {
+                     const std::vector<bool>& keep,
+                     const std::vector<bool>& line, std::vector<Level>& lev,
+                     double* range, bool exact, int threads, bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -605,16 +606,15 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
     L.i0 = static_cast<double>(first >> j);
     L.cc = (static_cast<double>(N >> j) - 1) / 2;
   };
-  if (line0) {
-    for (int p = 0; p < P; ++p) set_line(part[p][0], 0, cut[p]);
-  }
   for (int j = 0; j <= jin; ++j) {
+    if (line[j] || keep[j]) {  // level_step() stores in the line's loop
+      for (int p = 0; p < P; ++p) set_line(part[p][j], j, cut[p]);
+    }
     if (!keep[j]) continue;
     part[0][j].store.resize(static_cast<size_t>(N >> j));
     for (int p = 0; p < P; ++p) {
       part[p][j].keep = true;
       part[p][j].z = part[0][j].store.data() + (cut[p] >> j);
-      set_line(part[p][j], j, cut[p]);
     }
   }
   std::vector<std::vector<double> > th(P), tl(P);
@@ -667,8 +667,8 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
       if (lev[j].keep) {
         lev[j].store.resize(static_cast<size_t>(cur));
         lev[j].z = lev[j].store.data();
-        set_line(lev[j], j, 0);
       }
+      if (line[j] || lev[j].keep) set_line(lev[j], j, 0);
       cur = exact ? level_step<true>(h.data(), l.data(), cur, lev[j], j < J)
                   : level_step<false>(h.data(), l.data(), cur, lev[j], j < J);
     }
@@ -706,16 +706,22 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const R_xlen_t m = mid[j];
     int lj = 0;
     while ((static_cast<R_xlen_t>(1) << lj) < m) ++lj;
+    const R_xlen_t n = N >> lj;
     const double* z = lj == 0 ? v : lev[lj].z;
-    const R_xlen_t n = lj == 0 ? N : lev[lj].zn;
     allanvar::NoiseId id;
     if (n >= rules.acf_min) {
       // the line read in the octave pass: level 0's sums are of v - c
       const Level& L = lev[lj];
       const allanvar::AcfLine ln =
           allanvar::acf_line_from(L.s0, L.sp, lj == 0 ? c : 0.0, n, false);
-      id = allanvar::acf_noise_id_line([z](R_xlen_t i) { return z[i]; }, n,
-                                       false, dmax, ln);
+      if (lj == 1) {  // not kept: pairs of the samples
+        id = allanvar::acf_noise_id_line(
+            [v, c](R_xlen_t i) { return (v[2 * i] - c) + (v[2 * i + 1] - c); },
+            n, false, dmax, ln);
+      } else {
+        id = allanvar::acf_noise_id_line([z](R_xlen_t i) { return z[i]; }, n,
+                                         false, dmax, ln);
+      }
     } else {
       id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], modified, rules,
                                  [&]() { return rn.ratio(m); });
@@ -773,18 +779,23 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     for (R_xlen_t m : mid) top = std::max(top, m);
     int J = 0;
     while ((static_cast<R_xlen_t>(1) << (J + 1)) <= top) ++J;
-    std::vector<bool> keep(J + 1, false);
-    bool line0 = false;
+    // The ACF rows keep their line's sums; every row but level 0 (the
+    // samples) and 1 (pairs of them, read from the samples again: a 40% of
+    // N store, written, zeroed by the kernel and read, cost more) keeps its
+    // values.
+    std::vector<bool> keep(J + 1, false), line(J + 1, false);
     for (R_xlen_t m : mid) {
       int lj = 0;
       while ((static_cast<R_xlen_t>(1) << lj) < m) ++lj;
-      if (lj > 0 && lj <= J) keep[lj] = true;
-      if (lj == 0) line0 = true;
+      if (lj > J) continue;
+      const bool acf = (N >> lj) >= rules.acf_min;
+      line[lj] = acf;
+      keep[lj] = lj > 1 || (lj == 1 && !acf);
     }
     std::vector<Level> lev;
     // the range only where the sums' kernel below needs it
     have_range = !std_octave && opts.sums;
-    standard_octave(v, N, v[0], J, keep, line0, lev,
+    standard_octave(v, N, v[0], J, keep, line, lev,
                     have_range ? range : nullptr, std_octave, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
