@@ -772,17 +772,17 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   double range[2] = {v[0], v[0]};
   bool have_range = false;
   if (std_octave || octave_id) {
-    // Any constant works as the centre here (cluster sums are double-double
-    // and constants cancel); NaN or Inf shows up in the sums.
+    // Any constant works as the centre here (constants cancel; the cluster
+    // sums are double-double where the standard sums are reported); NaN or
+    // Inf shows up in the sums.
     R_xlen_t top = 1;
     if (std_octave) for (R_xlen_t m : ms) top = std::max(top, m);
     for (R_xlen_t m : mid) top = std::max(top, m);
     int J = 0;
     while ((static_cast<R_xlen_t>(1) << (J + 1)) <= top) ++J;
-    // The ACF rows keep their line's sums; every row but level 0 (the
-    // samples) and 1 (pairs of them, read from the samples again: a 40% of
-    // N store, written, zeroed by the kernel and read, cost more) keeps its
-    // values.
+    // ACF rows sum their line in the pass; every level but 0 (the samples)
+    // and 1 (pairs of them, read from the samples again: a store of N/2
+    // values, written, zeroed by the kernel and read, cost more) is stored.
     std::vector<bool> keep(J + 1, false), line(J + 1, false);
     for (R_xlen_t m : mid) {
       int lj = 0;
