@@ -245,7 +245,6 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     # min() and max() of the column: no copies of a long curve
     sj <- if (ch$nc == 1L) res$sums else res$sums[, j]
     if (is.finite(max(sj)) && min(sj) >= 2^-900) next
-    sj <- res$sums[, j]
     xj <- if (ch$nc == 1L) ch$values else ch$values[(j - 1) * N + seq_len(N)]
     e <- range_exponent(xj)
     # zero sums of a constant channel are right as they are

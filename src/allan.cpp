@@ -458,6 +458,18 @@ struct Level {
 // Consume n dd values at level j: accumulate squared differences, keep the
 // cluster sums for noise id when asked, and pair them into level j+1 in
 // place.
+// A level's value at k, and the difference of its values at a and b: hi +
+// lo, or (Exact = false) h alone.
+template <bool Exact>
+inline double level_at(const double* h, const double* l, R_xlen_t k) {
+  return Exact ? h[k] + l[k] : h[k];
+}
+template <bool Exact>
+inline double level_diff(const double* h, const double* l, R_xlen_t a,
+                         R_xlen_t b) {
+  return Exact ? (h[a] - h[b]) + (l[a] - l[b]) : h[a] - h[b];
+}
+
 // Exact = false (noise id alone): plain double sums in h, l unused; their
 // rounding (1e-16 of a sum) is far below what a noise type can feel.
 template <bool Exact>
@@ -475,16 +487,13 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
     }
     R_xlen_t i = 1;
     for (; i + 2 <= n; i += 2) {
-      const double d0 = Exact ? (h[i] - h[i - 1]) + (l[i] - l[i - 1])
-                              : h[i] - h[i - 1];
-      const double d1 = Exact ? (h[i + 1] - h[i]) + (l[i + 1] - l[i])
-                              : h[i + 1] - h[i];
+      const double d0 = level_diff<Exact>(h, l, i, i - 1);
+      const double d1 = level_diff<Exact>(h, l, i + 1, i);
       s += d0 * d0;
       s1 += d1 * d1;
     }
     if (i < n) {
-      const double d = Exact ? (h[i] - h[i - 1]) + (l[i] - l[i - 1])
-                             : h[i] - h[i - 1];
+      const double d = level_diff<Exact>(h, l, i, i - 1);
       s += d * d;
     }
     L.ph = h[n - 1];
@@ -497,8 +506,8 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
     double a0 = 0, a1 = 0, q0 = 0, q1 = 0;
     R_xlen_t k = 0;
     for (; k + 2 <= n; k += 2) {
-      const double z0 = Exact ? h[k] + l[k] : h[k];
-      const double z1 = Exact ? h[k + 1] + l[k + 1] : h[k + 1];
+      const double z0 = level_at<Exact>(h, l, k);
+      const double z1 = level_at<Exact>(h, l, k + 1);
       if (L.keep) {
         z[k] = z0;
         z[k + 1] = z1;
@@ -510,7 +519,7 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
       q1 += (tk + 1) * z1;
     }
     if (k < n) {
-      const double z0 = Exact ? h[k] + l[k] : h[k];
+      const double z0 = level_at<Exact>(h, l, k);
       if (L.keep) z[k] = z0;
       a0 += z0;
       q0 += (t + static_cast<double>(k)) * z0;
