@@ -236,8 +236,10 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
                                  "touch missing values)"), ".",
           class = "values")
   }
-  norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
-                 2 * m^2)
+  # the estimator's divisor: one vector (a long curve's temporaries cost
+  # more in page faults than in arithmetic)
+  den <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
+                2 * m^2) * nterms
   # Sums that overflowed (or underflowed) in a channel of huge (tiny) but
   # finite numbers: that channel again on x 2^-e (exact), scaled back.
   sc <- rep(0, ch$nc)
@@ -259,7 +261,7 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   }
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {
-    av <- res$sums[, j] / (norm * nterms)
+    av <- res$sums[, j] / den
     if (!rate && sc[j] == 0) {
       av <- times_freq2(av, freq)
     } else if (sc[j] != 0) {
