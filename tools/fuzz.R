@@ -322,8 +322,13 @@ fuzz_cases <- function(quick = FALSE) {
     "print.summary.allan_sources" = q(print(summary(hat))),
     "print.summary.avfit" = q(print(summary(fit))),
     "print.tool_curve" = q(print(read_avr_curve(f_avr))),
-    "predict.avfit" = q(predict(fit, c(0.1, 1))))
+    "predict.avfit" = q(predict(fit, c(0.1, 1))),
+    "[.allan" = q(av[av$tau > 0.05, ]),
+    "[.allan_sources" = q(hat[hat$source == hat$source[1], ]),
+    "[.tool_curve" = q(read_avr_curve(f_avr)[1:2, ]))
   for (m in names(methods)) add(m, "valid", methods[[m]])
+  add("[.allan", "columns", q(print(av[, c("tau", "adev")])))
+  add("[.allan", "no rows", q(print(av[av$tau < 0, ])))
   # IMU workflow
   sub_arg("imu_record", q(imu_record(x = rec$data, freq = 100)), "x", series)
   sub_arg("imu_record", q(imu_record(x = cbind(gyro_x = x), freq = 100)),
