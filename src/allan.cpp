@@ -87,6 +87,8 @@ inline double grid_step(double bound) {
 // Prefix sums with a leading zero of (v - c): levels = 1 gives X (n + 1
 // points), levels = 2 the prefix sums of X (n + 2 points). `bound` bounds
 // |v - c|.
+const R_xlen_t kPrefixBlock = static_cast<R_xlen_t>(1) << 16;
+
 void build_prefix(const double* v, R_xlen_t n, double c, double bound,
                   int levels, Split& out, int threads, bool main) {
   const R_xlen_t len = n + levels;
@@ -96,39 +98,66 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   double* lo = out.lo.data();
   hi[0] = lo[0] = 0;
   if (levels == 2) hi[1] = lo[1] = 0;
-  double b = bound * static_cast<double>(n) * (1 + 1e-9);
-  if (levels == 2) b *= static_cast<double>(n + 1);
+  const double nn = static_cast<double>(n);
+  double b = bound * nn * (1 + 1e-9);
+  if (levels == 2) b *= nn + 1;
+  // room for the grid's rounding of n increments (n q/2 <= n b 2^-50)
+  if (levels == 1) b *= 1 + nn * 1.7763568394002505e-15;  // 2^-49
   const double q = grid_step(b);
   const double C = 1.5 * q * 4503599627370496.0;  // 1.5 q 2^52: ulp(C) = q
   if (levels == 1) {
-    // X_{i+1} = X_i + (v_i - c). With two threads the second one first runs
-    // the same additions over the first part without storing them, so the
-    // result is bit-identical to the serial loop.
-    auto run = [&](R_xlen_t i0, R_xlen_t i1, double& s1, double& e1, bool store) {
-      for (R_xlen_t i = i0; i < i1; ++i) {
-        if ((i & kPoll) == kPoll && allanvar::interrupted()) return;
-        double r, re, t, te;
-        two_sum(v[i], -c, r, re);
-        two_sum(s1, r, t, te);
-        s1 = t;
-        e1 += te + re;
-        if (store) {
-          const double h = (s1 + C) - C;
-          hi[i + 1] = h;
-          lo[i + 1] = (s1 - h) + e1;
+    // X_{i+1} = X_i + (v_i - c). Each increment v_i - c = r + re (TwoSum)
+    // is split into a on the grid q and the remainder (r - a) + re (at most
+    // q/2 and an ulp): hi sums the a exactly (multiples of q below 2^50 q,
+    // in any order), lo the remainders in plain double (rounding about
+    // eps n q, far below q). hi being exact, the record is cut into fixed
+    // blocks: their sums first, then each block's prefix from its start,
+    // both in parallel; the result does not depend on the thread count.
+    auto split = [C, c](double x, double& a, double& rem) {
+      double r, re;
+      two_sum(x, -c, r, re);
+      a = (r + C) - C;
+      rem = (r - a) + re;
+    };
+    const R_xlen_t nb = (n + kPrefixBlock - 1) / kPrefixBlock;
+    std::vector<double> hbase(nb + 1, 0.0), lbase(nb + 1, 0.0);
+    run_items(nb, threads, main, [&](R_xlen_t k) {
+      const R_xlen_t i0 = k * kPrefixBlock, i1 = std::min(n, i0 + kPrefixBlock);
+      double h[4] = {0, 0, 0, 0}, l[4] = {0, 0, 0, 0};
+      R_xlen_t i = i0;
+      for (; i + 4 <= i1; i += 4) {
+        for (int u = 0; u < 4; ++u) {
+          double a, rem;
+          split(v[i + u], a, rem);
+          h[u] += a;
+          l[u] += rem;
         }
       }
-    };
-    const R_xlen_t cut = (threads > 1 && n >= 65536)
-                             ? static_cast<R_xlen_t>(0.58 * static_cast<double>(n))
-                             : n;
-    run_items(cut < n ? 2 : 1, threads, main, [&](R_xlen_t p) {
-      double s1 = 0, e1 = 0;
-      if (p == 0) {
-        run(0, cut, s1, e1, true);
-      } else {
-        run(0, cut, s1, e1, false);
-        run(cut, n, s1, e1, true);
+      for (; i < i1; ++i) {
+        double a, rem;
+        split(v[i], a, rem);
+        h[0] += a;
+        l[0] += rem;
+      }
+      hbase[k + 1] = (h[0] + h[1]) + (h[2] + h[3]);
+      lbase[k + 1] = (l[0] + l[1]) + (l[2] + l[3]);
+    });
+    if (allanvar::interrupt_state().stop.load()) return;
+    for (R_xlen_t k = 0; k < nb; ++k) {
+      hbase[k + 1] += hbase[k];
+      lbase[k + 1] += lbase[k];
+    }
+    run_items(nb, threads, main, [&](R_xlen_t k) {
+      const R_xlen_t i0 = k * kPrefixBlock, i1 = std::min(n, i0 + kPrefixBlock);
+      double h = hbase[k], l = 0;
+      const double l0 = lbase[k];
+      for (R_xlen_t i = i0; i < i1; ++i) {
+        double a, rem;
+        split(v[i], a, rem);
+        h += a;
+        l += rem;
+        hi[i + 1] = h;
+        lo[i + 1] = l0 + l;
       }
     });
     return;
