@@ -89,6 +89,41 @@ inline double grid_step(double bound) {
 // |v - c|.
 const R_xlen_t kPrefixBlock = static_cast<R_xlen_t>(1) << 16;
 
+// One block [i0, i1) of build_prefix(levels = 1): the exact sum of its grid
+// parts and the sum of its remainders in four lanes (the last (i1 - i0) % 4
+// in lane 0: the same additions whether or not the values are stored), and
+// with Store its X values from h + (l0 + l) on.
+template <bool Store>
+void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
+                  double C, double h, double l0, double* hi, double* lo,
+                  double& hsum, double& lsum) {
+  double hl[4] = {0, 0, 0, 0}, ll[4] = {0, 0, 0, 0}, l = 0;
+  auto step = [&](R_xlen_t i, int u) {
+    double r, re;
+    two_sum(v[i], -c, r, re);
+    const double a = (r + C) - C;
+    const double rem = (r - a) + re;
+    hl[u] += a;
+    ll[u] += rem;
+    if (Store) {
+      h += a;
+      l += rem;
+      hi[i + 1] = h;
+      lo[i + 1] = l0 + l;
+    }
+  };
+  R_xlen_t i = i0;
+  for (; i + 4 <= i1; i += 4) {
+    step(i, 0);
+    step(i + 1, 1);
+    step(i + 2, 2);
+    step(i + 3, 3);
+  }
+  for (; i < i1; ++i) step(i, 0);
+  hsum = (hl[0] + hl[1]) + (hl[2] + hl[3]);
+  lsum = (ll[0] + ll[1]) + (ll[2] + ll[3]);
+}
+
 void build_prefix(const double* v, R_xlen_t n, double c, double bound,
                   int levels, Split& out, int threads, bool main) {
   const R_xlen_t len = n + levels;
@@ -111,36 +146,35 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     // q/2 and an ulp): hi sums the a exactly (multiples of q below 2^50 q,
     // in any order), lo the remainders in plain double (rounding about
     // eps n q, far below q). hi being exact, the record is cut into fixed
-    // blocks: their sums first, then each block's prefix from its start,
-    // both in parallel; the result does not depend on the thread count.
-    auto split = [C, c](double x, double& a, double& rem) {
-      double r, re;
-      two_sum(x, -c, r, re);
-      a = (r + C) - C;
-      rem = (r - a) + re;
-    };
+    // blocks: on two threads their sums first, then each block's prefix
+    // from its start; on one, a single pass making the same additions. The
+    // result does not depend on the thread count.
     const R_xlen_t nb = (n + kPrefixBlock - 1) / kPrefixBlock;
+    auto ends = [n](R_xlen_t k, R_xlen_t& i0, R_xlen_t& i1) {
+      i0 = k * kPrefixBlock;
+      i1 = std::min(n, i0 + kPrefixBlock);
+    };
+    if (threads < 2 || nb < 2) {
+      // one pass: each block from the running sums of those before it
+      double h = 0, l0 = 0;
+      for (R_xlen_t k = 0; k < nb; ++k) {
+        if ((k & 15) == 15 && allanvar::interrupted()) return;
+        R_xlen_t i0, i1;
+        ends(k, i0, i1);
+        double hs, ls;
+        prefix_block<true>(v, i0, i1, c, C, h, l0, hi, lo, hs, ls);
+        h += hs;
+        l0 += ls;
+      }
+      return;
+    }
+    // two passes on the threads: block sums, then each block from its start
     std::vector<double> hbase(nb + 1, 0.0), lbase(nb + 1, 0.0);
     run_items(nb, threads, main, [&](R_xlen_t k) {
-      const R_xlen_t i0 = k * kPrefixBlock, i1 = std::min(n, i0 + kPrefixBlock);
-      double h[4] = {0, 0, 0, 0}, l[4] = {0, 0, 0, 0};
-      R_xlen_t i = i0;
-      for (; i + 4 <= i1; i += 4) {
-        for (int u = 0; u < 4; ++u) {
-          double a, rem;
-          split(v[i + u], a, rem);
-          h[u] += a;
-          l[u] += rem;
-        }
-      }
-      for (; i < i1; ++i) {
-        double a, rem;
-        split(v[i], a, rem);
-        h[0] += a;
-        l[0] += rem;
-      }
-      hbase[k + 1] = (h[0] + h[1]) + (h[2] + h[3]);
-      lbase[k + 1] = (l[0] + l[1]) + (l[2] + l[3]);
+      R_xlen_t i0, i1;
+      ends(k, i0, i1);
+      prefix_block<false>(v, i0, i1, c, C, 0, 0, hi, lo, hbase[k + 1],
+                          lbase[k + 1]);
     });
     if (allanvar::interrupt_state().stop.load()) return;
     for (R_xlen_t k = 0; k < nb; ++k) {
@@ -148,17 +182,10 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
       lbase[k + 1] += lbase[k];
     }
     run_items(nb, threads, main, [&](R_xlen_t k) {
-      const R_xlen_t i0 = k * kPrefixBlock, i1 = std::min(n, i0 + kPrefixBlock);
-      double h = hbase[k], l = 0;
-      const double l0 = lbase[k];
-      for (R_xlen_t i = i0; i < i1; ++i) {
-        double a, rem;
-        split(v[i], a, rem);
-        h += a;
-        l += rem;
-        hi[i + 1] = h;
-        lo[i + 1] = l0 + l;
-      }
+      R_xlen_t i0, i1;
+      ends(k, i0, i1);
+      double hs, ls;
+      prefix_block<true>(v, i0, i1, c, C, hbase[k], lbase[k], hi, lo, hs, ls);
     });
     return;
   }
