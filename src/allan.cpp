@@ -1,10 +1,12 @@
-// allan(): the Allan-family estimators from compensated prefix sums.
+// allan(): the Allan-family estimators from exact-grid prefix sums.
 //
 // Every estimator is a sum of squares of small integer combinations of a
 // phase sequence X (the running sum of the rate samples, or the integrated
 // input itself). X is held as hi + lo, where hi lies on a grid of step q with
 // |hi| <= 2^50 q: any combination with integer weights of total size <= 8 is
-// then exact in double, and lo (|lo| <= q/2) carries the rest. Differences of
+// then exact in double, and lo carries the rest (at most q/2 per point, or
+// per summed increment for the running sums of rate data: far below the
+// data's own scale, since q is 2^-50 of the largest |X|). Differences of
 // huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
 // drift or length of the record.
 #include "buffer.h"
