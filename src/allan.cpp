@@ -86,6 +86,15 @@ inline double grid_step(double bound) {
   return std::ldexp(1.0, e - 50);
 }
 
+// x - c as a on the grid of C (C = 1.5 q 2^52: ulp(C) = q) plus the rest
+// rem = (r - a) + re (at most q/2 and an ulp; r + re = x - c exactly).
+inline void grid_split(double x, double c, double C, double& a, double& rem) {
+  double r, re;
+  two_sum(x, -c, r, re);
+  a = (r + C) - C;
+  rem = (r - a) + re;
+}
+
 // Prefix sums with a leading zero of (v - c): levels = 1 gives X (n + 1
 // points), levels = 2 the prefix sums of X (n + 2 points). `bound` bounds
 // |v - c|.
@@ -101,10 +110,8 @@ void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
                   double& hsum, double& lsum) {
   double hl[4] = {0, 0, 0, 0}, ll[4] = {0, 0, 0, 0}, l = 0;
   auto step = [&](R_xlen_t i, int u) {
-    double r, re;
-    two_sum(v[i], -c, r, re);
-    const double a = (r + C) - C;
-    const double rem = (r - a) + re;
+    double a, rem;
+    grid_split(v[i], c, C, a, rem);
     hl[u] += a;
     ll[u] += rem;
     if (Store) {
@@ -225,13 +232,7 @@ void build_split(const double* v, R_xlen_t n, double c, double bound,
   out.lo.resize(n);
   const double q = grid_step(bound * (1 + 1e-9));
   const double C = 1.5 * q * 4503599627370496.0;
-  for (R_xlen_t i = 0; i < n; ++i) {
-    double r, re;
-    two_sum(v[i], -c, r, re);
-    const double h = (r + C) - C;
-    out.hi[i] = h;
-    out.lo[i] = (r - h) + re;
-  }
+  for (R_xlen_t i = 0; i < n; ++i) grid_split(v[i], c, C, out.hi[i], out.lo[i]);
 }
 
 // Sum of squared second (D = 2) or third (D = 3) differences at stride 1,
