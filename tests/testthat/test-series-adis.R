@@ -1,5 +1,5 @@
 # series_effects() on the measured ADIS16405 recordings (../shared/data;
-# skipped without them). data-raw/adis16405-study.md: the gyros y carry one
+# skipped without them). bench/adis16405/adis16405-study.md: the gyros y carry one
 # spike of 2.05 deg/s; unit 1's accelerometers show transients (a knock, a
 # tilt that returns) at 2154, 6817 and 7027 s on all three axes; no gyro has
 # a bias step.

@@ -6,8 +6,8 @@
 # decide which effects the catalogue needs.
 #
 # Reads ../shared/data (not shipped) at run time; writes only derived
-# figures to data-raw/adis16405-study.txt.
-#   Rscript data-raw/adis16405-study.R        (about 2 minutes)
+# figures to bench/adis16405/adis16405-study.txt.
+#   Rscript bench/adis16405/adis16405-study.R        (about 2 minutes)
 pkgload::load_all(".", quiet = TRUE)
 shared <- Sys.getenv("ALLANVAR_SHARED_DATA", "../shared/data")
 if (!dir.exists(shared)) shared <- "/work/shared/data"
@@ -34,13 +34,13 @@ white_level <- function(av) {
 
 rows <- list()
 line_rows <- list()
-out <- file("data-raw/adis16405-study.txt", "w")
+out <- file("bench/adis16405/adis16405-study.txt", "w")
 say <- function(...) {
   txt <- sprintf(...)
   cat(txt, "\n", sep = "")
   writeLines(txt, out)
 }
-say("# ADIS16405: what the raw data show (data-raw/adis16405-study.R, %s)", format(Sys.Date()))
+say("# ADIS16405: what the raw data show (bench/adis16405/adis16405-study.R, %s)", format(Sys.Date()))
 for (k in 1:3) {
   mat <- readRDS(file.path(shared, sprintf("adis16405_unit%d.rds", k)))
   freq <- attr(mat, "freq")
