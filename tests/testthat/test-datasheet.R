@@ -41,7 +41,8 @@ test_that("average = TRUE appends the mean of the axes, and only then", {
   g <- ds$gyro
   expect_identical(g$axis, c("gyro_x", "gyro_y", "mean of axes"))
   expect_equal(g[["N [deg/sqrt(h)]"]][3], mean(g[["N [deg/sqrt(h)]"]][1:2]))
-  expect_error(datasheet(a, average = NA), "`average`")
+  expect_error(datasheet(a, average = NA), "`average`",
+    class = "allanvar_error_argument")
 })
 
 test_that("the effects the closed loop added are listed", {
@@ -64,7 +65,8 @@ test_that("write_datasheet() writes the long and wide CSV", {
   expect_equal(d$value, datasheet(a)$long$value)
   write_datasheet(datasheet(a), f, format = "wide")
   expect_true(any(grepl("N \\[deg/sqrt\\(h\\)\\]", readLines(f))))
-  expect_error(write_datasheet(1, f), "imu_datasheet")
+  expect_error(write_datasheet(1, f), "imu_datasheet",
+    class = "allanvar_error_argument")
 })
 
 test_that("datasheet() and write_datasheet() errors are classed and worded", {

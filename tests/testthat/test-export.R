@@ -19,8 +19,10 @@ test_that("filter_params() follows the stated discrete-time conventions", {
   expect_equal(fp$continuous[fp$parameter == "sigma_d"], 0.01)
   fp2 <- filter_params(c(N = 0.01, B = 0.002), dt = dt, bias_instability = "omit")
   expect_identical(fp2$parameter, "sigma_d")
-  expect_error(filter_params(c(N = 1)), "`dt`")
-  expect_error(filter_params(c(N = 1), dt = -1), "`dt`")
+  expect_error(filter_params(c(N = 1)), "`dt`",
+    class = "allanvar_error_missing_argument")
+  expect_error(filter_params(c(N = 1), dt = -1), "`dt`",
+    class = "allanvar_error_argument")
 })
 
 test_that("simulating the discrete parameters gives back the continuous model", {
@@ -69,8 +71,10 @@ test_that("write_kalibr_yaml() writes Kalibr's keys with units in comments", {
   y2 <- yaml::read_yaml(f)
   expect_equal(y2$gyroscope_random_walk, 4e-5)
   expect_equal(y2$update_rate, 200)
-  expect_error(write_kalibr_yaml(vals[-1], f), "lacks gyroscope_noise_density")
-  expect_error(write_kalibr_yaml(vals, f, inflate = 0.5), "`inflate`")
+  expect_error(write_kalibr_yaml(vals[-1], f), "lacks gyroscope_noise_density",
+    class = "allanvar_error_argument")
+  expect_error(write_kalibr_yaml(vals, f, inflate = 0.5), "`inflate`",
+    class = "allanvar_error_argument")
 })
 
 test_that("write_kalibr_yaml() takes the worst axis of an analysis and says so", {
@@ -185,7 +189,7 @@ test_that("writers refuse bad output paths and leave no half file", {
   expect_error(write_atomic(f, function(path) {
     writeLines("half", path)
     stop("disk full")
-  }), "disk full")
+  }), "disk full", class = "simpleError")
   expect_identical(readLines(f), "old")
   expect_identical(list.files(d, all.files = TRUE, no.. = TRUE), "imu.yaml")
   # a success replaces it whole

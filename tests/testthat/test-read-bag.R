@@ -67,7 +67,8 @@ test_that("the LZ4 frame decoder inverts the reference lz4 tool", {
     z <- readBin(o, "raw", file.size(o))
     expect_identical(allanvar:::lz4_decompress_cpp(z, 0), x)
   }
-  expect_error(allanvar:::lz4_decompress_cpp(as.raw(1:10), 0), "lz4")
+  expect_error(allanvar:::lz4_decompress_cpp(as.raw(1:10), 0), "lz4",
+    class = "Rcpp::exception")
 })
 
 test_that("long reads report progress through progressr, and only when asked", {
@@ -102,7 +103,7 @@ test_that("bz2 chunks read through libbz2 and, without it, through memDecompress
   if (allanvar:::bz2_available_cpp()) {
     expect_error(allanvar:::rosbag_imu(b, s$chunks$off[k], s$chunks$len[k], 2L,
                                        s$chunks$size[k] + 1, 0L),
-                 "stated size")
+                 "stated size", class = "Rcpp::exception")
   }
   skip_if_not_installed("callr")
   skip_if_not(installed_allanvar(), "needs the installed package")
