@@ -167,13 +167,33 @@
 #'   left out, as Stable32 and allantools' `gradev` do (see the section Gaps;
 #'   the count of missing values is printed and kept in the attribute
 #'   `missing`); or `"error"`: refuse them. `Inf` is always an error.
+#' @param ci `TRUE` (default): confidence limits, which need the noise type
+#'   identified at every tau and its EDF. `FALSE`: the values alone, without
+#'   noise identification (faster: for the standard type at octave taus the
+#'   one pass over the data is all): the columns stay, `lower`, `upper`,
+#'   `edf` and `alpha` are `NA` (the bias-corrected `"mtotdev"`,
+#'   `"ttotdev"`, `"htotdev"` and `"theo1"` still identify the type their
+#'   correction needs, and report it in `alpha`). `print()` says there are
+#'   no intervals and `plot()` draws no bars.
+#' @param unbiased `FALSE` (default): `adev` is the square root of the
+#'   unbiased variance estimate, which underestimates the deviation at small
+#'   EDF (its mean is \eqn{c_4(\nu)\sigma}). `TRUE`: `adev` is divided by
+#'   \eqn{c_4(\nu) = E\sqrt{\chi^2_\nu/\nu} = \sqrt{2/\nu}\,
+#'   \Gamma((\nu+1)/2)/\Gamma(\nu/2)} at the row's EDF \eqn{\nu}, an
+#'   unbiased estimate of the deviation (as SigmaTheta reports it); `avar`
+#'   is unchanged, and so are `lower` and `upper`: they are a confidence
+#'   interval for the true deviation, which the unbiased value estimates
+#'   (scaling them too would lower their coverage). Needs the EDF, so the
+#'   noise type is identified even with `ci = FALSE`. Statistics without an
+#'   EDF (`"mtie"`, `"tierms"`) ignore it.
 #' @return A data frame of class `c("allan", "data.frame")` with columns
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
 #'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
 #'   has several columns, `channel` (the column name; rows stacked channel by
 #'   channel), and last `alpha` (the integer noise exponent behind the EDF;
 #'   `NA` where too few points identify it).
-#'   Attributes: `freq`, `type`, `input`, `N` (samples per channel), `conf`.
+#'   Attributes: `freq`, `type`, `input`, `N` (samples per channel), `conf`;
+#'   `ci = FALSE` and `unbiased = TRUE` when those were asked for.
 #' @seealso [avar()], [avarn()] and [avari()] for the results of
 #'   'allanvar' 1.1.
 #' @export
@@ -252,16 +272,16 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     sj <- if (ch$nc == 1L) res$sums else res$sums[, j]
     if (is.finite(max(sj)) && min(sj) >= 2^-900) next
     xj <- if (ch$nc == 1L) ch$values else ch$values[(j - 1) * N + seq_len(N)]
-    e <- range_exponent(xj)
+    ex <- range_exponent(xj)
     # zero sums of a constant channel are right as they are
-    if (e == 0 || (all(sj == 0) && diff(range(xj)) == 0)) next
-    rj <- allan_call_kernel(allan_sums_cpp(times_pow2(as.double(xj), -e), N,
+    if (ex == 0 || (all(sj == 0) && diff(range(xj)) == 0)) next
+    rj <- allan_call_kernel(allan_sums_cpp(times_pow2(as.double(xj), -ex), N,
                                            m, nterms, m[sub],
                                            allan_opts(type, rate, octave)),
                             N, 1L)
     res$sums[, j] <- rj$sums[, 1L]
     res$alpha_int[, j] <- rj$alpha_int[, 1L]
-    sc[j] <- e
+    sc[j] <- ex
   }
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {

@@ -17,7 +17,10 @@ allan_subset <- function(m) {
   first <- findInterval(64, m) + 1L  # m is sorted: the first m > 64
   if (first > length(m)) return(seq_along(m))
   t <- 10^seq(log10(m[first]), log10(m[length(m)]), by = 1 / 40)
-  sort(unique(c(seq_len(first - 1L), findInterval(t, m), first, length(m))))
+  # t[1] may round to just below m[first]: findInterval() then gives the
+  # row before it, 0 when first = 1 (no row 0: alpha and m would misalign)
+  sort(unique(c(seq_len(first - 1L), pmax(1L, findInterval(t, m)), first,
+                length(m))))
 }
 
 # EDF for every row of a curve. alpha_int: identified noise exponent at the

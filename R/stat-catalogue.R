@@ -19,6 +19,8 @@
 #                 upper): intervals the kernel computed itself)
 #   divisor(m)  the estimator's divisor per term (times the number of
 #                 terms gives the variance's); "sums" kernels only
+#   min_points  phase points a window needs for one term at m = 1
+#                 (dynamic_allan()'s windows)
 #   max_m(L)    largest cluster size with a term, for L phase points
 #   nterms(m, L, theo_row)  terms behind each value (Stable32's "#")
 #   taus(taus, freq, L, maxm)  the cluster sizes asked for: list(m,
@@ -90,13 +92,13 @@ new_stat <- function(name, title, ylab, max_m, nterms, kernel = "sums",
                      unbiased = !is.na(edf), gaps = "sums",
                      aliases = character(),
                      edf_fallback = function(m, n, L) n,
-                     octave_pass = FALSE) {
+                     octave_pass = FALSE, min_points = 3L) {
   list(name = name, title = title, ylab = ylab, max_m = max_m,
        nterms = nterms, kernel = kernel, divisor = divisor, taus = taus,
        edf = edf, alpha_range = as.integer(alpha_range), id_base = id_base,
        noise_id = noise_id, debias = debias, unbiased = unbiased, gaps = gaps,
        aliases = aliases, edf_fallback = edf_fallback,
-       octave_pass = octave_pass)
+       octave_pass = octave_pass, min_points = min_points)
 }
 
 validate_stat <- function(e) {
