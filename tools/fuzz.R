@@ -1,4 +1,4 @@
-# Fuzz battery (issue 12): bad and extreme inputs to every exported function,
+# Fuzz battery: bad and extreme inputs to every exported function,
 # the S3 methods, the CLI (in process and through inst/bin/allanvar) and
 # malformed files. Each call is classified:
 #   OK       a finite, sane result (or a clean return from a plot/print);
@@ -366,7 +366,7 @@ fuzz_cases <- function(quick = FALSE) {
   add("print.series_effects", "valid", q(print(series_effects(x, 100))))
   sub_arg("write_kalibr_yaml", q(write_kalibr_yaml(x = ana, file = file.path(dir, "imu.yaml"))),
           c("x", "file", "axis", "rostopic", "inflate"))
-  # what is copied from the user must come back as written (issue 12 item 3)
+  # what is copied from the user must come back as written
   add("write_kalibr_yaml", "rostopic with newline",
       q({
         f <- write_kalibr_yaml(ana, file.path(dir, "imu2.yaml"), rostopic = "a\nb: evil")
@@ -387,7 +387,7 @@ fuzz_cases <- function(quick = FALSE) {
              "f_binary", "f_fakebag", "f_fakemcap", "f_fakedb3", "f_missing", "f_dir")
   for (f in files) add("read_imu", paste("file =", f), S("read_imu", as.name(f)))
   # a malformed file that is read must report the fault with its line and
-  # column (issue 12 item 2); otherwise the case counts as GARBAGE
+  # column; otherwise the case counts as GARBAGE
   faults <- c(f_extra = "line 11.*column 8", f_short = "line 11.*column 6",
               f_inf = "line 11, column accel_z", f_nan = "line 11, column accel_z",
               f_abc = "line 11, column 7", f_empty_cell = "line 11, column accel_z",
@@ -465,7 +465,7 @@ fuzz_cases <- function(quick = FALSE) {
   }
   if (quick) {
     # a deterministic subset: every function keeps at least its first cases
-    # the faults issue 12 names, plus a deterministic subset spread over
+    # the faults the battery was built for, plus a deterministic subset spread over
     # each function's arguments
     keys <- c("integrated input, freq 1e300", "huge coef", "Inf coef", "tau 1e-300",
               "tau Inf", "fixed gm1.tc = -1", "tau_B = -1", "negative N",

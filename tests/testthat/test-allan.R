@@ -323,7 +323,7 @@ interrupt_delay <- function(setup, run, wait = 4) {
 test_that("Ctrl-C stops a long allan() within a second", {
   skip_on_cran()
   skip_in_check()
-  # before: 460 s for the first, 11.6 s for two channels (issue 12)
+  # before: 460 s for the first, 11.6 s for two channels
   d <- interrupt_delay("x <- rnorm(1e7)",
                        "allan(x, 100, taus = 'all', type = 'overlapping')")
   expect_false(is.na(d))  # interrupted, not finished

@@ -498,7 +498,7 @@ test_that("the further types' noise type (identification without sums) is allan(
   }
 })
 
-test_that("limits agree with Stable32's on >= 95% of its reference rows (issue 10)", {
+test_that("limits agree with Stable32's on >= 95% of its reference rows", {
   # Both limits within 25% of Stable32's half-width, over every Stable32 run
   # of allantools' and allantoolkit's test suites (tools/check-stable32.R,
   # the Allan types, and tools/check-stable32-types.R, the further types),
