@@ -173,9 +173,9 @@ effect_band <- function() {
     # The bands of the raw data propose their own spectrum: the strongest
     # band the curve can see, every parameter but the scale pinned.
     propose = function(raw, tau, sig) {
-      mb <- raw$band_spectra
+      mb <- diag_part(raw, "band_spectra")
       if (!length(mb)) return(list())
-      hi <- min(0.5 / min(tau), 0.499 * raw$freq)
+      hi <- min(0.5 / min(tau), 0.499 * diag_value(raw, "freq"))
       ok <- vapply(mb, function(m) (m$f_lo + m$f_hi) / 2 > 1 / max(tau) &&
                      (m$f_lo + m$f_hi) / 2 < hi, NA)
       mb <- mb[ok]
@@ -204,6 +204,15 @@ effect_band <- function() {
            support = ok)
     },
     peak_tau = function(par) 0.371 * 2 / (par[["f_lo"]] + par[["f_hi"]]),
+    # each band of the raw periodogram's own spectrum, read once per call
+    diagnose = list(
+      part = "band_spectra", reads = "raw", needs = "bands",
+      make = function(x, freq, dg) {
+        bands <- diag_part(dg, "bands")
+        Filter(Negate(is.null), lapply(seq_len(nrow(bands)), function(j) {
+          measure_band(x, freq, bands[j, ])
+        }))
+      }),
     describe = function(values) {
       sprintf("measured band (%s Hz)", paste(sprintf("%s-%s", signif(values$f_lo, 3),
                                                      signif(values$f_hi, 3)),

@@ -7,7 +7,7 @@ sin_peak_adev <- 0.7246       # ... where ADEV = 0.7246 A
 
 # Raw-data evidence: a periodogram line near f0.
 evidence_sinusoid <- function(par, raw, x, freq) {
-  l <- raw$lines
+  l <- diag_part(raw, "lines")
   f0 <- par[["f0"]] %||% NA_real_
   res <- attr(l, "resolution") %||% 0
   if (nrow(l) && is.finite(f0)) {
@@ -96,11 +96,11 @@ effect_sinusoid <- function() {
            score = if (ctx$kind == "oscillation") 3 else 1)
     },
     propose = function(raw, tau, sig) {
-      lines <- raw$lines
+      lines <- diag_part(raw, "lines")
       out <- list()
       if (is.null(lines) || !nrow(lines)) return(out)
       # only lines the curve can see; harmonics of one source say so
-      b <- visible_band(min(tau), max(tau), raw$freq)
+      b <- visible_band(min(tau), max(tau), diag_value(raw, "freq"))
       lines <- harmonic_sets(lines)
       for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
@@ -123,6 +123,18 @@ effect_sinusoid <- function() {
       out
     },
     evidence = evidence_sinusoid,
+    # The periodogram's lines, less the bins of the broad bands (a
+    # resonance's bins are not sinusoids); the checks of the other effects
+    # see the series with them taken out (a line disturbs the ACF that
+    # confirms a Gauss-Markov process).
+    diagnose = list(
+      part = "lines", reads = "raw", needs = "bands",
+      make = function(x, freq, dg) {
+        lines_outside_bands(diag_value(dg, "lines"), diag_part(dg, "bands"))
+      },
+      clean = function(x, freq, lines) {
+        if (nrow(lines)) remove_lines(x, freq, lines$f0) else x
+      }),
     peak_tau = function(par) sin_peak_ratio / par[["f0"]],
     describe = function(values) {
       sprintf("sinusoid (f0 = %s Hz)", paste(signif(values$f0, 3), collapse = ", "))
