@@ -272,8 +272,6 @@ validate_effect <- function(e) {
   e
 }
 
-`%||%` <- function(a, b) if (is.null(a)) b else a
-
 # ---- queries ----------------------------------------------------------------
 
 # Kinds, in canonical order; by default those avfit() can fit.

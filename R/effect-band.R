@@ -77,7 +77,7 @@ sim_band <- function(n, tau0, scale, f_lo, f_hi, s) {
 # gives the systematic spread. Returns list(f_lo, f_hi, s, u, power) or
 # NULL when the band has no measurable excess.
 measure_band <- function(x, freq, b, seg = 512L, knots = band_knots) {
-  w <- welch_psd_lin(x - mean(x), freq, seg)
+  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
   wd <- max(b$f_to - b$f_from, 4 * w$df)
   fl <- (w$f > b$f_from - wd & w$f < b$f_from & w$f > 0) |
     (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))

@@ -163,7 +163,10 @@ effect_flicker <- function() {
     reading = list(symbol = "B", role = "flicker", tau = NA_real_, slope = 0,
                    anchor = "min", unit = "rate", bound = FALSE, resolve = FALSE,
                    pch = 24, legend = "B: flat minimum (ADEV = 0.664 B)",
-                   slope_method = "min ADEV / 0.664"),
+                   slope_method = "min ADEV / 0.664",
+                   # how filter_params() may stand in for B (the first is
+                   # its default): one Gauss-Markov term, or left out
+                   approximations = c("gm", "omit")),
     # No finite-state model exists; optionally approximated by one GM whose
     # ADEV peak (0.6174 sigma at tau = 1.893 Tc) sits on the flat minimum.
     discrete = function(par, dt, unit, opts) {

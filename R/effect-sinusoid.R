@@ -11,10 +11,10 @@ evidence_sinusoid <- function(par, raw, x, freq) {
   f0 <- par[["f0"]] %||% NA_real_
   res <- attr(l, "resolution") %||% 0
   if (nrow(l) && is.finite(f0)) {
-    # within the periodogram's resolution (issue 9), not a fraction of f0
-    near <- which(abs(l$f0 - f0) <= 1.5 * res)
-    j <- near[which.max(l$ratio[near])]
-    if (length(near)) {
+    # the strongest line within 1.5 bins of the periodogram's resolution,
+    # not a fraction of f0
+    j <- match_line(f0, l, tol = 1.5, pick = "strongest")
+    if (!is.na(j)) {
       return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)",
                                  format_num(l$f0[j], 4), format_num(l$amp[j]),
                                  l$p_value[j]),
@@ -100,11 +100,11 @@ effect_sinusoid <- function() {
       out <- list()
       if (is.null(lines) || !nrow(lines)) return(out)
       # only lines the curve can see; harmonics of one source say so
-      b <- visible_band(min(tau), max(tau), diag_value(raw, "freq"))
-      lines <- harmonic_sets(lines)
+      lines <- visible_lines(harmonic_sets(lines), min(tau), max(tau),
+                             diag_value(raw, "freq"))
       for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
-        if (f0 < b[["lo"]] || f0 > b[["hi"]]) next
+        if (!lines$visible[j]) next
         t1 <- sin_peak_ratio / f0
         h <- lines$harmonic[j]
         src <- if (lines$pattern[j] != "single") {

@@ -17,6 +17,7 @@
 // (sum, compensation), so a quiet window after a loud stretch keeps its
 // digits.
 #include "buffer.h"
+#include "dd.h"
 #include "opts-dynamic.h"
 #include "parallel.h"
 #include "types.h"
@@ -34,12 +35,8 @@ using allanvar::Buffer;
 
 namespace {
 
-// a + b = s + e exactly (Knuth's TwoSum).
-inline void two_sum(double a, double b, double& s, double& e) {
-  s = a + b;
-  const double bb = s - a;
-  e = (a - (s - bb)) + (b - bb);
-}
+// a + b = s + e exactly (Knuth's TwoSum, src/dd.h).
+using allanvar::two_sum;
 
 // A running sum kept unevaluated as s + c.
 struct Pair {
