@@ -101,7 +101,10 @@ noise_name <- function(alpha) {
 #' @param alpha Family-wise false-alarm level for spectral lines.
 #' @return An object of class `avdiagnose`: a list with `freq`, `n`,
 #'   `lines` (data.frame `f0` (Hz), `amp` (input unit), `ratio` (peak over
-#'   background), `p_value`, `significance` (\eqn{-\log_{10} p})),
+#'   background), `p_value`, `significance` (\eqn{-\log_{10} p}),
+#'   `concentration` (share of the excess power within 64 bins that sits in
+#'   the peak's main lobe) and `kind` (`"line"`, or `"band"` for the top of
+#'   a broad band)),
 #'   `acf1` (lag-1 autocorrelation of the raw samples) and `acf1_z` (its
 #'   z-score), `noise_id` (data.frame `m`, `tau`, `alpha`, `noise`),
 #'   `grid` (list `step`, `levels`, `on_grid` fraction, `quantized`,

@@ -45,16 +45,7 @@ using allanvar::two_sum;
 
 // Sum of many squares: four interleaved chains, folded into a compensated
 // total block by block, keep the rounding far below 1e-15 relative.
-struct Acc {
-  double s = 0, c = 0;
-  void add(double v) {
-    double t, e;
-    two_sum(s, v, t, e);
-    s = t;
-    c += e;
-  }
-  double value() const { return s + c; }
-};
+using Acc = allanvar::CompSum;
 
 // Runs f(i) for i in [0, n): from the main thread through parallel_for
 // (which polls for interrupts between items), serially and without any R

@@ -30,6 +30,24 @@ inline void fast_two_sum(double a, double b, double& s, double& e) {
   e = b - (s - a);
 }
 
+// A running sum kept unevaluated as s + c: each addition's rounding error
+// (TwoSum) collected in c (allan.cpp's sums of squares, dynamic.cpp's
+// windowed sums).
+struct CompSum {
+  double s = 0, c = 0;
+  void add(double v) {
+    double t, e;
+    two_sum(s, v, t, e);
+    s = t;
+    c += e;
+  }
+  void add(const CompSum& p) {
+    add(p.s);
+    c += p.c;
+  }
+  double value() const { return s + c; }
+};
+
 // a = ah + al with ah holding the upper 26 bits (Veltkamp's split).
 inline void dd_split(double a, double& ah, double& al) {
   const double t = 134217729.0 * a;  // 2^27 + 1

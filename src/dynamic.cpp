@@ -39,19 +39,7 @@ namespace {
 using allanvar::two_sum;
 
 // A running sum kept unevaluated as s + c.
-struct Pair {
-  double s = 0, c = 0;
-  void add(double v) {
-    double t, e;
-    two_sum(s, v, t, e);
-    s = t;
-    c += e;
-  }
-  void add(const Pair& p) {
-    add(p.s);
-    c += p.c;
-  }
-};
+using Pair = allanvar::CompSum;
 
 // (a - b) evaluated once, to the last bit of the difference.
 inline double pair_diff(const Pair& a, const Pair& b) {
