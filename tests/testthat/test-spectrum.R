@@ -1,4 +1,4 @@
-# Spectral lines and harmonic sets. Series built here with base R (sin,
+# Spectral lines and harmonic sets (R/spectrum.R). Series built here with base R (sin,
 # sign, rnorm, cumsum), not with the package's simulator.
 
 test_that("a square wave is one source: f, 3f, 5f, each within the resolution", {
