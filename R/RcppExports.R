@@ -37,8 +37,8 @@ avar_white_cov <- function(m, n, overlapping, threads) {
     .Call(`_allanvar_avar_white_cov`, m, n, overlapping, threads)
 }
 
-avfit_exact_edf <- function(m, M, overlapping, w, q, p, s2, phi) {
-    .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, w, q, p, s2, phi)
+avfit_exact_edf <- function(m, M, overlapping, shape, coef, phi) {
+    .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, shape, coef, phi)
 }
 
 bz2_available_cpp <- function() {

@@ -340,12 +340,6 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 5000L,
        level = f$c)
 }
 
-remove_warmup <- function(x, freq, warmup) {
-  if (!isTRUE(warmup$present)) return(x)
-  t <- (seq_along(x) - 1) / freq
-  x - warmup$amplitude * exp(-t / warmup$tc)
-}
-
 # Scale of a residual robust to a few outliers and to coarse quantization
 # (where the MAD can be 0): the root mean square of the central 99%
 # (values beyond the 0.5% and 99.5% quantiles dropped), corrected to a

@@ -244,8 +244,6 @@ choice_arg <- function(x, choices, arg) {
   check_choice(x, choices, arg)
 }
 
-`%||%` <- function(a, b) if (is.null(a)) b else a
-
 # progressr's progressor for long reads: silent unless handlers are set
 # (progressr::handlers()), as everywhere in the package.
 read_progress <- function(steps) {

@@ -127,19 +127,17 @@ BEGIN_RCPP
 END_RCPP
 }
 // avfit_exact_edf
-Rcpp::NumericVector avfit_exact_edf(const Rcpp::NumericVector& m, const Rcpp::NumericVector& M, bool overlapping, double w, double q, double p, const Rcpp::NumericVector& s2, const Rcpp::NumericVector& phi);
-RcppExport SEXP _allanvar_avfit_exact_edf(SEXP mSEXP, SEXP MSEXP, SEXP overlappingSEXP, SEXP wSEXP, SEXP qSEXP, SEXP pSEXP, SEXP s2SEXP, SEXP phiSEXP) {
+Rcpp::NumericVector avfit_exact_edf(const Rcpp::NumericVector& m, const Rcpp::NumericVector& M, bool overlapping, const Rcpp::IntegerVector& shape, const Rcpp::NumericVector& coef, const Rcpp::NumericVector& phi);
+RcppExport SEXP _allanvar_avfit_exact_edf(SEXP mSEXP, SEXP MSEXP, SEXP overlappingSEXP, SEXP shapeSEXP, SEXP coefSEXP, SEXP phiSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type M(MSEXP);
     Rcpp::traits::input_parameter< bool >::type overlapping(overlappingSEXP);
-    Rcpp::traits::input_parameter< double >::type w(wSEXP);
-    Rcpp::traits::input_parameter< double >::type q(qSEXP);
-    Rcpp::traits::input_parameter< double >::type p(pSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type s2(s2SEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type shape(shapeSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type coef(coefSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phi(phiSEXP);
-    rcpp_result_gen = Rcpp::wrap(avfit_exact_edf(m, M, overlapping, w, q, p, s2, phi));
+    rcpp_result_gen = Rcpp::wrap(avfit_exact_edf(m, M, overlapping, shape, coef, phi));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -616,7 +614,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_log_nnls", (DL_FUNC) &_allanvar_avfit_log_nnls, 7},
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
-    {"_allanvar_avfit_exact_edf", (DL_FUNC) &_allanvar_avfit_exact_edf, 8},
+    {"_allanvar_avfit_exact_edf", (DL_FUNC) &_allanvar_avfit_exact_edf, 6},
     {"_allanvar_bz2_available_cpp", (DL_FUNC) &_allanvar_bz2_available_cpp, 0},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},

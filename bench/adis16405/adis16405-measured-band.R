@@ -24,7 +24,7 @@ options(allanvar.threads = 1L)
 
 F4 <- function(x) 3 * x / 8 - sin(2 * x) / 4 + sin(4 * x) / 32
 measured_band <- function(x, freq, b, seg = 512L, degree = 2L) {
-  w <- welch_psd_lin(x - mean(x), freq, seg)
+  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
   wd <- b$f_to - b$f_from
   fl <- (w$f > b$f_from - wd & w$f < b$f_from) |
     (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))

@@ -450,7 +450,8 @@ test_that("the exact EDF kernel reduces to the exact single-noise values", {
   m <- c(1, 2, 5, 16, 64)
   M <- nn + 1 - 2 * m
   kern <- function(w, q, p = 0, overlapping = TRUE, mm = m, MM = M) {
-    avfit_exact_edf(mm, MM, overlapping, w, q, p, numeric(0), numeric(0))
+    # the three power-law parts of the structure function (shapes 0-2)
+    avfit_exact_edf(mm, MM, overlapping, 0:2, c(w, q, p), numeric(3))
   }
   # Isserlis moments for white and random-walk rate noise (src/edf.cpp)
   expect_equal(kern(0.09, 0), allan_edf_direct("overlapping", m, M, nn + 1, rep(0L, 5)),
