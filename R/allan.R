@@ -273,6 +273,8 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     check_representable(av, nonzero = res$sums[, j] > 0)
     e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
     ci <- allan_ci(av, e$edf, conf)
+    ci <- exact_limits_merge(ci, allan_limits_exact(type, m, nterms, L,
+                                                    e$alpha, conf))
     d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
               adev = ci$adev, lower = ci$lower, upper = ci$upper,
               edf = e$edf)

@@ -1,0 +1,132 @@
+# Exact confidence limits at few averages (issue 29, item 2). Where N/m is
+# small the Allan-family estimate over its expectation is far from a
+# chi-square with the two-moment EDF: it is a generalized chi-square,
+# sum_i lambda_i chi2_1, the lambda the eigenvalues of its terms'
+# covariance under the power-law noise (src/gchisq.cpp), skewed when a few
+# dominate. Its quantiles (Imhof's integral) give the interval
+# [adev / sqrt(q_{1-p}), adev / sqrt(q_p)].
+#
+# The noise type is read from the data at each tau, and at a few averages
+# that reading is weak; so the interval is the union of the intervals of
+# the type read and its neighbours (alpha - 1, alpha + 1 among the
+# exponents the type admits): every type at an unidentified row.
+#
+# Which rows: N/m <= getOption("allanvar.ci_exact", 16) (N rate samples);
+# Inf makes every row exact, 0 none. Types: the Allan and Hadamard families
+# (standard, overlapping, modified, hadamard, ohadamard; tdev through
+# modified, TheoH's Allan rows through overlapping).
+#
+# Cost: an eigenproblem of the terms (at most `exact_nmax` of them) and two
+# Imhof quantiles per (type, m, n, alpha, conf), cached for the session.
+# Larger problems are scaled down: the terms of non-overlapping types at
+# m > exact_mcap are taken at m = exact_mcap (the same n; for FM noise the
+# correlation of the terms is that of the continuous-time limit within a
+# few 1e-3 there, for white PM it does not depend on m, for flicker PM
+# slowly through ln m); overlapping types keep n/m at m' = min(m,
+# exact_mcap, m nmax / n). Under PM noise the overlapping estimators' EDF
+# grows with m at fixed N/m, which that scaling would lose: such rows keep
+# the chi-square interval, whose EDF there is large.
+
+exact_nmax <- 300L
+exact_mcap <- 64L
+exact_cache <- new.env(parent = emptyenv())
+
+# Types with exact limits, by allan()'s names.
+exact_ci_types <- c("standard", "overlapping", "modified", "hadamard",
+                    "ohadamard")
+
+# The rows whose limits are exact: N/m at or below the option's threshold.
+exact_rows <- function(m, L) {
+  lim <- getOption("allanvar.ci_exact", 16)
+  if (!is.numeric(lim) || length(lim) != 1L || is.na(lim)) {
+    abort("`options(allanvar.ci_exact)` must be a single number (N/m at ",
+          "or below which limits are exact; Inf for every row), not ",
+          format(lim)[1L], ".", class = "argument")
+  }
+  (L - 1) / m <= lim
+}
+
+# Lower and upper factors (times the deviation) of the exact interval for
+# one problem: type code, cluster size m, n terms, noise exponent alpha
+# (integer), level conf. NA where it does not apply (see above).
+exact_factors_one <- function(code, m, n, alpha, conf) {
+  info <- allan_type_table()
+  ov <- info$overlapping[match(code, info$code)]
+  if (ov) {
+    mp <- min(m, exact_mcap, max(1, floor(m * exact_nmax / n)))
+    np <- max(1, round(n * mp / m))
+    if (mp < m && alpha >= 1L) return(c(NA_real_, NA_real_))
+  } else {
+    mp <- min(m, exact_mcap)
+    np <- n
+  }
+  key <- paste(code, mp, np, alpha, format(conf, digits = 15), sep = ":")
+  hit <- exact_cache[[key]]
+  if (!is.null(hit)) return(hit)
+  lam <- gchisq_weights_cpp(as.integer(code), mp, np, as.integer(alpha))
+  p <- (1 - conf) / 2
+  if (length(lam) == 1L || max(lam) - min(lam) < 1e-12 * max(lam)) {
+    nu <- length(lam)  # equal weights: the chi-square itself
+    q <- stats::qchisq(c(p, 1 - p), nu) / nu
+  } else {
+    q <- gchisq_quantile_cpp(lam, c(p, 1 - p))
+  }
+  out <- c(sqrt(1 / q[2L]), sqrt(1 / q[1L]))
+  assign(key, out, envir = exact_cache)
+  out
+}
+
+# The noise exponents whose intervals are joined at a row: the exponent
+# read and its neighbours; every admissible one where none was read.
+exact_alts <- function(alpha, lo) {
+  if (is.na(alpha)) return(lo:2L)
+  max(lo, alpha - 1L):min(2L, alpha + 1L)
+}
+
+#' Exact limits of Allan-family rows (internal)
+#'
+#' The hook of allan()'s limits: lower and upper factors (multiply the
+#' deviation) of the generalized chi-square interval, the union over the
+#' plausible noise types, for the rows where they apply (`exact_rows()`),
+#' `NA` elsewhere.
+#' @param type allan()'s type name.
+#' @param m,n,L cluster sizes, numbers of terms, phase points.
+#' @param alpha identified integer noise exponents (`NA`: unknown).
+#' @param conf confidence level.
+#' @return A list of numeric vectors `lower` and `upper`, one per row.
+#' @noRd
+allan_limits_exact <- function(type, m, n, L, alpha, conf) {
+  k <- length(m)
+  lower <- upper <- rep(NA_real_, k)
+  if (!type %in% exact_ci_types) return(list(lower = lower, upper = upper))
+  rows <- which(exact_rows(m, L) & n >= 1)
+  if (!length(rows)) return(list(lower = lower, upper = upper))
+  code <- allan_type_code(type)
+  lo <- if (type %in% c("hadamard", "ohadamard")) -4L else -2L
+  alpha <- rep_len(as.integer(alpha), k)
+  for (i in rows) {
+    f <- vapply(exact_alts(alpha[i], lo), function(a) {
+      f1 <- exact_factors_one(code, m[i], n[i], a, conf)
+      if (anyNA(f1)) {
+        # a type the exact route leaves to chi-square: its interval
+        e <- allan_edf_direct(type, m[i], n[i], L, a)
+        f1 <- sqrt(e / stats::qchisq(c(1 - (1 - conf) / 2, (1 - conf) / 2), e))
+      }
+      f1
+    }, numeric(2))
+    lower[i] <- min(f[1L, ])
+    upper[i] <- max(f[2L, ])
+  }
+  list(lower = lower, upper = upper)
+}
+
+# allan()'s chi-square limits (allan_ci()) with the exact ones put in where
+# allan_limits_exact() gave them.
+exact_limits_merge <- function(ci, ex) {
+  ok <- which(!is.na(ex$lower))
+  if (length(ok)) {
+    ci$lower[ok] <- ci$adev[ok] * ex$lower[ok]
+    ci$upper[ok] <- ci$adev[ok] * ex$upper[ok]
+  }
+  ci
+}
