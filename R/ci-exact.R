@@ -8,8 +8,7 @@
 #
 # The noise type is read from the data at each tau, and at a few averages
 # that reading is weak; so the interval is the union of the intervals of
-# the type read and its neighbours (alpha - 1, alpha + 1 among the
-# exponents the type admits): every type at an unidentified row.
+# the types the reading leaves plausible (exact_alts(), exact_alpha()).
 #
 # Which rows: N/m <= getOption("allanvar.ci_exact", 16) (N rate samples);
 # Inf makes every row exact, 0 none. Types: the Allan and Hadamard families
@@ -24,11 +23,39 @@
 # few 1e-3 there, for white PM it does not depend on m, for flicker PM
 # slowly through ln m); overlapping types keep n/m at m' = min(m,
 # exact_mcap, m nmax / n). Under PM noise the overlapping estimators' EDF
-# grows with m at fixed N/m, which that scaling would lose: such rows keep
-# the chi-square interval, whose EDF there is large.
+# grows with m at fixed N/m, which that scaling would lose: they are
+# computed as they are up to exact_nmax_pm terms (0.3 s at 900), and
+# beyond keep the chi-square interval, whose EDF there is large (white PM
+# about N/2; flicker PM 20 at N/m = 4, m = 1000).
+
+#' @name allan
+#' @rdname allan
+#' @section Exact intervals at few averages:
+#' Where a row has few averages, \eqn{N/m \le 16} (\eqn{N} rate samples),
+#' the limits of the Allan and Hadamard types (`"standard"`,
+#' `"overlapping"`, `"modified"`, `"hadamard"`, `"ohadamard"`, and so
+#' `"tdev"`) are not the chi-square ones: the estimate over its expectation
+#' is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
+#' \eqn{\lambda_i} the eigenvalues of the covariance of its terms under
+#' discrete power-law noise of the row's noise type (\eqn{x = (1 -
+#' B)^{-(2 - \alpha)/2} e}), and the interval is
+#' \eqn{[\sigma / \sqrt{q_{1-p}}, \sigma / \sqrt{q_p}]} with its quantiles
+#' \eqn{q} (Imhof's integral). The noise type read at a few averages is
+#' weak, so the interval is the union over the types the reading leaves
+#' plausible: an FM type and its redder neighbour; below \eqn{N/m = 4},
+#' where nothing can be read, the type read at the nearest shorter tau with
+#' \eqn{N/m \ge 4}. `options(allanvar.ci_exact = k)` moves the threshold
+#' \eqn{N/m \le k} (`Inf`: every row, `0`: chi-square everywhere). The
+#' `edf` column keeps the two-moment EDF. Each (type, \eqn{m}, terms,
+#' type of noise, level) is computed once per session; large problems are
+#' scaled to at most 300 terms at \eqn{m \le 64} with the same
+#' \eqn{N/m} (FM noise), or, under PM noise on the overlapping types
+#' beyond 1000 terms, keep the chi-square interval.
+NULL
 
 exact_nmax <- 300L
 exact_mcap <- 64L
+exact_nmax_pm <- 1000L
 exact_cache <- new.env(parent = emptyenv())
 
 # Types with exact limits, by allan()'s names.
@@ -52,10 +79,15 @@ exact_rows <- function(m, L) {
 exact_factors_one <- function(code, m, n, alpha, conf) {
   info <- allan_type_table()
   ov <- info$overlapping[match(code, info$code)]
-  if (ov) {
+  if (ov && alpha >= 1L) {
+    # PM: no scaling (the EDF grows with m at fixed N/m); the problem as it
+    # is up to exact_nmax_pm terms
+    if (n > exact_nmax_pm) return(c(NA_real_, NA_real_))
+    mp <- m
+    np <- n
+  } else if (ov) {
     mp <- min(m, exact_mcap, max(1, floor(m * exact_nmax / n)))
     np <- max(1, round(n * mp / m))
-    if (mp < m && alpha >= 1L) return(c(NA_real_, NA_real_))
   } else {
     mp <- min(m, exact_mcap)
     np <- n
@@ -76,11 +108,34 @@ exact_factors_one <- function(code, m, n, alpha, conf) {
   out
 }
 
-# The noise exponents whose intervals are joined at a row: the exponent
-# read and its neighbours; every admissible one where none was read.
+# The noise exponents whose intervals are joined at a row. At N/m <= 16
+# the identification errs toward the whiter neighbour under FM noise
+# (Monte Carlo, N = 1024, overlapping: random-walk FM read as flicker or
+# white FM in 10-50% of records, flicker FM as white in 25-75%), while
+# white PM is read right in 95-100% of records at N/m >= 4 and flicker PM
+# in 90-100% (read as white FM, a wider interval, at N/m 6-8). So: an FM
+# reading joins its redder neighbour (alpha - 1); a PM reading stands alone.
 exact_alts <- function(alpha, lo) {
   if (is.na(alpha)) return(lo:2L)
-  max(lo, alpha - 1L):min(2L, alpha + 1L)
+  if (alpha >= 1L) return(alpha)
+  max(lo, alpha - 1L):alpha
+}
+
+# The noise exponent each row's interval rests on. Below N/m = 4 the
+# reading carries no information (there it returns white FM or nothing
+# whatever the noise), so such rows, and rows without a reading, take the
+# reading of the nearest shorter tau with N/m >= 4; NA where there is none.
+exact_alpha <- function(m, L, alpha) {
+  own <- ifelse((L - 1) / m >= 4, alpha, NA_integer_)
+  o <- order(m)
+  a <- own[o]
+  last <- NA_integer_
+  for (i in seq_along(a)) {
+    if (is.na(a[i])) a[i] <- last else last <- a[i]
+  }
+  out <- integer(length(m))
+  out[o] <- a
+  out
 }
 
 #' Exact limits of Allan-family rows (internal)
@@ -103,7 +158,7 @@ allan_limits_exact <- function(type, m, n, L, alpha, conf) {
   if (!length(rows)) return(list(lower = lower, upper = upper))
   code <- allan_type_code(type)
   lo <- if (type %in% c("hadamard", "ohadamard")) -4L else -2L
-  alpha <- rep_len(as.integer(alpha), k)
+  alpha <- exact_alpha(m, L, rep_len(as.integer(alpha), k))
   for (i in rows) {
     f <- vapply(exact_alts(alpha[i], lo), function(a) {
       f1 <- exact_factors_one(code, m[i], n[i], a, conf)

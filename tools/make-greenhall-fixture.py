@@ -34,4 +34,6 @@ for name, d, ov, mod in types:
                     # allantools has no value (alpha = 2 with r <= d;
                     # its Table 2 stops at alpha = -2)
                     continue
+                if e <= 0:  # allantools' -1: no terms
+                    continue
                 print("%s,%d,%d,%d,%.12g" % (name, alpha, m, N, float(e)))
