@@ -9,7 +9,7 @@
 # own type alone (allan_limits_exact() with that type, no union). A row is
 # ok when cov68 is in 0.60-0.76 and cov95 in 0.92-0.975.
 #
-#   Rscript tools/mc-coverage-exact.R [replicates] [N] [types]
+#   [ALLANVAR_CI_EXACT=0] Rscript tools/mc-coverage-exact.R [replicates] [N] [types]
 source(file.path("tools", "mc-coverage.R"), local = TRUE)  # mc_generators()
 
 mc_exact <- function(type, gen, reps, m, alpha_true) {
@@ -64,6 +64,10 @@ if (sys.nframe() == 0L) {
     library(allanvar)
   }
   options(allanvar.threads = 1)
+  # ALLANVAR_CI_EXACT=0: the chi-square limits, for comparison
+  if (nzchar(Sys.getenv("ALLANVAR_CI_EXACT"))) {
+    options(allanvar.ci_exact = as.numeric(Sys.getenv("ALLANVAR_CI_EXACT")))
+  }
   set.seed(29)
   gens <- mc_generators(N)
   alphas <- c(wfm = 0L, ffm = -1L, rwfm = -2L, wpm = 2L, fpm = 1L)
