@@ -46,7 +46,9 @@
 #' where flicker PM and white FM can no longer be told apart, the type read
 #' at the nearest shorter tau with \eqn{N/m \ge 8}. `options(allanvar.ci_exact = k)` moves the threshold
 #' \eqn{N/m \le k} (`Inf`: every row, `0`: chi-square everywhere). The
-#' `edf` column keeps the two-moment EDF. Each (type, \eqn{m}, terms,
+#' `edf` column keeps the two-moment EDF. Series with missing values
+#' (`gaps = "skip"`) keep the chi-square limits (their terms are not a
+#' stationary sequence). Each (type, \eqn{m}, terms,
 #' type of noise, level) is computed once per session; large problems are
 #' scaled to at most 300 terms at \eqn{m \le 64} with the same
 #' \eqn{N/m} (FM noise), or, under PM noise on the overlapping types
