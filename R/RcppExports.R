@@ -85,6 +85,18 @@ grid_stats <- function(x) {
     .Call(`_allanvar_grid_stats`, x)
 }
 
+gchisq_weights_cpp <- function(type, m, n, alpha) {
+    .Call(`_allanvar_gchisq_weights_cpp`, type, m, n, alpha)
+}
+
+gchisq_cdf_cpp <- function(lambda, q) {
+    .Call(`_allanvar_gchisq_cdf_cpp`, lambda, q)
+}
+
+gchisq_quantile_cpp <- function(lambda, p) {
+    .Call(`_allanvar_gchisq_quantile_cpp`, lambda, p)
+}
+
 line_sums <- function(y, f, freq) {
     .Call(`_allanvar_line_sums`, y, f, freq)
 }

@@ -273,6 +273,41 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gchisq_weights_cpp
+Rcpp::NumericVector gchisq_weights_cpp(int type, double m, double n, int alpha);
+RcppExport SEXP _allanvar_gchisq_weights_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP alphaSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< int >::type type(typeSEXP);
+    Rcpp::traits::input_parameter< double >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type n(nSEXP);
+    Rcpp::traits::input_parameter< int >::type alpha(alphaSEXP);
+    rcpp_result_gen = Rcpp::wrap(gchisq_weights_cpp(type, m, n, alpha));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gchisq_cdf_cpp
+Rcpp::NumericVector gchisq_cdf_cpp(const Rcpp::NumericVector& lambda, const Rcpp::NumericVector& q);
+RcppExport SEXP _allanvar_gchisq_cdf_cpp(SEXP lambdaSEXP, SEXP qSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type lambda(lambdaSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type q(qSEXP);
+    rcpp_result_gen = Rcpp::wrap(gchisq_cdf_cpp(lambda, q));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gchisq_quantile_cpp
+Rcpp::NumericVector gchisq_quantile_cpp(const Rcpp::NumericVector& lambda, const Rcpp::NumericVector& p);
+RcppExport SEXP _allanvar_gchisq_quantile_cpp(SEXP lambdaSEXP, SEXP pSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type lambda(lambdaSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type p(pSEXP);
+    rcpp_result_gen = Rcpp::wrap(gchisq_quantile_cpp(lambda, p));
+    return rcpp_result_gen;
+END_RCPP
+}
 // line_sums
 Rcpp::NumericVector line_sums(const Rcpp::NumericVector& y, double f, double freq);
 RcppExport SEXP _allanvar_line_sums(SEXP ySEXP, SEXP fSEXP, SEXP freqSEXP) {
@@ -626,6 +661,9 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_welch_segments", (DL_FUNC) &_allanvar_welch_segments, 3},
     {"_allanvar_welch_accumulate", (DL_FUNC) &_allanvar_welch_accumulate, 3},
     {"_allanvar_grid_stats", (DL_FUNC) &_allanvar_grid_stats, 1},
+    {"_allanvar_gchisq_weights_cpp", (DL_FUNC) &_allanvar_gchisq_weights_cpp, 4},
+    {"_allanvar_gchisq_cdf_cpp", (DL_FUNC) &_allanvar_gchisq_cdf_cpp, 2},
+    {"_allanvar_gchisq_quantile_cpp", (DL_FUNC) &_allanvar_gchisq_quantile_cpp, 2},
     {"_allanvar_line_sums", (DL_FUNC) &_allanvar_line_sums, 3},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
     {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
