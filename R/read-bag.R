@@ -8,6 +8,7 @@ bag_version <- "#ROSBAG V2.0\n"
 # The index: connections, chunks and their time spans, topics with counts.
 bag_scan <- function(file) {
   s <- rosbag_index_cpp(path.expand(file))
+  if (!s$indexed && s$bz2) s <- bag_bz2_conns(file, s)
   conns <- s$conns
   topics <- if (nrow(conns)) {
     u <- !duplicated(conns$topic)
@@ -20,8 +21,24 @@ bag_scan <- function(file) {
   s
 }
 
+# Without an index, the connection records inside bz2 chunks (which the C++
+# pass leaves to R): each chunk decompressed in turn.
+bag_bz2_conns <- function(file, s) {
+  path <- path.expand(file)
+  for (pos in s$chunks$pos) {
+    d <- rosbag_chunk_cpp(path, pos)
+    if (d$compression != "bz2") next
+    raw <- memDecompress(d$data, type = "bzip2")
+    cn <- rosbag_decode_cpp(raw, integer(), -Inf, Inf)$conns
+    s$conns <- rbind(s$conns, cn[!cn$conn %in% s$conns$conn, , drop = FALSE])
+  }
+  s$conns$n <- NA_real_
+  s
+}
+
 bag_read_imu <- function(file, topic, progress, range = NULL) {
   path <- path.expand(file)
+  if (!is.null(progress)) progress("scanning the bag")
   s <- bag_scan(file)
   if (!s$indexed) {
     warn("\"", basename(file), "\" has no index (a recording cut off?); ",

@@ -60,10 +60,12 @@ db3_read_imu <- function(file, topic, progress, range = NULL) {
     # Seconds from the first message of the bag.
     t0 <- DBI::dbGetQuery(con, "SELECT MIN(timestamp) AS t0 FROM messages")$t0
     t0 <- bit64::as.integer64(t0)
-    where <- paste(where, "AND timestamp >= ? AND timestamp <= ?")
-    params <- c(params, list(as.character(t0 + bit64::as.integer64(round(range[1L] * 1e9))),
-                             as.character(t0 + bit64::as.integer64(round(range[2L] * 1e9)))))
-    params[2:3] <- lapply(params[2:3], bit64::as.integer64)
+    where <- paste(where, "AND timestamp >= ?")
+    params <- c(params, list(t0 + bit64::as.integer64(round(range[1L] * 1e9))))
+    if (is.finite(range[2L])) {
+      where <- paste(where, "AND timestamp <= ?")
+      params <- c(params, list(t0 + bit64::as.integer64(round(range[2L] * 1e9))))
+    }
   }
   # Streamed in pages: one page of blobs in memory at a time.
   q <- DBI::dbSendQuery(con, paste("SELECT timestamp, data FROM messages", where,

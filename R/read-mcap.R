@@ -21,6 +21,7 @@ mcap_scan <- function(file) {
 
 mcap_read_imu <- function(file, topic, progress, range = NULL) {
   path <- path.expand(file)
+  if (!is.null(progress)) progress("scanning the MCAP file")
   s <- mcap_scan(file)
   topic <- select_topic(s$topics, topic, file)
   ch <- s$channels[s$channels$topic == topic, , drop = FALSE]

@@ -193,6 +193,18 @@ int read_chunk(FileReader& f, const file_record& r, std::vector<unsigned char>& 
   return 0;
 }
 
+Rcpp::DataFrame conn_frame(const sink& s) {
+  Rcpp::CharacterVector topic(s.conn_topic.size()), type(s.conn_type.size());
+  for (std::size_t k = 0; k < s.conn_topic.size(); ++k) {
+    topic[k] = s.conn_topic[k];
+    type[k] = s.conn_type[k].empty() ? Rcpp::String(NA_STRING) : Rcpp::String(s.conn_type[k]);
+  }
+  return Rcpp::DataFrame::create(
+      Rcpp::Named("conn") = Rcpp::wrap(s.conn_id), Rcpp::Named("topic") = topic,
+      Rcpp::Named("type") = type, Rcpp::Named("n") = Rcpp::wrap(s.conn_n),
+      Rcpp::Named("stringsAsFactors") = false);
+}
+
 Rcpp::List fault_list(double off, const std::string& why) {
   return Rcpp::List::create(Rcpp::Named("off") = off, Rcpp::Named("what") = why);
 }
@@ -293,11 +305,6 @@ Rcpp::List rosbag_index_cpp(std::string path) {
   } catch (const format_error& e) {
     Rcpp::stop(e.what());
   }
-  Rcpp::CharacterVector topic(s.conn_topic.size()), type(s.conn_type.size());
-  for (std::size_t k = 0; k < s.conn_topic.size(); ++k) {
-    topic[k] = s.conn_topic[k];
-    type[k] = s.conn_type[k].empty() ? Rcpp::String(NA_STRING) : Rcpp::String(s.conn_type[k]);
-  }
   if (indexed) {
     std::fill(s.conn_n.begin(), s.conn_n.end(), 0.0);
     for (std::size_t e = 0; e < cc_conn.size(); ++e) {
@@ -311,10 +318,7 @@ Rcpp::List rosbag_index_cpp(std::string path) {
   return Rcpp::List::create(
       Rcpp::Named("indexed") = indexed, Rcpp::Named("bz2") = has_bz2,
       Rcpp::Named("size") = size, Rcpp::Named("bytes") = bytes,
-      Rcpp::Named("conns") = Rcpp::DataFrame::create(
-          Rcpp::Named("conn") = Rcpp::wrap(s.conn_id), Rcpp::Named("topic") = topic,
-          Rcpp::Named("type") = type, Rcpp::Named("n") = Rcpp::wrap(s.conn_n),
-          Rcpp::Named("stringsAsFactors") = false),
+      Rcpp::Named("conns") = conn_frame(s),
       Rcpp::Named("chunks") = Rcpp::DataFrame::create(
           Rcpp::Named("pos") = Rcpp::wrap(ch_pos), Rcpp::Named("start") = Rcpp::wrap(ch_start),
           Rcpp::Named("end") = Rcpp::wrap(ch_end)),
@@ -374,6 +378,7 @@ Rcpp::List rosbag_read_cpp(std::string path, const Rcpp::NumericVector& pos,
 Rcpp::List rosbag_chunk_cpp(std::string path, double pos) {
   std::vector<unsigned char> d;
   std::uint32_t size = 0;
+  std::string comp;
   try {
     FileReader f(path);
     file_record r;
@@ -381,15 +386,18 @@ Rcpp::List rosbag_chunk_cpp(std::string path, double pos) {
     if (!read_record_header(f, static_cast<std::uint64_t>(pos), r, &why)) throw format_error(why);
     if (!f.read(r.data, static_cast<std::size_t>(r.data_len), d)) throw format_error("a chunk cut off");
     field_u32(r.hdr.data(), r.hdr.size(), "size", &size);
+    comp = field_str(r.hdr.data(), r.hdr.size(), "compression");
   } catch (const format_error& e) {
     Rcpp::stop(e.what());
   }
   Rcpp::RawVector out(d.size());
   if (!d.empty()) std::memcpy(RAW(out), d.data(), d.size());
-  return Rcpp::List::create(Rcpp::Named("data") = out, Rcpp::Named("size") = static_cast<double>(size));
+  return Rcpp::List::create(Rcpp::Named("data") = out, Rcpp::Named("size") = static_cast<double>(size),
+                            Rcpp::Named("compression") = comp);
 }
 
-// The messages of a decompressed chunk (as rosbag_read_cpp()).
+// The messages of a decompressed chunk (as rosbag_read_cpp()), and its
+// connection records.
 // [[Rcpp::export(rng = false)]]
 Rcpp::List rosbag_decode_cpp(const Rcpp::RawVector& raw, const Rcpp::IntegerVector& conns,
                              double from, double to) {
@@ -397,11 +405,13 @@ Rcpp::List rosbag_decode_cpp(const Rcpp::RawVector& raw, const Rcpp::IntegerVect
   s.conns.assign(conns.begin(), conns.end());
   s.from = from;
   s.to = to;
+  s.want_conns = true;
   try {
     chunk_messages(RAW(raw), raw.size(), s);
   } catch (const format_error& e) {
     Rcpp::stop(e.what());
   }
   return Rcpp::List::create(Rcpp::Named("imu") = as_matrix(s.rows),
-                            Rcpp::Named("bad") = static_cast<double>(s.bad));
+                            Rcpp::Named("bad") = static_cast<double>(s.bad),
+                            Rcpp::Named("conns") = conn_frame(s));
 }
