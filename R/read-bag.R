@@ -44,6 +44,7 @@ bag_read_imu <- function(file, topic, progress, range = NULL) {
     warn("\"", basename(file), "\" has no index (a recording cut off?); ",
          "its chunks were read one after the other.", class = "unindexed")
   }
+  no_topics_before_fault(file, s)
   topic <- select_topic(s$topics, topic, file)
   ids <- as.integer(s$conns$conn[s$conns$topic == topic])
   ch <- s$chunks

@@ -23,6 +23,7 @@ mcap_read_imu <- function(file, topic, progress, range = NULL) {
   path <- path.expand(file)
   if (!is.null(progress)) progress("scanning the MCAP file")
   s <- mcap_scan(file)
+  no_topics_before_fault(file, s)
   topic <- select_topic(s$topics, topic, file)
   ch <- s$channels[s$channels$topic == topic, , drop = FALSE]
   enc <- match(ch$encoding, c("ros1", "cdr")) - 1L

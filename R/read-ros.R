@@ -80,6 +80,15 @@ read_ros_imu <- function(file, fmt, topic, columns, units, progress, range = NUL
   ros_source(got, columns, units)
 }
 
+# A file damaged before its first connection or channel record.
+no_topics_before_fault <- function(file, s) {
+  if (length(s$fault) && !nrow(s$topics)) {
+    abort("\"", basename(file), "\" is damaged at byte ",
+          format(s$fault$off, scientific = FALSE), " (", s$fault$what,
+          ") and no topic is described before it.", class = "file_format")
+  }
+}
+
 # Chunks read in batches of `batch` (one C++ call each: `read_batch(k)`
 # returns imu, bad, done, fault, bytes), with progress between batches
 # (progressr, bytes read) and the first fault turned into a classed warning
