@@ -177,3 +177,81 @@ test_that("bz2 chunks are decompressed by R's own bzip2, and a bad one is report
   expect_identical(unname(r$data), unname(ref$data[seq_len(nrow(r$data)), ]))
   expect_lt(nrow(r$data), 300L)
 })
+
+test_that("a bag larger than the memory allowed is read, a chunk at a time", {
+  skip_on_cran()
+  skip_if_not(.Platform$OS.type == "unix" && nzchar(Sys.which("sh")), "needs ulimit")
+  skip_if_not_installed("callr")
+  skip_if_not(installed_allanvar(), "needs the installed package")
+  # A 600 MB bag, written here: per chunk 50 sensor_msgs/Imu messages
+  # (ROS1 serialization, written out field by field) and one 4 MB blob
+  # of another topic; the index at the end.
+  f <- tempfile(fileext = ".bag")
+  on.exit(unlink(f))
+  u32 <- function(x) writeBin(as.integer(x), raw(), size = 4L, endian = "little")
+  u64 <- function(x) c(u32(x %% 2^32), u32(x %/% 2^32))
+  f64 <- function(x) writeBin(as.double(x), raw(), size = 8L, endian = "little")
+  fld <- function(k, v) { v <- if (is.raw(v)) v else charToRaw(v); c(u32(nchar(k) + 1L + length(v)), charToRaw(paste0(k, "=")), v) }
+  rec <- function(h, d) c(u32(length(h)), h, u32(length(d)), d)
+  conn <- function(id, topic, type) rec(c(fld("op", as.raw(7)), fld("conn", u32(id)), fld("topic", topic)),
+                                        c(fld("topic", topic), fld("type", type)))
+  conns <- c(conn(0, "/imu0", "sensor_msgs/Imu"), conn(1, "/blob", "std_msgs/ByteMultiArray"))
+  t0 <- 1700000000
+  imu_msg <- function(i) {
+    s <- t0 + i %/% 100; ns <- (i %% 100) * 1e7
+    c(u32(i), u32(s), u32(ns), u32(0), f64(c(0, 0, 0, 1)), f64(rep(0, 9)),
+      f64(c(i, -i, 2 * i)), f64(rep(0, 9)), f64(c(1, 2, 3) + i), f64(rep(0, 9)))
+  }
+  msg <- function(id, i, d) rec(c(fld("op", as.raw(2)), fld("conn", u32(id)),
+                                  fld("time", c(u32(t0 + i %/% 100), u32((i %% 100) * 1e7)))), d)
+  blob <- msg(1, 0, as.raw(rep(1:255, length.out = 4e6)))
+  con <- file(f, "wb")
+  writeBin(charToRaw("#ROSBAG V2.0\n"), con)
+  writeBin(raw(4096), con)
+  pos <- 13 + 4096
+  infos <- list()
+  n_chunk <- 150L
+  for (k in seq_len(n_chunk) - 1L) {
+    ii <- k * 50L + 0:49
+    body <- c(conns, unlist(lapply(ii, function(i) msg(0, i, imu_msg(i)))), blob)
+    ch <- rec(c(fld("op", as.raw(5)), fld("compression", "none"), fld("size", u32(length(body)))), body)
+    writeBin(ch, con)
+    infos[[k + 1L]] <- rec(c(fld("op", as.raw(6)), fld("ver", u32(1)), fld("chunk_pos", u64(pos)),
+                             fld("start_time", c(u32(t0 + ii[1] %/% 100), u32(0))),
+                             fld("end_time", c(u32(t0 + ii[50] %/% 100 + 1), u32(0))),
+                             fld("count", u32(2))), c(u32(0), u32(50), u32(1), u32(1)))
+    pos <- pos + length(ch)
+  }
+  writeBin(c(conns, unlist(infos)), con)
+  h <- c(fld("op", as.raw(3)), fld("index_pos", u64(pos)), fld("conn_count", u32(2)),
+         fld("chunk_count", u32(n_chunk)))
+  seek(con, 13, rw = "write")
+  writeBin(rec(h, charToRaw(strrep(" ", 4096 - 8 - length(h)))), con)
+  close(con)
+  expect_gt(file.size(f), 6e8)
+  # In a child whose address space is limited to 450 MB (R itself takes
+  # about 130 MB): the file could not be held in memory.
+  out <- tempfile(fileext = ".rds")
+  on.exit(unlink(out), add = TRUE)
+  code <- sprintf(paste0("r <- allanvar::read_imu(%s, topic = '/imu0'); ",
+                         "saveRDS(list(n = nrow(r$data), gx = r$data[, 1L], ",
+                         "ax = r$data[, 4L], time = r$time), %s)"),
+                  deparse(f), deparse(out))
+  limited <- function(code) {
+    suppressWarnings(system2("sh", c("-c", shQuote(paste("ulimit -v 450000;",
+      shQuote(file.path(R.home("bin"), "Rscript")), "-e", shQuote(code)))),
+      env = paste0("R_LIBS=", paste(.libPaths(), collapse = ":")), stdout = TRUE, stderr = TRUE))
+  }
+  # The limit bites: the whole file cannot be read into memory there.
+  whole <- tempfile(fileext = ".rds")
+  limited(sprintf("x <- readBin(%s, 'raw', file.size(%s)); saveRDS(length(x), %s)",
+                  deparse(f), deparse(f), deparse(whole)))
+  expect_false(file.exists(whole))
+  st <- limited(code)
+  expect_true(file.exists(out), info = paste(st, collapse = "\n"))
+  res <- readRDS(out)
+  expect_identical(res$n, 7500L)
+  expect_identical(res$gx, as.numeric(0:7499))
+  expect_identical(res$ax, as.numeric(0:7499) + 1)
+  expect_identical(res$time, (0:7499) / 100)
+})
