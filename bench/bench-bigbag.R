@@ -224,8 +224,13 @@ child <- function(file, expr) {
 
 cat_time <- function(f) system.time(system2("sh", c("-c", shQuote(paste("cat", shQuote(f), "> /dev/null")))))[["elapsed"]]
 
+specs <- list(c("bag", "none"), c("bag", "lz4"), c("mcap", "none"), c("mcap", "zstd"))
+only <- Sys.getenv("ALLANVAR_BENCH_ONLY", "")  # e.g. "bag:none,mcap:none"
+if (nzchar(only)) {
+  specs <- Filter(function(x) paste(x, collapse = ":") %in% strsplit(only, ",")[[1]], specs)
+}
 rows <- list()
-for (spec in list(c("bag", "none"), c("bag", "lz4"), c("mcap", "none"), c("mcap", "zstd"))) {
+for (spec in specs) {
   f <- file.path(dir, paste0("big_", spec[2], ".", spec[1]))
   keepdir <- tempfile("keep")
   dir.create(keepdir)

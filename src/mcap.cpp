@@ -127,6 +127,37 @@ void chunk(const unsigned char* p, std::size_t n, std::vector<unsigned char>& ra
   s.records(raw.data(), raw.size());
 }
 
+// An uncompressed chunk walked in the file, the messages of other channels
+// (camera images) skipped, never read; false for compressed chunks. Throws
+// format_error.
+bool uncompressed_chunk_walk(FileReader& f, std::uint64_t at, std::uint64_t n, sink& s) {
+  unsigned char b[40];
+  if (n < 40 || !f.read(at, 32, b)) throw format_error("a truncated chunk");
+  const std::uint32_t clen = rd_u32(b + 28);
+  if (clen != 0) return false;
+  if (!f.read(at + 32, 8, b)) throw format_error("a truncated chunk");
+  const std::uint64_t rlen = rd_u64(b);
+  if (rlen > n - 40) throw format_error("chunk records run past the chunk");
+  std::uint64_t i = at + 40;
+  const std::uint64_t end = i + rlen;
+  std::vector<unsigned char> c;
+  while (i < end) {
+    if (end - i < 9 || !f.read(i, 9, b)) throw format_error("a record cut off inside a chunk");
+    const std::uint64_t len = rd_u64(b + 1);
+    if (len > end - i - 9) throw format_error("a record runs past its chunk");
+    if (b[0] == 0x05) {
+      if (len < 22 || !f.read(i + 9, 2, b + 9)) throw format_error("a truncated message record");
+      const int ch = rd_u16(b + 9);
+      if (std::find(s.id.begin(), s.id.end(), ch) != s.id.end()) {
+        if (!f.read(i + 9, static_cast<std::size_t>(len), c)) throw format_error("a message cut off");
+        s.message(c.data(), c.size());
+      }
+    }
+    i += 9 + len;
+  }
+  return true;
+}
+
 Rcpp::List fault_list(double off, const std::string& why) {
   return Rcpp::List::create(Rcpp::Named("off") = off, Rcpp::Named("what") = why);
 }
@@ -298,7 +329,19 @@ Rcpp::List mcap_read_cpp(std::string path, const Rcpp::NumericVector& pos,
       if (!f.read(off, 9, b)) { fault = fault_list(pos[k], "a record header cut off"); break; }
       const std::uint64_t len = rd_u64(b.data() + 1);
       if (b[0] != 0x06 && b[0] != 0x05) { fault = fault_list(pos[k], "no chunk where the index says"); break; }
-      if (len > f.size() - off - 9 || !f.read(off + 9, static_cast<std::size_t>(len), c)) {
+      if (len > f.size() - off - 9) {
+        fault = fault_list(pos[k], "a record runs past the end of the file");
+        break;
+      }
+      if (b[0] == 0x06) {
+        try {
+          if (uncompressed_chunk_walk(f, off + 9, len, s)) continue;
+        } catch (const format_error& e) {
+          fault = fault_list(pos[k], e.what());
+          break;
+        }
+      }
+      if (!f.read(off + 9, static_cast<std::size_t>(len), c)) {
         fault = fault_list(pos[k], "a record runs past the end of the file");
         break;
       }

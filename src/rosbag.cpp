@@ -181,10 +181,49 @@ int read_chunk(FileReader& f, const file_record& r, std::vector<unsigned char>& 
   field_u32(r.hdr.data(), r.hdr.size(), "size", &size);
   if (c == "bz2") return 2;
   if (c != "none" && c != "lz4") throw format_error("chunks compressed with \"" + c + "\" (none, bz2 and lz4 are read)");
-  if (!f.read(r.data, static_cast<std::size_t>(r.data_len), comp)) throw format_error("a chunk cut off");
   if (c == "none") {
-    chunk_messages(comp.data(), comp.size(), s);
+    // Uncompressed: the records walked in the file, the data of other
+    // topics (camera images) skipped, never read.
+    std::uint64_t i = r.data;
+    unsigned char b[4];
+    std::vector<unsigned char> h, d;
+    while (i < r.end) {
+      if (r.end - i < 8 || !f.read(i, 4, b)) throw format_error("a record cut off inside a chunk");
+      const std::uint64_t hl = rd_u32(b);
+      if (hl > r.end - i - 8) throw format_error("a record header cut off inside a chunk");
+      if (!f.read(i + 4, static_cast<std::size_t>(hl), h) || !f.read(i + 4 + hl, 4, b)) {
+        throw format_error("a record cut off inside a chunk");
+      }
+      const std::uint64_t dl = rd_u32(b);
+      const std::uint64_t at = i + 8 + hl;
+      if (dl > r.end - at) throw format_error("a record runs past its chunk");
+      const int op = field_op(h.data(), h.size());
+      bool want = op == 7 && s.want_conns;
+      std::uint32_t conn = 0;
+      if (op == 2) {
+        if (!field_u32(h.data(), h.size(), "conn", &conn)) throw format_error("a message record without its connection");
+        want = std::find(s.conns.begin(), s.conns.end(), static_cast<int>(conn)) != s.conns.end();
+        if (!want && s.want_conns) {
+          for (std::size_t k = 0; k < s.conn_id.size(); ++k) {
+            if (s.conn_id[k] == conn) s.conn_n[k] += 1;
+          }
+        }
+      }
+      if (want) {
+        // The record re-assembled as chunk_messages() reads it.
+        d.resize(static_cast<std::size_t>(8 + hl + dl));
+        std::memcpy(d.data() + 4, h.data(), h.size());
+        for (int k = 0; k < 4; ++k) {
+          d[k] = static_cast<unsigned char>(hl >> (8 * k));
+          d[4 + hl + k] = static_cast<unsigned char>(dl >> (8 * k));
+        }
+        if (!f.read(at, static_cast<std::size_t>(dl), d.data() + 8 + hl)) throw format_error("a record cut off inside a chunk");
+        chunk_messages(d.data(), d.size(), s);
+      }
+      i = at + dl;
+    }
   } else {
+    if (!f.read(r.data, static_cast<std::size_t>(r.data_len), comp)) throw format_error("a chunk cut off");
     raw.clear();
     allanvar::lz4_frame_decode(comp.data(), comp.size(), raw, size);
     if (raw.size() != size) throw format_error("an lz4 chunk does not decompress to its stated size");
