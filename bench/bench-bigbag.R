@@ -261,7 +261,7 @@ for (spec in specs) {
     range10_s = round(part$s, 2), range10_read_pct = round(100 * part$MB_read * 1e6 / size, 1),
     range10_rows = part$rows)
   print(rows[[length(rows)]])
-  unlink(f)
+  if (Sys.getenv("ALLANVAR_BENCH_KEEP") != "1") unlink(f)
 }
 cat("\n", format(Sys.time(), "%Y-%m-%d %H:%M UTC", tz = "UTC"), " git ",
     system("git rev-parse --short HEAD", intern = TRUE), ", ", gb, " GB target\n", sep = "")
