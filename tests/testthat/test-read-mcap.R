@@ -58,3 +58,46 @@ test_that("without libzstd only zstd chunks are refused, saying what to install"
   expect_match(res$msg, "libzstd")
   expect_equal(res$lz4, 300L)
 })
+
+test_that("an MCAP file cut off mid-file gives the messages before the cut, with a warning", {
+  ref <- read_imu(ros_fixture("imu.csv"))
+  for (cmp in c("none", "lz4")) {
+    src <- ros_fixture(paste0("imu_", cmp, ".mcap"))
+    b <- readBin(src, "raw", file.size(src))
+    f <- tempfile(fileext = ".mcap")
+    on.exit(unlink(f), add = TRUE)
+    # Chunk records (op 0x06) start where the bytes say; cut inside the third.
+    s <- allanvar:::mcap_scan(src)
+    cut <- s$chunks$pos[3L] + 500
+    writeBin(b[seq_len(cut)], f)
+    expect_warning(r <- read_imu(f, topic = "/imu0"),
+                   paste0("damaged at byte ", format(s$chunks$pos[3L], scientific = FALSE)),
+                   class = "allanvar_warning_damaged_file")
+    n <- nrow(r$data)
+    # the /imu0 messages of the first two chunks (256 records of three topics)
+    expect_gt(n, 200L)
+    expect_lt(n, 256L)
+    expect_identical(unname(r$data), unname(ref$data[seq_len(n), ]))
+    # cut inside the first chunk: nothing to trust
+    writeBin(b[seq_len(s$chunks$pos[1L] + 100)], f)
+    expect_error(read_imu(f, topic = "/imu0"), "damaged", class = "allanvar_error_file_format")
+  }
+})
+
+test_that("a damaged lz4 or zstd chunk is a classed condition naming the chunk's byte", {
+  for (cmp in c("lz4", "zstd")) {
+    if (cmp == "zstd" && !allanvar:::zstd_available_cpp()) next
+    src <- ros_fixture(paste0("imu_", cmp, ".mcap"))
+    b <- readBin(src, "raw", file.size(src))
+    s <- allanvar:::mcap_scan(src)
+    f <- tempfile(fileext = ".mcap")
+    on.exit(unlink(f), add = TRUE)
+    # Bytes in the middle of the first chunk's compressed records.
+    at <- s$chunks$pos[1L] + 200
+    b[at + 0:40] <- as.raw(0xAB)
+    writeBin(b, f)
+    expect_error(read_imu(f, topic = "/imu0"),
+                 paste0("damaged at byte ", format(s$chunks$pos[1L], scientific = FALSE)),
+                 class = "allanvar_error_file_format")
+  }
+})
