@@ -164,7 +164,9 @@ report_raw_series <- function(a, record, raw) {
     return(out)
   }
   if (is.null(record)) return(out)
-  d <- tryCatch(record_segment(record, "longest"), error = function(e) NULL)
+  # (the analysed segment: the whole record unless it has gaps)
+  d <- if (NROW(record$data) == a$n) record$data
+       else tryCatch(record_segment(record, "longest"), error = function(e) NULL)
   if (is.null(d)) return(out)
   for (ch in a$channels) {
     if (ch$channel %in% colnames(d) && nrow(d) == ch$n) {
@@ -385,7 +387,14 @@ report_loop <- function(ch, x) {
   steps <- fit$steps
   r <- fit$refine
   unit <- ch$unit
-  psd <- if (!is.null(x) && length(x) >= 256L) welch_psd(x, ch$freq)
+  # the periodogram is computed once per axis, when a step needs it
+  psd_cache <- NULL
+  psd <- function() {
+    if (is.null(psd_cache) && !is.null(x) && length(x) >= 256L) {
+      psd_cache <<- welch_psd(x, ch$freq)
+    }
+    psd_cache
+  }
   panels <- lapply(seq_len(NROW(steps)), function(k) {
     report_step(steps[k, ], k, fit, ch, x, psd, unit)
   })
@@ -465,7 +474,7 @@ report_evidence <- function(par, x, freq, psd, unit) {
   u <- stats::setNames(par$unit, par$param)
   hz <- v[u == "Hz"]
   secs <- v[u == "s"]
-  if (length(hz) && !is.null(psd)) {
+  if (length(hz) && !is.null(psd <- psd())) {
     band <- if (length(hz) >= 2L) range(hz)
             else if (length(secs)) hz[[1L]] + c(-1, 1) / (2 * pi * secs[[1L]])
     mark <- if (length(hz) == 1L) hz[[1L]] else numeric()
