@@ -359,6 +359,9 @@ fuzz_cases <- function(quick = FALSE) {
                                                    file = file.path(dir, "kalibr_imu_chain.yaml"))),
           c("x", "tool", "file", "axis", "noise_type", "rostopic"))
   add("write_tool_params", "file is a directory", q(write_tool_params(ana, "imu_utils", dir)))
+  sub_arg("write_report", q(write_report(x = ana, file = file.path(dir, "report.html"))),
+          c("x", "file", "record", "title"))
+  add("write_report", "file is a directory", q(write_report(ana, dir)))
   sub_arg("datasheet.avfit", q(datasheet(x = fit)), c("average", "unit"))
   add("datasheet.default", "a number", q(datasheet(1)))
   sub_arg("series_effects", q(series_effects(x = x, freq = 100)), c("x"), series)
