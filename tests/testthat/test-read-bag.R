@@ -140,7 +140,8 @@ test_that("the LZ4 frame decoder inverts the reference lz4 tool", {
     z <- readBin(o, "raw", file.size(o))
     expect_identical(allanvar:::lz4_decompress_cpp(z, 0), x)
   }
-  expect_error(allanvar:::lz4_decompress_cpp(as.raw(1:10), 0), "lz4")
+  expect_error(allanvar:::lz4_decompress_cpp(as.raw(1:10), 0), "lz4",
+    class = "Rcpp::exception")
   # Checksums verified: a flipped byte in a block is caught (block checksum
   # with -BX, content checksum by default), as is one in the frame header.
   for (opt in list(c("-B4", "-BX"), c("-B4"))) {
@@ -150,10 +151,12 @@ test_that("the LZ4 frame decoder inverts the reference lz4 tool", {
     z2 <- z
     k <- 70000L  # inside the literals of the first block
     z2[k] <- xor(z2[k], as.raw(1))
-    expect_error(allanvar:::lz4_decompress_cpp(z2, 0), "checksum mismatch")
+    expect_error(allanvar:::lz4_decompress_cpp(z2, 0), "checksum mismatch",
+      class = "Rcpp::exception")
     z3 <- z
     z3[6L] <- xor(z3[6L], as.raw(0x40))  # the block-maximum-size byte
-    expect_error(allanvar:::lz4_decompress_cpp(z3, 0), "lz4")
+    expect_error(allanvar:::lz4_decompress_cpp(z3, 0), "lz4",
+      class = "Rcpp::exception")
   }
 })
 
