@@ -95,7 +95,7 @@ plot_block_acf <- function(x, freq, tc, main = "ACF of block means") {
     graphics::text(0.5, 0.5, "too few blocks for an ACF")
     return(invisible())
   }
-  r <- acf_fft(detrend_linear(b), min(length(b) - 2L, 48L))[-1L]
+  r <- acf_lags(detrend_linear(b), min(length(b) - 2L, 48L))[-1L]
   lag <- seq_along(r) * m / freq
   graphics::plot(lag, r, type = "h", lwd = 2, col = "grey35",
                  ylim = range(c(r, 0, 1)), xlab = "lag [s]", ylab = "ACF",
@@ -111,7 +111,7 @@ plot_block_acf <- function(x, freq, tc, main = "ACF of block means") {
 # The short-lag ACF of the raw samples: a sensor's own filter shows as an
 # excess over white noise (0 beyond lag 0).
 plot_lag_acf <- function(x, main = "ACF of the raw samples") {
-  r <- acf_fft(x, 10L)[-1L]
+  r <- acf_lags(x, 10L)[-1L]
   z <- 2 / sqrt(length(x))
   graphics::barplot(r, names.arg = seq_along(r), col = "#7570b3", border = NA,
                     ylim = range(c(r, 0, z, -z)), xlab = "lag [samples]",
