@@ -284,7 +284,7 @@ remove_steps <- function(x, steps) {
 #' (`warmup_noise()`; the sensor's filter and quantization are inside a
 #' block and count as white). The Kalman filter of that model (level
 #' diffuse: the intercept c) whitens the block means and the exponential of
-#' every T on a log grid from 2 blocks to half the record in one pass; T
+#' every T on a log grid from 2 blocks to 40% of the record in one pass; T
 #' maximises the profile likelihood, refined by a parabola in log T. The
 #' noise model is fitted again with the warm-up found taken out (else its
 #' Gauss-Markov components would explain the warm-up) until T settles.
@@ -311,7 +311,7 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1500L,
                level = mean(x),
                all = data.frame(amplitude = numeric(), tc = numeric(), z = numeric()))
   if (is.null(min_tc)) min_tc <- 2 * dt
-  max_tc <- nb * dt / 2
+  max_tc <- 0.4 * nb * dt
   # a constant series has no warm-up (and no noise to judge one by)
   if (max_tc <= min_tc || nb < 64L || max(x) == min(x)) return(none)
   grid <- exp(seq(log(min_tc), log(max_tc), by = 0.05))
@@ -343,13 +343,18 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1500L,
     if (nrow(found) && abs(log(tc / found$tc[1L])) < log(2)) break
     found <- rbind(found, data.frame(amplitude = prof$A, tc = tc, z = abs(prof$z)))
     if (nrow(found) == 2L) {
-      # the first again, given the second
-      fixed <- list(X = matrix(expo(tc), nb), A = prof$A)
-      near <- which(abs(log(grid / found$tc[1L])) <= 1)
-      p1 <- warmup_profile(y, X[, near, drop = FALSE], grid[near], model, fixed$X)
-      if (is.finite(p1$z) && abs(log(p1$tc / tc)) >= log(2)) {
-        found[1L, ] <- data.frame(amplitude = p1$A, tc = p1$tc, z = abs(p1$z))
-        found$amplitude[2L] <- p1$A_fixed
+      # each again given the other, alternately (the first was found with
+      # the second left in)
+      for (pass in 1:3) {
+        for (i in 1:2) {
+          o <- 3L - i
+          near <- which(abs(log(grid / found$tc[i])) <= 1)
+          pi <- warmup_profile(y, X[, near, drop = FALSE], grid[near], model,
+                               matrix(expo(found$tc[o]), nb))
+          if (!is.finite(pi$z) || abs(log(pi$tc / found$tc[o])) < log(2)) next
+          found[i, ] <- data.frame(amplitude = pi$A, tc = pi$tc, z = abs(pi$z))
+          found$amplitude[o] <- pi$A_fixed
+        }
       }
       break
     }
@@ -375,7 +380,7 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1500L,
 # (about sqrt(nb / m)).
 warmup_noise <- function(y, dt) {
   nb <- length(y)
-  ms <- 2^(0:floor(log2(nb / 8)))
+  ms <- 2^(0:floor(log2(nb / 4)))
   cs <- c(0, cumsum(y - mean(y)))
   av <- vapply(ms, function(m) {
     i <- seq_len(nb - 2 * m + 1)
@@ -396,6 +401,13 @@ warmup_noise <- function(y, dt) {
     c(stats::var(y), rep(0, ncol(B) - 1L))
   coef <- pmax(as.numeric(coef), 0)
   if (!(coef[1L] > 0)) coef[1L] <- max(av[1L], .Machine$double.eps) * 1e-3
+  # A random walk the fit set to 0 still wanders: one realisation's long-m
+  # points can lie low, and a model without the walk would read its wander
+  # as a slow exponential. The walk is at least what the two longest m
+  # leave over the other components.
+  top <- utils::tail(which(ok), 2L)
+  rest <- as.numeric(B[top, -2L, drop = FALSE] %*% coef[-2L])
+  coef[2L] <- max(coef[2L], (av[top] - rest) / B[top, 2L], 0)
   keep <- which(coef[-(1:2)] > 0)
   list(h = coef[1L], q = coef[2L], phi = phis[keep], s = coef[-(1:2)][keep],
        dt = dt)
@@ -523,17 +535,20 @@ robust_scale <- function(r, trim = 0.005) {
 #' adding an unrelated effect changes the robust scale by a few percent
 #' and a fixed cut then moved a dozen real outliers across it. The
 #' threshold is therefore the log-midpoint of the gap of the sorted |z|
-#' that holds the level, when that gap is at least `gap` wide in log (a
-#' scale change of `gap` / 2 moves nothing across), else of the next such
-#' gap above (within zc / 1.15 and 1.5 zc). (A tail fitted to the record's
-#' own |z| was tried and dropped: on coarsely quantized accelerometers it
+#' that holds the level when it is at least `gap` wide in log (a scale
+#' change of `gap` / 2 moves nothing across), else of the first such gap
+#' above it (within zc / 1.15 and 1.1 zc), else the level itself. A candidate is kept only when it is also an additive
+#' outlier of the series' own AR(10) model at `ao_min` (`spike_ao_z()`):
+#' the running median's residual of a resonant or strongly filtered series
+#' has heavy tails without any outlier. (A tail fitted to the record's own
+#' |z| was tried and dropped: on coarsely quantized accelerometers it
 #' swung with any added dither.)
 #' @return data.frame `index`, `time` (s), `value` (the sample), `size`
 #'   (its excess over the running median), `z`; attribute `threshold` (in
 #'   robust sd).
 #' @noRd
 detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6,
-                          gap = 0.04) {
+                          gap = 0.04, ao_min = 4.5) {
   n <- length(x)
   med <- stats::runmed(x, k, endrule = "median", algorithm = "Turlach")
   r <- x - med
@@ -545,27 +560,60 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6,
   z <- r / s
   zc <- spike_threshold(abs(z), max(min_z, stats::qnorm(1 - alpha / (2 * n))), gap)
   i <- which(abs(z) > zc)
+  if (length(i)) {
+    # the local noise model's word: the candidate must also stand out from
+    # its neighbours as an additive outlier of the series' own AR model
+    # (a resonant or strongly filtered series gives the running median's
+    # residual heavy tails that are not outliers)
+    ao <- spike_ao_z(x, i, med + pmax(pmin(r, 4 * s), -4 * s))
+    i <- i[!(abs(ao) < ao_min)]
+  }
   out <- data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
                     z = z[i])
   attr(out, "threshold") <- zc
   out
 }
 
+# The additive-outlier statistic (Fox 1972; Chang, Tiao and Chen 1988) at
+# samples `at`: an AR(p) model a(B) x = e fitted by Yule-Walker to the
+# winsorised series `xw` (at most its first 2e5 samples), the outlier size
+# w = sum_j pi_j e(t + j) / sum pi_j^2 over its standard error sigma_e /
+# sqrt(sum pi_j^2); sigma_e the robust scale of the innovations. NA near
+# the ends.
+spike_ao_z <- function(x, at, xw, p = 10L) {
+  n <- length(x)
+  m <- min(n, 200000L)
+  mu <- mean(xw[seq_len(m)])
+  fit <- stats::ar.yw(xw[seq_len(m)] - mu, aic = FALSE, order.max = p,
+                      demean = FALSE)
+  pi <- c(1, -as.numeric(fit$ar))
+  p <- length(pi) - 1L
+  e <- as.numeric(stats::filter(xw[seq_len(m)] - mu, pi, sides = 1L))
+  se <- robust_scale(e[-seq_len(p)])
+  vapply(at, function(t) {
+    if (t <= 2L * p || t + 2L * p > n || !(se > 0)) return(NA_real_)
+    win <- x[(t - p):(t + p)] - mu
+    et <- as.numeric(stats::filter(win, pi, sides = 1L))[(p + 1L):(2L * p + 1L)]
+    sum(pi * et) / (sqrt(sum(pi^2)) * se)
+  }, 0)
+}
+
 # The spike threshold: level zc moved into a gap of the sorted |z| `a`
 # (see detect_spikes()).
 spike_threshold <- function(a, zc, gap) {
-  # into a gap: the log-midpoint of the gap of the sorted values that holds
-  # zc when it is at least `gap` wide, else of the next such gap above
-  # (bounded by zc / 1.15 and 1.5 zc)
+  # the gap of the sorted values that holds zc when it is at least `gap`
+  # wide in log, else the first such gap above, its midpoint within zc /
+  # 1.15 and 1.1 zc; zc itself when there is none (values spread densely:
+  # any cut moves them in proportion)
   lo <- zc / 1.15
-  hi <- 1.5 * zc
+  hi <- 1.1 * zc
   v <- sort(a[a > lo & a < hi])
   pts <- log(c(lo, v, hi))
   w <- diff(pts)
   from <- findInterval(log(zc), pts, rightmost.closed = TRUE)
   ok <- which(w >= gap & seq_along(w) >= from)
-  j <- if (length(ok)) ok[1L] else from - 1L + which.max(w[from:length(w)])
-  exp((pts[j] + pts[j + 1L]) / 2)
+  if (!length(ok)) return(zc)
+  exp((pts[ok[1L]] + pts[ok[1L] + 1L]) / 2)
 }
 
 # The series with spikes replaced by the running median around them.
