@@ -299,7 +299,7 @@ remove_steps <- function(x, steps) {
 #'   fit), and `all`: a data.frame (`amplitude`, `tc`, `z`) of every
 #'   exponential found (none, one or two), strongest first.
 #' @noRd
-detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1500L,
+detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1000L,
                           min_tc = NULL, max_iter = 4L) {
   n <- length(x)
   tau0 <- 1 / freq
@@ -314,7 +314,7 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1500L,
   max_tc <- 0.4 * nb * dt
   # a constant series has no warm-up (and no noise to judge one by)
   if (max_tc <= min_tc || nb < 64L || max(x) == min(x)) return(none)
-  grid <- exp(seq(log(min_tc), log(max_tc), by = 0.05))
+  grid <- exp(seq(log(min_tc), log(max_tc), by = 0.07))
   # exact block means of exp(-t / T), t from the first sample
   expo <- function(tc) {
     exp(-(seq_len(nb) - 1) * dt / tc) * (1 - exp(-tau0 * b / tc)) /
@@ -584,9 +584,13 @@ spike_ao_z <- function(x, at, xw, p = 10L) {
   n <- length(x)
   m <- min(n, 200000L)
   mu <- mean(xw[seq_len(m)])
-  fit <- stats::ar.yw(xw[seq_len(m)] - mu, aic = FALSE, order.max = p,
-                      demean = FALSE)
-  pi <- c(1, -as.numeric(fit$ar))
+  # Yule-Walker from the sample autocovariance (C, O(m p))
+  g <- as.numeric(stats::acf(xw[seq_len(m)] - mu, lag.max = p, type = "covariance",
+                             plot = FALSE, demean = FALSE)$acf)
+  ar <- tryCatch(solve(stats::toeplitz(g[seq_len(p)]), g[-1L]),
+                 error = function(e) numeric(0))
+  if (!all(is.finite(ar))) ar <- numeric(0)
+  pi <- c(1, -ar)
   p <- length(pi) - 1L
   e <- as.numeric(stats::filter(xw[seq_len(m)] - mu, pi, sides = 1L))
   se <- robust_scale(e[-seq_len(p)])
