@@ -16,7 +16,13 @@
 #' Each detector sees the series with the instances found before it taken
 #' out (a spike does not disturb the step search). Thresholds are
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
-#' steps) standard deviations.
+#' steps) standard deviations; the spike threshold sits in a gap of the
+#' sorted residuals near that level (so the count does not flip when the
+#' noise scale moves a little) and a spike must also be an additive outlier
+#' of the series' own AR model. The warm-up is fitted by generalised least
+#' squares under the series' own noise model (white, random walk and
+#' Gauss-Markov components from its Allan variance); up to two
+#' exponentials are named.
 #'
 #' The Allan deviation of the series as given is compared with that of the
 #' series with every effect found taken out, on the octave grid of
