@@ -37,3 +37,17 @@ test_that("ADIS16405 unit 1 accel_z: the transient at 2154 s", {
   expect_true(all(sp$removed))
   expect_false(any(se$table$kind %in% c("steps", "warmup")))
 })
+
+test_that("ADIS16405 unit 2 gyro_z: an added warm-up of tc 5% of the record is named within 25%", {
+  skip_if_no_shared()
+  skip_on_cran()
+  m <- readRDS(shared_file("adis16405_unit2.rds"))
+  freq <- attr(m, "freq")
+  x <- m[, "gyro_z"]
+  t <- (seq_along(x) - 1) / freq
+  tc <- 0.05 * length(x) / freq
+  amp <- 50 * allan(x, freq, taus = I(tc))$adev
+  w <- series_effects(x + amp * exp(-t / tc), freq, kinds = "warmup")$table
+  expect_equal(nrow(w), 1L)
+  expect_lt(abs(w$tc / tc - 1), 0.25)
+})

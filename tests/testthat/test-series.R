@@ -257,3 +257,30 @@ test_that("a transient whose return is weak is paired, and a bias step stays a s
   }
   expect_gte(found, 5L)
 })
+
+test_that("series_reading_bias(): what outliers left in do to N, against the clean series' Allan deviation", {
+  n <- 1e5
+  freq <- 100
+  clean <- gen_white_walk(n, rw = 1e-5, seed = 121)
+  set.seed(121)
+  at <- sample.int(n, 200)
+  x <- clean
+  x[at] <- x[at] + sample(c(-1, 1), 200, TRUE) * 1.5
+  se <- series_effects(x, freq, kinds = "spikes")
+  b <- series_reading_bias(se)
+  expect_identical(b, se$reading_bias)
+  expect_setequal(b$term, c("N", "B", "K"))
+  expect_identical(unique(b$kind), "spikes")
+  # independent reference: ADEV at 1 s with the outliers over the clean series'
+  ref <- allan(x, freq, taus = I(1))$adev / allan(clean, freq, taus = I(1))$adev - 1
+  expect_gt(ref, 0.02)
+  expect_equal(b$bias_change[b$term == "N"], ref, tolerance = 0.05)
+  # readings' own taus are used
+  rb <- series_reading_bias(se, data.frame(term = c("N", "K"), tau = c(0.1, 100)))
+  expect_equal(rb$tau[rb$term == "N"], 0.1)
+  # removed kinds bias nothing
+  expect_equal(nrow(series_reading_bias(series_effects(x, freq, kinds = "spikes",
+                                                       remove = "spikes"))), 0L)
+  expect_error(series_reading_bias(list()), class = "allanvar_error_argument")
+  expect_error(series_reading_bias(se, readings = 1), class = "allanvar_error_argument")
+})
