@@ -38,7 +38,7 @@
 #' * `--terms N,B,K` terms to fit (of [av_terms()]: Q, N, B, K, R, gm,
 #'   sinusoid); `--no-refine` skip [avrefine()];
 #' * `--remove spikes,steps` non-stationary effects to take out of each
-#'   axis first (see [series_effects()]; `all` for every kind);
+#'   axis first (see [detect_series_effects()]; `all` for every kind);
 #' * `--width PX`, `--height PX` size of the PNG (default 700 per sensor
 #'   by 600);
 #' * `--axis max|mean` which value goes into imu.yaml; `--average` adds the
@@ -315,7 +315,7 @@ cli_run <- function(args) {
                      sub("^`x`: ", "", conditionMessage(e)),
                      class = "record_too_short")
              })
-    utils::write.csv(filter_params(a), path(4), row.names = FALSE)
+    utils::write.csv(kalman_params(a), path(4), row.names = FALSE)
     if (!isTRUE(opt$`no-report`)) write_report(a, path(5), record = rec)
     cat("\n", a$name, "\n", sep = "")
     print(ds)

@@ -2,7 +2,7 @@
 # (component "series"): isolated spikes, bias steps, transients (a pulse
 # that returns) and an exponential warm-up. They are not terms of the Allan
 # variance: each entry's `detect(x, freq)` finds its instances in the
-# series and `remove(x, freq, par)` takes them out; series_effects()
+# series and `remove(x, freq, par)` takes them out; detect_series_effects()
 # (R/series.R) runs them in catalogue order. The detectors themselves are
 # in R/nonstationary.R.
 #

@@ -307,6 +307,11 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1000L,
   y <- block_avg(x, b)
   nb <- length(y)
   dt <- b * tau0
+  # fitted in units of the largest block mean: the GLS's variances would
+  # overflow for values beyond about 1e150 (amplitudes scaled back below)
+  s <- max(abs(y))
+  if (!is.finite(s) || s == 0) s <- 1
+  y <- y / s
   none <- list(present = FALSE, amplitude = 0, tc = NA_real_, z = 0,
                level = mean(x),
                all = data.frame(amplitude = numeric(), tc = numeric(), z = numeric()))
@@ -363,9 +368,10 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1000L,
   if (!nrow(found)) {
     none$z <- if (exists("prof")) abs(prof$z) else 0
     none$tc <- if (exists("prof")) prof$tc else NA_real_
-    none$amplitude <- if (exists("prof")) prof$A else 0
+    none$amplitude <- if (exists("prof")) prof$A * s else 0
     return(none)
   }
+  found$amplitude <- found$amplitude * s
   found <- found[order(-found$z), , drop = FALSE]
   rownames(found) <- NULL
   list(present = TRUE, amplitude = found$amplitude[1L], tc = found$tc[1L],

@@ -67,10 +67,10 @@
 #' x <- rnorm(1e5, sd = 0.1) + cumsum(rnorm(1e5, sd = 1e-4))
 #' x[60001:1e5] <- x[60001:1e5] + 0.05        # a bias step at 600 s
 #' x[c(1000, 42000)] <- x[c(1000, 42000)] + 2  # two spikes
-#' se <- series_effects(x, 100, remove = "spikes")
+#' se <- detect_series_effects(x, 100, remove = "spikes")
 #' se
 #' se$table[, c("kind", "time", "size", "z", "removed")]
-series_effects <- function(x, freq, remove = character(), ..., kinds = NULL) {
+detect_series_effects <- function(x, freq, remove = character(), ..., kinds = NULL) {
   check_dots_empty(...)
   check_present(missing(x), "x", "a rate series")
   was_ts <- stats::is.ts(x)
@@ -224,7 +224,7 @@ print.series_effects <- function(x, ...) {
 #' about as much). The row `kind = "all"` takes every kind left in out
 #' together.
 #'
-#' @param pass A [series_effects()] result (also the `$series` of an
+#' @param pass A [detect_series_effects()] result (also the `$series` of an
 #'   [avrefine()] fit or of an analysis channel).
 #' @param readings `NULL`, or readings with columns `term` and `tau` (s),
 #'   e.g. an analysis channel's `$readings`: the taus where N, B and K are
@@ -238,11 +238,11 @@ print.series_effects <- function(x, ...) {
 #' set.seed(1)
 #' x <- rnorm(1e5, sd = 0.1)
 #' x[sample.int(1e5, 200)] <- 3                  # 200 outliers
-#' se <- series_effects(x, 100)
+#' se <- detect_series_effects(x, 100)
 #' series_reading_bias(se)
 series_reading_bias <- function(pass, readings = NULL) {
   if (!inherits(pass, "series_effects")) {
-    abort("`pass` must be a series_effects() result, not ", describe_type(pass),
+    abort("`pass` must be a detect_series_effects() result, not ", describe_type(pass),
           ".", class = "argument")
   }
   out <- data.frame(kind = character(), term = character(), tau = numeric(),

@@ -30,7 +30,7 @@ warmup_case <- function(x, frac, seed, k_amp = 50) {
     sample(c(-1, 1), 1)
   y <- x + amp * exp(-t / tc)
   t0 <- proc.time()[[3]]
-  se <- series_effects(y, freq, kinds = c("spikes", "warmup"))
+  se <- detect_series_effects(y, freq, kinds = c("spikes", "warmup"))
   el <- proc.time()[[3]] - t0
   w <- se$table[se$table$kind == "warmup", ]
   # the found exponential nearest the added one (an axis may have its own)
@@ -47,7 +47,7 @@ cat("== warm-up, simulated (5000 s at 100 Hz; amplitude 50 x ADEV(tc), random si
 rows <- list()
 for (g in names(gen)) for (s in seeds) {
   x <- gen[[g]](5e5, 100 + s)
-  ctl <- series_effects(x, freq, kinds = c("spikes", "warmup"))$table
+  ctl <- detect_series_effects(x, freq, kinds = c("spikes", "warmup"))$table
   for (f in fracs) {
     set.seed(s)
     rows[[length(rows) + 1L]] <- cbind(noise = g, seed = s, frac = f,
@@ -70,7 +70,7 @@ if (all(file.exists(files))) {
     m <- readRDS(files[u])
     for (ax in colnames(m)) {
       x <- m[, ax]
-      ctl <- series_effects(x, freq, kinds = c("spikes", "warmup"))$table
+      ctl <- detect_series_effects(x, freq, kinds = c("spikes", "warmup"))$table
       own <- ctl[ctl$kind == "warmup", ]
       for (f in fracs) {
         set.seed(u * 10 + match(ax, colnames(m)))
@@ -104,7 +104,7 @@ if (all(file.exists(files))) {
       cnt <- vapply(list(x, x + gm, x + 0.5 * s0 * sin(2 * pi * 1.7 * t),
                          x + rnorm(n, sd = 0.2 * s0)),
                     function(y) nrow(ns$detect_spikes(y, freq)), 0L)
-      se <- series_effects(x, freq, kinds = "spikes")
+      se <- detect_series_effects(x, freq, kinds = "spikes")
       nb <- se$reading_bias
       rows[[length(rows) + 1L]] <- data.frame(unit = u, axis = ax, as_is = cnt[1],
         plus_gm = cnt[2], plus_line = cnt[3], plus_2pc = cnt[4],

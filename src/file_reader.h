@@ -42,7 +42,7 @@ class FileReader {
       return true;
     }
     if (n >= kWindow) return direct(off, n, out);
-    const std::size_t len = static_cast<std::size_t>(std::min<std::uint64_t>(kWindow, size_ - off));
+    const std::size_t len = static_cast<std::size_t>(std::min<std::uint64_t>(std::uint64_t{kWindow}, size_ - off));
     win_.resize(kWindow);
     win_len_ = 0;
     if (!direct(off, len, win_.data())) return false;
