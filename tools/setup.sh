@@ -2,7 +2,7 @@
 # Installs what the package needs and is missing: Debian's prebuilt r-cran-*
 # packages first (seconds), CRAN for anything Debian lacks.
 set -euo pipefail
-pkgs="Rcpp RcppEigen gplots future future.apply knitr rmarkdown yaml testthat callr vdiffr data.table bit64 DBI RSQLite progressr cli htmltools svglite png"
+pkgs="Rcpp RcppEigen gplots future future.apply knitr rmarkdown yaml testthat callr vdiffr data.table bit64 DBI RSQLite progressr cli htmltools svglite png CompQuadForm"
 missing=$(Rscript --vanilla -e "p <- strsplit('$pkgs', ' ')[[1]]; cat(p[!vapply(p, requireNamespace, logical(1), quietly = TRUE)])")
 if [ -n "$missing" ]; then
   echo "setup: installing $missing"
