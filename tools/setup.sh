@@ -19,13 +19,6 @@ if [ -n "$missing" ]; then
     Rscript --vanilla -e "install.packages(strsplit('$still', ' ')[[1]], repos = 'https://cloud.r-project.org')"
   fi
 fi
-# MCAP zstd chunks are decoded by the system's libzstd.so.1, loaded at run
-# time (part of every Debian base system; installed here if a slim image
-# lacks it).
-if ! ldconfig -p 2>/dev/null | grep -q 'libzstd\.so\.1' \
-   && command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
-  apt-get install -y -qq --no-install-recommends libzstd1 >/dev/null || true
-fi
 # Headless Chromium opens the HTML reports in the tests (test-report.R skips
 # without it).
 if ! command -v chromium >/dev/null 2>&1 && ! command -v chromium-browser >/dev/null 2>&1 \
