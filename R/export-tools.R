@@ -106,7 +106,7 @@ tool_readings <- function(x) {
     k <- reading_of(rd, "random_walk")
     data.frame(sensor = ch$sensor, axis = ch$channel, N = val("white"),
                B = val("flicker"), K = val("random_walk"),
-               K_bound = nrow(k) > 0L && isTRUE(k$is_bound[1L]),
+               K_bound = nrow(k) > 0L && identical(k$verdict[1L], "upper_bound"),
                stringsAsFactors = FALSE)
   })
   out <- do.call(rbind, rows)

@@ -69,7 +69,7 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
                      function(cc) {
                        r <- reading_of(cc$readings, role)
                        data.frame(axis = cc$channel, value = r$value,
-                                  is_bound = isTRUE(r$is_bound),
+                                  is_bound = identical(r$verdict, "upper_bound"),
                                   stringsAsFactors = FALSE)
                      })
       if (!length(rows)) {

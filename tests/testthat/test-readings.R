@@ -41,7 +41,12 @@ test_that("readings are typed columns; rewording the method text changes no expo
   a$channels$gyro_x$readings <- rd
   expect_identical(rd$term, c("N", "B", "K"))
   expect_identical(rd$source, c("fit", "fit", "bound"))
-  expect_identical(rd$is_bound, c(FALSE, FALSE, TRUE))
+  # coefficients not fitted to this curve: the verdicts are read from the
+  # curve, and is_bound follows them
+  expect_identical(rd$is_bound, rd$verdict %in% c("upper_bound", "lower_bound"))
+  expect_identical(rd$verdict[3], "upper_bound")
+  expect_true(all(rd$verdict %in% c("measured", "upper_bound", "lower_bound",
+                                    "not_determined")))
   expect_identical(rd$folded, c("gm1", "", ""))
   expect_equal(rd$adev, rd$value * c(1, sqrt(2 * log(2) / pi), 1))
   # the same analysis with every method string reworded
@@ -76,4 +81,25 @@ test_that("readings are typed columns; rewording the method text changes no expo
   ds_a <- datasheet(a)$long
   ds_b <- datasheet(b)$long
   expect_identical(ds_b[names(ds_b) != "method"], ds_a[names(ds_a) != "method"])
+})
+
+test_that("K is never measured when the curve's long-tau end falls below the K line", {
+  # an exact white + random-walk curve (own formulas), its last points
+  # lowered by a factor 3 in ADEV with tight limits
+  tau <- 2^(0:14) / 100
+  N <- 1e-3; K <- 1e-4
+  av <- N^2 / tau + K^2 * tau / 3
+  adev <- sqrt(av)
+  low <- tau > 60
+  adev[low] <- adev[low] / 3
+  curve <- data.frame(tau = tau, m = 2^(0:14), adev = adev, lower = adev * 0.9,
+                      upper = adev * 1.1, edf = rep(100, length(tau)))
+  rd <- allanvar:::channel_readings(curve, c(N = N, K = K), "gyro")
+  expect_identical(rd$verdict[rd$term == "K"], "upper_bound")
+  expect_match(rd$why[rd$term == "K"], "above")
+  # the untouched curve: K measured over the +1/2 region
+  curve$adev <- sqrt(av); curve$lower <- curve$adev * 0.9; curve$upper <- curve$adev * 1.1
+  rd <- allanvar:::channel_readings(curve, c(N = N, K = K), "gyro")
+  expect_identical(rd$verdict[rd$term == "K"], "measured")
+  expect_gt(rd$tau_lo[rd$term == "K"], 1)
 })
