@@ -230,8 +230,9 @@ progress_handlers <- function() {
 # arguments and the package's namespace.
 analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
-  # Effects the user asked to remove go before the curve (R/series.R).
-  series <- if (length(opts$remove)) detect_series_effects(job$x, job$freq, remove = opts$remove)
+  # The series pass runs on every axis: its effects mark the readings they
+  # change; those the user asked to remove go before the curve (R/series.R).
+  series <- if (length(job$x) >= 256L) detect_series_effects(job$x, job$freq, remove = opts$remove)
   if (!is.null(series)) job$x <- series$x
   curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
   if (!any(is.finite(curve$adev) & curve$adev > 0)) {
@@ -272,7 +273,8 @@ analyze_channel <- function(job, opts) {
   }
   coef <- if (is.null(fit)) numeric() else fit$coefficients
   readings <- channel_readings(curve, coef, job$sensor, se = fit_se(fit),
-                               fitted = if (!is.null(fit)) fit$data)
+                               fitted = if (!is.null(fit)) fit$data,
+                               series = if (!is.null(fit$series)) fit$series else series)
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = failure$message, fit_condition = failure$condition,

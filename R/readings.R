@@ -17,9 +17,15 @@
 #'   instances folded into the value, comma-separated, "" for none);
 #' * `slope` (the ADEV slope of the reading's line) and `adev` (the ADEV at
 #'   `tau` on that line, where plots put the marker);
-#' * `method`, the same facts as display text.
+#' * `method`, the same facts as display text;
+#' * the verdict columns of R/verdicts.R: `verdict` ("measured",
+#'   "upper_bound", "lower_bound", "not_determined"), `why`, `tau_lo`,
+#'   `tau_hi` (the taus the reading rests on), `biased_by` (series effects
+#'   left in that change it), `bias_change`, `removed` (kinds taken out).
+#' `series`: the axis' series pass (detect_series_effects()) or NULL.
 #' @noRd
-channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL) {
+channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL,
+                             series = NULL) {
   tau <- curve$tau
   adev <- curve$adev
   ok <- is.finite(adev) & adev > 0
@@ -37,10 +43,7 @@ channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL) {
   })
   out <- do.call(rbind, rows)
   rownames(out) <- NULL
-  out <- reading_verdicts(out, curve, lay, ok, rel)
-  out$biased_by <- rep("", nrow(out))
-  out$bias_change <- rep(NA_real_, nrow(out))
-  out
+  mark_series_bias(reading_verdicts(out, curve, lay, ok, rel), series)
 }
 
 # The readings of a dead axis: one row per reading, no value, `reason` as
@@ -55,7 +58,7 @@ dead_readings <- function(sensor, reason) {
                role = spec$role, slope = spec$slope, adev = NA_real_,
                verdict = "not_determined", why = reason,
                tau_lo = NA_real_, tau_hi = NA_real_, biased_by = "",
-               bias_change = NA_real_, stringsAsFactors = FALSE)
+               bias_change = NA_real_, removed = "", stringsAsFactors = FALSE)
   })
   out <- do.call(rbind, rows)
   rownames(out) <- NULL
@@ -189,132 +192,3 @@ unfolded_coef <- function(coef, folded = folded_labels(coef), kinds = NULL) {
   if (!nrow(lay)) return(numeric())
   stats::setNames(lay$value, coef_layout(layout_terms(lay))$name)
 }
-
-# ---- verdicts ----------------------------------------------------------------
-
-# Relative tolerance added to the points' confidence limits when the model
-# is compared with the curve: the intervals of short-tau points are a few
-# tenths of a percent wide, finer than any filter needs; a model within 2%
-# of such a point agrees with it for every use of the reading.
-verdict_tolerance <- 0.02
-
-# The verdict of each reading from the curve and the final model: measured
-# only where the model stays within the points' confidence limits over the
-# taus the reading rests on (N, K: where their term makes at least half of
-# the model's AV, the -1/2 and +1/2 regions; B: the flat minimum, where the
-# model's ADEV is within 10% of its least value); otherwise a bound (the
-# side the model leaves the curve on) or not determined, with the reason.
-reading_verdicts <- function(rd, curve, lay, ok, rel) {
-  n <- nrow(rd)
-  rd$verdict <- rep("measured", n)
-  rd$why <- rep("", n)
-  rd$tau_lo <- rep(NA_real_, n)
-  rd$tau_hi <- rep(NA_real_, n)
-  tau <- curve$tau
-  model <- NULL
-  if (!is.null(lay) && nrow(lay)) {
-    tau0 <- if (!is.null(curve$m) && is.finite(curve$m[1L]) && curve$m[1L] > 0)
-      tau[1L] / curve$m[1L] else NULL
-    comp <- tryCatch(model_components(tau, tau0, lay), error = function(e) NULL)
-    if (!is.null(comp) && all(is.finite(comp))) model <- rowSums(comp)
-  }
-  lim <- !is.null(curve$lower) && !is.null(curve$upper)
-  for (i in seq_len(n)) {
-    r <- rd[i, ]
-    e <- reading_entry(r$role)
-    set <- function(v, why, lo = NA_real_, hi = NA_real_) {
-      rd$verdict[i] <<- v
-      rd$why[i] <<- why
-      rd$tau_lo[i] <<- lo
-      rd$tau_hi[i] <<- hi
-    }
-    if (r$source == "none" || !is.finite(r$value)) {
-      set("not_determined", paste0("no ", r$term, " could be read from the curve",
-                                   if (grepl("fit .* = 0", r$method)) " (the fit set it to 0)"))
-      next
-    }
-    if (r$source == "bound") {
-      set("upper_bound", sprintf("the %+g/2 region is not reached: %s is at most the curve allows",
-                                 2 * e$reading$slope, r$term),
-          min(tau[ok]), max(tau[ok]))
-      next
-    }
-    if (r$source == "slope" || is.null(model)) {
-      # A slope line touches the curve where it is read.
-      if (identical(e$reading$anchor, "min")) {
-        j <- which(rel)
-        last <- j[length(j)]
-        at <- j[which.min(curve$adev[j])]
-        if (at == last) {
-          set("upper_bound", paste0("the Allan deviation still falls at the longest ",
-                                    "reliable tau (EDF >= 10): the flat minimum is not reached"),
-              tau[at], tau[at])
-        } else {
-          set("measured", "", tau[at], tau[at])
-        }
-      } else {
-        set("measured", "", r$tau, r$tau)
-      }
-      next
-    }
-    share <- r$value^2 * e$basis(tau, NULL, NULL) / model
-    if (identical(e$reading$anchor, "min")) {
-      madev <- sqrt(model)
-      at <- which(ok)[which.min(madev[ok])]
-      span <- ok & madev <= 1.1 * madev[at]
-      j <- which(rel)
-      if (!length(j) || tau[at] >= tau[j[length(j)]]) {
-        w <- which(span)
-        set("upper_bound", paste0("the model's minimum lies at or beyond the longest ",
-                                  "reliable tau (EDF >= 10): the flat minimum is not reached"),
-            min(tau[w]), max(tau[w]))
-        next
-      }
-    } else {
-      span <- ok & is.finite(share) & share >= 0.5
-    }
-    if (!any(span)) {
-      set("upper_bound", sprintf(paste0("the %s term never makes half of the model ",
-                                        "within the curve's taus: %s is at most this"),
-                                 r$term, r$term))
-      next
-    }
-    lo <- min(tau[span])
-    hi <- max(tau[span])
-    if (!lim) {
-      set("not_determined", "the curve has no confidence limits to check the model against",
-          lo, hi)
-      next
-    }
-    w <- which(span & is.finite(curve$lower) & is.finite(curve$upper))
-    if (!length(w)) {
-      set("not_determined", "no point with confidence limits in its range", lo, hi)
-      next
-    }
-    m <- sqrt(model[w])
-    above <- m > curve$upper[w] * (1 + verdict_tolerance)
-    below <- m < curve$lower[w] * (1 - verdict_tolerance)
-    rng <- sprintf("%.3g-%.3g s", lo, hi)
-    if (!any(above | below)) {
-      set("measured", "", lo, hi)
-    } else if (!any(below)) {
-      f <- max(m[above] / curve$adev[w][above])
-      set("upper_bound", sprintf(paste0("the model lies above the curve's confidence ",
-                                        "limits over %s (up to %.2gx): %s is at most this"),
-                                 rng, f, r$term), lo, hi)
-    } else if (!any(above)) {
-      f <- max(curve$adev[w][below] / m[below])
-      set("lower_bound", sprintf(paste0("the model lies below the curve's confidence ",
-                                        "limits over %s (down to 1/%.2g): %s is at least this"),
-                                 rng, f, r$term), lo, hi)
-    } else {
-      set("not_determined", sprintf(paste0("the model leaves the curve's confidence ",
-                                           "limits on both sides over %s"), rng), lo, hi)
-    }
-  }
-  rd$is_bound <- rd$verdict %in% c("upper_bound", "lower_bound")
-  rd
-}
-
-# Verdict display: "measured", "upper bound", ...
-verdict_label <- function(v) gsub("_", " ", v, fixed = TRUE)

@@ -1,0 +1,210 @@
+# The verdict of every reading, from the data: measured only where the
+# final model agrees with the curve, within the points' confidence limits,
+# over the taus the reading rests on; otherwise a bound (which side, why) or
+# not determined (why). Series effects left in mark the readings they
+# change. The datasheet, the exports, the plots, the CLI, the report and the
+# guidance read these columns (verdict, why, tau_lo, tau_hi, biased_by,
+# bias_change, removed), never decide a verdict of their own.
+
+# Relative tolerance added to the points' confidence limits when the model
+# is compared with the curve: the intervals of short-tau points are a few
+# tenths of a percent wide, finer than any filter needs; a model within 2%
+# of such a point agrees with it for every use of the reading.
+verdict_tolerance <- 0.02
+
+# A series effect left in that changes a reading by this much marks it; by
+# `bias_bound` or more the reading is no longer a measurement of the sensor
+# but an upper bound (every effect left in adds to the Allan variance).
+bias_mark <- 0.05
+bias_bound <- 0.25
+
+verdict_levels <- c("measured", "upper_bound", "lower_bound", "not_determined")
+
+# Verdict display: "measured", "upper bound", ...
+verdict_label <- function(v) gsub("_", " ", v, fixed = TRUE)
+
+# The verdict columns of readings `rd` (one row per reading) from `curve`
+# (tau, adev, lower, upper, edf, m) and the model's layout `lay`; `ok` the
+# usable points, `rel` the reliable ones (EDF >= 10).
+reading_verdicts <- function(rd, curve, lay, ok, rel) {
+  ctx <- list(curve = curve, ok = ok, rel = rel,
+              model = verdict_model(curve, lay),
+              limits = !is.null(curve$lower) && !is.null(curve$upper))
+  v <- lapply(seq_len(nrow(rd)), function(i) judge_reading(rd[i, ], ctx))
+  rd$verdict <- vapply(v, `[[`, "", "verdict")
+  rd$why <- vapply(v, `[[`, "", "why")
+  rd$tau_lo <- vapply(v, `[[`, 0, "lo")
+  rd$tau_hi <- vapply(v, `[[`, 0, "hi")
+  rd$is_bound <- rd$verdict %in% c("upper_bound", "lower_bound")
+  rd
+}
+
+# The final model's Allan variance at the curve's taus (NULL without one).
+verdict_model <- function(curve, lay) {
+  if (is.null(lay) || !nrow(lay)) return(NULL)
+  tau <- curve$tau
+  tau0 <- if (!is.null(curve$m) && is.finite(curve$m[1L]) && curve$m[1L] > 0)
+    tau[1L] / curve$m[1L] else NULL
+  comp <- tryCatch(model_components(tau, tau0, lay), error = function(e) NULL)
+  if (is.null(comp) || !all(is.finite(comp))) return(NULL)
+  rowSums(comp)
+}
+
+verdict <- function(v, why = "", lo = NA_real_, hi = NA_real_) {
+  list(verdict = v, why = why, lo = lo, hi = hi)
+}
+
+# One reading's verdict.
+judge_reading <- function(r, ctx) {
+  e <- reading_entry(r$role)
+  tau <- ctx$curve$tau
+  ok <- ctx$ok
+  if (r$source == "none" || !is.finite(r$value)) {
+    return(verdict("not_determined", paste0(
+      "no ", r$term, " could be read from the curve",
+      if (grepl("fit .* = 0", r$method)) " (the fit set it to 0)")))
+  }
+  if (r$source == "bound") {
+    return(verdict("upper_bound", sprintf(
+      "the %+g/2 region is not reached: %s is at most what the curve allows",
+      2 * e$reading$slope, r$term), min(tau[ok]), max(tau[ok])))
+  }
+  flat <- identical(e$reading$anchor, "min")
+  if (r$source == "slope" || is.null(ctx$model)) {
+    return(judge_slope_reading(r, flat, ctx))
+  }
+  model <- ctx$model
+  if (flat) {
+    madev <- sqrt(model)
+    at <- which(ok)[which.min(madev[ok])]
+    span <- ok & madev <= 1.1 * madev[at]
+    j <- which(ctx$rel)
+    if (!length(j) || tau[at] >= tau[j[length(j)]]) {
+      w <- which(span)
+      return(verdict("upper_bound", paste0(
+        "the model's minimum lies at or beyond the longest reliable tau ",
+        "(EDF >= 10): the flat minimum is not reached"), min(tau[w]), max(tau[w])))
+    }
+  } else {
+    share <- r$value^2 * e$basis(tau, NULL, NULL) / model
+    span <- ok & is.finite(share) & share >= 0.5
+  }
+  if (!any(span)) {
+    return(verdict("upper_bound", sprintf(paste0(
+      "the %s term never makes half of the model within the curve's taus: ",
+      "%s is at most this"), r$term, r$term)))
+  }
+  judge_span(r$term, span, sqrt(model), ctx)
+}
+
+# A reading from a slope line (no model): the line touches the curve where
+# it is read; a flat minimum at the longest reliable tau is not reached.
+judge_slope_reading <- function(r, flat, ctx) {
+  tau <- ctx$curve$tau
+  if (!flat) return(verdict("measured", "", r$tau, r$tau))
+  j <- which(ctx$rel)
+  at <- j[which.min(ctx$curve$adev[j])]
+  if (at == j[length(j)]) {
+    return(verdict("upper_bound", paste0(
+      "the Allan deviation still falls at the longest reliable tau ",
+      "(EDF >= 10): the flat minimum is not reached"), tau[at], tau[at]))
+  }
+  verdict("measured", "", tau[at], tau[at])
+}
+
+# Model ADEV `m` against the curve's limits over the points in `span`.
+judge_span <- function(term, span, m, ctx) {
+  cv <- ctx$curve
+  tau <- cv$tau
+  lo <- min(tau[span])
+  hi <- max(tau[span])
+  if (!ctx$limits) {
+    return(verdict("not_determined",
+                   "the curve has no confidence limits to check the model against", lo, hi))
+  }
+  w <- which(span & is.finite(cv$lower) & is.finite(cv$upper))
+  if (!length(w)) {
+    return(verdict("not_determined", "no point with confidence limits in its range", lo, hi))
+  }
+  m <- m[w]
+  above <- m > cv$upper[w] * (1 + verdict_tolerance)
+  below <- m < cv$lower[w] * (1 - verdict_tolerance)
+  rng <- sprintf("%s-%s s", format_num(lo), format_num(hi))
+  if (!any(above | below)) return(verdict("measured", "", lo, hi))
+  if (!any(below)) {
+    f <- max(m[above] / cv$adev[w][above])
+    return(verdict("upper_bound", sprintf(paste0(
+      "the model lies above the curve's confidence limits over %s (up to %.2gx): ",
+      "%s is at most this"), rng, f, term), lo, hi))
+  }
+  if (!any(above)) {
+    f <- max(cv$adev[w][below] / m[below])
+    return(verdict("lower_bound", sprintf(paste0(
+      "the model lies below the curve's confidence limits over %s (by up to %.2gx): ",
+      "%s is at least this"), rng, f, term), lo, hi))
+  }
+  verdict("not_determined", sprintf(
+    "the model leaves the curve's confidence limits on both sides over %s", rng), lo, hi)
+}
+
+# Series effects (a detect_series_effects() pass) and the readings: each
+# reading a kind left in changes by `bias_mark` or more is marked
+# (`biased_by`, `bias_change`: the relative change of the Allan deviation
+# with the kind left in, at the tau of the reading's range where its term
+# weighs most: the short end for a falling line, the long end for a rising
+# one, the middle of a flat minimum). By `bias_bound` or more the reading
+# no longer measures the sensor: a measured one becomes an upper bound,
+# a lower bound (of the curve with the effect in) not determined.
+# `removed`: the kinds taken out before the curve (the readings are the
+# corrected ones).
+mark_series_bias <- function(rd, pass) {
+  n <- nrow(rd)
+  rd$biased_by <- rep("", n)
+  rd$bias_change <- rep(NA_real_, n)
+  rd$removed <- rep(if (is.null(pass) || !length(pass$removed)) ""
+                    else paste(pass$removed, collapse = ","), n)
+  if (is.null(pass) || !nrow(pass$table)) return(rd)
+  left <- unique(pass$table$kind[!pass$table$removed])
+  ak <- pass$adev_kinds
+  for (i in seq_len(n)) {
+    if (!is.finite(rd$value[i])) next
+    lo <- rd$tau_lo[i]
+    hi <- rd$tau_hi[i]
+    if (!is.finite(lo) || !is.finite(hi)) lo <- hi <- rd$tau[i]
+    at <- if (rd$slope[i] < 0) lo else if (rd$slope[i] > 0) hi else sqrt(lo * hi)
+    ch <- vapply(left, function(k) {
+      d <- ak[ak$kind == k & ak$before > 0 & ak$after > 0, , drop = FALSE]
+      if (nrow(d) < 2L) return(NA_real_)
+      exp(stats::approx(log(d$tau), log(d$before / d$after), log(at), rule = 2)$y) - 1
+    }, 0)
+    ch <- ch[is.finite(ch) & abs(ch) >= bias_mark]
+    if (!length(ch)) next
+    ch <- ch[order(-abs(ch))]
+    k <- names(ch)[1L]
+    rd$biased_by[i] <- paste(names(ch), collapse = ",")
+    rd$bias_change[i] <- ch[[1L]]
+    if (ch[[1L]] < bias_bound) next
+    note <- sprintf(paste0("%s left in the series raise the Allan deviation at %s s by ",
+                           "%+.0f%%; remove = \"%s\" corrects it"),
+                    k, format_num(at), 100 * ch[[1L]], k)
+    rd$why[i] <- switch(rd$verdict[i],
+      measured = paste0(note, ": ", rd$term[i], " is at most this"),
+      lower_bound = paste0(note, ": ", rd$term[i], " of the sensor is not determined"),
+      paste0(rd$why[i], "; ", note))
+    rd$verdict[i] <- switch(rd$verdict[i], measured = "upper_bound",
+                            lower_bound = "not_determined", rd$verdict[i])
+  }
+  rd$is_bound <- rd$verdict %in% c("upper_bound", "lower_bound")
+  rd
+}
+
+# One line for a file's comment or a summary: the verdict and what marks it.
+verdict_note <- function(verdict, why = "", biased_by = "", bias_change = NA_real_) {
+  out <- toupper(verdict_label(verdict))
+  if (verdict != "measured" && nzchar(why)) out <- paste0(out, ": ", why)
+  if (nzchar(biased_by) && is.finite(bias_change) && verdict == "measured") {
+    out <- sprintf("%s; %s left in change it by %+.0f%% (remove = \"%s\")", out,
+                   biased_by, 100 * bias_change, strsplit(biased_by, ",")[[1L]][1L])
+  }
+  out
+}
