@@ -609,6 +609,11 @@ plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
   }
   ok <- is.finite(d$adev) & d$adev > 0
   ylim <- range(c(d$lower[ok], d$upper[ok], d$adev[ok]), finite = TRUE)
+  leg <- list(legend = chans, col = col, lty = 1, pch = 20)
+  if (legend && length(chans) > 1L) {
+    op <- reserve_legend(leg)
+    on.exit(graphics::par(op))
+  }
   graphics::plot(d$tau[ok], d$adev[ok], type = "n", log = "xy", xlab = xlab,
                  ylab = ylab, main = main, ylim = ylim, ...)
   graphics::grid(equilogs = FALSE)
@@ -622,8 +627,7 @@ plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
     }
   }
   if (legend && length(chans) > 1L) {
-    graphics::legend("topright", legend = chans, col = col, lty = 1, pch = 20,
-                     bty = "n")
+    legend_beside(leg)
   }
   invisible(x)
 }

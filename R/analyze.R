@@ -189,7 +189,7 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
               duration = nrow(r$data) / r$freq,
               record = list(file = r$file, problems = r$problems,
                             segments = r$segments, units = r$units,
-                            sampling = r$sampling),
+                            sampling = r$sampling, unit_checks = r$unit_checks),
               channels = res, call = match.call())
     class(a) <- "imu_analysis"
     a$datasheet <- datasheet(a)
@@ -202,12 +202,13 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
     }
     g <- imu_guidance(a)
     g <- g[!g$channel %in% names(dead), , drop = FALSE]
-    if (nrow(g)) {
-      msg <- paste0(r$name, ": guidance on the record and its readings:\n",
-                    paste0("  - ", g$channel, ": ", g$message, collapse = "\n"))
-      warning(structure(class = c("allanvar_guidance", "allanvar_warning",
-                                  "warning", "condition"),
-                        list(message = msg, call = NULL)))
+    if (nrow(g) && isTRUE(progress)) {
+      # one line: the notes themselves are printed with the analysis
+      message(structure(class = c("allanvar_guidance", "allanvar_message",
+                                  "message", "condition"),
+                        list(message = sprintf(
+                          "%s: %d guidance note(s) on the record and its readings; print the analysis or see imu_guidance().\n",
+                          r$name, nrow(g)), call = NULL)))
     }
     a
   })
@@ -336,8 +337,10 @@ print.imu_analysis <- function(x, ...) {
         " (see $record$problems)\n", sep = "")
   }
   print(x$datasheet)
-  g <- unlist(lapply(x$channels, function(cc) if (length(cc$guidance))
-    paste0(cc$channel, ": ", cc$guidance)))
+  g <- unlist(lapply(x$channels, function(cc) {
+    m <- cc$guidance[nzchar(cc$guidance)]
+    if (length(m)) paste0(cc$channel, ": ", m)
+  }))
   if (length(g)) {
     cat("\nGuidance:\n")
     cat(paste0("  - ", g, "\n"), sep = "")

@@ -587,6 +587,18 @@ plot.avfit <- function(x, terms = TRUE, residuals = TRUE, unit = NULL, ...) {
   yl <- range(c(lo, hi, sqrt(tot)), finite = TRUE)
   # room below the data for the terms' curves (down to half their peak)
   yl[1] <- max(min(yl[1], 0.5 * apply(sqrt(comp), 2, max)), yl[2] * 1e-4)
+  cols <- grDevices::hcl.colors(max(ncol(comp), 2), "Dark 3")
+  labs <- colnames(comp)
+  # an oscillating term (a sinusoid's lobes) is drawn as its upper
+  # envelope: dashes along every lobe would hide the model
+  wavy <- apply(sqrt(comp), 2, n_peaks) > 2L
+  labs[wavy] <- paste(labs[wavy], "(envelope)")
+  leg <- list(legend = c("data", "model", if (terms) labs),
+              lty = c(NA, 1, if (terms) rep(2, ncol(comp))),
+              pch = c(19, NA, if (terms) rep(NA, ncol(comp))),
+              lwd = c(NA, 2, if (terms) rep(1, ncol(comp))),
+              col = c("black", "black", if (terms) cols[seq_len(ncol(comp))]))
+  reserve_legend(leg, cex = 0.8)
   graphics::plot(d$tau, sqrt(d$avar), log = "xy", ylim = yl, pch = 19,
                  cex = 0.7, xlab = if (residuals) "" else "tau [s]",
                  ylab = if (is.null(unit)) "Allan deviation [u]" else
@@ -600,30 +612,18 @@ plot.avfit <- function(x, terms = TRUE, residuals = TRUE, unit = NULL, ...) {
     graphics::arrows(d$tau[bar], lo[bar], d$tau[bar], hi[bar], angle = 90,
                      code = 3, length = 0.02, col = "grey40")
   }
-  cols <- grDevices::hcl.colors(max(ncol(comp), 2), "Dark 3")
-  labs <- colnames(comp)
   if (terms) {
     for (k in seq_len(ncol(comp))) {
       v <- sqrt(comp[, k])
-      # an oscillating term (a sinusoid's lobes) is drawn as its upper
-      # envelope: dashes along every lobe would hide the model
-      if (n_peaks(v) > 2L) {
-        v <- rev(cummax(rev(v)))
-        labs[k] <- paste(labs[k], "(envelope)")
-      }
+      if (wavy[k]) v <- rev(cummax(rev(v)))
       v[v < yl[1] / 10] <- NA
       graphics::lines(tt, v, lty = 2, col = grDevices::adjustcolor(cols[k], 0.8))
     }
   }
   graphics::lines(tt, sqrt(tot), lwd = 2)
-  leg <- list(legend = c("data", "model", if (terms) labs),
-              lty = c(NA, 1, if (terms) rep(2, ncol(comp))),
-              pch = c(19, NA, if (terms) rep(NA, ncol(comp))),
-              lwd = c(NA, 2, if (terms) rep(1, ncol(comp))),
-              col = c("black", "black", if (terms) cols[seq_len(ncol(comp))]))
-  draw_legend(leg, d$tau, sqrt(d$avar), cex = 0.8)
+  legend_beside(leg, cex = 0.8)
   if (residuals) {
-    graphics::par(mar = c(0.5, 4.5, 0.5, 1))
+    graphics::par(mar = c(0.5, 4.5, 0.5, graphics::par("mar")[4L]))
     zr <- max(3, abs(d$z), na.rm = TRUE)
     graphics::plot(d$tau, d$z, log = "x", ylim = c(-zr, zr), pch = 19,
                    cex = 0.7, xlab = "", ylab = "z")

@@ -297,7 +297,7 @@ cli_run <- function(args) {
       rec, terms = terms, refine = !isTRUE(opt$`no-refine`), progress = progress,
       remove = if (is.null(opt$remove)) character()
                else trimws(strsplit(opt$remove, ",", fixed = TRUE)[[1L]]))),
-      allanvar_guidance = function(w) invokeRestart("muffleWarning"))
+      allanvar_guidance = function(m) invokeRestart("muffleMessage"))
     prefix <- if (several) paste0(sub("\\.[^.]*$", "", basename(f)), "_") else ""
     names_out <- paste0(prefix, c("allan_deviation.png", "datasheet.csv",
                                   "imu.yaml", "filter_params.csv",
@@ -320,6 +320,7 @@ cli_run <- function(args) {
     cat("\n", a$name, "\n", sep = "")
     print(ds)
     g <- imu_guidance(a)
+    g <- g[nzchar(g$message), , drop = FALSE]
     if (nrow(g)) {
       cat("Guidance:\n")
       cat(paste0("  - ", g$channel, ": ", g$message, "\n"), sep = "")

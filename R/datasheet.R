@@ -31,8 +31,13 @@
 #' @return An object of class `"imu_datasheet"`: a list with one wide data
 #'   frame per sensor (`gyro`, `accel`; columns named with their units) and
 #'   `long`, the same numbers as a long data frame (`record`, `sensor`,
-#'   `axis`, `term`, `value`, `unit`, `tau`, `method`, `effects`), which is
-#'   what `as.data.frame()` returns and [write_datasheet()] writes.
+#'   `axis`, `term`, `value`, `unit`, `tau`, `method`, `effects`, and each
+#'   reading's verdict: `verdict` ("measured", "upper_bound",
+#'   "lower_bound", "not_determined"), `why`, `tau_lo`, `tau_hi` (the taus
+#'   the reading rests on), `biased_by` and `bias_change` (series effects
+#'   left in that change it, and by how much), `removed` (kinds taken out
+#'   first), `warning` (failed unit checks of the axis)), which is what
+#'   `as.data.frame()` returns and [write_datasheet()] writes.
 #' @export
 #' @examples
 #' \donttest{
@@ -76,6 +81,7 @@ datasheet.imu_analysis_list <- function(x, average = FALSE, ...) {
 datasheet.imu_analysis <- function(x, average = FALSE, ...) {
   check_average(average)
   long <- list()
+  uw <- unit_warnings(x)
   for (ch in x$channels) {
     rd <- ch$readings
     eff <- if (is.null(ch$dead)) added_effects(ch$fit) else "none"
@@ -89,6 +95,9 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
         value = vapply(us, function(u) if (u == si) r$value else
           convert_units(r$value, si, u), 0),
         unit = us, tau = r$tau, method = r$method, effects = eff,
+        verdict = r$verdict, why = r$why, tau_lo = r$tau_lo, tau_hi = r$tau_hi,
+        biased_by = r$biased_by, bias_change = r$bias_change, removed = r$removed,
+        warning = paste(uw$warning[uw$channel == ch$channel], collapse = "; "),
         stringsAsFactors = FALSE)
     }
   }
@@ -103,6 +112,17 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
     avg$axis <- "mean of axes"
     avg$method <- "arithmetic mean of the axes"
     avg$effects <- ""
+    # the mean is measured only where every axis is
+    worst <- stats::aggregate(verdict ~ record + sensor + term + unit, data = long,
+                              FUN = function(v) if (all(v == "measured")) "measured"
+                                                else if (all(v == "upper_bound")) "upper_bound"
+                                                else "not_determined")
+    avg$verdict <- worst$verdict
+    avg$why <- ifelse(avg$verdict == "measured", "",
+                      "not every axis is measured: see each axis")
+    avg$tau_lo <- avg$tau_hi <- avg$bias_change <- NA_real_
+    avg$biased_by <- avg$removed <- ""
+    avg$warning <- paste(unique(uw$warning), collapse = "; ")
     long <- rbind(long, avg[names(long)])
   }
   out <- list(long = long)
@@ -160,6 +180,15 @@ wide_table <- function(l) {
     r <- r[!duplicated(r$term), ]
     if (length(unique(r$method)) == 1L) r$method[1L]
     else paste0(r$term, ": ", r$method, collapse = "; ")
+  }, "")
+  cols$verdict <- vapply(axes, function(a) {
+    r <- l[l$axis == a, ]
+    r <- r[!duplicated(r$term), ]
+    lab <- verdict_label(r$verdict)
+    lab <- ifelse(nzchar(r$biased_by) & r$verdict == "measured",
+                  paste0(lab, " (", r$biased_by, " left in)"), lab)
+    if (all(r$verdict == "measured") && !any(nzchar(r$biased_by))) "measured"
+    else paste0(r$term, ": ", lab, collapse = "; ")
   }, "")
   cols$effects <- vapply(axes, function(a) l$effects[l$axis == a][1L], "")
   df <- as.data.frame(cols, stringsAsFactors = FALSE, check.names = FALSE)

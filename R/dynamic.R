@@ -501,6 +501,11 @@ dyn_plot_lines <- function(x, what, at, col, main, xlab, ylab, dev_name,
   }))
   yl <- range(all_v[is.finite(all_v) & all_v > 0])
   if (!all(is.finite(yl))) yl <- c(1, 10)
+  lab <- if (windows) paste0("t = ", signif(x$time[pick], 4), " s")
+         else paste0("tau = ", signif(x$tau[pick], 4), " s")
+  leg <- list(legend = lab, col = col, lty = 1, pch = 20)
+  op <- reserve_legend(leg, cex = 0.8)
+  on.exit(graphics::par(op))
   graphics::plot(range(xs), yl, type = "n", log = if (windows) "xy" else "y",
                  xlab = if (!is.null(xlab)) xlab else if (windows) "tau (s)"
                    else "time of window centre (s)",
@@ -521,8 +526,5 @@ dyn_plot_lines <- function(x, what, at, col, main, xlab, ylab, dev_name,
                        code = 3, length = 0.02, col = col[i])
     }
   }
-  lab <- if (windows) paste0("t = ", signif(x$time[pick], 4), " s")
-         else paste0("tau = ", signif(x$tau[pick], 4), " s")
-  graphics::legend("topright", legend = lab, col = col, lty = 1, pch = 20,
-                   bg = "white", box.col = NA, inset = 0.01, cex = 0.8)
+  legend_beside(leg, cex = 0.8)
 }

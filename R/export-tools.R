@@ -27,8 +27,10 @@
 #'   RandomWalk are multiplied by `sqrt(2)` (a one-sided PSD holds the power
 #'   of both signs of frequency).
 #'
-#' Dead axes ([analyze_imu()]) are left out. A value that is only an upper
-#' bound (K when the +1/2 region was not reached) is marked in `bound`.
+#' Dead axes ([analyze_imu()]) are left out. Every value carries the
+#' verdict of the reading it comes from (see [analyze_imu()]): `verdict`
+#' and `note` (the verdict with its reason, as the files' comments say it);
+#' `bound` is TRUE for an upper bound.
 #'
 #' @param x An `imu_analysis` ([analyze_imu()]) or an [avfit()] of a curve
 #'   of known unit (see [datasheet()]).
@@ -44,7 +46,8 @@
 #'   `"single-sided"`.
 #' @return A data frame with columns `tool`, `sensor`, `axis` (a channel,
 #'   `"max"`, `"mean"`), `key` (the tool's name of the value), `value`,
-#'   `unit`, `formula`, `bound` (TRUE for an upper bound).
+#'   `unit`, `formula`, `verdict`, `note`, `bound` (TRUE for an upper
+#'   bound).
 #' @seealso [conventions], [write_tool_params()], [write_kalibr_yaml()].
 #' @export
 #' @examples
@@ -89,25 +92,28 @@ tool_params <- function(x, tool, axis = "max", freq = NULL,
 
 tool_names <- c("kalibr", "openvins", "imu_utils", "vins", "matlab")
 
-# Per axis: sensor, axis, N, B, K (SI), K_bound; dead axes left out.
+# Per axis: sensor, axis, N, B, K (SI) and each one's verdict and note
+# (`N_verdict`, `N_note`, ...; R/verdicts.R); dead axes left out.
 tool_readings <- function(x) {
   if (inherits(x, "avfit")) x <- fit_analysis(x)
   if (!inherits(x, "imu_analysis")) {
     abort("`x` must be an imu_analysis (analyze_imu()) or an avfit, not ",
           describe_type(x), ".", class = "argument")
   }
+  roles <- c(N = "white", B = "flicker", K = "random_walk")
   rows <- lapply(x$channels, function(ch) {
     if (!is.null(ch$dead) || is.na(ch$sensor)) return(NULL)
-    rd <- ch$readings
-    val <- function(role) {
-      r <- reading_of(rd, role)
-      if (nrow(r)) r$value[1L] else NA_real_
+    out <- data.frame(sensor = ch$sensor, axis = ch$channel, stringsAsFactors = FALSE)
+    for (k in names(roles)) {
+      r <- reading_of(ch$readings, roles[[k]])
+      have <- nrow(r) > 0L
+      out[[k]] <- if (have) r$value[1L] else NA_real_
+      out[[paste0(k, "_verdict")]] <- if (have) r$verdict[1L] else "not_determined"
+      out[[paste0(k, "_note")]] <- if (have)
+        verdict_note(r$verdict[1L], r$why[1L], r$biased_by[1L], r$bias_change[1L])
+        else "NOT DETERMINED"
     }
-    k <- reading_of(rd, "random_walk")
-    data.frame(sensor = ch$sensor, axis = ch$channel, N = val("white"),
-               B = val("flicker"), K = val("random_walk"),
-               K_bound = nrow(k) > 0L && identical(k$verdict[1L], "upper_bound"),
-               stringsAsFactors = FALSE)
+    out
   })
   out <- do.call(rbind, rows)
   if (is.null(out)) {
@@ -117,15 +123,35 @@ tool_readings <- function(x) {
   out
 }
 
-# One row of the worst ("max") or mean axis; `label` names it.
+# One row of the worst ("max") or mean axis; `label` names it. The max
+# carries the verdict of the axis it comes from; the mean is measured only
+# when every axis is.
 combine_axes <- function(d, how, label = how) {
-  f <- if (how == "max") function(v) suppressWarnings(max(v, na.rm = TRUE))
-       else function(v) mean(v, na.rm = TRUE)
-  out <- data.frame(sensor = d$sensor[1L], axis = label, N = f(d$N),
-                    B = f(d$B), K = f(d$K), K_bound = any(d$K_bound),
-                    stringsAsFactors = FALSE)
-  out[c("N", "B", "K")] <- lapply(out[c("N", "B", "K")], function(v)
-    if (is.finite(v)) v else NA_real_)
+  out <- data.frame(sensor = d$sensor[1L], axis = label, stringsAsFactors = FALSE)
+  for (k in c("N", "B", "K")) {
+    v <- d[[k]]
+    vk <- d[[paste0(k, "_verdict")]]
+    nk <- d[[paste0(k, "_note")]]
+    if (!any(is.finite(v))) {
+      out[[k]] <- NA_real_
+      out[[paste0(k, "_verdict")]] <- "not_determined"
+      out[[paste0(k, "_note")]] <- "NOT DETERMINED on any axis"
+    } else if (how == "max") {
+      i <- which.max(v)
+      out[[k]] <- v[i]
+      out[[paste0(k, "_verdict")]] <- vk[i]
+      out[[paste0(k, "_note")]] <- nk[i]
+    } else {
+      out[[k]] <- mean(v, na.rm = TRUE)
+      ok <- all(vk == "measured")
+      out[[paste0(k, "_verdict")]] <- if (ok) "measured" else
+        if (all(vk == "upper_bound")) "upper_bound" else "not_determined"
+      out[[paste0(k, "_note")]] <- if (ok) nk[1L] else
+        paste0(toupper(verdict_label(out[[paste0(k, "_verdict")]])),
+               ": mean of axes not all measured (",
+               paste0(d$axis, " ", verdict_label(vk), collapse = ", "), ")")
+    }
+  }
   out
 }
 
@@ -139,28 +165,31 @@ tool_rows <- function(tool, sensor, d, freq, noise_type) {
   long <- if (g) "gyroscope" else "accelerometer"
   spec <- switch(tool,
     kalibr = , openvins = list(
-      list(paste0(long, "_noise_density"), d$N, nd, "N", FALSE),
-      list(paste0(long, "_random_walk"), d$K, kd, "K", TRUE)),
+      list(paste0(long, "_noise_density"), d$N, nd, "N", "N"),
+      list(paste0(long, "_random_walk"), d$K, kd, "K", "K")),
     imu_utils = list(
-      list(paste0(pre, "_n"), d$N * sqrt(freq), u, "N * sqrt(freq)", FALSE),
+      list(paste0(pre, "_n"), d$N * sqrt(freq), u, "N * sqrt(freq)", "N"),
       list(paste0(pre, "_w"), d$B * bias_floor, u,
-           "0.664 * B (min ADEV, the flat floor)", FALSE)),
+           "0.664 * B (min ADEV, the flat floor)", "B")),
     vins = list(
-      list(paste0(pre, "_n"), d$N * sqrt(freq), u, "N * sqrt(freq)", FALSE),
-      list(paste0(pre, "_w"), d$K * sqrt(freq), u, "K * sqrt(freq)", TRUE)),
+      list(paste0(pre, "_n"), d$N * sqrt(freq), u, "N * sqrt(freq)", "N"),
+      list(paste0(pre, "_w"), d$K * sqrt(freq), u, "K * sqrt(freq)", "K")),
     matlab = {
       s2 <- if (noise_type == "single-sided") sqrt(2) else 1
       f2 <- if (s2 == 1) "" else " * sqrt(2) (single-sided)"
       list(list("NoiseDensity", d$N * s2, paste0("(", u, ")/sqrt(Hz)"),
-                paste0("N", f2), FALSE),
-           list("BiasInstability", d$B, u, "B", FALSE),
+                paste0("N", f2), "N"),
+           list("BiasInstability", d$B, u, "B", "B"),
            list("RandomWalk", d$K * s2, paste0("(", u, ")*sqrt(Hz)"),
-                paste0("K", f2), TRUE))
+                paste0("K", f2), "K"))
     })
   do.call(rbind, lapply(spec, function(s) {
     data.frame(tool = tool, sensor = sensor, axis = d$axis, key = s[[1L]],
                value = s[[2L]], unit = s[[3L]], formula = s[[4L]],
-               bound = s[[5L]] & d$K_bound, stringsAsFactors = FALSE)
+               verdict = d[[paste0(s[[5L]], "_verdict")]],
+               note = d[[paste0(s[[5L]], "_note")]],
+               bound = d[[paste0(s[[5L]], "_verdict")]] == "upper_bound",
+               stringsAsFactors = FALSE)
   }))
 }
 
@@ -225,7 +254,10 @@ write_tool_params <- function(x, tool, file, axis = "max", freq = NULL,
   freq <- freq %||% x$freq
   head <- c(sprintf("written by allanvar %s from %s; conventions: ?allanvar::conventions",
                     utils::packageVersion("allanvar"), comment_text(x$name)),
-            unique(paste0(tp$key, " = ", tp$formula)))
+            unit_warning_lines(x),
+            unique(paste0(tp$key, " = ", tp$formula)),
+            "verdicts (measured: the model agrees with the data over the taus the value rests on):",
+            unique(sprintf("  %s %s: %s", tp$axis, tp$key, comment_text(tp$note))))
   num <- function(v) if (is.finite(v)) sprintf("%.10e", v) else ".nan"
   out <- switch(tool,
     imu_utils = {
@@ -250,12 +282,11 @@ write_tool_params <- function(x, tool, file, axis = "max", freq = NULL,
     vins = c("%YAML:1.0", paste0("# ", head),
              "# IMU noise: per-sample standard deviations (discrete time)",
              sprintf("%s: %s   # [%s] %s%s", tp$key, vapply(tp$value, num, ""),
-                     tp$unit, tp$formula,
-                     ifelse(tp$bound, "; UPPER BOUND, +1/2 region not reached", ""))),
+                     tp$unit, tp$formula, file_note(tp))),
     openvins = c("%YAML:1.0", "", paste0("# ", head), "imu0:",
                  sprintf("  %s: %s   # [%s] %s%s", tp$key,
                          vapply(tp$value, num, ""), tp$unit, tp$formula,
-                         ifelse(tp$bound, "; UPPER BOUND, +1/2 region not reached", "")),
+                         file_note(tp)),
                  "  model: calibrated",
                  paste0("  rostopic: ", yaml_quote(rostopic)),
                  "  time_offset: 0.0",
@@ -286,4 +317,10 @@ write_tool_params <- function(x, tool, file, axis = "max", freq = NULL,
 axis_letter <- function(ch) {
   l <- sub(".*[_.]([xyzXYZ])$", "\\1", ch)
   ifelse(nchar(l) == 1L, tolower(l), as.character(seq_along(ch)))
+}
+
+# "; UPPER BOUND: ..." after a value whose reading is not measured.
+file_note <- function(tp) {
+  ifelse(tp$verdict == "measured", "",
+         paste0("; ", toupper(verdict_label(tp$verdict))))
 }

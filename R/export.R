@@ -11,9 +11,12 @@
 #'
 #' Kalibr takes one number per sensor, so by default the worst (largest)
 #' axis is written (`axis = "max"`); the per-axis values and the axis used
-#' are listed in comments. When K could not be read (the +1/2 region was not
-#' reached), the value written is the upper bound from the longest tau (see
-#' [imu_guidance()]) and the comment says so. Kalibr's documentation
+#' are listed in comments. Each value's comment carries the verdict of its
+#' reading (MEASURED, UPPER BOUND, LOWER BOUND, NOT DETERMINED, with why;
+#' see [analyze_imu()]): e.g. when K could not be read (the +1/2 region was
+#' not reached), the value written is the upper bound from the longest tau
+#' (see [imu_guidance()]). Failed unit checks of the record are repeated as
+#' WARNING lines at the top. Kalibr's documentation
 #' advises inflating the values for real use; `inflate` multiplies all four
 #' (default 1, stated in the file).
 #'
@@ -69,7 +72,9 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
                      function(cc) {
                        r <- reading_of(cc$readings, role)
                        data.frame(axis = cc$channel, value = r$value,
-                                  is_bound = identical(r$verdict, "upper_bound"),
+                                  verdict = r$verdict,
+                                  note = verdict_note(r$verdict, r$why, r$biased_by,
+                                                      r$bias_change),
                                   stringsAsFactors = FALSE)
                      })
       if (!length(rows)) {
@@ -79,7 +84,8 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
       rows <- do.call(rbind, rows)
       header <- c(header, sprintf("#   %-28s %s", k, comment_text(paste(sprintf(
         "%s = %s", rows$axis, ifelse(is.na(rows$value), "NA (dead axis)",
-                                     sprintf("%.4e", rows$value))),
+                                     sprintf("%.4e (%s)", rows$value,
+                                             verdict_label(rows$verdict)))),
         collapse = ", "))))
       # dead axes carry no value and take no part in the max or the mean
       rows <- rows[is.finite(rows$value), , drop = FALSE]
@@ -93,14 +99,13 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
       if (axis == "max") {
         i <- which.max(rows$value)
         vals[k] <- rows$value[i]
-        notes[k] <- sprintf("worst axis (%s)", rows$axis[i])
-        bound <- rows$is_bound[i]
+        notes[k] <- sprintf("worst axis (%s); %s", rows$axis[i], rows$note[i])
       } else {
         vals[k] <- mean(rows$value)
-        notes[k] <- "mean of the axes"
-        bound <- any(rows$is_bound)
+        notes[k] <- if (all(rows$verdict == "measured")) "mean of the axes; MEASURED"
+          else paste0("mean of the axes; NOT all MEASURED: ",
+                      paste0(rows$axis, " ", rows$note, collapse = "; "))
       }
-      if (bound) notes[k] <- paste0(notes[k], "; UPPER BOUND, +1/2 region not reached")
     }
     # A measured sensor needs both of its values: a yaml with one of them
     # missing (a record too short for any reading) is refused, not written.
@@ -118,7 +123,10 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
     rate <- x$freq
     src <- sprintf("# Source: %s, %d samples at %.6g Hz (%.3g h), Allan deviation per axis.",
                    comment_text(x$name), x$n, x$freq, x$duration / 3600)
-    header <- c(src, paste0("# Kalibr takes one value per sensor; written: ",
+    header <- c(src, paste0("# ", unit_warning_lines(x)),
+                "# MEASURED: the model agrees with the data over the taus the value rests on;",
+                "# otherwise the value is a bound or not determined, and the comment says why.",
+                paste0("# Kalibr takes one value per sensor; written: ",
                             if (axis == "max") "the worst (largest) axis."
                             else "the mean of the axes.",
                             " Per axis:"), header)
@@ -218,6 +226,9 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
 #'   `term`, `parameter`, `value`, `unit`, `continuous` (the coefficient it
 #'   comes from), `continuous_unit`, `dt` and `convention`; rows in the
 #'   catalogue's order of the terms (N, B, K, then the Gauss-Markov terms).
+#'   For an analysis also `verdict` and `why` (of the reading N, B or K the
+#'   row comes from, see [analyze_imu()]; "" for other model terms) and
+#'   `warning` (failed unit checks of the axis).
 #' @export
 #' @examples
 #' kalman_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
@@ -251,9 +262,17 @@ kalman_params <- function(x, dt = NULL, bias_instability = NULL,
       cf <- cf[!names(cf) %in% rd$term]
       cf <- c(stats::setNames(rd$value, rd$term), cf)
       flat <- reading_of(rd, "flicker")
-      discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability,
-                    tau_B %||% if (nrow(flat)) flat$tau else NA_real_,
-                    bounds = rd$term[rd$is_bound])
+      d <- discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability,
+                         tau_B %||% if (nrow(flat)) flat$tau else NA_real_,
+                         bounds = rd$term[rd$is_bound])
+      # each parameter carries the verdict of the reading it comes from
+      i <- match(d$term, rd$term)
+      d$verdict <- ifelse(is.na(i), "", rd$verdict[i])
+      d$why <- ifelse(is.na(i), "", rd$why[i])
+      uw <- unit_warnings(x)
+      d$warning <- rep(paste(uw$warning[uw$channel == ch$channel], collapse = "; "),
+                       nrow(d))
+      d
     })
     out <- do.call(rbind, rows)
   } else {

@@ -28,7 +28,11 @@
 #'   count, the first times, the largest size in noise standard deviations,
 #'   the change they make to the Allan deviation, and how to remove them.
 #'
-#' [analyze_imu()] runs these checks and warns when any fails.
+#' * **every reading whose verdict is not "measured"** (see [analyze_imu()],
+#'   readings): the verdict and why.
+#'
+#' [analyze_imu()] runs these checks; printing the analysis lists them after
+#' the datasheet.
 #'
 #' @param x An `imu_analysis` ([analyze_imu()]), or an [avfit()] of a curve
 #'   alone (for example another tool's curve, [read_allan_variance_ros_curve()]), read as
@@ -116,7 +120,7 @@ channel_guidance <- function(ch) {
   n2 <- if (isTRUE(is.finite(N))) N^2 else 0
   b2 <- if (isTRUE(is.finite(B))) B^2 else 0
   need <- function(tau) T * 3 * tau / tau_rel
-  if (isTRUE(walk$is_bound)) {
+  if (identical(walk$source, "bound")) {
     tx <- tau_cross(n2, b2, K)
     msg <- c(msg, sprintf(
       "the +1/2 (rate random walk) region is never reached up to tau = %s: K <= %.3g %s only; resolving a K that large needs a record of at least %s (this one is %s), a smaller K a longer one.",
@@ -140,6 +144,11 @@ channel_guidance <- function(ch) {
   if (!isTRUE(is.finite(N))) {
     msg <- c(msg, "no -1/2 (white noise) region found: N not read; a higher sampling rate shows more of the short-tau region.")
   }
+  # Every other reading the data do not support as measured, with why.
+  judged <- rd[rd$verdict != "measured" & rd$source %in% c("fit", "slope") &
+                 nzchar(rd$why), , drop = FALSE]
+  msg <- c(msg, sprintf("%s = %.3g %s is %s: %s.", judged$term, judged$value,
+                        judged$unit, verdict_label(judged$verdict), judged$why))
   fit <- ch$fit
   if (!is.null(fit) && !is.null(fit$vcov) && length(fit$coefficients)) {
     cf <- fit$coefficients
@@ -179,9 +188,10 @@ series_guidance <- function(se, hours) {
     effect <- if (is.na(worst)) "" else sprintf(
       "; left in, they change the Allan deviation by up to %+.0f%% (at tau = %s)",
       100 * ch$change[worst], hours(ch$tau[worst]))
-    sprintf("%d x %s in the raw series (at %s; up to %.3g standard deviations)%s: take them out with remove = \"%s\" (command line: --remove %s).",
-            nrow(k), effect_entry(kind)$title, at, max(abs(k$z), na.rm = TRUE),
-            effect, kind, kind)
+    z <- abs(k$z[is.finite(k$z)])
+    size <- if (length(z)) sprintf("; up to %.3g standard deviations", max(z)) else ""
+    sprintf("%d x %s in the raw series (at %s%s)%s: take them out with remove = \"%s\" (command line: --remove %s).",
+            nrow(k), effect_entry(kind)$title, at, size, effect, kind, kind)
   }, "", USE.NAMES = FALSE)
 }
 

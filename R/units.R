@@ -277,6 +277,7 @@ check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
   ch <- colnames(x)
   src <- rep(if (assumed) "assumed" else units_source, length(ch))
   evidence <- rep(NA_character_, length(ch))
+  warning_text <- rep("", length(ch))
   acc <- which(sensors == "accel")
   said <- NULL
   if (length(acc) == 3L) {
@@ -299,6 +300,8 @@ check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
                hit, ": give units = c(accel = \"", hit, "\") if so.",
                class = "accel_units")
           evidence[acc] <- paste0(evidence[acc], ": looks like ", hit)
+          warning_text[acc] <- sprintf(
+            "units suspect: the accelerometers' mean norm %.5g %s is gravity in %s", r, u, hit)
         }
       } else if (length(hit)) {
         if (assumed) {
@@ -320,7 +323,8 @@ check_imu_units <- function(x, sensors, units, freq, assumed, units_source,
   list(units = units,
        checks = data.frame(channel = ch, sensor = unname(sensors),
                            unit = unname(units), source = src,
-                           evidence = evidence, stringsAsFactors = FALSE))
+                           evidence = evidence, warning = warning_text,
+                           stringsAsFactors = FALSE))
 }
 
 # Gyroscopes: white noise N from the Allan deviation at about 1 s (N = ADEV
@@ -358,6 +362,10 @@ check_gyro_noise <- function(x, sensors, units, freq, checks, source,
       alt <- N * f / cur
       ok <- cand[alt >= 1e-4 & alt <= 30 & cand != units[[j]]]
       checks$evidence[j] <- paste0(checks$evidence[j], ": implausible")
+      checks$warning[j] <- sprintf(
+        "units suspect: white noise N ~ %.3g deg/sqrt(h)%s as %s, outside what real gyros show",
+        N, if (mean_rate > gyro_mean_limit) sprintf(" and mean %.3g rad/s", mean_rate) else "",
+        units[[j]])
       msgs <- c(msgs, sprintf("%s: white noise N ~ %.3g deg/sqrt(h)%s if the samples are %s%s",
                               colnames(x)[j], N,
                               if (mean_rate > gyro_mean_limit)
@@ -380,4 +388,23 @@ check_gyro_noise <- function(x, sensors, units, freq, checks, source,
          class = "gyro_units")
   }
   checks
+}
+
+# The unit checks that failed in an analysis' record: one row per channel
+# with its warning (none for a record without checks).
+unit_warnings <- function(a) {
+  uc <- a$record$unit_checks
+  if (is.null(uc) || is.null(uc$warning)) {
+    return(data.frame(channel = character(), warning = character()))
+  }
+  uc <- uc[nzchar(uc$warning), , drop = FALSE]
+  data.frame(channel = uc$channel, warning = uc$warning, stringsAsFactors = FALSE)
+}
+
+# The failed unit checks as comment lines for a written file ("" prefix).
+unit_warning_lines <- function(a) {
+  w <- unit_warnings(a)
+  if (!nrow(w)) return(character())
+  c("WARNING: the units failed their checks; the values below are wrong if the units are:",
+    sprintf("WARNING:   %s: %s", w$channel, w$warning))
 }
