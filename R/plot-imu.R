@@ -129,8 +129,8 @@ plot_sensor <- function(x, s, units, ...) {
     rd <- drawn_readings(chans[[i]]$readings)
     for (j in seq_len(nrow(rd))) draw_reading(rd[j, ], cv, rng_x, k, cols[i], pch_of)
   }
-  legend_beside(leg, cex = 0.75)
-  invisible(list(legend = leg$legend, position = "beside"))
+  drawn <- legend_beside(leg, cex = 0.75)
+  invisible(list(legend = leg$legend, rect = drawn$rect, usr = graphics::par("usr")))
 }
 
 # One reading: its line (dotted) and marker; a bound open, with an arrow

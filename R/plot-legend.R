@@ -16,9 +16,9 @@ reserve_legend <- function(args, cex = 0.8) {
   graphics::par(mar = mar)
 }
 
-# Draws legend `args` in the right margin, top-aligned with the plot region.
+# Draws legend `args` in the right margin, top-aligned with the plot region;
+# returns graphics::legend()'s value (its rectangle in user coordinates).
 legend_beside <- function(args, cex = 0.8) {
-  do.call(graphics::legend, c(list("topleft", inset = c(1.01, 0), xpd = NA,
-                                   bty = "n", cex = cex), args))
-  invisible("beside")
+  invisible(do.call(graphics::legend, c(list("topleft", inset = c(1.01, 0), xpd = NA,
+                                             bty = "n", cex = cex), args)))
 }

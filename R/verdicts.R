@@ -1,6 +1,6 @@
 # The verdict of every reading, from the data: measured only where the
-# final model agrees with the curve, within the points' confidence limits,
-# over the taus the reading rests on; otherwise a bound (which side, why) or
+# final model agrees with the curve, within the points' confidence limits
+# (jointly at 95% over the range), over the taus the reading rests on; otherwise a bound (which side, why) or
 # not determined (why). Series effects left in mark the readings they
 # change. The datasheet, the exports, the plots, the CLI, the report and the
 # guidance read these columns (verdict, why, tau_lo, tau_hi, biased_by,
@@ -94,7 +94,7 @@ judge_reading <- function(r, ctx) {
       "the %s term never makes half of the model within the curve's taus: ",
       "%s is at most this"), r$term, r$term)))
   }
-  judge_span(r$term, span, sqrt(model), ctx)
+  judge_span(r, e, span, sqrt(model), ctx)
 }
 
 # A reading from a slope line (no model): the line touches the curve where
@@ -112,12 +112,30 @@ judge_slope_reading <- function(r, flat, ctx) {
   verdict("measured", "", tau[at], tau[at])
 }
 
-# Model ADEV `m` against the curve's limits over the points in `span`.
-judge_span <- function(term, span, m, ctx) {
+# Model ADEV `m` against the curve's limits over the points in `span`. A
+# range with no reliable point (EDF >= 10) measures nothing: the reading is
+# then an upper bound when the reliable points allow it (its term alone
+# stays under their upper limits), else not determined.
+judge_span <- function(r, e, span, m, ctx) {
+  term <- r$term
   cv <- ctx$curve
   tau <- cv$tau
   lo <- min(tau[span])
   hi <- max(tau[span])
+  if (!any(span & ctx$rel) && any(ctx$rel) && !is.null(cv$upper)) {
+    j <- which(ctx$rel & is.finite(cv$upper))
+    reach <- format_num(max(tau[ctx$rel]))
+    allowed <- min(cv$upper[j] / sqrt(e$basis(tau[j], NULL, NULL)))
+    if (length(j) && is.finite(allowed) && r$value <= allowed) {
+      return(verdict("upper_bound", sprintf(paste0(
+        "its range (%s-%s s) lies beyond the reliable taus (EDF >= 10 up to %s s): ",
+        "%s is at most what the reliable points allow"), format_num(lo), format_num(hi),
+        reach, term), lo, hi))
+    }
+    return(verdict("not_determined", sprintf(
+      "its range (%s-%s s) lies beyond the reliable taus (EDF >= 10 up to %s s)",
+      format_num(lo), format_num(hi), reach), lo, hi))
+  }
   if (!ctx$limits) {
     return(verdict("not_determined",
                    "the curve has no confidence limits to check the model against", lo, hi))
@@ -126,9 +144,10 @@ judge_span <- function(term, span, m, ctx) {
   if (!length(w)) {
     return(verdict("not_determined", "no point with confidence limits in its range", lo, hi))
   }
+  lim <- joint_limits(cv, w)
   m <- m[w]
-  above <- m > cv$upper[w] * (1 + verdict_tolerance)
-  below <- m < cv$lower[w] * (1 - verdict_tolerance)
+  above <- m > lim$upper * (1 + verdict_tolerance)
+  below <- m < lim$lower * (1 - verdict_tolerance)
   rng <- sprintf("%s-%s s", format_num(lo), format_num(hi))
   if (!any(above | below)) return(verdict("measured", "", lo, hi))
   if (!any(below)) {
@@ -145,6 +164,25 @@ judge_span <- function(term, span, m, ctx) {
   }
   verdict("not_determined", sprintf(
     "the model leaves the curve's confidence limits on both sides over %s", rng), lo, hi)
+}
+
+# Limits of the curve's points `w` that hold jointly at `verdict_level`
+# (Bonferroni over the points of the range): 68% limits point by point
+# would reject a true model somewhere in most ranges of five or more
+# points. From each point's EDF (chi-square); the curve's own limits where
+# it has no EDF.
+verdict_level <- 0.95
+joint_limits <- function(cv, w) {
+  lower <- cv$lower[w]
+  upper <- cv$upper[w]
+  edf <- if (is.null(cv$edf)) rep(NA_real_, length(w)) else cv$edf[w]
+  ok <- is.finite(edf) & edf > 0
+  if (any(ok)) {
+    a <- (1 - verdict_level) / length(w)
+    lower[ok] <- cv$adev[w][ok] * sqrt(edf[ok] / stats::qchisq(1 - a / 2, edf[ok]))
+    upper[ok] <- cv$adev[w][ok] * sqrt(edf[ok] / stats::qchisq(a / 2, edf[ok]))
+  }
+  list(lower = lower, upper = upper)
 }
 
 # Series effects (a detect_series_effects() pass) and the readings: each

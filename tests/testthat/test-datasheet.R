@@ -61,7 +61,9 @@ test_that("write_datasheet() writes the long and wide CSV", {
   write_datasheet(a, f)
   d <- utils::read.csv(f)
   expect_identical(names(d), c("record", "sensor", "axis", "term", "value",
-                               "unit", "tau", "method", "effects"))
+                               "unit", "tau", "method", "effects", "verdict",
+                               "why", "tau_lo", "tau_hi", "biased_by",
+                               "bias_change", "removed", "warning"))
   expect_equal(d$value, datasheet(a)$long$value)
   write_datasheet(datasheet(a), f, format = "wide")
   expect_true(any(grepl("N \\[deg/sqrt\\(h\\)\\]", readLines(f))))

@@ -66,10 +66,15 @@ test_that("tool_params() applies each tool's convention to the readings", {
   expect_equal(ms$value[ms$sensor == "gyro" & ms$key == "BiasInstability"],
                unname(B))
   # a hand check of one number: N = 1e-4 at 100 Hz is gyr_n = 1e-3
-  one <- tool_rows("vins", "gyro", data.frame(sensor = "gyro", axis = "x",
-                                               N = 1e-4, B = 1e-5, K = 1e-6,
-                                               K_bound = FALSE), 100, "double-sided")
+  d1 <- data.frame(sensor = "gyro", axis = "x", N = 1e-4, B = 1e-5, K = 1e-6,
+                   N_verdict = "measured", B_verdict = "measured",
+                   K_verdict = "upper_bound", N_note = "MEASURED",
+                   B_note = "MEASURED", K_note = "UPPER BOUND: why")
+  one <- tool_rows("vins", "gyro", d1, 100, "double-sided")
   expect_equal(one$value, c(1e-3, 1e-5))
+  # each value carries the verdict of the reading it comes from
+  expect_identical(one$verdict, c("measured", "upper_bound"))
+  expect_identical(one$bound, c(FALSE, TRUE))
 })
 
 test_that("written files read back to the same numbers under each convention", {

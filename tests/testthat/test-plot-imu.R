@@ -24,8 +24,8 @@ test_that("plot() errors are classed and worded", {
   })
 })
 
-test_that("markers sit where the readings are; the legend lists only what is drawn", {
-  # white noise only: K is an upper bound, not drawn nor listed
+test_that("markers sit where the readings are; the legend lists only what is drawn, beside the plot", {
+  # white noise only: K and B are upper bounds, drawn open and listed so
   set.seed(31)
   r <- imu_record(cbind(gyro_x = rnorm(2e4) * 1e-3, gyro_y = rnorm(2e4) * 2e-3),
                   freq = 100, units = c("rad/s", "rad/s"))
@@ -35,31 +35,42 @@ test_that("markers sit where the readings are; the legend lists only what is dra
   expect_equal(rd$adev[rd$term == "B"], sqrt(2 * log(2) / pi) * rd$value[rd$term == "B"])
   # N on the -1/2 line at tau = 1 s: ADEV(1 s) = N
   expect_equal(rd$adev[rd$term == "N"], rd$value[rd$term == "N"])
-  expect_true(rd$is_bound[rd$term == "K"])
+  expect_identical(rd$verdict, c("measured", "upper_bound", "upper_bound"))
   pdf(NULL)
   on.exit(dev.off())
   leg <- expect_no_warning(plot_sensor(a, "gyro", "SI"))
-  expect_false(any(grepl("^K|\\+1/2", leg$legend)))
+  expect_true(any(grepl("^K: upper bound", leg$legend)))
+  expect_true(any(grepl("^B: upper bound", leg$legend)))
   expect_true(any(grepl("-1/2 line", leg$legend, fixed = TRUE)))
-  expect_true(any(grepl("^B", leg$legend)))
+  expect_false(any(grepl("^K: \\+1/2 line", leg$legend)))
+  # the legend lies right of the plot region (user coordinates: log10 on
+  # log axes), so it covers no data
+  expect_gt(leg$rect$left, leg$usr[2L])
   # with a resolved K (rate random walk simulated strongly) it is listed
   b <- suppressWarnings(analyze_imu(two_records()[[1]], refine = FALSE,
                                     progress = FALSE))
-  if (!any(b$channels$gyro_x$readings$is_bound)) {
-    leg2 <- plot_sensor(b, "gyro", "SI")
-    expect_true(any(grepl("^K", leg2$legend)))
-    expect_true(any(grepl("+1/2", leg2$legend, fixed = TRUE)))
-  }
+  expect_identical(b$channels$gyro_x$readings$verdict[3L], "measured")
+  leg2 <- plot_sensor(b, "gyro", "SI")
+  expect_true(any(grepl("^K: \\+1/2 line", leg2$legend)))
 })
 
-test_that("the legend goes to the corner with the fewest data points", {
+test_that("legends of fits and curves sit beside the plot region", {
   pdf(NULL)
   on.exit(dev.off())
-  x <- 10^seq(0, 3, length.out = 30)
-  # data along the top: the legend avoids the top corners
-  plot(x, rep(c(100, 90), 15), log = "xy", ylim = c(1, 120))
-  pos <- draw_legend(list(legend = c("a long label", "another")), x, rep(c(100, 90), 15))
-  expect_true(pos %in% c("bottomleft", "bottomright"))
+  tau <- 10^seq(-1, 2.5, by = 0.1)
+  cv <- data.frame(tau = tau, avar = 1e-8 / tau + 1e-9 * tau)
+  fit <- avfit(cv, c("N", "K"), n = 1e6, freq = 100)
+  op <- par(no.readonly = TRUE)
+  plot(fit, residuals = FALSE)
+  # the right margin was widened for the legend, then restored
+  expect_identical(par("mar"), op$mar)
+  args <- list(legend = c("a long label for a legend", "b"), lty = 1)
+  old <- reserve_legend(args)
+  expect_gt(par("mar")[4L], old$mar[4L])
+  plot(1:10, log = "xy")
+  r <- legend_beside(args)
+  expect_gt(r$rect$left, par("usr")[2L])
+  par(old)
 })
 
 test_that("plot snapshots: IMU analysis and fits with units, envelopes, no warnings", {
