@@ -337,10 +337,7 @@ print.imu_analysis <- function(x, ...) {
         " (see $record$problems)\n", sep = "")
   }
   print(x$datasheet)
-  g <- unlist(lapply(x$channels, function(cc) {
-    m <- cc$guidance[nzchar(cc$guidance)]
-    if (length(m)) paste0(cc$channel, ": ", m)
-  }))
+  g <- guidance_lines(imu_guidance(x))
   if (length(g)) {
     cat("\nGuidance:\n")
     cat(paste0("  - ", g, "\n"), sep = "")

@@ -145,14 +145,17 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
   start <- check_named(start, "start", lay$name)
   fixed <- check_named(fixed, "fixed", lay$name)
   lay$fixed <- lay$name %in% names(fixed)
-  for (nm in names(fixed)) {
-    # amplitudes >= 0, time constants and frequencies > 0 (as in av_model())
-    v <- fixed[[nm]]
-    role <- lay$role[lay$name == nm]
-    if ((role == "amp" && v < 0) || (role == "nonlinear" && v <= 0)) {
-      abort("`fixed`: ", nm,
-            " must be ", if (role == "amp") "non-negative" else "positive",
-            ", not ", format(v), ".", class = "argument")
+  for (arg in c("start", "fixed")) {
+    given <- get(arg)
+    for (nm in names(given)) {
+      # amplitudes >= 0, time constants and frequencies > 0 (as in av_model())
+      v <- given[[nm]]
+      role <- lay$role[lay$name == nm]
+      if ((role == "amp" && v < 0) || (role == "nonlinear" && v <= 0)) {
+        abort("`", arg, "`: ", nm,
+              " must be ", if (role == "amp") "non-negative" else "positive",
+              ", not ", format(v), ".", class = "argument")
+      }
     }
   }
   # an entry measured from the raw series (a band's spectrum) cannot be
@@ -238,9 +241,11 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
   data$z <- z
   input <- curve
   if (curve$edf_source == "model") input$data$edf <- NA_real_
+  se <- stats::setNames(sqrt(pmax(diag(vc), 0)), lay$name)
+  check_fit_finite(stats::setNames(lay$value, lay$name), se)
   new_avfit(
     coefficients = stats::setNames(lay$value, lay$name),
-    se = stats::setNames(sqrt(pmax(diag(vc), 0)), lay$name), vcov = vc,
+    se = se, vcov = vc,
     chi2 = chi2, rms = 100 * sqrt(mean((sqrt(data$avar / fitted) - 1)^2)),
     objective = objective, logdet = w_logdet(pr$W),
     df.residual = dfres, nobs = nrow(data), npar = nfree, terms = terms,
@@ -249,6 +254,26 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
     bias_correct = pr$bias_correct, correlation = !is.null(pr$corr),
     corr = pr$corr, steps = new_steps(), input = input,
     convergence = res$convergence, control = control, call = cl)
+}
+
+# Coefficients or standard errors that are not finite are never returned
+# without a word: a classed warning names them and says why.
+check_fit_finite <- function(coef, se) {
+  bad_c <- names(coef)[!is.finite(coef)]
+  bad_s <- setdiff(names(se)[!is.finite(se)], bad_c)
+  if (length(bad_c)) {
+    warn("the fit left ", paste(bad_c, collapse = ", "), " not finite: the curve ",
+         "does not determine ", if (length(bad_c) > 1L) "them" else "it",
+         " (too few points or degrees of freedom for these terms); drop the ",
+         "term or give a longer curve.", class = "fit_not_finite")
+  }
+  if (length(bad_s)) {
+    warn("no finite standard error for ", paste(bad_s, collapse = ", "),
+         ": the fit is flat in ", if (length(bad_s) > 1L) "these directions" else "this direction",
+         " (the curve does not determine ", if (length(bad_s) > 1L) "them" else "it",
+         ").", class = "fit_not_finite")
+  }
+  invisible()
 }
 
 #' Construct and validate an avfit object (internal)

@@ -48,10 +48,21 @@
 #' * `--no-report` do not write `report.html`;
 #' * `--quiet` no progress messages; `--help`.
 #'
+#' * `--units-checked` the units are right although they fail the checks
+#'   (gravity for accelerometers, plausible white noise for gyroscopes).
+#'
+#' Exit status of the launcher (`allanvar`): 0 when every file was read,
+#' analysed and written; 1 on an error (nothing written); 3 when the files
+#' were written but the units failed their checks (every file carries the
+#' warning) and `--units-checked` was not given. Through `Rscript -e` the
+#' last case is an error too (status 1).
+#'
 #' @param args Character vector of command-line arguments (default: those
 #'   after `--args`).
 #' @return Invisibly, a list with the analyses and the paths written. Errors
-#'   are signalled as R errors, so that `Rscript` exits with status 1.
+#'   are signalled as R errors, so that `Rscript` exits with status 1; units
+#'   that fail their checks end the run with an error of class
+#'   `allanvar_error_units_unchecked` after the files are written.
 #' @export
 #' @examples
 #' allanvar_cli("--help")
@@ -94,13 +105,15 @@ cli_usage <- function() {
     "  --height PX            PNG height (default 600)",
     "  --workers N            parallel R sessions (future multisession)",
     "  --no-report            do not write report.html",
+    "  --units-checked        the units are right though they fail the checks",
+    "                         (else such a run writes marked files and exits with 3)",
     "  --quiet                no progress messages",
     "  --help                 this text",
     sep = "\n")
 }
 
 cli_flags <- c("--no-time", "--no-refine", "--average", "--quiet", "--help",
-               "--no-report")
+               "--no-report", "--units-checked")
 cli_valued <- c("--out", "--rate", "--time-col", "--time-unit", "--gyro-cols",
                 "--accel-cols", "--gyro-units", "--accel-units", "--sep", "--dec",
                 "--topic", "--gap", "--terms", "--remove", "--axis", "--workers", "--width",
@@ -319,17 +332,30 @@ cli_run <- function(args) {
     if (!isTRUE(opt$`no-report`)) write_report(a, path(5), record = rec)
     cat("\n", a$name, "\n", sep = "")
     print(ds)
-    g <- imu_guidance(a)
-    g <- g[nzchar(g$message), , drop = FALSE]
-    if (nrow(g)) {
+    g <- guidance_lines(imu_guidance(a))
+    if (length(g)) {
       cat("Guidance:\n")
-      cat(paste0("  - ", g$channel, ": ", g$message, "\n"), sep = "")
+      cat(paste0("  - ", g, "\n"), sep = "")
     }
     staged <- c(staged, names_out)
     analyses[[f]] <- a
   }
   written <- cli_commit(stage, staged, out)
   cat("Written: ", paste(written, collapse = ", "), "\n", sep = "")
+  # Units that fail their checks: the files are written and marked, and the
+  # run ends in an error (exit status 3 from the launcher) unless the user
+  # says the units have been looked at.
+  suspect <- Filter(function(a) nrow(unit_warnings(a)) > 0L, analyses)
+  if (length(suspect) && !isTRUE(opt$`units-checked`)) {
+    w <- do.call(rbind, lapply(suspect, function(a) {
+      cbind(file = a$name, unit_warnings(a))
+    }))
+    abort("the units failed their checks (", paste0(w$file, " ", w$channel, ": ",
+                                                     w$warning, collapse = "; "),
+          "); the files were written and say so. Give the units with ",
+          "--gyro-units / --accel-units, or pass --units-checked if they are right.",
+          class = "units_unchecked")
+  }
   invisible(list(analyses = analyses, files = written))
 }
 

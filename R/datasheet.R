@@ -80,6 +80,7 @@ datasheet.imu_analysis_list <- function(x, average = FALSE, ...) {
 #' @export
 datasheet.imu_analysis <- function(x, average = FALSE, ...) {
   check_average(average)
+  check_analysis(x)
   long <- list()
   uw <- unit_warnings(x)
   for (ch in x$channels) {
@@ -132,6 +133,25 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
   }
   class(out) <- "imu_datasheet"
   out
+}
+
+# An imu_analysis whose parts the readers of it need: channels, each with
+# its name, sensor and readings (with the verdict columns).
+check_analysis <- function(x, arg = "x") {
+  need <- c("term", "value", "unit", "tau", "method", "verdict", "why")
+  ok <- is.list(x) && is.list(x$channels) && length(x$channels) > 0L &&
+    all(vapply(x$channels, function(ch) {
+      is.list(ch) && is.character(ch$channel) && length(ch$channel) == 1L &&
+        length(ch$sensor) == 1L && is.data.frame(ch$readings) &&
+        all(need %in% names(ch$readings))
+    }, logical(1)))
+  if (!ok) {
+    abort("`", arg, "` is not a well-formed imu_analysis: its `channels` must ",
+          "each hold `channel`, `sensor` and `readings` (as analyze_imu() ",
+          "makes them); analyse the record again with analyze_imu().",
+          class = "argument")
+  }
+  invisible(x)
 }
 
 check_average <- function(average) {

@@ -100,6 +100,7 @@ tool_readings <- function(x) {
     abort("`x` must be an imu_analysis (analyze_imu()) or an avfit, not ",
           describe_type(x), ".", class = "argument")
   }
+  check_analysis(x)
   roles <- c(N = "white", B = "flicker", K = "random_walk")
   rows <- lapply(x$channels, function(ch) {
     if (!is.null(ch$dead) || is.na(ch$sensor)) return(NULL)

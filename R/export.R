@@ -62,6 +62,7 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
   notes <- stats::setNames(rep("", 4L), keys)
   header <- character()
   if (inherits(x, "imu_analysis")) {
+    check_analysis(x)
     vals <- numeric()
     for (k in keys) {
       sensor <- if (startsWith(k, "gyro")) "gyro" else "accel"
@@ -252,6 +253,7 @@ kalman_params <- function(x, dt = NULL, bias_instability = NULL,
     }
   }
   if (inherits(x, "imu_analysis")) {
+    check_analysis(x)
     if (is.null(dt)) dt <- 1 / x$freq
     rows <- lapply(x$channels, function(ch) {
       rd <- ch$readings

@@ -150,7 +150,17 @@ as_av_curve <- function(av, n = NULL, freq = NULL, type = NULL, channel = NULL) 
           class = "argument")
   }
   ok <- is.finite(tau) & tau > 0 & is.finite(avv) & avv > 0
-  if (!is.null(edf)) ok <- ok & is.finite(edf) & edf > 0
+  if (!is.null(edf)) ok <- ok & is.finite(edf) & edf >= 1
+  if (!all(ok)) {
+    # An estimate rests on at least one degree of freedom: an EDF below 1
+    # (or none) makes its weight and bias correction meaningless.
+    low <- !is.null(edf) & is.finite(edf) & edf < 1
+    warn(sum(!ok), " of ", length(ok), " point(s) of `av` left out of the fit: ",
+         "tau, variance and EDF must be finite and positive",
+         if (any(low)) paste0(", the EDF at least 1 (down to ",
+                              format(signif(min(edf[low]), 3)), " here)"),
+         ".", class = "points_dropped")
+  }
   m <- if (is.null(freq)) rep(NA_real_, length(tau)) else tau * freq
   if (is.null(edf) && !is.null(n)) ok <- ok & m <= n / 2
   data <- data.frame(tau = tau[ok], m = m[ok], avar = avv[ok],

@@ -135,7 +135,13 @@ channel_guidance <- function(ch) {
     }
   }
   tau_b <- flat$tau
+  said <- character()
+  if (identical(walk$source, "bound") ||
+      (isTRUE(is.finite(K) && K > 0) && tau_rel < 3 * tau_cross(n2, b2, K))) {
+    said <- c(said, walk$term)
+  }
   if (isTRUE(is.finite(tau_b) && tau_b > tau_rel / 3)) {
+    said <- c(said, flat$term)
     msg <- c(msg, sprintf(
       "the Allan deviation minimum (tau = %s) is not inside the reliable range (up to %s / 3): B = %.3g %s may be an overestimate of the flat region; a record of at least %s is needed (this one is %s).",
       hours(tau_b), hours(tau_rel), B, flat$unit,
@@ -146,9 +152,9 @@ channel_guidance <- function(ch) {
   }
   # Every other reading the data do not support as measured, with why.
   judged <- rd[rd$verdict != "measured" & rd$source %in% c("fit", "slope") &
-                 nzchar(rd$why), , drop = FALSE]
+                 nzchar(rd$why) & !rd$term %in% said, , drop = FALSE]
   msg <- c(msg, sprintf("%s = %.3g %s is %s: %s.", judged$term, judged$value,
-                        judged$unit, verdict_label(judged$verdict), judged$why))
+                        judged$unit, verdict_phrase(judged$verdict), judged$why))
   fit <- ch$fit
   if (!is.null(fit) && !is.null(fit$vcov) && length(fit$coefficients)) {
     cf <- fit$coefficients
@@ -178,6 +184,14 @@ channel_guidance <- function(ch) {
 series_guidance <- function(se, hours) {
   if (is.null(se) || !NROW(se$table)) return(character())
   tab <- se$table[!se$table$removed, , drop = FALSE]
+  # a kind that changes the Allan deviation by less than 1% anywhere
+  # changes no reading: not worth a line
+  ak <- se$adev_kinds
+  matters <- vapply(unique(tab$kind), function(kind) {
+    ch <- ak$change[ak$kind == kind]
+    any(is.finite(ch) & abs(ch) >= 0.01)
+  }, logical(1))
+  tab <- tab[tab$kind %in% unique(tab$kind)[matters], , drop = FALSE]
   vapply(unique(tab$kind), function(kind) {
     k <- tab[tab$kind == kind, , drop = FALSE]
     at <- paste0(vapply(utils::head(k$time, 3L), hours, ""), collapse = ", ")
@@ -200,4 +214,14 @@ tau_cross <- function(n2, b2, K) {
   a <- K^2 / 3
   c0 <- 2 * log(2) / pi * b2
   (c0 + sqrt(c0^2 + 4 * a * n2)) / (2 * a)
+}
+
+# The guidance as printed: one line per message, the axes that share it
+# named together.
+guidance_lines <- function(g) {
+  g <- g[nzchar(g$message), , drop = FALSE]
+  if (!nrow(g)) return(character())
+  msgs <- unique(g$message)
+  vapply(msgs, function(m) paste0(paste(unique(g$channel[g$message == m]), collapse = ", "),
+                                  ": ", m), "", USE.NAMES = FALSE)
 }

@@ -39,7 +39,15 @@ plot.imu_analysis <- function(x, sensor = NULL, units = "SI", ...) {
     op <- graphics::par(mfrow = c(1L, length(sensors)))
     on.exit(graphics::par(op))
   }
-  for (s in sensors) plot_sensor(x, s, units, ...)
+  uw <- unit_warnings(x)
+  for (s in sensors) {
+    plot_sensor(x, s, units, ...)
+    # failed unit checks are said on the plot too
+    if (nrow(uw)) {
+      graphics::mtext("WARNING: the units failed their checks (see the datasheet)",
+                      side = 3, line = 0.3, col = "red", cex = 0.8)
+    }
+  }
   invisible(x)
 }
 

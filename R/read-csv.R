@@ -52,6 +52,7 @@ read_csv_imu <- function(file, time, time_unit, columns, units, sep, dec,
             "); choose them with `columns = ` (and `sensors = `).",
             class = "no_columns")
     }
+    check_unplaced(clean, raw_names, data_cols, time_col, file)
     ch_names <- known$name[data_cols]
     ch_sensor <- known$sensor[data_cols]
     if (any(known$layout[data_cols] %in% c("kalibr", "euroc"))) {
@@ -362,4 +363,31 @@ guess_time_unit <- function(t, hdr, layout, integral = TRUE) {
     return(list(unit = g, note = TRUE))
   }
   list(unit = g)
+}
+
+# Columns that are neither data nor time: those whose names say what else
+# they hold (sequence numbers, temperature, magnetometer, orientation,
+# covariances, ROS header fields) are left out with a message; any other is
+# an error, never a silent drop: it may be an axis under a name not known.
+other_columns_re <- paste0(
+  "^(seq|sequence|count|counter|index|id|status|flags?|header.*|frame.*|",
+  "temp.*|temperature.*|mag.*|m[xyz]|q[wxyz]|quat.*|orientation.*|.*cov.*|",
+  "time.*|.*stamp.*|secs|nsecs|sec|nsec|t|x|unnamed.*|v[0-9]+)$")
+
+check_unplaced <- function(clean, raw_names, data_cols, time_col, file) {
+  rest <- setdiff(seq_along(clean), c(data_cols, time_col))
+  if (!length(rest)) return(invisible())
+  other <- grepl(other_columns_re, clean[rest])
+  if (any(!other)) {
+    bad <- raw_names[rest[!other]]
+    example <- encodeString(c(raw_names[data_cols], bad), quote = "\"")
+    abort("column(s) ", paste(bad, collapse = ", "), " of \"", basename(file),
+          "\" could not be placed as gyroscope or accelerometer axes or time; ",
+          "choose the data columns with `columns = ` (and `sensors = `), e.g. ",
+          "columns = c(", paste(example, collapse = ", "), ").",
+          class = "unplaced_columns")
+  }
+  message(basename(file), ": column(s) ", paste(raw_names[rest], collapse = ", "),
+          " left out (not IMU axes).")
+  invisible()
 }

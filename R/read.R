@@ -356,6 +356,10 @@ imu_record <- function(x, freq = NULL, units = NULL, sensors = NULL,
     abort("`x` must be a matrix or data frame of samples, not ",
           if (is.null(x)) "NULL" else "an empty object", ".", class = "argument")
   }
+  if (!is.data.frame(x) && !is.atomic(x)) {
+    abort("`x` must be a matrix or data frame of samples, not ", describe_type(x),
+          ".", class = "argument")
+  }
   gap <- choice_arg(gap, c("segments", "error", "ignore"), "gap")
   if (!is.null(name)) check_string(name, "name")
   if (is.null(freq)) freq <- attr(x, "freq")
@@ -589,8 +593,13 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
     if (is.null(freq)) {
       freq <- 1 / dt_med
     } else if (abs(freq * dt_med - 1) > 0.01) {
-      add("rate", 1L, sprintf("given freq = %g Hz but the stamps say %.6g Hz",
-                              freq, 1 / dt_med), "given freq used")
+      # one of the two is wrong, and every reading would scale with it
+      abort(source, ": `freq` = ", format(freq), " Hz but the timestamps",
+            if (!is.null(time_label)) paste0(" (read as ", time_label$unit, ")"),
+            " say ", format(signif(1 / dt_med, 6)), " Hz, ",
+            format(signif(abs(freq * dt_med - 1) * 100, 3)), "% apart (more than 1%). ",
+            "Give the rate the stamps say, or check `time_unit`; ",
+            "or give `freq = ` without the time column.", class = "rate_mismatch")
     }
     dt <- 1 / freq
   }
@@ -630,14 +639,19 @@ new_imu_record <- function(x, time, time_unit, freq, units, sensors, gap,
 # A rate no IMU has, for the unit the stamps were read in: stop, naming
 # the column and the unit that would give a plausible rate.
 check_stamp_rate <- function(rate, label, source) {
-  if (is.null(label) || (rate <= 1e5 && rate >= 1e-3)) return(invisible())
+  lim <- imu_rate_range
+  if (is.null(label) || (rate <= lim[2L] && rate >= lim[1L])) return(invisible())
   per <- c(s = 1, ms = 1e3, us = 1e6, ns = 1e9)
   cur <- per[[label$unit]]
-  alt <- names(per)[rate * per / cur >= 0.1 & rate * per / cur <= 1e5]
+  as_unit <- rate * per / cur
+  alt <- names(per)[as_unit >= lim[1L] & as_unit <= lim[2L]]
   abort(source, ": the stamps of ", label$what, ", read as ", label$unit,
         if (!isTRUE(label$declared)) " (detected)", ", give a sampling rate of ",
         format(signif(rate, 4)), " Hz (from line ", label$line %||% 1L,
-        " on), which no IMU has.",
+        " on), which no IMU has (", format(lim[1L]), " Hz to ",
+        format(lim[2L], scientific = FALSE), " Hz). Read as ",
+        paste0(names(per), ": ", vapply(as_unit, function(v) format(signif(v, 4)), ""),
+               " Hz", collapse = "; "), ".",
         if (length(alt)) paste0(" They look like ", alt[1L], ": use time_unit = \"",
                                 alt[1L], "\"."),
         " (Or give the rate with `freq = ` and no time column.)",

@@ -181,12 +181,18 @@ check_string <- function(x, arg, empty_ok = TRUE) {
 # per-sample arithmetic of the readers loses its integers).
 check_imu_freq <- function(freq, arg = "freq") {
   freq <- check_freq(freq, arg)
-  if (freq > 1e9) {
+  if (freq < imu_rate_range[1L] || freq > imu_rate_range[2L]) {
     abort("`", arg, "` = ", format(freq), " Hz is not a plausible IMU sampling ",
-          "rate (at most 1e9 Hz); give the rate in Hz.", class = "argument")
+          "rate (", format(imu_rate_range[1L]), " Hz to ",
+          format(imu_rate_range[2L], scientific = FALSE), " Hz); give the rate in Hz.",
+          class = "argument")
   }
   freq
 }
+
+# Sampling rates of IMU logs (Hz): slower or faster ones come from a wrong
+# time unit or rate, never from an IMU.
+imu_rate_range <- c(1, 5e4)
 
 # Samples the diagnostics (avdiagnose(), avrefine(data =)) can work on: not
 # constant, and of a magnitude whose squares neither overflow nor underflow

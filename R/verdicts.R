@@ -20,8 +20,13 @@ bias_bound <- 0.25
 
 verdict_levels <- c("measured", "upper_bound", "lower_bound", "not_determined")
 
-# Verdict display: "measured", "upper bound", ...
+# Verdict display: "measured", "upper bound", ...; in a sentence ("is an
+# upper bound").
 verdict_label <- function(v) gsub("_", " ", v, fixed = TRUE)
+verdict_phrase <- function(v) {
+  ifelse(v %in% c("upper_bound", "lower_bound"), paste("an", verdict_label(v)),
+         verdict_label(v))
+}
 
 # The verdict columns of readings `rd` (one row per reading) from `curve`
 # (tau, adev, lower, upper, edf, m) and the model's layout `lay`; `ok` the

@@ -108,6 +108,11 @@ fuzz_setup <- function(pkg_path) {
   e$f_const <- w("const.csv", c(hdr, paste0(sprintf("%.0f", ts), ",0,0,0,0,0,0")))
   e$f_noheader <- w("noheader.csv", body)
   e$f_semicolon <- w("semi.csv", gsub(",", ";", c(hdr, body)))
+  # axes under names the reader cannot place (ax1, ...)
+  e$f_unplaced <- w("unplaced.csv", c("t,wx,wy,wz,ax1,ay1,az1",
+                                      apply(cbind(sprintf("%.2f", seq_len(n) / 100),
+                                                  matrix(sprintf("%.6f", g), n, 6)), 1,
+                                            paste, collapse = ",")))
   e$f_binary <- file.path(d, "binary.bag")
   writeBin(as.raw(c(0:255, 255:0)), e$f_binary)
   e$f_fakebag <- w("fake.bag", "#ROSBAG V2.0\nnot really")
@@ -425,7 +430,30 @@ fuzz_cases <- function(quick = FALSE) {
   sub_arg("read_imu_utils_yaml", q(read_imu_utils_yaml(file = f_yaml_neg)), c("file", "freq", "curve", "scaled"))
   sub_arg("read_imu_utils_curve", q(read_imu_utils_curve(dir = dir, name = "x")), c("dir", "name", "fitted"))
   # CLI in process
+  # inputs that cannot be right: a classed error naming the argument
+  add("read_imu", "ns stamps read as s", q(read_imu(f_good, time_unit = "s")))
+  add("read_imu", "freq disagrees with stamps", q(read_imu(f_good, freq = 1000)))
+  add("read_imu", "unplaced columns", q(read_imu(f_unplaced)))
+  add("imu_record", "x = function", q(imu_record(x = function(x) x, freq = 100)))
+  add("imu_record", "freq = 0.01", q(imu_record(cbind(gyro_x = rnorm(1000)), freq = 0.01)))
+  add("imu_record", "ms stamps read as s",
+      q(imu_record(cbind(gyro_x = rnorm(1000)), time = (0:999) * 10, time_unit = "s")))
+  add("avfit", "start gm1.tc = -1", q(avfit(av, c("N", "gm"), start = c(gm1.tc = -1))))
+  add("avfit", "edf below 1", q(avfit(data.frame(tau = c(1, 2, 4, 8), avar = c(1, 0.5, 0.3, 0.2),
+                                                 edf = 0.01), c("N", "K"))))
+  add("datasheet", "malformed analysis",
+      q(datasheet(structure(list(channels = list(1)), class = "imu_analysis"))))
+  add("write_datasheet", "malformed analysis",
+      q(write_datasheet(structure(list(channels = list(1)), class = "imu_analysis"),
+                        file.path(dir, "ds.csv"))))
+  add("avdiagnose", "integers near integer.max",
+      q(avdiagnose(as.integer(.Machine$integer.max - rep(0:3, 1250)), 100)))
   cli <- function(label, ...) add("allanvar_cli", label, S("allanvar_cli", c(...)))
+  add("allanvar_cli", "ns stamps as --time-unit s",
+      q(allanvar_cli(c(f_good, "--time-unit", "s", "--quiet", "--no-refine",
+                       "--out", file.path(dir, "cliout")))))
+  add("allanvar_cli", "unplaced columns",
+      q(allanvar_cli(c(f_unplaced, "--quiet", "--no-refine", "--out", file.path(dir, "cliout")))))
   for (f in files) add("allanvar_cli", paste("file =", f),
                        bquote(allanvar_cli(c(.(as.name(f)), "--out", file.path(dir, .(f)), "--quiet", "--no-refine"))))
   flags <- list(c("--out="), c("--out", ""), c("--out", "/"), c("--out", "OUTFILE"),
@@ -487,7 +515,11 @@ fuzz_cases <- function(quick = FALSE) {
               "file = f_comma", "file = f_two", "file = f_const", "file = f_dir",
               "file = f_secs", "file = f_latin1", "report of f_extra",
               "report of f_inf", "report of f_abc", "good --out=", "good --terms X",
-              "x = huge 1e300", "x = constant")
+              "x = huge 1e300", "x = constant", "ns stamps read as s",
+              "freq disagrees with stamps", "unplaced columns", "x = function",
+              "freq = 0.01", "ms stamps read as s", "start gm1.tc = -1", "edf below 1",
+              "malformed analysis", "integers near integer.max",
+              "ns stamps as --time-unit s")
     funs <- vapply(cases, `[[`, "", "fun")
     labels <- vapply(cases, `[[`, "", "label")
     keep <- unlist(lapply(split(seq_along(cases), factor(funs, unique(funs))), function(i)
