@@ -99,7 +99,10 @@
 #' @param ... Must be empty (an unknown argument is an error).
 #' @return An object of class `"avfit"`: a list with `coefficients` (named:
 #'   `Q`, `N`, `B`, `K`, `R`, `gm1.sigma`, `gm1.tc`, `sinusoid1.amp`,
-#'   `sinusoid1.f0`, ...), `se`, `vcov`, `chi2` (sum of squared
+#'   `sinusoid1.f0`, ...), `se` (`NA` for the nonlinear parameters of a
+#'   term whose amplitude is 0; any other SE or coefficient that is not
+#'   finite comes with a warning of class `allanvar_warning_fit_not_finite`),
+#'   `vcov`, `chi2` (sum of squared
 #'   standardized residuals per degree of freedom), `rms` (RMS relative
 #'   error of the Allan deviation in percent: the measured ADEV relative to
 #'   the model's,
@@ -109,6 +112,9 @@
 #'   `objective`, `df.residual`, `nobs`, `terms`, `layout` (one row per
 #'   coefficient: name, term label, kind, parameter, role, unit, fixed),
 #'   `data` (data frame `tau`, `m`, `avar`, `edf`, `fitted`, `z`),
+#'   `model_error` (the relative model error the weights include, 0 when
+#'   the model agrees with the curve within the points' scatter; see
+#'   [avfit_control()]),
 #'   `components` (each term's AV at the data taus), `freq`, `n`, `type`,
 #'   `edf_source`, `steps` (zero-row data frame with the columns of
 #'   [avrefine()]'s steps),
@@ -221,7 +227,22 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
     pr <- fit_problem(data, tau0, lay, bias_correct, corr)
     res <- fit_search(pr, start, res, control)
   }
-  finish_fit(res, pr, curve, terms, control, cl)
+  # An honest model-error term where the model departs from the curve
+  # beyond the points' scatter (avfit_control(model_error =)): re-weighted
+  # until its estimate settles.
+  model_var <- 0
+  if (isTRUE(control$model_error)) {
+    for (it in 1:4) {
+      v <- model_error_var(res, pr)
+      if (v == 0 || abs(v - model_var) <= 0.05 * v) break
+      model_var <- v
+      pr <- fit_problem(data, tau0, lay, bias_correct, corr, model_var = model_var)
+      res <- fit_search(pr, start, res, control)
+    }
+  }
+  out <- finish_fit(res, pr, curve, terms, control, cl)
+  out$model_error <- sqrt(model_var)
+  out
 }
 
 # Everything a fit reports, from the search result `res` on problem `pr`.
@@ -242,7 +263,10 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
   input <- curve
   if (curve$edf_source == "model") input$data$edf <- NA_real_
   se <- stats::setNames(sqrt(pmax(diag(vc), 0)), lay$name)
-  check_fit_finite(stats::setNames(lay$value, lay$name), se)
+  # a nonlinear parameter of a term whose amplitude is 0 has no value to
+  # err about (its SE is NA by design, see fit_vcov())
+  absent <- lay$role == "nonlinear" & is.na(diag(vc))
+  check_fit_finite(stats::setNames(lay$value, lay$name), se[!absent])
   new_avfit(
     coefficients = stats::setNames(lay$value, lay$name),
     se = se, vcov = vc,
@@ -505,6 +529,11 @@ print.avfit <- function(x, ...) {
   note_hidden(hid)
   cat(sprintf("chi2/dof = %.3g (dof %d), RMS ADEV error = %.3g %%\n",
               x$chi2, x$df.residual, x$rms))
+  if (isTRUE(x$model_error > 0)) {
+    cat(sprintf(paste0("The model departs from the curve beyond its points' scatter: ",
+                       "weights include a model error of %.3g%% (relative AV); ",
+                       "see the residuals (z).\n"), 100 * x$model_error))
+  }
   if (nrow(x$steps)) cat(nrow(x$steps), "refinement step(s); see $steps\n")
   print_convergence(x$convergence)
   invisible(x)

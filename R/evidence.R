@@ -50,6 +50,9 @@ lag1_noise_id <- function(x, m = 1L) {
     a <- acf_sums(bc, 1L)
     r1 <- a[2L] / a[1L]
     delta <- r1 / (1 + r1)
+    # a series with no variance left (constant after differencing) has no
+    # noise type
+    if (!is.finite(delta)) return(NA_real_)
     if (delta < 0.25 || d >= 2L) break
     b <- diff(b)
     d <- d + 1L

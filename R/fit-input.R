@@ -151,7 +151,7 @@ as_av_curve <- function(av, n = NULL, freq = NULL, type = NULL, channel = NULL) 
   }
   ok <- is.finite(tau) & tau > 0 & is.finite(avv) & avv > 0
   if (!is.null(edf)) ok <- ok & is.finite(edf) & edf >= 1
-  if (!all(ok)) {
+  if (!all(ok) && any(ok)) {
     # An estimate rests on at least one degree of freedom: an EDF below 1
     # (or none) makes its weight and bias correction meaningless.
     low <- !is.null(edf) & is.finite(edf) & edf < 1

@@ -68,7 +68,8 @@ avmle <- function(x, freq, terms = c("N", "K", "gm"), start = NULL) {
           class = "argument")
   }
   tau0 <- 1 / freq
-  fit0 <- avfit(allan(x, freq), terms)
+  # the curve fit only starts the likelihood: its own SEs are not reported
+  fit0 <- quiet_fit_warnings(avfit(allan(x, freq), terms))
   p0 <- coef(fit0)
   if (!is.null(start)) p0[names(start)] <- start
   p0 <- mle_start(p0, lay, fit0, tau0, entries)
@@ -86,9 +87,10 @@ avmle <- function(x, freq, terms = c("N", "K", "gm"), start = NULL) {
                                                 ndeps = rep(1e-4, length(p0)))),
                 error = function(e) NULL)
   vc <- mle_vcov(H, est$par, lay)
-  fit <- avfit(fit0$input, terms, fixed = est$par)
+  fit <- quiet_fit_warnings(avfit(fit0$input, terms, fixed = est$par))
   fit$se <- stats::setNames(sqrt(pmax(diag(vc), 0)), lay$name)
   fit$se[is.na(diag(vc))] <- NA_real_
+  check_fit_finite(fit$coefficients, fit$se)
   fit$vcov <- vc
   fit$layout$fixed <- FALSE
   fit$npar <- nrow(lay)
@@ -206,4 +208,10 @@ mle_vcov <- function(H, par, lay) {
     }
   }
   vc
+}
+
+# `expr` without the warnings of fits whose SEs are not reported.
+quiet_fit_warnings <- function(expr) {
+  withCallingHandlers(expr, allanvar_warning_fit_not_finite = function(w)
+    invokeRestart("muffleWarning"))
 }

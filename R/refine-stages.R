@@ -26,6 +26,12 @@ step_stages <- function() {
 # first (R/series.R); what the user asks to remove is taken out of the data
 # the loop then sees. Then the raw-data diagnostics, once per call.
 stage_prepare <- function(st) {
+  # the loop weighs points by their own scatter (refit_settings()): a fit
+  # given with a model-error term starts it refitted without one
+  if (isTRUE(st$current$model_error > 0)) {
+    r <- try_refit(refit_args(st$current, st$current$terms, st$settings), "prepare")
+    if (!is.null(r$fit)) st$current <- r$fit
+  }
   if (is.null(st$data)) return(st)
   a <- st$args
   if (is.null(a$series)) {

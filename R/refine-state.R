@@ -44,11 +44,16 @@ validate_refine_state <- function(st) {
 # The settings every refit uses, explicitly: the fit's own, overridden by
 # the arguments in `dots`.
 refit_settings <- function(fit, dots) {
-  utils::modifyList(
+  out <- utils::modifyList(
     list(bias_correct = !isFALSE(fit$bias_correct),
          correlation = isTRUE(fit$correlation),
          control = fit$control %||% avfit_control()),
     dots)
+  # candidates are judged on the points' own scatter: a model-error term
+  # would hide the departures they are meant to explain
+  out$control <- check_control(out$control)
+  out$control$model_error <- FALSE
+  out
 }
 
 # The criterion of a fit, and the penalty of one parameter on its scale.

@@ -474,3 +474,27 @@ test_that("the exact EDF kernel reduces to the exact single-noise values", {
   e <- edf_fit_model(mm, 1e8, "overlapping", mm / 100, 0.01, lay)
   expect_true(all(is.finite(e) & e >= 1))
 })
+
+test_that("model_error = TRUE: a discrepancy estimated where the model departs, none where it fits", {
+  # an exact N + K curve with a Gauss-Markov bump the N + K model lacks
+  tau <- 10^seq(-2, 3.3, by = 0.1)
+  q <- tau / 300
+  gm <- 2 * (2e-3)^2 * 300 / tau * (1 - (3 - 4 * exp(-q) + exp(-2 * q)) / (2 * q))
+  n <- 20 * 3600 * 400
+  edf <- pmax(1, 1.5 * n / (tau * 400))
+  exact <- data.frame(tau = tau, avar = 1e-6 / tau + 1e-10 * tau / 3, edf = edf)
+  f0 <- avfit(exact, c("N", "K"), control = avfit_control(model_error = TRUE))
+  expect_identical(f0$model_error, 0)
+  bumped <- exact
+  bumped$avar <- bumped$avar + gm
+  plain <- avfit(bumped, c("N", "K"))
+  f1 <- avfit(bumped, c("N", "K"), control = avfit_control(model_error = TRUE))
+  expect_identical(plain$model_error, 0)
+  expect_gt(plain$chi2, 5)
+  expect_gt(f1$model_error, 0.05)
+  # the discrepancy brings the chi-square per dof to about 1
+  expect_equal(f1$chi2, 1, tolerance = 0.1)
+  expect_output(print(f1), "model error of")
+  # the loop judges candidates on the points' own scatter
+  expect_false(refit_settings(f1, list())$control$model_error)
+})
