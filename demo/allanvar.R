@@ -8,11 +8,18 @@ freq <- frequency(gyroz)
 guide_lines <- function(av) {
   abline(1.0 + log(av$time[1]), -1/2, col = "green", lwd = 4, lty = 10)
   abline(1.0 + log(av$time[1]), 1/2, col = "green", lwd = 4, lty = 10)
-  # (the original placed these at fixed coordinates, past the right edge of
-  # short records; the corners keep them inside the plot)
-  legend("bottomleft", "Random Walk", inset = 0.02, cex = 0.9)
-  legend("bottomright", "Rate Random Walk", inset = 0.02, cex = 0.9)
+  # plotav() keeps the original's axis title; the unit goes beneath it
+  mtext("(rad/s)", side = 2, line = 4)
+  # the legend in the right margin, clear of the data (the original placed
+  # its labels at fixed coordinates, past the right edge of short records)
+  legend("topleft", inset = c(1.02, 0), xpd = NA, bty = "n", cex = 0.85,
+         legend = c("slope -1/2:", "angle random walk", "slope +1/2:",
+                    "rate random walk"),
+         col = "green", lwd = c(4, NA, 4, NA), lty = c(10, NA, 10, NA))
 }
+
+# Room for the unit of the y axis and the legend beside the plot.
+op <- par(mar = c(5, 5.5, 4, 9))
 
 # Non-overlapping Allan variance at octave cluster sizes.
 av_octave <- avar(rate, freq)
@@ -31,6 +38,7 @@ plotav(av_angle)
 guide_lines(av_angle)
 
 # All three on one plot.
+par(op)
 plot(av_octave$time, sqrt(av_octave$av), log = "xy", xaxt = "n", yaxt = "n",
      type = "l", col = "blue", xlab = "", ylab = "")
 lines(av_all$time, sqrt(av_all$av), col = "green", lwd = 1)
