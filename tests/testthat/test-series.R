@@ -211,8 +211,11 @@ test_that("analyze_imu(remove =) and the CLI's --remove take the effects out bef
                                      remove = "spikes"))
   expect_identical(ar$channels$gyro_x$fit$series, ar$channels$gyro_x$series)
   expect_identical(ar$channels$gyro_x$fit$refine$removed, "spikes")
+  # without `remove` the pass still runs (its effects mark the readings),
+  # and nothing is taken out
   keep <- suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE))
-  expect_null(keep$channels$gyro_x$series)
+  expect_identical(keep$channels$gyro_x$series$removed, character())
+  expect_identical(keep$channels$gyro_x$series$table$index, as.integer(spikes))
   expect_lt(a$channels$gyro_x$curve$adev[1], 0.97 * keep$channels$gyro_x$curve$adev[1])
   capture.output(res <- suppressMessages(suppressWarnings(allanvar_cli(c(
     f, "--out", out, "--gyro-cols", "gx", "--accel-cols", "ax", "--time-unit", "s",
