@@ -29,7 +29,7 @@
 #'    least 10 percent;
 #' 4. repeats until nothing pays or `max_steps` effects were added.
 #'
-#' The rules of acceptance (issue 9):
+#' The rules of acceptance:
 #' * Candidates are compared by the criterion, not gated by a residual
 #'   threshold: with no residual signature left, every candidate is still
 #'   tried (screening pass only).

@@ -1,4 +1,4 @@
-# Exact confidence limits at few averages (issue 29, item 2). Where N/m is
+# Exact confidence limits at few averages. Where N/m is
 # small the Allan-family estimate over its expectation is far from a
 # chi-square with the two-moment EDF: it is a generalized chi-square,
 # sum_i lambda_i chi2_1, the lambda the eigenvalues of its terms'

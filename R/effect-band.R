@@ -1,4 +1,4 @@
-# Catalogue entry of a measured spectral band (issue 9): a narrow-band
+# Catalogue entry of a measured spectral band: a narrow-band
 # process that no parametric shape describes (the ADIS16405 z gyros' band
 # near 20 Hz falls faster below its peak than a Lorentzian and has a
 # shoulder above it). Its spectrum IS the raw data's: the Welch estimate

@@ -1,6 +1,5 @@
-# Catalogue entries of the sensor's own filtering (issue 9, items 1-2): white
-# noise through the sensor's low-pass filter ("filter", a family of
-# variants), and a narrow-band random process ("resonance"). The math,
+# Catalogue entries of the sensor's own filtering: white noise through the
+# sensor's low-pass filter ("filter", a family of variants), and a narrow-band random process ("resonance"). The math,
 # simulators and raw-data evidence live in R/filter-noise.R and
 # R/resonance.R; this file states the facts the catalogue asks for.
 

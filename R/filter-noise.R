@@ -1,6 +1,6 @@
 # Filtered white noise: white rate noise seen through the sensor's own
 # low-pass (decimation/averaging) filter. The math, the simulator and the
-# raw-data evidence of one effect (issue 9, item 1); the catalogue entry
+# raw-data evidence of one effect; the catalogue entry
 # reads these functions.
 #
 # Normalisation. The filter has unit DC gain, so N keeps its meaning: N^2 is

@@ -14,8 +14,12 @@
 log_bias <- function(edf) digamma(edf / 2) - log(edf / 2)
 log_sd <- function(edf) sqrt(trigamma(edf / 2))
 
-# The estimator name the EDF engine knows for avfit's `type`.
-engine_type <- function(type) if (identical(type, "overlapping")) "overlapping" else "standard"
+# The catalogue entry of avfit's `type` (its "non-overlapping" is the
+# standard estimator); engine_type(): the name the EDF engine knows.
+fit_stat <- function(type) {
+  stat_entry(if (identical(type, "non-overlapping")) "standard" else type)
+}
+engine_type <- function(type) fit_stat(type)$name
 
 # EDF of the AV estimates at cluster sizes m (rounded to whole samples) for
 # power-law noise of rate-PSD exponent `alpha` (one value): n samples, L
@@ -80,7 +84,7 @@ edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
   mm <- pmax(round(m), 1)
   nu_g <- avfit_exact_edf(as.double(mm),
                           as.double(allan_nterms(engine_type(type), mm, L)),
-                          identical(type, "overlapping"),
+                          fit_stat(type)$overlapping,
                           parts$shape, parts$coef, parts$phi)
   av_g <- rowSums(comp[, exact, drop = FALSE])
   e <- rowSums(comp)^2 / (av_g^2 / nu_g)
@@ -110,7 +114,7 @@ exact_edf_parts <- function(plan, values, tau0) {
 # noise (exact Gaussian moments, C++).
 white_corr <- function(m, n, type) {
   C <- avar_white_cov(as.double(round(m)), as.double(n),
-                      type == "overlapping", allanvar_threads())
+                      fit_stat(type)$overlapping, allanvar_threads())
   d <- sqrt(diag(C))
   R <- C / outer(d, d)
   R[!is.finite(R)] <- 0

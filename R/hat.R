@@ -125,8 +125,8 @@ three_cornered_hat <- function(x, freq, pairs = NULL, taus = "octave",
                                conf = 0.683) {
   check_present(missing(x), "x", "the three pairwise comparisons")
   if (missing(freq)) freq <- hat_ts_freq(x)
-  if (is.character(type) && length(type) == 1L &&
-      type %in% c("mtie", "tierms", "tie")) {
+  e <- if (is.character(type) && length(type) == 1L && !is.na(type)) stat_entry(type)
+  if (!is.null(e) && !e$variance) {
     abort("`type` must be a variance for the three-cornered hat; \"", type,
           "\" is a time-error statistic.", class = "argument")
   }

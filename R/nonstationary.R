@@ -1,6 +1,6 @@
-# Non-stationary effects read from the raw series (issue 9, item 3): bias
-# steps, an exponential warm-up and isolated spikes. They are not terms of
-# the Allan variance model: each is found in the series, reported (where,
+# Non-stationary effects read from the raw series: bias steps, an
+# exponential warm-up and isolated spikes. They are not terms of the Allan
+# variance model: each is found in the series, reported (where,
 # how large) and corrected in the series only when asked. Every detector is
 # O(n) or O(n log n).
 #

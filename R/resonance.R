@@ -1,8 +1,7 @@
 # A narrow-band random process (a damped resonance): the broad spectral
 # bump that the ADIS16405 z gyroscopes show at 18-22 Hz. Not a line: its
 # power is spread over a band of width ~1/(pi Tc) around f_r, so no
-# sinusoid describes it. Math, simulator and raw-data evidence (issue 9,
-# item 2).
+# sinusoid describes it. Here: its math, simulator and raw-data evidence.
 #
 # Model: the real part of a complex AR(1), z_k = r e^{i w} z_{k-1} + e_k,
 # r = exp(-tau0 / Tc), w = 2 pi f_r tau0. Its autocovariance is

@@ -46,6 +46,9 @@
 #                 a function(x, freq, taus, input, conf, unbiased); or a
 #                 string: why the statistic is not defined with gaps (the
 #                 error message)
+#   variance    whether the statistic is a variance (a deviation squared),
+#                 so that sums and differences of it mean something (the
+#                 three-cornered hat); FALSE for the time interval errors
 #   title       what the deviation column holds, for print()'s header
 #   ylab        plot()'s y-axis label
 
@@ -95,14 +98,14 @@ new_stat <- function(name, title, ylab, max_m, nterms, kernel = "sums",
                      aliases = character(),
                      edf_fallback = function(m, n, L) n,
                      octave_pass = FALSE, min_points = 3L,
-                     exact_ci = FALSE) {
+                     exact_ci = FALSE, variance = TRUE) {
   list(name = name, title = title, ylab = ylab, max_m = max_m,
        nterms = nterms, kernel = kernel, divisor = divisor, taus = taus,
        edf = edf, alpha_range = as.integer(alpha_range), id_base = id_base,
        noise_id = noise_id, debias = debias, unbiased = unbiased, gaps = gaps,
        aliases = aliases, edf_fallback = edf_fallback,
        octave_pass = octave_pass, min_points = min_points,
-       exact_ci = exact_ci)
+       exact_ci = exact_ci, variance = variance)
 }
 
 validate_stat <- function(e) {
@@ -113,6 +116,9 @@ validate_stat <- function(e) {
   }
   for (f in c("max_m", "nterms", "taus", "noise_id", "edf_fallback")) {
     if (!is.function(e[[f]])) bad("`", f, "` must be a function.")
+  }
+  if (!isTRUE(e$variance) && !isFALSE(e$variance)) {
+    bad("`variance` must be TRUE or FALSE.")
   }
   if (!is.null(e$debias) && !is.function(e$debias)) {
     bad("`debias` must be a function or NULL.")

@@ -57,11 +57,11 @@ stats_further <- function() {
     further("mtie", "maximum time interval error MTIE", time = TRUE,
             max_m = function(L) L - 1,
             nterms = function(m, L, theo_row = NULL) L - m,
-            kernel = kernel_mtie),
+            kernel = kernel_mtie, variance = FALSE),
     further("tierms", "rms time interval error TIE rms", time = TRUE,
             max_m = function(L) L - 1,
             nterms = function(m, L, theo_row = NULL) L - m,
-            kernel = kernel_tierms),
+            kernel = kernel_tierms, variance = FALSE),
     further("pdev", "parabolic deviation",
             max_m = function(L) floor((L - 1) / 2),
             nterms = function(m, L, theo_row = NULL) {

@@ -1,5 +1,5 @@
 // The exact distribution of an Allan-family estimator under discrete
-// power-law noise (issue 29): the estimate over its expectation is a
+// power-law noise: the estimate over its expectation is a
 // generalized chi-square, sum_i lambda_i chi2_1 with sum lambda = 1, the
 // lambda the eigenvalues of the terms' covariance matrix over its trace.
 //  * noise: phase x = (1 - B)^(-delta) e, e white, delta = (2 - alpha)/2

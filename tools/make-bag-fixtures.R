@@ -324,6 +324,31 @@ make_fixtures <- function(dir) {
   invisible(list.files(dir, full.names = TRUE))
 }
 
+# Damaged copies of the lz4 bag and the zstd MCAP: one bit flipped 200
+# bytes into the compressed data of the second chunk (found by its frame's
+# magic number), so that the reader's checks, not a cut, must find it.
+damage_second_frame <- function(src, dst, magic) {
+  b <- readBin(src, "raw", file.size(src))
+  at <- which(b == magic[1L])
+  at <- at[vapply(at, function(i) identical(b[i + 0:3], magic), NA)]
+  if (length(at) < 2L) stop("fewer than two compressed chunks in ", src)
+  k <- at[2L] + 200L
+  b[k] <- xor(b[k], as.raw(1L))
+  writeBin(b, dst)
+  invisible(k - 1L)  # the flipped byte's 0-based offset
+}
+
+make_damaged_fixtures <- function(dir) {
+  c(lz4_bag = damage_second_frame(file.path(dir, "imu_lz4.bag"),
+                                  file.path(dir, "imu_lz4_damaged.bag"),
+                                  as.raw(c(0x04, 0x22, 0x4D, 0x18))),
+    zstd_mcap = damage_second_frame(file.path(dir, "imu_zstd.mcap"),
+                                    file.path(dir, "imu_zstd_damaged.mcap"),
+                                    as.raw(c(0x28, 0xB5, 0x2F, 0xFD))))
+}
+
 if (sys.nframe() == 0L) {
-  print(make_fixtures(file.path("tests", "testthat", "fixtures", "ros")))
+  dir <- file.path("tests", "testthat", "fixtures", "ros")
+  print(make_fixtures(dir))
+  print(make_damaged_fixtures(dir))
 }

@@ -1,5 +1,4 @@
-# The loop's rules for a filtered sensor with a resonance (issue 9, items 1,
-# 2 and 4), on series from generators written here (not avsim): white noise
+# The loop's rules for a filtered sensor with a resonance, on series from generators written here (not avsim): white noise
 # through a second-order Butterworth low-pass (bilinear transform), a
 # damped resonance as a real AR(2) with poles r exp(+-iw), a random walk.
 

@@ -1,6 +1,6 @@
-# The rules of the closed loop (issue 9, items 4-5) on series generated
-# here (stats::filter, rnorm; not the package's simulator). References: the
-# generating parameters and the issue's tolerances.
+# The rules of the closed loop on series generated here (stats::filter,
+# rnorm; not the package's simulator). References: the generating
+# parameters, recovered within tolerances fixed in advance.
 
 gen_white <- function(n, freq, N) rnorm(n, sd = N * sqrt(freq))
 gen_ma <- function(n, freq, N, L) {

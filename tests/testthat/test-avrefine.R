@@ -1,6 +1,6 @@
 # The closed loop on simulated series whose generating model has exactly one
 # effect more than the declared terms. References: the simulated model's own
-# coefficients (avsim), and the issue's tolerances (Tc, f0 within 10%,
+# coefficients (avsim), within tolerances fixed in advance (Tc, f0 within 10%,
 # amplitudes within 25%, chi2/dof after within 2 while far above before).
 
 curve_of <- function(x) allan(x, 100, taus = 10)

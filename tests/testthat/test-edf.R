@@ -158,7 +158,7 @@ test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
   # random walk below 64 averaged frequencies, where the default follows
   # Stable32's B1 (expected ratios for N = the statistic's term count), which
   # types it flicker or white FM and moves overlapping ADEV to 0.615-0.623 at
-  # N/m = 8-32: there the issue's band 0.60-0.76. The rules before
+  # N/m = 8-32: inside the accepted coverage band 0.60-0.76. The rules before
   # (options(allanvar.noise_id = "coverage")) keep 65-72% on every row
   # (0.651-0.671 there).
   old <- options(allanvar.threads = 1, allanvar.noise_id = NULL)
@@ -190,7 +190,7 @@ test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
       for (g in c("white", "walk")) {
         r <- if (g == "white") cw else cr
         # N/m <= 16: the exact limits (R/ci-exact.R), whose union over the
-        # plausible noise types is held to the issue's band 0.60-0.76
+        # plausible noise types is held to the accepted band 0.60-0.76
         long <- (rule == "default" & g == "walk" & N %/% r$m < 64) |
           N / r$m <= 16
         expect_gte(sum(!long), 5)

@@ -16,7 +16,7 @@ test_that("a 400 Hz curve with a 4-tap average: filter term gives N and L, N+B+K
   expect_equal(cf[["filter.L"]], 4, tolerance = 0.1)
   expect_equal(cf[["K"]], 1e-4, tolerance = 0.5)
   expect_lt(f$chi2, 2)
-  # the datasheet model misreads such a curve (the issue's failure)
+  # the datasheet model misreads such a curve (why the filter effect exists)
   f0 <- avfit(a, terms = c("N", "B", "K"))
   expect_gt(f0$chi2, 20)
 })

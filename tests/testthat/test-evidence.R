@@ -11,7 +11,7 @@ test_that("a periodogram line is found at f0 with its amplitude and significance
   expect_equal(d$lines$f0[1], 0.5, tolerance = 0.01)
   expect_equal(d$lines$amp[1], 0.02, tolerance = 0.1)
   expect_lt(d$lines$p_value[1], 1e-10)
-  # matched within the periodogram's resolution (issue 9), no longer 25%
+  # matched within the periodogram's resolution, not a fixed 25%
   res <- attr(d$lines, "resolution")
   ev <- raw_evidence("sinusoid", list(f0 = 0.5 + res), d, x, 100)
   expect_true(ev$support)

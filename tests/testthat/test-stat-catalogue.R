@@ -5,7 +5,8 @@ test_that("no file of allan() and its helpers switches on statistic names", {
   dir <- testthat::test_path("..", "..", "R")
   skip_if_not(dir.exists(dir), "the R sources are not at hand")
   files <- file.path(dir, c("allan.R", "allan-types.R", "theo1-type.R",
-                            "taus.R", "edf.R", "dynamic.R"))
+                            "taus.R", "edf.R", "dynamic.R", "fit-weights.R",
+                            "hat.R"))
   files <- c(files, list.files(dir, "^stat-.*[.]R$", full.names = TRUE))
   expect_true(all(file.exists(files)))
   names <- stat_names()
@@ -28,6 +29,7 @@ test_that("no file of allan() and its helpers switches on statistic names", {
   expect_true(grepl(pats[1], "  switch(type, standard = 1)"))
   expect_true(grepl(pats[2], "if (type == \"theo1\") 1"))
   expect_true(grepl(pats[3], "type %in% c(\"mtie\", \"tierms\")"))
+  expect_true(grepl(pats[4], "identical(type, \"overlapping\")"))
 })
 
 test_that("every statistic of src/types.h has one entry, and back", {
