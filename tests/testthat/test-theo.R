@@ -110,3 +110,28 @@ test_that("the recurrence keeps its digits on long random-walk FM records", {
   ref <- theo1_all_cpp(x, FALSE, max(k), k)[k]
   expect_lt(max(abs(theo1_incr_cpp(x, FALSE, k, 2L) / ref - 1)), 1e-10)
 })
+
+test_that("Theo1 sums are the same bit for bit between calls and threads", {
+  # the edge sums of the recurrence were gathered per worker, in an order
+  # set by the threads' timing: two calls on 2 threads differed in the
+  # last bits (one run in five at N = 4000)
+  x <- theobr_sets(6001L, 29)$rwfm
+  k <- seq(32, 2000, by = 3)
+  a <- theo1_incr_cpp(x, FALSE, k, 2L)
+  for (i in 1:4) expect_identical(theo1_incr_cpp(x, FALSE, k, 2L), a)
+  expect_identical(theo1_incr_cpp(x, FALSE, k, 1L), a)
+  m <- c(2, 64, 1000, 4096)
+  s <- theo1_sums_cpp(x, FALSE, m, 2L)
+  expect_identical(theo1_sums_cpp(x, FALSE, m, 2L), s)
+  expect_identical(theo1_sums_cpp(x, FALSE, m, 1L), s)
+  on_threads <- function(nt, type) {
+    op <- options(allanvar.threads = nt)
+    on.exit(options(op))
+    allan(x, 1, type = type, input = "integrated")
+  }
+  for (type in c("theo1", "theobr", "theoh")) {
+    b <- on_threads(2L, type)
+    for (i in 1:2) expect_identical(on_threads(2L, type), b, label = type)
+    expect_identical(on_threads(1L, type), b, label = type)
+  }
+})
