@@ -208,7 +208,8 @@ allan_theoh_taus <- function(taus, freq, L) {
 # The further types (see allan()): `e` their entry. Arguments are checked
 # by allan().
 allan_extra <- function(x, freq, taus, e, input, conf, debias,
-                        gaps = "skip", ci = TRUE, unbiased = FALSE) {
+                        gaps = "skip", ci = TRUE, unbiased = FALSE,
+                        theo = e$theo) {
   rate <- input == "rate"
   type <- e$name
   ch <- allan_channels(x, min_n = if (rate) 2L else 3L)
@@ -247,7 +248,7 @@ allan_extra <- function(x, freq, taus, e, input, conf, debias,
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {
     d <- extra_channel(col(j), freq, m, grid$theo_row, e, rate, L, conf,
-                       debias, ci, unbiased)
+                       debias, ci, unbiased, theo)
     if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
     d$alpha <- d$alpha_
     d$alpha_ <- NULL
@@ -267,7 +268,7 @@ allan_extra <- function(x, freq, taus, e, input, conf, debias,
 # noise type is identified where the limits, the unbiased deviation or the
 # bias correction need it.
 extra_channel <- function(v, freq, m, theo_row, e, rate, L, conf, debias,
-                          ci = TRUE, unbiased = FALSE) {
+                          ci = TRUE, unbiased = FALSE, theo = e$theo) {
   input <- if (rate) "rate" else "integrated"
   limits <- ci && stat_has_limits(e)
   unbiased <- unbiased && e$unbiased
@@ -276,6 +277,7 @@ extra_channel <- function(v, freq, m, theo_row, e, rate, L, conf, debias,
               L = L, n = e$nterms(m, L, theo_row), conf = conf,
               debias = debias, ci = limits, unbiased = unbiased,
               input = input, entry = e, threads = allanvar_threads(),
+              theo = theo,
               sc_rate = if (rate) 1 else freq^2,   # fractional frequency
               sc_time = if (rate) 1 / freq^2 else 1,  # squared phase
               identify = function(mm) {
@@ -346,27 +348,4 @@ theo1_many <- function(v, rate, m, threads) {
   if (any(small)) T[small] <- theo1_sums_cpp(v, rate, m[small], threads)
   if (any(!small)) T[!small] <- theo1_incr_cpp(v, rate, m[!small] / 2, threads)
   T
-}
-
-# TheoBR's bias-removal factor (NIST SP 1065 eq. 33): the mean over
-# i = 0..n, n = floor(N/6 - 3), of AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),
-# two estimates at the same averaging time. Theo1 at every needed m comes
-# from theo1_many(), AVAR from the overlapping estimator. NA when the record
-# is too short (N < 19 phase points).
-theobr_factor <- function(v, freq, rate, L, threads = 1L) {
-  n <- floor(L / 6 - 3)
-  if (n < 0) return(NA_real_)
-  i <- 0:n
-  mt <- 12 + 4 * i
-  ma <- 9 + 3 * i
-  ok <- mt <= L - 1 & ma <= floor((L - 1) / 2)
-  if (!any(ok)) return(NA_real_)
-  mt <- mt[ok]
-  ma <- ma[ok]
-  T <- theo1_many(v, rate, mt, threads)
-  th <- T / (0.75 * (L - mt) * mt^2)
-  input <- if (rate) "rate" else "integrated"
-  a <- allan(v, 1, taus = I(ma), type = "overlapping", input = input,
-             ci = FALSE)
-  mean(a$avar / th)
 }

@@ -206,7 +206,7 @@
 #' allan(cbind(x = y, z = 2 * y), type = "modified", taus = "decade")
 allan <- function(x, freq, taus = "octave", type = "overlapping",
                   input = "rate", conf = 0.683, gaps = "skip",
-                  debias = TRUE, ci = TRUE, unbiased = FALSE) {
+                  debias = TRUE, ci = TRUE, unbiased = FALSE, theo = NULL) {
   check_present(missing(x), "x", "the samples")
   if (missing(freq)) {
     if (!stats::is.ts(x)) {
@@ -224,9 +224,10 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   debias <- check_true_false(debias, "debias")
   ci <- check_true_false(ci, "ci")
   unbiased <- check_true_false(unbiased, "unbiased")
+  theo <- check_theo(theo, e)
   if (!identical(e$kernel, "sums")) {
     return(allan_extra(x, freq, taus, e, input, conf, debias, gaps, ci,
-                       unbiased))
+                       unbiased, theo))
   }
   ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)
   N <- ch$N
