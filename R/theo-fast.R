@@ -31,7 +31,8 @@ theo_defaults <- function() {
 }
 
 # `theo` of allan(): NULL or a list of some of ladder ("N/6", "N/30"),
-# method ("auto", "exact", "fast"); the entry's defaults fill the rest.
+# method ("auto", "exact", "fast"), fast_points (the averaged phase's
+# length, a whole number >= 64); the entry's defaults fill the rest.
 check_theo <- function(theo, e) {
   if (is.null(theo)) return(e$theo)
   if (is.null(e$theo)) {
@@ -39,9 +40,10 @@ check_theo <- function(theo, e) {
           e$name, "\".", class = "argument")
   }
   if (!is.list(theo) || (length(theo) && is.null(names(theo))) ||
-      !all(names(theo) %in% c("ladder", "method"))) {
-    abort("`theo` must be NULL or a list with `ladder` and/or `method`, not ",
-          describe_type(theo), ".", class = "argument")
+      !all(names(theo) %in% c("ladder", "method", "fast_points"))) {
+    abort("`theo` must be NULL or a list with some of `ladder`, `method` ",
+          "and `fast_points`, not ", describe_type(theo), ".",
+          class = "argument")
   }
   o <- e$theo
   if (!is.null(theo$ladder)) {
@@ -50,6 +52,15 @@ check_theo <- function(theo, e) {
   if (!is.null(theo$method)) {
     o$method <- check_choice(theo$method, c("auto", "exact", "fast"),
                              "theo$method")
+  }
+  if (!is.null(theo$fast_points)) {
+    p <- theo$fast_points
+    if (!is.numeric(p) || length(p) != 1L || !is.finite(p) || p < 64 ||
+        p != round(p)) {
+      abort("`theo$fast_points` must be a whole number >= 64, not ",
+            format_value(p), ".", class = "argument")
+    }
+    o$fast_points <- p
   }
   o
 }
