@@ -18,8 +18,7 @@
 # the averaged one, computed here from the noise type's generalized
 # covariance (the averaging is a box filter; white FM K(s) = -|s|/2,
 # flicker FM s^2 log|s| / 2, random-walk FM |s|^3 / 12, each up to a
-# scale). The type is the one identified at the ladder's middle averaging
-# time. (Taylor & Howe's own correction formula was not at hand; this one
+# scale). The type is the one identified most often along the ladder. (Taylor & Howe's own correction formula was not at hand; this one
 # follows the same idea from first principles.) The Theo1 values
 # themselves stay exact on the full record: only the factor is estimated.
 
@@ -179,9 +178,22 @@ theobr_kernel_factor <- function(ctx) {
            " phase points, ", L, " here); `theo = list(method = \"exact\")` ",
            "for the exact factor.", class = "theo_fast")
   }
-  # the noise type at the middle of the ladder, for the correction
-  n <- theobr_ladder_n(L, o$ladder)
-  mid <- 9 + 3 * floor(max(n, 0) / 2)
-  alpha <- extra_alpha(ctx$v, ctx$freq, mid, "overlapping", ctx$input, L)
+  alpha <- theobr_ladder_alpha(ctx$v, ctx$freq, ctx$input, L, o$ladder)
   theobr_factor_fast(ctx$v, ctx$rate, L, r, alpha, ctx$threads, o$ladder)
+}
+
+# The noise type of the ladder, for the fast factor's correction: the most
+# frequent of the types identified at five averaging factors spaced
+# geometrically over the ladder (ties: the longer tau); the identification
+# fails (NA) at the ladder's long end, where few averages remain. NA when
+# none is read.
+theobr_ladder_alpha <- function(v, freq, input, L, ladder = "N/6") {
+  n <- theobr_ladder_n(L, ladder)
+  m <- unique(round(exp(seq(log(9), log(9 + 3 * max(n, 0)), length.out = 5))))
+  a <- extra_alpha(v, freq, m, "overlapping", input, L)
+  a <- rev(a[!is.na(a)])
+  if (!length(a)) return(NA_integer_)
+  tab <- table(a)
+  top <- names(tab)[tab == max(tab)]
+  a[match(TRUE, as.character(a) %in% top)]
 }

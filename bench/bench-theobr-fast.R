@@ -9,9 +9,10 @@
 #     rate input, octave taus, 2 threads: the fast path (the default above
 #     1e5 phase points) and the exact one; one run each (exact at 1e6 takes
 #     minutes), elapsed and user+system CPU.
-#   Rscript bench/bench-theobr-fast.R [reps]
+#   Rscript bench/bench-theobr-fast.R [reps] [part: both, error, speed]
 args <- commandArgs(TRUE)
 reps <- if (length(args)) as.integer(args[1]) else 3L
+part <- if (length(args) > 1L) args[2] else "both"
 source("bench/common.R")
 bench_install()
 options(allanvar.threads = 2L)
@@ -30,15 +31,14 @@ gens <- list("white PM" = function(N) rnorm(N),
              "flicker FM" = function(N) cumsum(flicker(N)),
              "random-walk FM" = function(N) cumsum(cumsum(rnorm(N))))
 
+if (part %in% c("both", "error")) {
 rows <- list()
 set.seed(2029)
 for (N in c(1e4, 3e4, 1e5)) for (nm in names(gens)) {
   e <- vapply(seq_len(reps), function(i) {
     x <- gens[[nm]](N)
     ex <- ns$theobr_factor(x, 1, FALSE, N, 2L)
-    n <- ns$theobr_ladder_n(N)
-    al <- ns$extra_alpha(x, 1, 9 + 3 * floor(n / 2), "overlapping",
-                         "integrated", N)
+    al <- ns$theobr_ladder_alpha(x, 1, "integrated", N)
     f4 <- ns$theobr_factor_fast(x, FALSE, N, 4L, al, 2L)
     f16 <- ns$theobr_factor_fast(x, FALSE, N, 16L, al, 2L)
     u16 <- ns$theobr_factor_fast(x, FALSE, N, 16L, NA, 2L)
@@ -53,7 +53,8 @@ for (N in c(1e4, 3e4, 1e5)) for (nm in names(gens)) {
 cat("\nTheoBR deviation, fast vs exact: error in % (mean (sd) of", reps,
     "records)\n")
 print(do.call(rbind, rows), row.names = FALSE)
-
+}
+if (part %in% c("both", "speed")) {
 tm <- list()
 set.seed(1)
 for (N in c(1e5, 1e6)) {
@@ -72,3 +73,4 @@ for (N in c(1e5, 1e6)) {
 }
 cat("\nallan(type = \"theobr\" / \"theoh\"), white FM, octave taus, 2 threads\n")
 print(do.call(rbind, tm), row.names = FALSE)
+}
