@@ -37,7 +37,7 @@
 #'   variance to \eqn{\tau = 0.75 (L-1)\tau_0} without a noise model
 #'   (Howe & Tasset 2004; as Stable32). Above \eqn{10^5} phase points the
 #'   factor comes by default from the phase averaged over blocks of
-#'   \eqn{r} points (\eqn{L/r \le 32768}; Taylor & Howe's "Fast ThêoBR"),
+#'   \eqn{r} points (\eqn{L/r \le 32768}; Taylor & Howe's "Fast TheoBR"),
 #'   times the ratio of the factor's expected values on the full and on the
 #'   averaged ladder for the noise type identified along the ladder
 #'   (from the type's generalized covariance: white and flicker PM, white,

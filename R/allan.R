@@ -199,7 +199,7 @@
 #'     the phase averaged over blocks of \eqn{r = \lceil L /
 #'     \mathrm{fast\_points} \rceil} points, with a correction for the
 #'     noise type identified along the ladder (Taylor & Howe, "Fast
-#'     ThêoBR", IEEE TUFFC 57(9), 2010; see "Further statistics");
+#'     TheoBR", IEEE TUFFC 57(9), 2010; see "Further statistics");
 #'   * `fast_points`: the length the averaged phase keeps (default 32768).
 #'
 #'   The Theo1 values themselves are exact on either path.

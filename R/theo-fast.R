@@ -10,7 +10,7 @@
 # calculations). The exact factor costs O(N log^2 N + kmax^2) with kmax ~
 # N/3 (N/6 ladder): minutes at 1e6.
 #
-# The fast path (Taylor & Howe, "Fast ThêoBR", IEEE TUFFC 57(9), 2010:
+# The fast path (Taylor & Howe, "Fast TheoBR", IEEE TUFFC 57(9), 2010:
 # average the phase before the ladder) takes the factor from the phase
 # averaged over blocks of r points, N' = floor(N/r) <= `fast_points`, with
 # the ladder on N', times a correction for the FM noise types: the ratio of
