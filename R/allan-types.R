@@ -32,9 +32,19 @@
 #'   \eqn{(L - m) m / 2}.
 #' * `"theobr"`: Theo1 times TheoBR's bias-removal factor (SP 1065 eq. 33),
 #'   the mean of \eqn{\mathrm{AVAR}(9 + 3i) / \mathrm{Theo1}(12 + 4i)} over
-#'   \eqn{i = 0, \dots, \lfloor L/6 - 3 \rfloor}: an estimate of the Allan
+#'   \eqn{i = 0, \dots, \lfloor L/6 - 3 \rfloor} (or \eqn{\lfloor 0.1 L/3 -
+#'   3 \rfloor}: `theo = list(ladder = "N/30")`): an estimate of the Allan
 #'   variance to \eqn{\tau = 0.75 (L-1)\tau_0} without a noise model
-#'   (Howe & Tasset 2004; as Stable32).
+#'   (Howe & Tasset 2004; as Stable32). Above \eqn{10^5} phase points the
+#'   factor comes by default from the phase averaged over blocks of
+#'   \eqn{r} points (\eqn{L/r \le 32768}; Taylor & Howe's "Fast TheoBR"),
+#'   times the ratio of the factor's expected values on the full and on the
+#'   averaged ladder for the noise type identified along the ladder
+#'   (from the type's generalized covariance: white and flicker PM, white,
+#'   flicker and random-walk FM). Measured against the exact factor (bench/
+#'   README.md) the deviation differs by well under 1\% for each pure
+#'   noise type; a record whose noise type changes along the ladder gets
+#'   the correction of one type only.
 #' * `"theoh"`: the hybrid of SP 1065 sec. 5.2.17: the overlapping Allan
 #'   deviation at \eqn{m \le 0.2 (L - 1)}, then TheoBR at the even \eqn{m}
 #'   whose \eqn{0.75 m} exceeds the last Allan \eqn{m} (so the `tau` column
@@ -111,8 +121,9 @@
 #' (structure functions by FFT of locally detrended blocks, the pairs near
 #' the ends of the record added as \eqn{m} grows; \eqn{O(L \log^2 L +
 #' m_{max}^2)}, agreeing with the definition to about \eqn{10^{-11}}), so
-#' `"theobr"` and `"theoh"` take seconds at \eqn{10^5} samples and minutes
-#' at \eqn{10^6}.
+#' the exact `"theobr"` and `"theoh"` take seconds at \eqn{10^5} samples and
+#' minutes at \eqn{10^6}; the fast factor (the default above \eqn{10^5}
+#' phase points) takes seconds at \eqn{10^6}.
 #' @param debias For `"mtotdev"`, `"ttotdev"`, `"htotdev"` and `"theo1"`:
 #'   apply NIST SP 1065's noise-dependent bias correction (default `TRUE`);
 #'   see "Further statistics". Ignored by the other types.
@@ -123,6 +134,11 @@
 #' allan(x, 1, type = "tdev", input = "integrated")
 #' allan(x, 1, type = "mtie", input = "integrated")
 #' allan(x, 1, type = "theo1", input = "integrated", taus = "decade")
+#' # TheoBR with Howe's shorter ladder; the fast factor asked for explicitly
+#' allan(x, 1, type = "theobr", input = "integrated", taus = "decade",
+#'       theo = list(ladder = "N/30"))
+#' allan(x, 1, type = "theobr", input = "integrated", taus = "decade",
+#'       theo = list(method = "fast", fast_points = 500))
 NULL
 
 # A single TRUE or FALSE.
@@ -208,7 +224,8 @@ allan_theoh_taus <- function(taus, freq, L) {
 # The further types (see allan()): `e` their entry. Arguments are checked
 # by allan().
 allan_extra <- function(x, freq, taus, e, input, conf, debias,
-                        gaps = "skip", ci = TRUE, unbiased = FALSE) {
+                        gaps = "skip", ci = TRUE, unbiased = FALSE,
+                        theo = e$theo) {
   rate <- input == "rate"
   type <- e$name
   ch <- allan_channels(x, min_n = if (rate) 2L else 3L)
@@ -247,7 +264,7 @@ allan_extra <- function(x, freq, taus, e, input, conf, debias,
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {
     d <- extra_channel(col(j), freq, m, grid$theo_row, e, rate, L, conf,
-                       debias, ci, unbiased)
+                       debias, ci, unbiased, theo)
     if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
     d$alpha <- d$alpha_
     d$alpha_ <- NULL
@@ -267,7 +284,7 @@ allan_extra <- function(x, freq, taus, e, input, conf, debias,
 # noise type is identified where the limits, the unbiased deviation or the
 # bias correction need it.
 extra_channel <- function(v, freq, m, theo_row, e, rate, L, conf, debias,
-                          ci = TRUE, unbiased = FALSE) {
+                          ci = TRUE, unbiased = FALSE, theo = e$theo) {
   input <- if (rate) "rate" else "integrated"
   limits <- ci && stat_has_limits(e)
   unbiased <- unbiased && e$unbiased
@@ -276,6 +293,7 @@ extra_channel <- function(v, freq, m, theo_row, e, rate, L, conf, debias,
               L = L, n = e$nterms(m, L, theo_row), conf = conf,
               debias = debias, ci = limits, unbiased = unbiased,
               input = input, entry = e, threads = allanvar_threads(),
+              theo = theo,
               sc_rate = if (rate) 1 else freq^2,   # fractional frequency
               sc_time = if (rate) 1 / freq^2 else 1,  # squared phase
               identify = function(mm) {
@@ -346,27 +364,4 @@ theo1_many <- function(v, rate, m, threads) {
   if (any(small)) T[small] <- theo1_sums_cpp(v, rate, m[small], threads)
   if (any(!small)) T[!small] <- theo1_incr_cpp(v, rate, m[!small] / 2, threads)
   T
-}
-
-# TheoBR's bias-removal factor (NIST SP 1065 eq. 33): the mean over
-# i = 0..n, n = floor(N/6 - 3), of AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i),
-# two estimates at the same averaging time. Theo1 at every needed m comes
-# from theo1_many(), AVAR from the overlapping estimator. NA when the record
-# is too short (N < 19 phase points).
-theobr_factor <- function(v, freq, rate, L, threads = 1L) {
-  n <- floor(L / 6 - 3)
-  if (n < 0) return(NA_real_)
-  i <- 0:n
-  mt <- 12 + 4 * i
-  ma <- 9 + 3 * i
-  ok <- mt <= L - 1 & ma <= floor((L - 1) / 2)
-  if (!any(ok)) return(NA_real_)
-  mt <- mt[ok]
-  ma <- ma[ok]
-  T <- theo1_many(v, rate, mt, threads)
-  th <- T / (0.75 * (L - mt) * mt^2)
-  input <- if (rate) "rate" else "integrated"
-  a <- allan(v, 1, taus = I(ma), type = "overlapping", input = input,
-             ci = FALSE)
-  mean(a$avar / th)
 }

@@ -186,6 +186,23 @@
 #'   (scaling them too would lower their coverage). Needs the EDF, so the
 #'   noise type is identified even with `ci = FALSE`. Statistics without an
 #'   EDF (`"mtie"`, `"tierms"`) ignore it.
+#' @param theo For `"theobr"` and `"theoh"` only: `NULL` (default) or a
+#'   list of some of
+#'   * `ladder`: the length of TheoBR's bias-factor ladder, `"N/6"`
+#'     (default; \eqn{n = \lfloor L/6 - 3 \rfloor}, Stable32's Run and
+#'     Plot) or `"N/30"` (\eqn{n = \lfloor 0.1 L/3 - 3 \rfloor}, Howe's
+#'     TheoH papers, Riley's TheoBR code, Stable32's "Sigma" calculations;
+#'     it leaves out the Allan variances at the fewest averages);
+#'   * `method`: `"auto"` (default: the exact factor up to
+#'     \eqn{10^5} phase points, the fast one above, with a message of class
+#'     `allanvar_message_theo_fast`), `"exact"` or `"fast"`: the factor from
+#'     the phase averaged over blocks of \eqn{r = \lceil L /
+#'     \mathrm{fast\_points} \rceil} points, with a correction for the
+#'     noise type identified along the ladder (Taylor & Howe, "Fast
+#'     TheoBR", IEEE TUFFC 57(9), 2010; see "Further statistics");
+#'   * `fast_points`: the length the averaged phase keeps (default 32768).
+#'
+#'   The Theo1 values themselves are exact on either path.
 #' @return A data frame of class `c("allan", "data.frame")` with columns
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
 #'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
@@ -206,7 +223,7 @@
 #' allan(cbind(x = y, z = 2 * y), type = "modified", taus = "decade")
 allan <- function(x, freq, taus = "octave", type = "overlapping",
                   input = "rate", conf = 0.683, gaps = "skip",
-                  debias = TRUE, ci = TRUE, unbiased = FALSE) {
+                  debias = TRUE, ci = TRUE, unbiased = FALSE, theo = NULL) {
   check_present(missing(x), "x", "the samples")
   if (missing(freq)) {
     if (!stats::is.ts(x)) {
@@ -224,9 +241,10 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   debias <- check_true_false(debias, "debias")
   ci <- check_true_false(ci, "ci")
   unbiased <- check_true_false(unbiased, "unbiased")
+  theo <- check_theo(theo, e)
   if (!identical(e$kernel, "sums")) {
     return(allan_extra(x, freq, taus, e, input, conf, debias, gaps, ci,
-                       unbiased))
+                       unbiased, theo))
   }
   ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)
   N <- ch$N

@@ -14,7 +14,7 @@
 #   kernel      "sums": the Allan-family sums kernel (src/allan.cpp) with
 #                 `divisor`; or function(ctx) for a statistic with a kernel
 #                 of its own (ctx: v, freq, m, theo_row, rate, L, n, conf,
-#                 debias, input, threads), returning list(av, alpha, edf)
+#                 debias, input, threads, theo), returning list(av, alpha, edf)
 #                 and optionally n, adev, and `limits` (list(rows, lower,
 #                 upper): intervals the kernel computed itself)
 #   divisor(m)  the estimator's divisor per term (times the number of
@@ -49,6 +49,9 @@
 #   variance    whether the statistic is a variance (a deviation squared),
 #                 so that sums and differences of it mean something (the
 #                 three-cornered hat); FALSE for the time interval errors
+#   theo        TheoBR's bias-factor options, the defaults of allan()'s
+#                 `theo` (ladder, method, fast_above, fast_points;
+#                 R/theo-fast.R), or NULL: `theo` does not apply
 #   title       what the deviation column holds, for print()'s header
 #   ylab        plot()'s y-axis label
 
@@ -98,14 +101,14 @@ new_stat <- function(name, title, ylab, max_m, nterms, kernel = "sums",
                      aliases = character(),
                      edf_fallback = function(m, n, L) n,
                      octave_pass = FALSE, min_points = 3L,
-                     exact_ci = FALSE, variance = TRUE) {
+                     exact_ci = FALSE, variance = TRUE, theo = NULL) {
   list(name = name, title = title, ylab = ylab, max_m = max_m,
        nterms = nterms, kernel = kernel, divisor = divisor, taus = taus,
        edf = edf, alpha_range = as.integer(alpha_range), id_base = id_base,
        noise_id = noise_id, debias = debias, unbiased = unbiased, gaps = gaps,
        aliases = aliases, edf_fallback = edf_fallback,
        octave_pass = octave_pass, min_points = min_points,
-       exact_ci = exact_ci, variance = variance)
+       exact_ci = exact_ci, variance = variance, theo = theo)
 }
 
 validate_stat <- function(e) {

@@ -46,14 +46,14 @@ stats_further <- function() {
     further("theobr", "bias-removed Theo1 deviation (TheoBR)",
             max_m = function(L) L - 1, nterms = theo_n,
             taus = stat_taus_theo, kernel = kernel_theo(own_type = FALSE),
-            edf = "theo1", id_base = "overlapping"),
+            edf = "theo1", id_base = "overlapping", theo = theo_defaults()),
     further("theoh", "TheoH deviation (Allan, then TheoBR)",
             max_m = function(L) L - 1,
             nterms = function(m, L, theo_row) {
               ifelse(theo_row, (L - m) * m / 2, L - 2 * m)
             },
             taus = stat_taus_theoh, kernel = kernel_theo(own_type = FALSE),
-            edf = "theo1", id_base = "overlapping"),
+            edf = "theo1", id_base = "overlapping", theo = theo_defaults()),
     further("mtie", "maximum time interval error MTIE", time = TRUE,
             max_m = function(L) L - 1,
             nterms = function(m, L, theo_row = NULL) L - m,
@@ -225,7 +225,7 @@ kernel_theo <- function(own_type) {
           t1 <- t1 * debias_factor(ctx$entry$name, alpha[theo_row], mt)
         }
       } else {
-        kf <- theobr_factor(ctx$v, ctx$freq, ctx$rate, L, ctx$threads)
+        kf <- theobr_kernel_factor(ctx)
         if (!is.finite(kf)) {
           abort("TheoBR needs at least 19 phase points (", L, " given).",
                 class = "argument")

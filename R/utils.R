@@ -50,6 +50,15 @@ warn <- function(..., class = NULL, call = user_call(), data = list()) {
                     class = cls))
 }
 
+# Messages likewise: c("allanvar_message_<class>", "allanvar_message",
+# "message", "condition"); suppressMessages() and classed handlers see them.
+inform <- function(..., class = NULL) {
+  cls <- c(if (length(class)) paste0("allanvar_message_", class),
+           "allanvar_message", "message", "condition")
+  message(structure(list(message = paste0(..., "\n"), call = NULL),
+                    class = cls))
+}
+
 # The user's call: the outermost frame running a function of this package
 # (the exported function or S3 method the user called), or NULL.
 user_call <- function() {

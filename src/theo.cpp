@@ -678,7 +678,12 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
   // above N - k. Each grows by O(k) pairs from k to k + 1. Their weighted
   // sums at the needed k are formed by items over ranges of lags (of d),
   // each item stepping k from 0 to kmax on its own range: no item waits for
-  // another, and the partial sums meet in per-worker compensated totals.
+  // another. The items and their kGroups groups (item j in group j mod
+  // kGroups, run in order by one worker, summed in compensated totals per
+  // group, the groups added in order) depend on N and the k only, never on
+  // the threads or their timing: the result is the same bit for bit on any
+  // number of threads (per-worker totals differed in the last bits between
+  // calls).
   std::vector<double> sfe(kmax + 1, 0.0), inv(kmax + 1, 0.0);
   for (R_xlen_t d = 1; d <= kmax; ++d) {
     sfe[d] = sf[2 * d];
@@ -701,8 +706,7 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
     // on; of d: 2 per step from k = d on
     const double kd = static_cast<double>(kmax);
     const double total = 5.0 * kd * kd;
-    const int nthr = std::max(1, threads);
-    const double pieces = std::max(2.0 * nthr, std::min(512.0, total / 3.3e7));
+    const double pieces = std::max(32.0, std::min(512.0, total / 3.3e7));
     const double per = total / pieces;
     double w = 0;
     R_xlen_t a = 1;
@@ -726,13 +730,15 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
     }
   }
   const int nthr = std::max(1, threads);
-  std::vector<allanvar::TauSums> edge(nthr, allanvar::TauSums(ks.size()));
+  const R_xlen_t kGroups = 8;
+  std::vector<allanvar::TauSums> edge(kGroups, allanvar::TauSums(ks.size()));
   const double* h = X.h.data();
   const double* l = X.l.data();
   const double* rh = X.rh.data();
   const double* rl = X.rl.data();
-  allanvar::parallel_for(static_cast<R_xlen_t>(items.size()), nthr,
-                         [&](R_xlen_t it, int worker) {
+  const R_xlen_t nitems = static_cast<R_xlen_t>(items.size());
+  // item `it` into the totals of group `worker`
+  auto run_item = [&](R_xlen_t it, R_xlen_t worker) {
     const EdgeItem I = items[it];
     std::vector<double> v(I.b - I.a, 0.0);
     double* t = v.data() - I.a;  // t[lag]
@@ -828,6 +834,12 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
         edge[worker].add(static_cast<size_t>(slot[kk]), acc);
       }
     }
+  };
+  allanvar::parallel_for(kGroups, nthr, [&](R_xlen_t grp, int) {
+    for (R_xlen_t it = grp; it < nitems; it += kGroups) {
+      if (allanvar::interrupted()) return;
+      run_item(it, grp);
+    }
   });
   scope.finish();
   std::vector<DD> harm(kmax + 1);  // harmonic numbers
@@ -837,7 +849,7 @@ Rcpp::NumericVector theo1_incr_cpp(const Rcpp::NumericVector& v, bool rate,
     double p, e;
     allanvar::dd_two_prod(-harm[ks[i]].value(), sf[2 * ks[i]], p, e);
     DD T(p, e);
-    for (int w = 0; w < nthr; ++w) T += DD(edge[w].value(i));
+    for (R_xlen_t w = 0; w < kGroups; ++w) T += DD(edge[w].value(i));
     if (X.c != 0) T += quad_part(ks[i]);
     for (R_xlen_t j : where[ks[i]]) out[j] = T.value();
   }

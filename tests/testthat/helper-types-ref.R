@@ -73,9 +73,7 @@ ref_oavar <- function(x, m) {
   sum(d^2) / (2 * (N - 2 * m) * m^2)
 }
 
-ref_theobr_factor <- function(x) {
-  N <- length(x)
-  n <- floor(N / 6 - 3)
+ref_theobr_factor <- function(x, n = floor(length(x) / 6 - 3)) {
   mean(vapply(0:n, function(i) ref_oavar(x, 9 + 3 * i) / ref_theo1(x, 12 + 4 * i),
               0))
 }

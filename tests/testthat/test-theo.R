@@ -110,3 +110,133 @@ test_that("the recurrence keeps its digits on long random-walk FM records", {
   ref <- theo1_all_cpp(x, FALSE, max(k), k)[k]
   expect_lt(max(abs(theo1_incr_cpp(x, FALSE, k, 2L) / ref - 1)), 1e-10)
 })
+
+test_that("Theo1 sums are the same bit for bit between calls and threads", {
+  # the edge sums of the recurrence were gathered per worker, in an order
+  # set by the threads' timing: two calls on 2 threads differed in the
+  # last bits (one run in five at N = 4000)
+  x <- theobr_sets(6001L, 29)$rwfm
+  k <- seq(32, 2000, by = 3)
+  a <- theo1_incr_cpp(x, FALSE, k, 2L)
+  for (i in 1:4) expect_identical(theo1_incr_cpp(x, FALSE, k, 2L), a)
+  expect_identical(theo1_incr_cpp(x, FALSE, k, 1L), a)
+  m <- c(2, 64, 1000, 4096)
+  s <- theo1_sums_cpp(x, FALSE, m, 2L)
+  expect_identical(theo1_sums_cpp(x, FALSE, m, 2L), s)
+  expect_identical(theo1_sums_cpp(x, FALSE, m, 1L), s)
+  on_threads <- function(nt, type) {
+    op <- options(allanvar.threads = nt)
+    on.exit(options(op))
+    allan(x, 1, type = type, input = "integrated")
+  }
+  for (type in c("theo1", "theobr", "theoh")) {
+    b <- on_threads(2L, type)
+    for (i in 1:2) expect_identical(on_threads(2L, type), b, label = type)
+    expect_identical(on_threads(1L, type), b, label = type)
+  }
+})
+
+test_that("the ladder N/30 is floor(0.1 N / 3 - 3) rungs", {
+  for (N in c(301L, 800L)) {
+    x <- theobr_sets(N, N)$rwfm
+    kf <- theobr_factor(x, 1, FALSE, N, 2L, ladder = "N/30")
+    expect_lt(abs(kf / ref_theobr_factor(x, floor(0.1 * N / 3 - 3)) - 1),
+              1e-10, label = N)
+  }
+})
+
+test_that("the fast path's expectations hold against dense covariances", {
+  # white FM: Theo1 is unbiased for AVAR, the ladder's ratio is 1 exactly
+  expect_equal(theo_ladder_ratio(function(s) abs(s), 40), 1, tolerance = 1e-13)
+  # AVAR of the phase averaged by r, from the box-filtered generalized
+  # covariance, against the quadratic form on the covariance matrix of the
+  # discrete noise: white PM, Kasdin's flicker PM, white FM (cumsum)
+  r <- 3L
+  nb <- 14L
+  n <- nb * r
+  # flicker PM: Kasdin's filter started P = 2e6 samples before the record
+  # (its increments become stationary as P grows; the rest is ~1e-6)
+  P <- 2e6
+  h <- cumprod(c(1, (seq_len(P + n) - 0.5) / seq_len(P + n)))
+  fl <- matrix(0, n, n)
+  for (d in 0:(n - 1)) {
+    cs <- cumsum(h[1:(P + n - d)] * h[(1 + d):(P + n)])
+    for (i in 1:(n - d)) fl[i, i + d] <- fl[i + d, i] <- cs[P + i]
+  }
+  covs <- list("2" = diag(n), "1" = fl,
+               "0" = outer(seq_len(n), seq_len(n), pmin))
+  B <- kronecker(diag(nb), matrix(1 / r, 1, r))  # the block means
+  for (a in names(covs)) {
+    K <- theo_gcov(as.integer(a))
+    u <- seq(-(r - 1), r - 1)
+    w <- (r - abs(u)) / r^2
+    Kr <- function(t) vapply(t, function(tt) sum(w * K(tt + u)), 0)
+    Dr <- function(s) 2 * (Kr(0) - Kr(r * s))
+    for (M in c(1L, 3L, 6L)) {
+      st <- numeric(nb)
+      st[c(1, 1 + M, 1 + 2 * M)] <- c(1, -2, 1)
+      dense <- drop(t(st) %*% B %*% covs[[a]] %*% t(B) %*% st)
+      expect_equal(4 * Dr(M) - Dr(2 * M), dense, tolerance = 1e-5,
+                   label = paste(a, M))
+    }
+  }
+})
+
+test_that("the fast factor is within 1% of the exact one for each noise type", {
+  skip_on_cran()
+  N <- 20000L
+  set.seed(29)
+  flick <- function(N) {
+    h <- cumprod(c(1, (seq_len(N - 1) - 0.5) / seq_len(N - 1)))
+    Re(stats::fft(stats::fft(c(h, numeric(N))) *
+                    stats::fft(c(rnorm(N), numeric(N))), inverse = TRUE))[
+      seq_len(N)] / (2 * N)
+  }
+  sets <- list("2" = rnorm(N), "1" = flick(N), "0" = cumsum(rnorm(N)),
+               "-1" = cumsum(flick(N)), "-2" = cumsum(cumsum(rnorm(N))))
+  for (a in names(sets)) {
+    x <- sets[[a]]
+    ex <- theobr_factor(x, 1, FALSE, N, 2L)
+    fast <- theobr_factor_fast(x, FALSE, N, 4L, as.integer(a), 2L)
+    expect_lt(abs(sqrt(fast / ex) - 1), 0.01, label = a)
+    if (a == "2") {
+      # without the correction, averaging white PM lowers it by 10%
+      raw <- theobr_factor_fast(x, FALSE, N, 4L, NA, 2L)
+      expect_gt(abs(sqrt(raw / ex) - 1), 0.05)
+    }
+  }
+  # allan() takes it when asked, the Theo1 values unchanged
+  a <- allan(sets[["0"]], 1, type = "theobr", input = "integrated",
+             taus = "decade")
+  b <- allan(sets[["0"]], 1, type = "theobr", input = "integrated",
+             taus = "decade", theo = list(method = "fast", fast_points = 5000))
+  k <- b$avar / a$avar
+  expect_equal(k, rep(k[1], length(k)), tolerance = 1e-12)
+  expect_lt(abs(sqrt(k[1]) - 1), 0.01)
+})
+
+test_that("above 1e5 phase points the fast factor is chosen, with a message", {
+  skip_on_cran()
+  set.seed(5)
+  y <- rnorm(1e5 + 10)
+  expect_snapshot(a <- allan(y, 1, type = "theoh", taus = "decade"))
+  expect_message(allan(y, 1, type = "theobr", taus = "decade"),
+                 class = "allanvar_message_theo_fast")
+  expect_no_message(allan(y[1:5000], 1, type = "theobr", taus = "decade"))
+})
+
+test_that("bad `theo` gives classed errors", {
+  y <- rnorm(200)
+  expect_error(allan(y, 1, type = "theobr", theo = list(ladder = "N/7")),
+               class = "allanvar_error_argument")
+  expect_error(allan(y, 1, type = "theobr", theo = list(method = "quick")),
+               class = "allanvar_error_argument")
+  expect_error(allan(y, 1, type = "theobr", theo = list(fast_points = 10)),
+               class = "allanvar_error_argument")
+  expect_error(allan(y, 1, type = "theobr", theo = list(speed = 1)),
+               class = "allanvar_error_argument")
+  expect_error(allan(y, 1, type = "theobr", theo = "fast"),
+               class = "allanvar_error_argument")
+  expect_error(allan(y, 1, type = "theo1", theo = list(method = "fast")),
+               class = "allanvar_error_argument")
+})
