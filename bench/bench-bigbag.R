@@ -208,7 +208,7 @@ write_big_mcap <- function(file, compression) {
   head <- c(as.raw(c(0x89, 0x4d, 0x43, 0x41, 0x50, 0x30, 0x0d, 0x0a)),
             mcap_rec(1, c(str32("ros2"), str32("allanvar bench"))), schema, chans)
   writeBin(head, con)
-  pos <- length(head)
+  pos <- as.numeric(length(head))  # double: offsets pass 2^31
   tmpls <- make_templates("cdr")
   idx <- vector("list", n_chunks)
   comp_name <- if (compression == "none") "" else compression
