@@ -345,6 +345,8 @@ Rcpp::List mcap_read_cpp(std::string path, const Rcpp::NumericVector& pos,
         fault = fault_list(pos[k], "a record runs past the end of the file");
         break;
       }
+      // The next chunk read ahead by the kernel while this one is decoded.
+      if (k + 1 < pos.size()) f.will_need(static_cast<std::uint64_t>(pos[k + 1]), len + 4096);
       try {
         if (b[0] == 0x06) chunk(c.data(), c.size(), raw, s); else s.message(c.data(), c.size());
       } catch (const format_error& e) {

@@ -172,32 +172,40 @@ Rcpp::NumericMatrix as_matrix(const std::vector<double>& v) {
   return m;
 }
 
-// Reads and decodes the chunk record `r` (already read up to its data).
-// Returns 0, or 2 for a bz2 chunk (left to R), and throws format_error.
+// Reads and decodes the chunk record `r` (already read up to its data);
+// `next`: where the records after it start. Returns 0, or 2 for a bz2
+// chunk (left to R), and throws format_error. A chunk of length 0 and
+// size 0 is one rosbag was writing when the recording stopped (it writes
+// the lengths when it closes the chunk): its message records follow it in
+// the file, read up to the first record of another kind or the end.
 int read_chunk(FileReader& f, const file_record& r, std::vector<unsigned char>& comp,
-               std::vector<unsigned char>& raw, sink& s) {
+               std::vector<unsigned char>& raw, sink& s, std::uint64_t* next = nullptr) {
   const std::string c = field_str(r.hdr.data(), r.hdr.size(), "compression");
   std::uint32_t size = 0;
   field_u32(r.hdr.data(), r.hdr.size(), "size", &size);
   if (c == "bz2") return 2;
   if (c != "none" && c != "lz4") throw format_error("chunks compressed with \"" + c + "\" (none, bz2 and lz4 are read)");
+  if (next) *next = r.end;
   if (c == "none") {
     // Uncompressed: the records walked in the file, the data of other
     // topics (camera images) skipped, never read.
+    const bool open = r.data_len == 0 && size == 0;
+    const std::uint64_t end = open ? f.size() : r.end;
     std::uint64_t i = r.data;
     unsigned char b[4];
     std::vector<unsigned char> h, d;
-    while (i < r.end) {
-      if (r.end - i < 8 || !f.read(i, 4, b)) throw format_error("a record cut off inside a chunk");
+    while (i < end) {
+      if (end - i < 8 || !f.read(i, 4, b)) throw format_error("a record cut off inside a chunk");
       const std::uint64_t hl = rd_u32(b);
-      if (hl > r.end - i - 8) throw format_error("a record header cut off inside a chunk");
+      if (hl > end - i - 8) throw format_error("a record header cut off inside a chunk");
       if (!f.read(i + 4, static_cast<std::size_t>(hl), h) || !f.read(i + 4 + hl, 4, b)) {
         throw format_error("a record cut off inside a chunk");
       }
       const std::uint64_t dl = rd_u32(b);
       const std::uint64_t at = i + 8 + hl;
-      if (dl > r.end - at) throw format_error("a record runs past its chunk");
       const int op = field_op(h.data(), h.size());
+      if (open && op != 2 && op != 7) break;  // the next chunk, or the index
+      if (dl > end - at) throw format_error("a record runs past its chunk");
       bool want = op == 7 && s.want_conns;
       std::uint32_t conn = 0;
       if (op == 2) {
@@ -221,9 +229,13 @@ int read_chunk(FileReader& f, const file_record& r, std::vector<unsigned char>& 
         chunk_messages(d.data(), d.size(), s);
       }
       i = at + dl;
+      if (open && next) *next = i;
     }
   } else {
     if (!f.read(r.data, static_cast<std::size_t>(r.data_len), comp)) throw format_error("a chunk cut off");
+    // The next chunk (usually right after, of a like size) read ahead by
+    // the kernel while this one is decompressed.
+    f.will_need(r.end, r.data_len + 4096);
     raw.clear();
     allanvar::lz4_frame_decode(comp.data(), comp.size(), raw, size);
     if (raw.size() != size) throw format_error("an lz4 chunk does not decompress to its stated size");
@@ -323,15 +335,23 @@ Rcpp::List rosbag_index_cpp(std::string path) {
         file_record r;
         if (!read_record_header(f, off, r, &why)) { fault = fault_list(static_cast<double>(off), why); break; }
         if (r.op == 5) {
+          std::uint64_t next = r.end;
           try {
-            if (read_chunk(f, r, comp, raw, s) == 2) has_bz2 = true;
+            if (read_chunk(f, r, comp, raw, s, &next) == 2) has_bz2 = true;
           } catch (const format_error& e) {
             fault = fault_list(static_cast<double>(off), e.what());
+            // The chunk is listed all the same: its records before the
+            // fault are read, and the fault reported, by the read.
+            ch_pos.push_back(static_cast<double>(off));
+            ch_start.push_back(NA_REAL);
+            ch_end.push_back(NA_REAL);
             break;
           }
           ch_pos.push_back(static_cast<double>(off));
           ch_start.push_back(NA_REAL);
           ch_end.push_back(NA_REAL);
+          off = next;
+          continue;
         } else if (r.op == 7) {
           std::vector<unsigned char> d;
           if (!f.read(r.data, static_cast<std::size_t>(r.data_len), d)) { fault = fault_list(static_cast<double>(off), "a connection record cut off"); break; }
