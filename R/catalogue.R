@@ -43,7 +43,9 @@
 #   trace(ctx)  from a residual signature (see trace.R) to list(init =
 #                 start values, score = how well it matches), or NULL
 #   propose(raw, tau, sig)  candidates read from the raw-data diagnostics
-#                 (each may `pin` parameters the raw data measure better)
+#                 (each may `pin` parameters the raw data measure better,
+#                 and name `after`: pinned values that must be in the model
+#                 first, the stronger lines of its harmonic set)
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
 #                 the raw series says about a fitted instance

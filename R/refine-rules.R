@@ -88,14 +88,28 @@ candidate_trials <- function(traced, present, candidates, sig) {
         score = 0, traced = FALSE, stringsAsFactors = FALSE)
       r$init <- list(list())
       r$pin <- list(NULL)
+      r$after <- list(NULL)
       rows[[length(rows) + 1L]] <- r[, c("effect", "tau_from", "tau_to", "signature",
-                                         "score", "init", "pin", "traced")]
+                                         "score", "init", "pin", "after", "traced")]
     }
   }
   if (!length(rows)) return(data.frame())
   do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
                                                 "signature", "score", "init",
-                                                "pin", "traced")]))
+                                                "pin", "after", "traced")]))
+}
+
+# The trials whose `after` values (a proposal's prerequisites: the stronger
+# lines of its harmonic set) are all pinned in the model already (`fixed`).
+# A set is entered strongest first, so a weak harmonic is not fitted before
+# a stronger one and left to absorb it on the curve.
+ready_trials <- function(trials, fixed) {
+  if (!nrow(trials) || is.null(trials$after)) return(trials)
+  ok <- vapply(trials$after, function(a) {
+    v <- unlist(a)
+    !length(v) || all(vapply(v, function(x) any(abs(fixed - x) <= 1e-9 * abs(x)), NA))
+  }, NA)
+  trials[ok, , drop = FALSE]
 }
 
 # The residual signature that matches an accepted term: the one whose tau

@@ -145,7 +145,8 @@ step_trace <- function(st) {
   traced <- trace_candidates(tau, cur$data$avar, cur$data$fitted, st$sig,
                              present = cur$terms, candidates = st$args$candidates,
                              raw = st$raw)
-  st$trials <- candidate_trials(traced, cur$terms, st$args$candidates, st$sig)
+  st$trials <- ready_trials(candidate_trials(traced, cur$terms, st$args$candidates,
+                                             st$sig), st$settings$fixed)
   if (!nrow(st$trials)) st$flow <- "stop"
   st
 }
