@@ -17,18 +17,57 @@ pin_values <- function(terms, effect, pin) {
 }
 
 # The model after adding `effect`: the kinds the effect's entry replaces
-# (the filter replaces N) leave.
-model_terms <- function(terms, effect) {
+# (the filter replaces N) leave; with the entry's `replaces_instance`, only
+# the instances it names (a measured band replaces the resonance at that
+# band), judged on the current model `fit` against the new instance's
+# known values `par`.
+model_terms <- function(terms, effect, par = NULL, fit = NULL) {
   sp <- split_term(effect)
-  gone <- effect_entry(sp$kind, sp$variant)$replaces
-  c(terms[!split_term(terms)$kind %in% gone], effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  kinds <- split_term(terms)$kind
+  gone <- kinds %in% e$replaces
+  if (any(gone) && !is.null(e$replaces_instance)) {
+    labs <- term_labels(terms)
+    for (i in which(gone)) {
+      old <- if (is.null(fit)) list() else
+        as.list(instance_params(stats::coef(fit), fit$layout, labs[i]))
+      gone[i] <- isTRUE(e$replaces_instance(as.list(par), kinds[i], old))
+    }
+  }
+  structure(c(terms[!gone], effect), gone = gone)
+}
+
+# Values named by the labels of `terms` (held values "resonance2.fr"),
+# renamed for `new_terms` = model_terms(terms, ...): a replaced instance
+# leaves (its values are dropped) and the later instances of its kind move
+# down a number (instances of a kind keep their order). `keep_gone`: the
+# values of the instances that left stay, under names no term has (pinned
+# values: a value pinned once is not proposed again).
+relabel_values <- function(v, terms, new_terms, keep_gone = FALSE) {
+  gone <- attr(new_terms, "gone")
+  if (!length(v) || !any(gone)) return(v)
+  map <- stats::setNames(term_labels(new_terms)[seq_len(sum(!gone))],
+                         term_labels(terms)[!gone])
+  lab <- sub("\\.[^.]*$", "", names(v))
+  par <- sub("^.*\\.", "", names(v))
+  ok <- lab %in% names(map)
+  out <- v[ok]
+  names(out) <- paste0(map[lab[ok]], rep(".", sum(ok)), par[ok])
+  if (keep_gone && any(!ok)) {
+    out <- c(out, stats::setNames(v[!ok], paste0("left:", names(v)[!ok])))
+  }
+  out
 }
 
 # Kinds that may still be added next to `present`: repeatable ones or those
-# absent, and never one that a present term replaced.
+# absent, and never one that a present term replaced (kind by kind; an
+# entry that replaces instance by instance leaves the others addable).
 addable_kind <- function(kind, present) {
   pk <- split_term(present)$kind
-  replaced <- unlist(lapply(unique(pk), function(k) effect_entry(k)$replaces))
+  replaced <- unlist(lapply(unique(pk), function(k) {
+    e <- effect_entry(k)
+    if (is.null(e$replaces_instance)) e$replaces
+  }))
   e <- effect_entry(kind)
   !kind %in% replaced && (e$repeatable || !kind %in% pk)
 }

@@ -201,7 +201,10 @@ step_settle <- function(st) {
 # taken.
 step_refit_winner <- function(st) {
   best <- st$best
-  if (length(best$pin)) st$settings$fixed <- c(st$settings$fixed, best$pin)
+  # the values pinned before, under the labels of the new model
+  if (length(best$pin) || !identical(best$fixed, st$settings$fixed)) {
+    st$settings$fixed <- c(best$fixed, best$pin)
+  }
   if (!length(st$hold)) return(st)
   lay <- best$fit$layout
   args <- refit_args(st$current, best$fit$terms, st$settings,

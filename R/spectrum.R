@@ -520,7 +520,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
       bg <- exp(stats::approx(keep, log(bg2), xout = seq_len(nb), rule = 2)$y)
     }
   }
-  r2 <- runs(bg)
+  r2 <- split_valleys(runs(bg), p, bg, w$nu, min_bins)
   # A run may be a line (or a few) that the coarse segments smear over
   # several bins: at the record's own resolution a line stays within the
   # taper's lobe and a band does not. Runs holding lines only are not
@@ -565,6 +565,59 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
   attr(out, "resolution") <- w$df
   attr(out, "lines") <- on_band
   out
+}
+
+# Two bands side by side make one run of significant bins when their
+# flanks meet; where the excess over the background (smoothed over 5 bins)
+# has a valley between two peaks that each stand at least half the
+# background above it, dropping below half the lower peak by more than 5
+# of its standard errors, the run is cut at the valley's deepest bin, each
+# side keeping at least `min_bins` bins (a wiggle on one band's flank, or
+# an error of the background under it, is not a second band). `r`: runs
+# (list(from, to, ratio)), `p`, `bg`: the Welch PSD and its background,
+# `nu`: the Welch EDF.
+split_valleys <- function(r, p, bg, nu, min_bins) {
+  if (!length(r$from)) return(r)
+  from <- integer()
+  to <- integer()
+  for (k in seq_along(r$from)) {
+    j <- r$from[k]:r$to[k]
+    cuts <- integer()
+    if (length(j) >= 2L * min_bins + 1L) {
+      ex <- p[j] - bg[j]
+      sm <- as.numeric(stats::filter(ex, rep(1 / 5, 5), sides = 2))
+      sm[is.na(sm)] <- ex[is.na(sm)]
+      # standard error of a 5-bin mean of Welch bins (chi-square with EDF
+      # nu; 1.5 for the overlap of the segments)
+      se <- 1.5 * bg[j] * sqrt(2 / nu) / sqrt(5)
+      pk <- which(vapply(seq_along(sm), function(i) {
+        sm[i] == max(sm[max(1L, i - 3L):min(length(sm), i + 3L)])
+      }, NA) & sm > 5 * se & sm > 0.5 * bg[j])
+      last <- if (length(pk)) pk[1L] else NA_integer_
+      for (q in pk[-1L]) {
+        v <- last + which.min(sm[last:q]) - 1L
+        low <- min(sm[last], sm[q])
+        if (sm[v] < 0.5 * low && low - sm[v] > 5 * se[v] &&
+            v - max(c(0L, cuts)) > min_bins && length(j) - v >= min_bins) {
+          cuts <- c(cuts, v)
+          last <- q
+        } else if (sm[q] > sm[last]) {
+          last <- q
+        }
+      }
+    }
+    edges <- c(0L, cuts, length(j))
+    for (e in seq_len(length(edges) - 1L)) {
+      # the valley bin belongs to neither side
+      lo <- edges[e] + 1L
+      hi <- if (e < length(edges) - 1L) edges[e + 1L] - 1L else edges[e + 1L]
+      from <- c(from, j[lo])
+      to <- c(to, j[hi])
+    }
+  }
+  r$from <- from
+  r$to <- to
+  r
 }
 
 # Least-squares fit of the resonance's one-sided PSD (2 x two-sided) to the

@@ -152,7 +152,7 @@ test_that("admissibility rules: a sub-sample GM and an invisible sinusoid are re
   expect_match(inadmissible("sinusoid", c(amp = 1, f0 = 1e-4), tau, 100),
                "outside the band")
   expect_null(inadmissible("sinusoid", c(amp = 1, f0 = 1), tau, 100))
-  expect_equal(model_terms(c("N", "B", "K"), "filter"), c("B", "K", "filter"))
+  expect_equal(c(model_terms(c("N", "B", "K"), "filter")), c("B", "K", "filter"))
   expect_false(addable_kind("N", c("filter", "K")))
   expect_true(addable_kind("gm", c("gm", "K")))
 })
