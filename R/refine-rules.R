@@ -46,13 +46,21 @@ model_terms <- function(terms, effect, par = NULL, fit = NULL) {
 relabel_values <- function(v, terms, new_terms, keep_gone = FALSE) {
   gone <- attr(new_terms, "gone")
   if (!length(v) || !any(gone)) return(v)
-  map <- stats::setNames(term_labels(new_terms)[seq_len(sum(!gone))],
-                         term_labels(terms)[!gone])
+  # labels number the instances of one kind in order (term_labels() sorts
+  # the kinds): the j-th kept instance of a kind takes its kind's j-th label
+  kinds <- split_term(terms)$kind
+  map <- character()
+  for (k in unique(kinds[!gone])) {
+    i <- which(kinds == k)
+    map[term_labels(terms[i])[!gone[i]]] <- term_labels(terms[i][!gone[i]])
+  }
   lab <- sub("\\.[^.]*$", "", names(v))
   par <- sub("^.*\\.", "", names(v))
   ok <- lab %in% names(map)
   out <- v[ok]
-  names(out) <- paste0(map[lab[ok]], rep(".", sum(ok)), par[ok])
+  # bare coefficients ("N") are their own label
+  bare <- !grepl(".", names(v)[ok], fixed = TRUE)
+  names(out) <- ifelse(bare, map[lab[ok]], paste0(map[lab[ok]], ".", par[ok]))
   if (keep_gone && any(!ok)) {
     out <- c(out, stats::setNames(v[!ok], paste0("left:", names(v)[!ok])))
   }
