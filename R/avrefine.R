@@ -53,7 +53,7 @@
 #' * Without raw data, `$refine$unconfirmed` lists the accepted effects that
 #'   could not be confirmed.
 #' * With raw data, the series' non-stationary effects (steps, warm-up,
-#'   spikes) are read first by [series_effects()],
+#'   spikes) are read first by [detect_series_effects()],
 #'   kept in `$series`, and removed from the data only when named in
 #'   `remove`.
 #'
@@ -96,7 +96,7 @@
 #'   to count as structure.
 #' @param remove Series effects to take out of `data` before the loop (kinds
 #'   of the catalogue's series components); never done unless asked.
-#' @param series `NULL`, or the [series_effects()] result that produced
+#' @param series `NULL`, or the [detect_series_effects()] result that produced
 #'   `data` (its cleaned series `series$x`), when that pass has already been
 #'   run (as [analyze_imu()] does when asked to `remove` effects before the
 #'   curve): it is kept in `$series` instead of running the pass again.
@@ -177,7 +177,7 @@ check_refine_args <- function(fit, data, candidates, max_steps, criterion,
   }
   if (!is.null(series)) {
     if (!inherits(series, "series_effects")) {
-      abort("`series` must be a series_effects() result or NULL, not ",
+      abort("`series` must be a detect_series_effects() result or NULL, not ",
             describe_type(series), ".", class = "argument")
     }
     if (is.null(data)) {
@@ -196,7 +196,7 @@ check_refine_args <- function(fit, data, candidates, max_steps, criterion,
 }
 
 # The raw series of avrefine(): at the fit's sampling frequency, and the
-# very series a given series_effects() pass left.
+# very series a given detect_series_effects() pass left.
 check_refine_data <- function(data, freq, series) {
   if (stats::is.ts(data) && !is.null(freq) &&
       abs(stats::frequency(data) - freq) > 1e-6 * freq) {
@@ -214,7 +214,7 @@ check_refine_data <- function(data, freq, series) {
   if (!is.null(series) && (!isTRUE(all.equal(series$freq, freq)) ||
                            !identical(as.numeric(series$x), data))) {
     abort("`data` must be `series$x` at the fit's sampling frequency: the ",
-          "series the given series_effects() pass left.", class = "argument")
+          "series the given detect_series_effects() pass left.", class = "argument")
   }
   data
 }

@@ -58,7 +58,7 @@
 #                 an instance that shows as part of another reading (a GM
 #                 with Tc well below 1 s is white noise at tau >= 1 s)
 #   discrete(par, dt, units, opts)  rows of a discrete-time filter model
-#                 (filter_params()), or NULL
+#                 (kalman_params()), or NULL
 #   describe(values)  datasheet text for the instances of this kind added by
 #                 the loop (values: data frame, one row per instance)
 #   detect(x, freq), remove(x, freq, par)  for "series" components
@@ -114,7 +114,7 @@ builtin_effects <- function() {
   list(effect_quantization(), effect_white(), effect_flicker(),
        effect_random_walk(), effect_ramp(), effect_gauss_markov(),
        effect_sinusoid(), effect_filter(), effect_resonance(), effect_band(),
-       # series effects, in the order series_effects() detects them
+       # series effects, in the order detect_series_effects() detects them
        effect_spike(), effect_warmup(), effect_bias_step(), effect_transient())
 }
 

@@ -233,7 +233,12 @@ stat_limits <- function(e, av, m, n, L, alpha, sub, conf, ci = TRUE,
     ed <- list(edf = rep(NA_real_, length(m)),
                alpha = rep(NA_integer_, length(m)))
   }
-  out <- stat_interval(av, ed$edf, conf, ci, unbiased && e$unbiased)
+  out <- stat_interval(av, ed$edf, conf, ci, FALSE)
+  # rows at few averages: the exact generalized chi-square limits
+  # (R/ci-exact.R) where the entry has them
+  if (ci) out <- exact_limits_merge(out, allan_limits_exact(e$name, m, n, L,
+                                                            ed$alpha, conf))
+  if (unbiased && e$unbiased) out$adev <- out$adev / stat_c4(ed$edf)
   out$edf <- ed$edf
   out$alpha <- ed$alpha
   out

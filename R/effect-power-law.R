@@ -164,7 +164,7 @@ effect_flicker <- function() {
                    anchor = "min", unit = "rate", bound = FALSE, resolve = FALSE,
                    pch = 24, legend = "B: flat minimum (ADEV = 0.664 B)",
                    slope_method = "min ADEV / 0.664",
-                   # how filter_params() may stand in for B (the first is
+                   # how kalman_params() may stand in for B (the first is
                    # its default): one Gauss-Markov term, or left out
                    approximations = c("gm", "omit")),
     # No finite-state model exists; optionally approximated by one GM whose
@@ -249,7 +249,7 @@ effect_ramp <- function() {
   )
 }
 
-# One row of filter_params().
+# One row of kalman_params().
 discrete_row <- function(term, parameter, value, unit, continuous,
                          continuous_unit, convention) {
   data.frame(term = term, parameter = parameter, value = value, unit = unit,

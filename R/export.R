@@ -7,7 +7,7 @@
 #' * `accelerometer_noise_density`: accelerometer N, m/s^2/sqrt(Hz);
 #' * `accelerometer_random_walk`: accelerometer K, m/s^3/sqrt(Hz);
 #' * `update_rate`: the sampling rate in Hz, which Kalibr uses to discretize
-#'   (sigma_d = N / sqrt(dt), sigma_bd = K * sqrt(dt); see [filter_params()]).
+#'   (sigma_d = N / sqrt(dt), sigma_bd = K * sqrt(dt); see [kalman_params()]).
 #'
 #' Kalibr takes one number per sensor, so by default the worst (largest)
 #' axis is written (`axis = "max"`); the per-axis values and the axis used
@@ -220,8 +220,8 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
 #'   catalogue's order of the terms (N, B, K, then the Gauss-Markov terms).
 #' @export
 #' @examples
-#' filter_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
-filter_params <- function(x, dt = NULL, bias_instability = NULL,
+#' kalman_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
+kalman_params <- function(x, dt = NULL, bias_instability = NULL,
                           tau_B = NULL, unit = NULL) {
   check_present(missing(x), "x", "an imu_analysis, an avfit or coefficients")
   # how B may stand in a finite-state model: the catalogue's flicker entry

@@ -29,7 +29,7 @@ stage_prepare <- function(st) {
   if (is.null(st$data)) return(st)
   a <- st$args
   if (is.null(a$series)) {
-    st$series <- series_effects(st$data, a$freq, remove = a$remove)
+    st$series <- detect_series_effects(st$data, a$freq, remove = a$remove)
     if (length(st$series$removed)) st$data <- st$series$x
   } else {
     st$series <- a$series

@@ -13,7 +13,7 @@ new_refine_state <- function(fit, args, settings) {
                                # level, remove, data, series, freq
     settings = settings,       # refit settings (refit_settings())
     data = args$data,          # the raw series the loop sees (NULL: curve only)
-    series = NULL,             # the series pass (series_effects()) or NULL
+    series = NULL,             # the series pass (detect_series_effects()) or NULL
     raw = NULL,                # refine_diagnostics() of `data`, or NULL
     current = fit,             # the model so far
     steps = list(),            # accepted steps of this call (step_row())

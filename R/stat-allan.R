@@ -19,12 +19,12 @@ stats_allan_family <- function() {
   }
   allan_dev <- function(name, title, ylab, max_m, nterms, divisor,
                         alpha_range = c(-2L, 2L), noise_id = id_common,
-                        gaps = "sums", ...) {
+                        gaps = "sums", exact_ci = TRUE, ...) {
     new_stat(name, title = title, ylab = ylab, max_m = max_m,
              nterms = function(m, L, theo_row = NULL) nterms(m, L),
              kernel = "sums", divisor = divisor, edf = "engine",
              alpha_range = alpha_range, noise_id = noise_id, gaps = gaps,
-             aliases = alias(name), ...)
+             aliases = alias(name), exact_ci = exact_ci, ...)
   }
   allan_div <- function(m) 2 * m^2
   list(
@@ -52,7 +52,7 @@ stats_allan_family <- function() {
     allan_dev("total", "total variance", "total deviation",
               max_m = function(L) if (L >= 3) L - 1 else 0,
               nterms = function(m, L) rep(L - 2, length(m)),
-              divisor = allan_div,
+              divisor = allan_div, exact_ci = FALSE,
               edf_fallback = function(m, n, L) 1.5 * (L - 1) / m,
               # random walk told from flicker FM by B1 with its own count;
               # R(n) never overrides white FM (its white-PM EDF is itself

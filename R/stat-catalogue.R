@@ -32,6 +32,8 @@
 #   octave_pass whether the one-pass octave kernel of rate data computes
 #                 the statistic at octave m (the standard type)
 #   alpha_range the noise exponents the EDF rule admits (c(lo, hi))
+#   exact_ci    whether rows at few averages take the exact generalized
+#                 chi-square limits (R/ci-exact.R; from alpha_range's lo)
 #   id_base     for kernel functions: the Allan-family statistic whose
 #                 noise identification gives the type at each tau (NA:
 #                 none, or the kernel's own)
@@ -92,13 +94,15 @@ new_stat <- function(name, title, ylab, max_m, nterms, kernel = "sums",
                      unbiased = !is.na(edf), gaps = "sums",
                      aliases = character(),
                      edf_fallback = function(m, n, L) n,
-                     octave_pass = FALSE, min_points = 3L) {
+                     octave_pass = FALSE, min_points = 3L,
+                     exact_ci = FALSE) {
   list(name = name, title = title, ylab = ylab, max_m = max_m,
        nterms = nterms, kernel = kernel, divisor = divisor, taus = taus,
        edf = edf, alpha_range = as.integer(alpha_range), id_base = id_base,
        noise_id = noise_id, debias = debias, unbiased = unbiased, gaps = gaps,
        aliases = aliases, edf_fallback = edf_fallback,
-       octave_pass = octave_pass, min_points = min_points)
+       octave_pass = octave_pass, min_points = min_points,
+       exact_ci = exact_ci)
 }
 
 validate_stat <- function(e) {

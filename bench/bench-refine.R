@@ -43,7 +43,7 @@ cases <- list(
   "acf_exponential (Tc = 0.05 s)" = function(x) ns_fun("acf_exponential")(x, freq, 0.05),
   "quantization_grid (radix sort)" = function(x) ns_fun("quantization_grid")(x),
   "welch_psd (seg 512)" = function(x) ns_fun("welch_psd")(x, freq, 512L, detrend = FALSE),
-  "series_effects" = function(x) series_effects(x, freq),
+  "series_effects" = function(x) detect_series_effects(x, freq),
   "avdiagnose (today)" = function(x) avdiagnose(x, freq),
   "avrefine(fit, data = x) (today's loop)" = function(x) {
     fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))

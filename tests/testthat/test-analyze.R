@@ -76,7 +76,7 @@ test_that("effects the closed loop adds reach the datasheet", {
   expect_true("gm" %in% st$effect)
   expect_match(a$datasheet$gyro$effects, "gm \\(Tc = ")
   # the GM (Tc near 2 s, not white-like) goes to the filter as phi, q_d
-  fp <- filter_params(a)
+  fp <- kalman_params(a)
   tc <- a$channels$gyro_x$coef[["gm1.tc"]]
   sig <- a$channels$gyro_x$coef[["gm1.sigma"]]
   expect_equal(fp$value[fp$term == "gm1" & fp$parameter == "phi"], exp(-0.01 / tc))
@@ -145,7 +145,7 @@ test_that("a dead (constant) axis is reported and the others analysed", {
   expect_match(ds$method[ds$axis == "gyro_y"], "dead axis")
   g <- imu_guidance(a)
   expect_match(g$message[g$channel == "gyro_y"], "dead axis")
-  fp <- filter_params(a)
+  fp <- kalman_params(a)
   expect_false("gyro_y" %in% fp$channel)
   expect_true(all(is.finite(fp$value)))
   # Kalibr: the worst live axis, the dead one listed in the comment

@@ -50,6 +50,7 @@ test_that("no effect kind is named outside the catalogue files", {
     "allan.R" = "N",        # attribute: the number of samples
     "hat.R" = "N",          # attribute: the number of samples
     "fit-input.R" = "N",    # attribute: the number of samples
+    "report.R" = "N",       # attribute: the number of samples
     "avfit.R" = "steps",    # the avfit object's `steps` field
     # the datasheet's reading symbols as other tools' files name them
     "export-tools.R" = c("N", "B", "K"),

@@ -57,7 +57,7 @@ test_that("a Kalibr CSV of a measured ADIS16405 gives plot, datasheet and imu.ya
   # the filter step of the yaml's rate: sigma_d = N / sqrt(0.01)
   sd <- o$fp$value[o$fp$parameter == "sigma_d" & o$fp$channel == "gyro_x"]
   expect_equal(sd, n_gyro[1] / sqrt(0.01), tolerance = 1e-6)
-  expect_length(res$files, 4)
+  expect_length(res$files, 5)  # with report.html
 })
 
 test_that("the same outputs come from one shell command", {
@@ -243,7 +243,7 @@ test_that("--width/--height size the PNG; --topic reads a bag", {
   # PNG IHDR: width and height as big-endian 32-bit integers at bytes 17-24
   be32 <- function(r) sum(as.numeric(r) * 256^(3:0))
   expect_identical(c(be32(png[17:20]), be32(png[21:24])), c(900, 450))
-  expect_length(res$files, 4L)
+  expect_length(res$files, 5L)  # with report.html
   expect_equal(res$analyses[[1]]$freq, 200, tolerance = 1e-9)
 })
 

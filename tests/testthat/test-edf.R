@@ -126,6 +126,10 @@ test_that("Riley's lag-1 autocorrelation identifies power-law noise", {
 })
 
 test_that("the chi-square interval of the deviation (NIST SP 1065 eq. 45)", {
+  # every row chi-square (at N/m <= 16 the default is the exact interval,
+  # R/ci-exact.R, tested in test-ci-exact.R)
+  old <- options(allanvar.ci_exact = 0)
+  on.exit(options(old))
   set.seed(23)
   a <- allan(rnorm(2000), 1, conf = 0.9)
   expect_equal(a$lower, sqrt(a$edf * a$avar / qchisq(0.95, a$edf)))
@@ -185,7 +189,10 @@ test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
       expect_gte(length(cw$cov), 7)
       for (g in c("white", "walk")) {
         r <- if (g == "white") cw else cr
-        long <- rule == "default" & g == "walk" & N %/% r$m < 64
+        # N/m <= 16: the exact limits (R/ci-exact.R), whose union over the
+        # plausible noise types is held to the issue's band 0.60-0.76
+        long <- (rule == "default" & g == "walk" & N %/% r$m < 64) |
+          N / r$m <= 16
         expect_gte(sum(!long), 5)
         expect_true(all(r$cov[!long] >= 0.65 & r$cov[!long] <= 0.72),
                     info = paste(rule, type, g, toString(r$cov)))
@@ -333,8 +340,10 @@ test_that("68% coverage of white and flicker PM where B1 reads a few averaged fr
       info <- paste(type, g, toString(round(r$cov, 3)), "true type:",
                     toString(round(r$cov_alpha, 3)))
       if (g == "fpm") {
-        expect_true(all(r$cov >= 0.60 & abs(r$cov - r$cov_alpha) <= 0.03),
-                    info = info)
+        # the exact limits (N/m <= 16, R/ci-exact.R) cover closer to 0.683
+        # than the true type's chi-square interval (`cov_alpha`, 0.75-0.76)
+        expect_true(all(r$cov >= 0.60 & r$cov <= 0.76 &
+                          r$cov <= r$cov_alpha + 0.03), info = info)
       } else {
         expect_true(all(r$cov >= 0.60 & r$cov <= 0.76), info = info)
       }
