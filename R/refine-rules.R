@@ -209,3 +209,41 @@ step_row <- function(effect, label, loc, par, evidence, confirmed, before,
             rms_before = before$rms, rms_after = after$rms,
             crit_before = crit_before, crit_after = crit_after)
 }
+
+# ---- terms that describe a series effect again --------------------------------
+
+# A model term that stands in for a series effect the same run found and
+# left in the data (a Gauss-Markov term describing an unremoved warm-up, a
+# slow term describing a bias step): where the term dominates the model
+# (of the taus where it holds at least half the fitted AV, the one where
+# its own AV is largest: a GM's peak), the AV that series effect adds to
+# the curve (ADEV^2 with it minus without it, from the series pass) is at
+# least `share` of the term's own AV. Returns NULL, or a one-row data frame:
+# the series kind, that ratio and the tau it was read at.
+series_duplicate <- function(series, fit, label, share = 0.5) {
+  if (is.null(series) || !NROW(series$table) || !NROW(series$adev_kinds)) return(NULL)
+  comp <- fit$components
+  if (!label %in% colnames(comp)) return(NULL)
+  tab <- series$table
+  left <- unique(tab$kind[!tab$removed])
+  tau <- fit$data$tau
+  sh <- comp[, label] / rowSums(comp)
+  # where the term dominates, the tau of its largest AV (a GM's peak)
+  j <- if (any(sh >= 0.5)) which.max(comp[, label] * (sh >= 0.5)) else which.max(sh)
+  own <- comp[j, label]
+  if (!(own > 0)) return(NULL)
+  out <- NULL
+  for (k in left) {
+    a <- series$adev_kinds[series$adev_kinds$kind == k, , drop = FALSE]
+    ex <- a$before^2 - a$after^2
+    ok <- is.finite(ex) & a$tau > 0
+    if (sum(ok) < 2L || tau[j] < min(a$tau[ok]) || tau[j] > max(a$tau[ok])) next
+    at <- stats::approx(log(a$tau[ok]), ex[ok], log(tau[j]))$y
+    r <- at / own
+    if (is.finite(r) && r >= share && (is.null(out) || r > out$ratio)) {
+      out <- data.frame(series_kind = k, ratio = r, tau = tau[j],
+                        stringsAsFactors = FALSE)
+    }
+  }
+  out
+}

@@ -96,6 +96,12 @@ screen_trial <- function(st, tr, nl_now) {
   }
   if (!is.null(jd$why)) {
     st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, jd$why)
+    if (!is.null(jd$dup)) {
+      st$duplicates <- rbind(st$duplicates, cbind(
+        data.frame(step = as.integer(st$step), effect = tr$effect,
+                   params = format_params(jd$par, tr$effect), stringsAsFactors = FALSE),
+        jd$dup))
+    }
     return(list(st = st, cand = NULL))
   }
   # raw-data support counts as a gain of min_gain
@@ -119,12 +125,20 @@ judge_instance <- function(st, f, effect, label, tau) {
   if (is.null(why) && isFALSE(ev$support)) {
     why <- paste("contradicted by the raw data:", ev$text)
   }
+  # a term standing in for a series effect this run found and left in the
+  # data describes one thing twice (remove it in the series instead)
+  dup <- if (is.null(why)) series_duplicate(st$series, f, label)
+  if (!is.null(dup)) {
+    why <- sprintf(paste("describes the %s found in the series (not removed): it adds",
+                         "%s%% of this term's AV at tau %s s"), dup$series_kind,
+                   format_num(100 * dup$ratio), format_num(dup$tau))
+  }
   moved <- FALSE
   if (is.null(why) && !earlier_hold(st, f)) {
     why <- "moves an effect accepted earlier to values the raw data contradict"
     moved <- TRUE
   }
-  list(par = par, why = why, ev = ev, moved = moved)
+  list(par = par, why = why, ev = ev, moved = moved, dup = dup)
 }
 
 # A family's form (the sensor filter's moving average, first- or

@@ -126,6 +126,7 @@ stage_assemble <- function(st) {
                      diagnostics = diag_report(st$raw),
                      remaining = st$remaining, start_terms = fit$terms,
                      failures = st$failures, rejected = st$rejected,
+                     series_duplicates = st$duplicates,
                      unconfirmed = unconfirmed, tau_range = st$tau_range,
                      removed = if (is.null(st$series)) character() else st$series$removed)
   class(out) <- unique(c("avrefine", class(out)))
