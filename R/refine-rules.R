@@ -218,9 +218,13 @@ step_row <- function(effect, label, loc, par, evidence, confirmed, before,
 # (of the taus where it holds at least half the fitted AV, the one where
 # its own AV is largest: a GM's peak), the AV that series effect adds to
 # the curve (ADEV^2 with it minus without it, from the series pass) is at
-# least `share` of the term's own AV. Returns NULL, or a one-row data frame:
-# the series kind, that ratio and the tau it was read at.
-series_duplicate <- function(series, fit, label, share = 0.5) {
+# least `share` of the term's own AV: with the series effect taken out, the
+# term would have nothing left to describe there. (A part only, 0.68 on a
+# measured accelerometer whose 20 s GM sits beside six 17-60 s transients,
+# does not make the term a duplicate: a GM's own excursions are transients
+# to the series pass.) Returns NULL, or a one-row data frame: the series
+# kind, that ratio and the tau it was read at.
+series_duplicate <- function(series, fit, label, share = 1) {
   if (is.null(series) || !NROW(series$table) || !NROW(series$adev_kinds)) return(NULL)
   comp <- fit$components
   if (!label %in% colnames(comp)) return(NULL)
