@@ -116,6 +116,11 @@
 #'   signatures left when the loop stopped and `failures` (a data frame
 #'   `step`, `effect`, `stage`, `message`, with the conditions in the list
 #'   column `condition`), `rejected` (step, effect, params, reason),
+#'   `series_duplicates` (the rejected terms that would have described a
+#'   series effect of this run again, which was left in the data: step,
+#'   effect, params, `series_kind`, `ratio` = the AV that series effect
+#'   adds over the term's own AV, at `tau`; the readings of such a run
+#'   carry that series effect's bias, see [series_reading_bias()]),
 #'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range) and
 #'   `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,
 #'   strength in sigma, size = largest ADEV error inside in percent,
@@ -240,6 +245,11 @@ print_refine_notes <- function(x) {
   if (nr) {
     cat(nr, " candidate(s) rejected (contradicted by the raw data or not a valid ",
         "instance); see $refine$rejected.\n", sep = "")
+  }
+  d <- unique(r$series_duplicates[c("effect", "series_kind")])
+  if (NROW(d)) {
+    cat(sprintf("Not added: %s would describe the %s left in the series (remove = \"%s\").\n",
+                d$effect, d$series_kind, d$series_kind), sep = "")
   }
   u <- x$unexplained
   if (NROW(u)) {

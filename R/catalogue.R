@@ -43,7 +43,9 @@
 #   trace(ctx)  from a residual signature (see trace.R) to list(init =
 #                 start values, score = how well it matches), or NULL
 #   propose(raw, tau, sig)  candidates read from the raw-data diagnostics
-#                 (each may `pin` parameters the raw data measure better)
+#                 (each may `pin` parameters the raw data measure better,
+#                 and name `after`: pinned values that must be in the model
+#                 first, the stronger lines of its harmonic set)
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
 #                 the raw series says about a fitted instance
@@ -62,6 +64,11 @@
 #   detect(x, freq), remove(x, freq, par)  for "series" components
 #   replaces    kinds this entry takes the place of when the loop adds it
 #                 (the filter replaces N: its DC level is the white level)
+#   replaces_instance  NULL (every instance of those kinds goes), or
+#                 function(par, kind, old) -> TRUE when the instance `old`
+#                 (its values) is the thing the new one (`par`: its pinned
+#                 and start values) describes (a measured band replaces the
+#                 resonance at the same band, not one elsewhere)
 #   proposed_only  TRUE when the loop tries the entry only where the raw
 #                 data propose it (its parameters are measured, not
 #                 searched: a tabulated band spectrum)
@@ -166,7 +173,7 @@ new_effect <- function(name, title, params, component = "av",
                        peak_tau = NULL, reading = NULL, fold = NULL,
                        discrete = NULL, describe = NULL, detect = NULL,
                        remove = NULL, replaces = character(),
-                       admissible = NULL, proposed_only = FALSE,
+                       replaces_instance = NULL, admissible = NULL, proposed_only = FALSE,
                        statespace = NULL, diagnose = NULL, family = NULL,
                        exact_edf = NULL) {
   list(name = name, title = title, params = params, component = component,
@@ -178,7 +185,8 @@ new_effect <- function(name, title, params, component = "av",
        propose = propose, evidence = evidence, peak_tau = peak_tau,
        reading = reading, fold = fold, discrete = discrete,
        describe = describe, detect = detect, remove = remove,
-       replaces = replaces, admissible = admissible,
+       replaces = replaces, replaces_instance = replaces_instance,
+       admissible = admissible,
        proposed_only = proposed_only, statespace = statespace,
        diagnose = diagnose, family = family, exact_edf = exact_edf)
 }
@@ -263,6 +271,9 @@ validate_effect <- function(e) {
   if (is.null(e$replaces)) e$replaces <- character()
   if (!is.character(e$replaces) || anyNA(e$replaces)) {
     bad("`replaces` must name effect kinds.")
+  }
+  if (!is.null(e$replaces_instance) && !is.function(e$replaces_instance)) {
+    bad("`replaces_instance` must be NULL or a function(par, kind, old).")
   }
   if (is.null(e$describe)) e$describe <- function(values) e$name
   # Coefficients are written bare ("N") when the entry is a single

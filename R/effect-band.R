@@ -138,7 +138,7 @@ effect_band <- function() {
   new_effect(
     name = "band", title = "measured spectral band",
     params = band_params(),
-    repeatable = FALSE, slope = NA_real_, psd_alpha = NA_real_,
+    repeatable = TRUE, slope = NA_real_, psd_alpha = NA_real_,
     formula = paste("amp^2 x exact AV of the measured band spectrum:",
                     "2 int S1(f) sin^4(pi f tau) / (m sin(pi f tau0))^2 df"),
     signature = paste("a bump near tau ~ 0.37 / f of the band with damped",
@@ -170,8 +170,10 @@ effect_band <- function() {
         stats::setNames(rep(list(c(1e-300, 1e300)), band_knots),
                         paste0("s", seq_len(band_knots))))
     },
-    # The bands of the raw data propose their own spectrum: the strongest
-    # band the curve can see, every parameter but the scale pinned.
+    # The bands of the raw data propose their own spectrum: each band the
+    # curve can see, strongest first, every parameter but the scale pinned
+    # (a band already in the model is not proposed again: its pinned values
+    # are).
     propose = function(raw, tau, sig) {
       mb <- diag_part(raw, "band_spectra")
       if (!length(mb)) return(list())
@@ -179,17 +181,17 @@ effect_band <- function() {
       ok <- vapply(mb, function(m) (m$f_lo + m$f_hi) / 2 > 1 / max(tau) &&
                      (m$f_lo + m$f_hi) / 2 < hi, NA)
       mb <- mb[ok]
-      if (!length(mb)) return(list())
-      m <- mb[[which.max(vapply(mb, `[[`, 0, "power"))]]
-      fc <- (m$f_lo + m$f_hi) / 2
-      pin <- c(list(f_lo = m$f_lo, f_hi = m$f_hi, u = m$u),
-               stats::setNames(as.list(m$s), paste0("s", seq_along(m$s))))
-      list(list(init = list(amp = 1), pin = pin,
-                tau_from = 0.371 / m$f_hi / 2, tau_to = 2 / m$f_lo, score = 2,
-                note = sprintf(paste("proposed by the spectral band at %s-%s Hz",
-                                     "(its measured spectrum, power %s)"),
-                               format_num(m$f_lo, 4), format_num(m$f_hi, 4),
-                               format_num(m$power))))
+      mb <- mb[order(-vapply(mb, `[[`, 0, "power"))]
+      lapply(mb, function(m) {
+        pin <- c(list(f_lo = m$f_lo, f_hi = m$f_hi, u = m$u),
+                 stats::setNames(as.list(m$s), paste0("s", seq_along(m$s))))
+        list(init = list(amp = 1), pin = pin,
+             tau_from = 0.371 / m$f_hi / 2, tau_to = 2 / m$f_lo, score = 2,
+             note = sprintf(paste("proposed by the spectral band at %s-%s Hz",
+                                  "(its measured spectrum, power %s)"),
+                            format_num(m$f_lo, 4), format_num(m$f_hi, 4),
+                            format_num(m$power)))
+      })
     },
     # the scale the curve asks for must be the measured one, within twice
     # the band power's relative uncertainty
@@ -218,8 +220,13 @@ effect_band <- function() {
                                                      signif(values$f_hi, 3)),
                                              collapse = ", "))
     },
-    # the measured band is the resonance's band as the data show it
+    # the measured band is the resonance's band as the data show it: it
+    # replaces the resonance whose centre lies in it, not one elsewhere
     replaces = "resonance",
+    replaces_instance = function(par, kind, old) {
+      fr <- old$fr %||% NA_real_
+      is.finite(fr) && !is.null(par$f_lo) && fr >= par$f_lo && fr <= par$f_hi
+    },
     # its spectrum is measured, never searched: tried only where proposed
     proposed_only = TRUE
   )

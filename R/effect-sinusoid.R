@@ -111,7 +111,12 @@ effect_sinusoid <- function() {
           sprintf(" (harmonic %d of the %s Hz source, %s harmonics)", h,
                   format_num(f0 / h, 4), lines$pattern[j])
         } else ""
+        # a harmonic set is entered strongest line first: on the curve a
+        # weak harmonic fitted early takes the power of the ones above it
+        stronger <- lines$visible & lines$source == lines$source[j] &
+          lines$amp > lines$amp[j]
         out[[length(out) + 1L]] <- list(
+          after = if (any(stronger)) list(f0 = lines$f0[stronger]),
           init = list(f0 = f0, amp = lines$amp[j]), tau_from = t1 / 2,
           tau_to = 2 / f0, score = 2,
           # the periodogram measures f0 far better than the curve does

@@ -17,18 +17,65 @@ pin_values <- function(terms, effect, pin) {
 }
 
 # The model after adding `effect`: the kinds the effect's entry replaces
-# (the filter replaces N) leave.
-model_terms <- function(terms, effect) {
+# (the filter replaces N) leave; with the entry's `replaces_instance`, only
+# the instances it names (a measured band replaces the resonance at that
+# band), judged on the current model `fit` against the new instance's
+# known values `par`.
+model_terms <- function(terms, effect, par = NULL, fit = NULL) {
   sp <- split_term(effect)
-  gone <- effect_entry(sp$kind, sp$variant)$replaces
-  c(terms[!split_term(terms)$kind %in% gone], effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  kinds <- split_term(terms)$kind
+  gone <- kinds %in% e$replaces
+  if (any(gone) && !is.null(e$replaces_instance)) {
+    labs <- term_labels(terms)
+    for (i in which(gone)) {
+      old <- if (is.null(fit)) list() else
+        as.list(instance_params(stats::coef(fit), fit$layout, labs[i]))
+      gone[i] <- isTRUE(e$replaces_instance(as.list(par), kinds[i], old))
+    }
+  }
+  structure(c(terms[!gone], effect), gone = gone)
+}
+
+# Values named by the labels of `terms` (held values "resonance2.fr"),
+# renamed for `new_terms` = model_terms(terms, ...): a replaced instance
+# leaves (its values are dropped) and the later instances of its kind move
+# down a number (instances of a kind keep their order). `keep_gone`: the
+# values of the instances that left stay, under names no term has (pinned
+# values: a value pinned once is not proposed again).
+relabel_values <- function(v, terms, new_terms, keep_gone = FALSE) {
+  gone <- attr(new_terms, "gone")
+  if (!length(v) || !any(gone)) return(v)
+  # labels number the instances of one kind in order (term_labels() sorts
+  # the kinds): the j-th kept instance of a kind takes its kind's j-th label
+  kinds <- split_term(terms)$kind
+  map <- character()
+  for (k in unique(kinds[!gone])) {
+    i <- which(kinds == k)
+    map[term_labels(terms[i])[!gone[i]]] <- term_labels(terms[i][!gone[i]])
+  }
+  lab <- sub("\\.[^.]*$", "", names(v))
+  par <- sub("^.*\\.", "", names(v))
+  ok <- lab %in% names(map)
+  out <- v[ok]
+  # bare coefficients ("N") are their own label
+  bare <- !grepl(".", names(v)[ok], fixed = TRUE)
+  names(out) <- ifelse(bare, map[lab[ok]], paste0(map[lab[ok]], ".", par[ok]))
+  if (keep_gone && any(!ok)) {
+    out <- c(out, stats::setNames(v[!ok], paste0("left:", names(v)[!ok])))
+  }
+  out
 }
 
 # Kinds that may still be added next to `present`: repeatable ones or those
-# absent, and never one that a present term replaced.
+# absent, and never one that a present term replaced (kind by kind; an
+# entry that replaces instance by instance leaves the others addable).
 addable_kind <- function(kind, present) {
   pk <- split_term(present)$kind
-  replaced <- unlist(lapply(unique(pk), function(k) effect_entry(k)$replaces))
+  replaced <- unlist(lapply(unique(pk), function(k) {
+    e <- effect_entry(k)
+    if (is.null(e$replaces_instance)) e$replaces
+  }))
   e <- effect_entry(kind)
   !kind %in% replaced && (e$repeatable || !kind %in% pk)
 }
@@ -88,14 +135,28 @@ candidate_trials <- function(traced, present, candidates, sig) {
         score = 0, traced = FALSE, stringsAsFactors = FALSE)
       r$init <- list(list())
       r$pin <- list(NULL)
+      r$after <- list(NULL)
       rows[[length(rows) + 1L]] <- r[, c("effect", "tau_from", "tau_to", "signature",
-                                         "score", "init", "pin", "traced")]
+                                         "score", "init", "pin", "after", "traced")]
     }
   }
   if (!length(rows)) return(data.frame())
   do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
                                                 "signature", "score", "init",
-                                                "pin", "traced")]))
+                                                "pin", "after", "traced")]))
+}
+
+# The trials whose `after` values (a proposal's prerequisites: the stronger
+# lines of its harmonic set) are all pinned in the model already (`fixed`).
+# A set is entered strongest first, so a weak harmonic is not fitted before
+# a stronger one and left to absorb it on the curve.
+ready_trials <- function(trials, fixed) {
+  if (!nrow(trials) || is.null(trials$after)) return(trials)
+  ok <- vapply(trials$after, function(a) {
+    v <- unlist(a)
+    !length(v) || all(vapply(v, function(x) any(abs(fixed - x) <= 1e-9 * abs(x)), NA))
+  }, NA)
+  trials[ok, , drop = FALSE]
 }
 
 # The residual signature that matches an accepted term: the one whose tau
@@ -147,4 +208,46 @@ step_row <- function(effect, label, loc, par, evidence, confirmed, before,
             chi2_before = before$chi2, chi2_after = after$chi2,
             rms_before = before$rms, rms_after = after$rms,
             crit_before = crit_before, crit_after = crit_after)
+}
+
+# ---- terms that describe a series effect again --------------------------------
+
+# A model term that stands in for a series effect the same run found and
+# left in the data (a Gauss-Markov term describing an unremoved warm-up, a
+# slow term describing a bias step): where the term dominates the model
+# (of the taus where it holds at least half the fitted AV, the one where
+# its own AV is largest: a GM's peak), the AV that series effect adds to
+# the curve (ADEV^2 with it minus without it, from the series pass) is at
+# least `share` of the term's own AV: with the series effect taken out, the
+# term would have nothing left to describe there. (A part only, 0.68 on a
+# measured accelerometer whose 20 s GM sits beside six 17-60 s transients,
+# does not make the term a duplicate: a GM's own excursions are transients
+# to the series pass.) Returns NULL, or a one-row data frame: the series
+# kind, that ratio and the tau it was read at.
+series_duplicate <- function(series, fit, label, share = 1) {
+  if (is.null(series) || !NROW(series$table) || !NROW(series$adev_kinds)) return(NULL)
+  comp <- fit$components
+  if (!label %in% colnames(comp)) return(NULL)
+  tab <- series$table
+  left <- unique(tab$kind[!tab$removed])
+  tau <- fit$data$tau
+  sh <- comp[, label] / rowSums(comp)
+  # where the term dominates, the tau of its largest AV (a GM's peak)
+  j <- if (any(sh >= 0.5)) which.max(comp[, label] * (sh >= 0.5)) else which.max(sh)
+  own <- comp[j, label]
+  if (!(own > 0)) return(NULL)
+  out <- NULL
+  for (k in left) {
+    a <- series$adev_kinds[series$adev_kinds$kind == k, , drop = FALSE]
+    ex <- a$before^2 - a$after^2
+    ok <- is.finite(ex) & a$tau > 0
+    if (sum(ok) < 2L || tau[j] < min(a$tau[ok]) || tau[j] > max(a$tau[ok])) next
+    at <- stats::approx(log(a$tau[ok]), ex[ok], log(tau[j]))$y
+    r <- at / own
+    if (is.finite(r) && r >= share && (is.null(out) || r > out$ratio)) {
+      out <- data.frame(series_kind = k, ratio = r, tau = tau[j],
+                        stringsAsFactors = FALSE)
+    }
+  }
+  out
 }

@@ -23,8 +23,15 @@ screen_trial <- function(st, tr, nl_now) {
         1e-9 * abs(v)), logical(1)))) {
     return(list(st = st, cand = NULL))
   }
-  r <- refit_with(cur, model_terms(cur$terms, tr$effect), tr$effect,
-                  tr$init[[1L]], st$settings, hold = c(hold_now, pin),
+  # the instances the new one replaces leave; the held values of the
+  # others follow their labels
+  tm <- model_terms(cur$terms, tr$effect, c(tr$init[[1L]], tr$pin[[1L]]), cur)
+  hold_now <- relabel_values(hold_now, cur$terms, tm)
+  nl_now <- relabel_values(nl_now, cur$terms, tm)
+  settings <- st$settings
+  settings$fixed <- relabel_values(settings$fixed, cur$terms, tm, keep_gone = TRUE)
+  r <- refit_with(cur, c(tm), tr$effect,
+                  tr$init[[1L]], settings, hold = c(hold_now, pin),
                   good_enough = function(f) crit_s(f) < c0 - min_gain)
   st$failures <- record_conditions(st$failures, r$conditions, st$step, tr$effect)
   new <- r$fit
@@ -42,7 +49,7 @@ screen_trial <- function(st, tr, nl_now) {
   # everything free before it is rejected: held at the one-term
   # compromise, a second GM lands at the wrong Tc.
   if (!is.null(jd$why) && length(hold_now)) {
-    args <- refit_args(cur, new$terms, st$settings,
+    args <- refit_args(cur, new$terms, settings,
                        start = stats::coef(new)[new$layout$role == "nonlinear"],
                        hold = pin)
     r <- state_refit(st, args, "free refit of a rejected screen", tr$effect)
@@ -69,7 +76,7 @@ screen_trial <- function(st, tr, nl_now) {
       any(startsWith(nm, paste0(broken, ".")))
     }, NA)]
     if (length(keep)) {
-      args <- refit_args(cur, new$terms, st$settings,
+      args <- refit_args(cur, new$terms, settings,
                          start = stats::coef(new)[new$layout$role == "nonlinear"],
                          hold = c(keep, pin))
       r <- state_refit(st, args, "refit with earlier effects held", tr$effect)
@@ -89,12 +96,19 @@ screen_trial <- function(st, tr, nl_now) {
   }
   if (!is.null(jd$why)) {
     st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, jd$why)
+    if (!is.null(jd$dup)) {
+      st$duplicates <- rbind(st$duplicates, cbind(
+        data.frame(step = as.integer(st$step), effect = tr$effect,
+                   params = format_params(jd$par, tr$effect), stringsAsFactors = FALSE),
+        jd$dup))
+    }
     return(list(st = st, cand = NULL))
   }
   # raw-data support counts as a gain of min_gain
   adj <- c1 - min_gain * isTRUE(jd$ev$support)
   list(st = st, cand = list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
-                            params = jd$par, ev = jd$ev, pin = pin))
+                            params = jd$par, ev = jd$ev, pin = pin,
+                            fixed = settings$fixed))
 }
 
 # An instance that is not a valid instance of its effect on this curve (a
@@ -111,12 +125,20 @@ judge_instance <- function(st, f, effect, label, tau) {
   if (is.null(why) && isFALSE(ev$support)) {
     why <- paste("contradicted by the raw data:", ev$text)
   }
+  # a term standing in for a series effect this run found and left in the
+  # data describes one thing twice (remove it in the series instead)
+  dup <- if (is.null(why)) series_duplicate(st$series, f, label)
+  if (!is.null(dup)) {
+    why <- sprintf(paste("describes the %s found in the series (not removed): it adds",
+                         "%s%% of this term's AV at tau %s s"), dup$series_kind,
+                   format_num(100 * dup$ratio), format_num(dup$tau))
+  }
   moved <- FALSE
   if (is.null(why) && !earlier_hold(st, f)) {
     why <- "moves an effect accepted earlier to values the raw data contradict"
     moved <- TRUE
   }
-  list(par = par, why = why, ev = ev, moved = moved)
+  list(par = par, why = why, ev = ev, moved = moved, dup = dup)
 }
 
 # A family's form (the sensor filter's moving average, first- or

@@ -132,6 +132,7 @@ stage_assemble <- function(st) {
                      diagnostics = diag_report(st$raw),
                      remaining = st$remaining, start_terms = fit$terms,
                      failures = st$failures, rejected = st$rejected,
+                     series_duplicates = st$duplicates,
                      unconfirmed = unconfirmed, tau_range = st$tau_range,
                      removed = if (is.null(st$series)) character() else st$series$removed)
   class(out) <- unique(c("avrefine", class(out)))
@@ -151,7 +152,8 @@ step_trace <- function(st) {
   traced <- trace_candidates(tau, cur$data$avar, cur$data$fitted, st$sig,
                              present = cur$terms, candidates = st$args$candidates,
                              raw = st$raw)
-  st$trials <- candidate_trials(traced, cur$terms, st$args$candidates, st$sig)
+  st$trials <- ready_trials(candidate_trials(traced, cur$terms, st$args$candidates,
+                                             st$sig), st$settings$fixed)
   if (!nrow(st$trials)) st$flow <- "stop"
   st
 }
@@ -206,7 +208,10 @@ step_settle <- function(st) {
 # taken.
 step_refit_winner <- function(st) {
   best <- st$best
-  if (length(best$pin)) st$settings$fixed <- c(st$settings$fixed, best$pin)
+  # the values pinned before, under the labels of the new model
+  if (length(best$pin) || !identical(best$fixed, st$settings$fixed)) {
+    st$settings$fixed <- c(best$fixed, best$pin)
+  }
   if (!length(st$hold)) return(st)
   lay <- best$fit$layout
   args <- refit_args(st$current, best$fit$terms, st$settings,

@@ -19,6 +19,7 @@ new_refine_state <- function(fit, args, settings) {
     steps = list(),            # accepted steps of this call (step_row())
     failures = new_failures(),
     rejected = new_rejected(),
+    duplicates = new_duplicates(), # terms rejected as a series effect again
     sig = NULL,                # residual signatures of the current model
     step = 0L,                 # the step being taken
     trials = NULL,             # that step's candidate trials
@@ -98,6 +99,15 @@ earlier_hold <- function(st, f) !length(earlier_broken(st, f))
 new_rejected <- function() {
   data.frame(step = integer(), effect = character(), params = character(),
              reason = character(), stringsAsFactors = FALSE)
+}
+
+# Terms rejected because they describe a series effect of the same run
+# again (series_duplicate()): the series kind, the share of the term's AV
+# that effect adds and the tau it was read at.
+new_duplicates <- function() {
+  data.frame(step = integer(), effect = character(), params = character(),
+             series_kind = character(), ratio = numeric(), tau = numeric(),
+             stringsAsFactors = FALSE)
 }
 
 add_rejected <- function(rejected, step, effect, par, reason) {

@@ -330,10 +330,15 @@ visible_lines <- function(lines, tau_min, tau_max, freq) {
 }
 
 # Lines that sit inside a broad band (find_bands()) are bins of that band,
-# not sinusoids: drop them.
+# not sinusoids: drop them, unless the record's own resolution shows a line
+# there on top of the band (find_bands()' attribute "lines").
 lines_outside_bands <- function(lines, bands) {
   if (!nrow(lines) || !nrow(bands)) return(lines)
-  inside <- vapply(lines$f0, function(f) any(f >= bands$f_from & f <= bands$f_to), NA)
+  on_band <- attr(bands, "lines") %||% numeric()
+  res <- attr(lines, "resolution") %||% 0
+  inside <- vapply(lines$f0, function(f) {
+    any(f >= bands$f_from & f <= bands$f_to) && !any(abs(on_band - f) <= 1.5 * res)
+  }, NA)
   out <- lines[!inside, , drop = FALSE]
   attr(out, "resolution") <- attr(lines, "resolution")
   attr(out, "nyquist") <- attr(lines, "nyquist")
@@ -370,6 +375,82 @@ remove_lines <- function(x, freq, f0) {
     xc <- xc - b[1L] * sin(2 * pi * o$minimum * t) - b[2L] * cos(2 * pi * o$minimum * t)
   }
   as.numeric(xc) + mean(x)
+}
+
+# ---- the record's own resolution ---------------------------------------------------
+
+# One-sided periodogram (u^2/Hz) of the whole record: resolution 1/T, the
+# finest the data have. A Blackman-Harris (4-term) taper keeps a line's
+# power in its main lobe (+-4 bins) with side lobes 92 dB down, so however
+# strong a line is, its power does not leak into the bins around it.
+# Zero-padded to a length with factors 2, 3, 5 (R's fft() is slow on large
+# primes); `res` is the record's resolution freq / n, `df` the bin spacing.
+record_periodogram <- function(x, freq) {
+  n <- length(x)
+  k <- 2 * pi * (seq_len(n) - 1) / n
+  w <- 0.35875 - 0.48829 * cos(k) + 0.14128 * cos(2 * k) - 0.01168 * cos(3 * k)
+  np <- stats::nextn(n, c(2L, 3L, 5L))
+  y <- detrend_linear(x) * w
+  X <- stats::fft(c(y, numeric(np - n)))
+  half <- np %/% 2L + 1L
+  p <- Mod(X[seq_len(half)])^2 / (freq * sum(w^2))
+  p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
+  list(f = (seq_len(half) - 1) * freq / np, psd = p, df = freq / np,
+       res = freq / n, lobe = ceiling(4 * np / n) + 1L)
+}
+
+# What a peak region [f_lo, f_hi] of a coarser spectrum holds at the
+# record's own resolution (`rp`, record_periodogram()): lines, a band, or
+# both. Lines: bins standing above the local running median (101 bins; a
+# bin is exponential about its mean, whose median is log 2 of it) beyond
+# the exponential tail at false-alarm rate `alpha` over the region, in
+# groups no wider than the taper's main lobe. Band: the excess over `bg`
+# (the background PSD, a function of f) outside the lines' lobes is
+# significant (5 sd of a sum of bins whose taper correlates them over its
+# 2-bin noise bandwidth) and at least a tenth of the lines' excess (else it
+# is the lines' own shoulder or an error of the background). Returns
+# list(lines = frequencies, line_power, band = logical, band_power).
+record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
+  nb <- length(rp$psd)
+  i_lo <- max(2L, floor(f_lo / rp$df) + 1L)
+  i_hi <- min(nb - 1L, ceiling(f_hi / rp$df) + 1L)
+  none <- list(lines = numeric(), line_power = numeric(), band = TRUE,
+               band_power = NA_real_)
+  if (i_hi - i_lo < 4L) return(none)
+  h <- 50L
+  ext <- max(1L, i_lo - h):min(nb, i_hi + h)
+  p <- rp$psd[ext]
+  loc <- stats::runmed(p, 2L * h + 1L, endrule = "median") / log(2)
+  reg <- (i_lo:i_hi) - ext[1L] + 1L
+  thr <- log(length(reg) / alpha)
+  hot <- reg[p[reg] > thr * loc[reg]]
+  lines <- numeric()
+  lpow <- numeric()
+  lobe <- rp$lobe
+  masked <- rep(FALSE, length(p))
+  b <- bg(rp$f[ext])
+  if (length(hot)) {
+    groups <- split(hot, cumsum(c(1, diff(hot) > 2L)))
+    for (g in groups) {
+      if (diff(range(g)) > 2L * lobe) next       # wider than a line: band bins
+      i <- g[which.max(p[g])]
+      a <- log(p[i - 1L]); c <- log(p[i + 1L]); m <- log(p[i])
+      d <- 0.5 * (a - c) / (a - 2 * m + c)
+      if (!is.finite(d) || abs(d) > 0.5) d <- 0
+      lines <- c(lines, rp$f[ext[i]] + d * rp$df)
+      j <- max(1L, min(g) - lobe):min(length(p), max(g) + lobe)
+      lpow <- c(lpow, sum(pmax(p[j] - b[j], 0)) * rp$df)
+      masked[j] <- TRUE
+    }
+  }
+  rest <- reg[!masked[reg]]
+  if (!length(lines)) return(none)
+  e_rest <- sum(p[rest] - b[rest])
+  sd_rest <- sqrt(2 * sum(b[rest]^2))
+  band <- length(rest) > 0L && e_rest > 5 * sd_rest &&
+    e_rest * rp$df > 0.1 * sum(lpow)
+  list(lines = lines, line_power = lpow, band = band,
+       band_power = max(e_rest, 0) * rp$df)
 }
 
 # ---- bands ------------------------------------------------------------------------
@@ -439,7 +520,26 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
       bg <- exp(stats::approx(keep, log(bg2), xout = seq_len(nb), rule = 2)$y)
     }
   }
-  r2 <- runs(bg)
+  r2 <- split_valleys(runs(bg), p, bg, w$nu, min_bins)
+  # A run may be a line (or a few) that the coarse segments smear over
+  # several bins: at the record's own resolution a line stays within the
+  # taper's lobe and a band does not. Runs holding lines only are not
+  # bands; the lines found on top of a band are kept as lines.
+  on_band <- numeric()
+  if (length(r2$from)) {
+    rp <- record_periodogram(x, freq)
+    lbg <- log(bg)
+    bgf <- function(f) exp(stats::approx(w$f, lbg, xout = f, rule = 2)$y)
+    keep <- logical(length(r2$from))
+    for (k in seq_along(r2$from)) {
+      sh <- record_peak_shape(rp, w$f[r2$from[k]] - w$df, w$f[r2$to[k]] + w$df,
+                              bgf, alpha)
+      keep[k] <- sh$band
+      if (sh$band) on_band <- c(on_band, sh$lines)
+    }
+    r2$from <- r2$from[keep]
+    r2$to <- r2$to[keep]
+  }
   total <- stats::var(x)
   rows <- lapply(seq_along(r2$from), function(k) {
     j <- r2$from[k]:r2$to[k]
@@ -463,7 +563,61 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
                width = numeric(), tc = numeric(), power = numeric(),
                share = numeric(), peak_ratio = numeric())
   attr(out, "resolution") <- w$df
+  attr(out, "lines") <- on_band
   out
+}
+
+# Two bands side by side make one run of significant bins when their
+# flanks meet; where the excess over the background (smoothed over 5 bins)
+# has a valley between two peaks that each stand at least half the
+# background above it, dropping below half the lower peak by more than 5
+# of its standard errors, the run is cut at the valley's deepest bin, each
+# side keeping at least `min_bins` bins (a wiggle on one band's flank, or
+# an error of the background under it, is not a second band). `r`: runs
+# (list(from, to, ratio)), `p`, `bg`: the Welch PSD and its background,
+# `nu`: the Welch EDF.
+split_valleys <- function(r, p, bg, nu, min_bins) {
+  if (!length(r$from)) return(r)
+  from <- integer()
+  to <- integer()
+  for (k in seq_along(r$from)) {
+    j <- r$from[k]:r$to[k]
+    cuts <- integer()
+    if (length(j) >= 2L * min_bins + 1L) {
+      ex <- p[j] - bg[j]
+      sm <- as.numeric(stats::filter(ex, rep(1 / 5, 5), sides = 2))
+      sm[is.na(sm)] <- ex[is.na(sm)]
+      # standard error of a 5-bin mean of Welch bins (chi-square with EDF
+      # nu; 1.5 for the overlap of the segments)
+      se <- 1.5 * bg[j] * sqrt(2 / nu) / sqrt(5)
+      pk <- which(vapply(seq_along(sm), function(i) {
+        sm[i] == max(sm[max(1L, i - 3L):min(length(sm), i + 3L)])
+      }, NA) & sm > 5 * se & sm > 0.5 * bg[j])
+      last <- if (length(pk)) pk[1L] else NA_integer_
+      for (q in pk[-1L]) {
+        v <- last + which.min(sm[last:q]) - 1L
+        low <- min(sm[last], sm[q])
+        if (sm[v] < 0.5 * low && low - sm[v] > 5 * se[v] &&
+            v - max(c(0L, cuts)) > min_bins && length(j) - v >= min_bins) {
+          cuts <- c(cuts, v)
+          last <- q
+        } else if (sm[q] > sm[last]) {
+          last <- q
+        }
+      }
+    }
+    edges <- c(0L, cuts, length(j))
+    for (e in seq_len(length(edges) - 1L)) {
+      # the valley bin belongs to neither side
+      lo <- edges[e] + 1L
+      hi <- if (e < length(edges) - 1L) edges[e + 1L] - 1L else edges[e + 1L]
+      from <- c(from, j[lo])
+      to <- c(to, j[hi])
+    }
+  }
+  r$from <- from
+  r$to <- to
+  r
 }
 
 # Least-squares fit of the resonance's one-sided PSD (2 x two-sided) to the

@@ -51,9 +51,9 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
     e$name %in% candidates && addable_kind(e$name, present)
   }, catalogue()[effect_kinds()])
   out <- list()
-  one <- function(effect, from, to, init, signature, score, pin = NULL) {
+  one <- function(effect, from, to, init, signature, score, pin = NULL, after = NULL) {
     list(effect = effect, tau_from = from, tau_to = to, init = init,
-         signature = signature, score = score, pin = pin)
+         signature = signature, score = score, pin = pin, after = after)
   }
   for (i in seq_len(nrow(sig))) {
     ctx <- trace_context(sig[i, ], tau, excess)
@@ -75,7 +75,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
         out[[length(out) + 1L]] <- one(
           p$effect %||% e$name, p$tau_from, p$tau_to, p$init,
           paste0(overlapping_signature(sig, p$tau_from, p$tau_to), "; ", p$note),
-          p$score, p$pin)
+          p$score, p$pin, p$after)
       }
     }
   }
@@ -92,6 +92,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
                    stringsAsFactors = FALSE)
   df$init <- lapply(out, `[[`, "init")
   df$pin <- lapply(out, function(o) o$pin)
+  df$after <- lapply(out, function(o) o$after)
   df[order(-df$score), , drop = FALSE]
 }
 

@@ -62,7 +62,7 @@ test_that("a filtered sensor with a resonance: the low-pass family, the band's c
   expect_equal(unname(cf[["filter_lp2.Nf"]]), N, tolerance = 0.1)
   # the resonance, its centre pinned within the periodogram's resolution
   expect_true("resonance" %in% st$effect)
-  expect_lt(abs(cf[["resonance.fr"]] - 15), 0.2)
+  expect_lt(abs(cf[["resonance1.fr"]] - 15), 0.2)
   # every step is confirmed by the raw data; no sinusoid stands in for the
   # random walk at the long-tau end
   expect_false(any(st$confirmed %in% FALSE))
@@ -105,9 +105,9 @@ test_that("a weak narrow band (below 2x its background): a resonance at the band
   ref <- suppressMessages(avrefine(fit, data = x, max_steps = 4))
   cf <- stats::coef(ref)
   expect_true("resonance" %in% ref$steps$effect)
-  expect_lt(abs(cf[["resonance.fr"]] - 10), attr(b, "resolution"))
+  expect_lt(abs(cf[["resonance1.fr"]] - 10), attr(b, "resolution"))
   # its width 1/(pi tc) within 3x of the band's, not a tone
-  expect_lt(abs(log(cf[["resonance.tc"]] / 0.5)), log(3))
+  expect_lt(abs(log(cf[["resonance1.tc"]] / 0.5)), log(3))
   expect_false(any(ref$steps$confirmed %in% FALSE))
   expect_false(any(abs(cf[grepl("\\.f0$", names(cf))] - 10) < 1))
 })

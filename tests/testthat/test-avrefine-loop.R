@@ -152,8 +152,29 @@ test_that("admissibility rules: a sub-sample GM and an invisible sinusoid are re
   expect_match(inadmissible("sinusoid", c(amp = 1, f0 = 1e-4), tau, 100),
                "outside the band")
   expect_null(inadmissible("sinusoid", c(amp = 1, f0 = 1), tau, 100))
-  expect_equal(model_terms(c("N", "B", "K"), "filter"), c("B", "K", "filter"))
+  expect_equal(c(model_terms(c("N", "B", "K"), "filter")), c("B", "K", "filter"))
   expect_false(addable_kind("N", c("filter", "K")))
+  # a measured band replaces only the resonance at its band; the values of
+  # the others follow their labels (resonance2 becomes resonance1)
+  fit <- list(coefficients = c(B = 1, resonance1.sigma = 1, resonance1.fr = 20,
+                               resonance1.tc = 0.2, resonance2.sigma = 1,
+                               resonance2.fr = 12, resonance2.tc = 0.3))
+  fit$layout <- coef_layout(c("B", "resonance", "resonance"))
+  class(fit) <- "avfit"
+  tm <- model_terms(c("B", "resonance", "resonance"), "band",
+                    list(f_lo = 15, f_hi = 28), fit)
+  expect_equal(c(tm), c("B", "resonance", "band"))
+  expect_equal(attr(tm, "gone"), c(FALSE, TRUE, FALSE))
+  expect_equal(relabel_values(c(B = 1, resonance1.fr = 20, resonance2.fr = 12),
+                              c("B", "resonance", "resonance"), tm),
+               c(B = 1, resonance1.fr = 12))
+  expect_equal(relabel_values(c(resonance1.fr = 20), c("B", "resonance", "resonance"),
+                              tm, keep_gone = TRUE), c(`left:resonance1.fr` = 20))
+  expect_true(addable_kind("resonance", c("band", "K")))
+  # the filter replaces N, every instance: its held values follow
+  tm <- model_terms(c("N", "B", "K", "resonance"), "filter")
+  expect_equal(relabel_values(c(N = 2, resonance1.fr = 20), c("N", "B", "K", "resonance"), tm),
+               c(resonance1.fr = 20))
   expect_true(addable_kind("gm", c("gm", "K")))
 })
 

@@ -77,10 +77,10 @@ test_that("a resonance term fits a narrow-band process", {
   z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
   x <- rnorm(n, sd = 0.5) + 0.5 * z / stats::sd(z)
   f <- avfit(allan(x, freq), terms = c("N", "resonance"),
-             start = c(resonance.fr = 19, resonance.tc = 0.05))
+             start = c(resonance1.fr = 19, resonance1.tc = 0.05))
   cf <- coef(f)
-  expect_equal(cf[["resonance.fr"]], 20, tolerance = 0.1)
-  expect_equal(cf[["resonance.sigma"]], 0.5, tolerance = 0.3)
+  expect_equal(cf[["resonance1.fr"]], 20, tolerance = 0.1)
+  expect_equal(cf[["resonance1.sigma"]], 0.5, tolerance = 0.3)
   # the generator is a white-driven AR(2), whose autocovariance has a small
   # sine part the entry's cos form lacks: a slightly larger chi2
   expect_lt(f$chi2, 5)

@@ -67,9 +67,9 @@ test_that("no nonlinear parameter leaves what the curve and record can see", {
   expect_lte(coef(gm)[["gm1.tc"]], 4 * tmax)
   expect_gte(coef(gm)[["gm1.tc"]], min(av$tau) / 4)
   # a band centre never above Nyquist, nor below what the curve sees
-  rs <- avfit(av, c("N", "resonance"), start = c(resonance.fr = 80))
-  expect_lte(coef(rs)[["resonance.fr"]], 0.499 * fw)
-  expect_gte(coef(rs)[["resonance.fr"]], 1 / tmax * (1 - 1e-9))
+  rs <- avfit(av, c("N", "resonance"), start = c(resonance1.fr = 80))
+  expect_lte(coef(rs)[["resonance1.fr"]], 0.499 * fw)
+  expect_gte(coef(rs)[["resonance1.fr"]], 1 / tmax * (1 - 1e-9))
   sn <- avfit(av, c("N", "sinusoid"), start = c(sinusoid1.f0 = 400))
   expect_lte(coef(sn)[grep("f0$", names(coef(sn)))][[1]], fw / 2)
   # the bounds are the entries' own

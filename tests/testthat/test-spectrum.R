@@ -119,3 +119,44 @@ test_that("line_sums() (phase rotation in blocks) equals the sums of sin and cos
                  tolerance = 1e-10)
   }
 })
+
+test_that("at the record's own resolution a line is a line and a band a band", {
+  set.seed(23)
+  freq <- 100
+  n <- 3e5
+  t <- seq_len(n) / freq
+  w <- rnorm(n, sd = 0.01)
+  # a line near Nyquist with the white noise's own amplitude: the coarse
+  # (512-sample) spectrum smears it over 3 bins, the record does not
+  x <- w + 0.01 * sin(2 * pi * 49.3 * t + 1)
+  expect_equal(nrow(find_bands(x, freq)), 0L)
+  l <- lines_outside_bands(spectral_lines(x, freq), find_bands(x, freq))
+  expect_lte(abs(l$f0[match_line(49.3, l)] - 49.3), attr(l, "resolution"))
+  # a square wave's harmonics: lines, however strong
+  y <- w + 0.01 * sign(sin(2 * pi * 0.8 * t + 0.2))
+  expect_equal(nrow(find_bands(y, freq)), 0L)
+  # record_peak_shape() directly: one line, no band power beyond its lobe
+  rp <- record_periodogram(x, freq)
+  expect_equal(rp$res, freq / n)
+  sh <- record_peak_shape(rp, 48.9, 49.7, function(f) rep(2 * 0.01^2 / freq, length(f)))
+  expect_length(sh$lines, 1L)
+  expect_lte(abs(sh$lines - 49.3), rp$res)
+  expect_false(sh$band)
+  # the line's power (A^2 / 2) is in its lobe
+  expect_equal(sh$line_power, 0.01^2 / 2, tolerance = 0.05)
+  # a resonance 0.2 Hz wide (Tc = 1.6 s; 320 record bins) stays a band,
+  # and a line on top of it is kept as a line
+  r <- exp(-1 / (freq * 1.6))
+  w0 <- 2 * pi * 12 / freq
+  z <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w0), -r^2), method = "recursive"))
+  b <- w + 0.01 * z / stats::sd(z)
+  bb <- find_bands(b, freq)
+  expect_equal(nrow(bb), 1L)
+  expect_equal(bb$f_center, 12, tolerance = 0.01)
+  bl <- b + 0.004 * sin(2 * pi * 12.21 * t)
+  bb <- find_bands(bl, freq)
+  expect_equal(nrow(bb), 1L)
+  expect_lte(min(abs(attr(bb, "lines") - 12.21)), 2 / 3000)
+  l <- lines_outside_bands(spectral_lines(bl, freq), bb)
+  expect_false(is.na(match_line(12.21, l)))
+})

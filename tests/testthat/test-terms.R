@@ -127,7 +127,7 @@ test_that("catalogue listing and argument checks", {
   expect_equal(coef_layout(c("gm", "N", "sinusoid", "gm"))$name,
                c("N", "gm1.sigma", "gm1.tc", "gm2.sigma", "gm2.tc",
                  "sinusoid1.amp", "sinusoid1.f0"))
-  expect_error(check_terms(c("N", "N")), "only gm and sinusoid",
+  expect_error(check_terms(c("N", "N")), "only gm, sinusoid, resonance and band",
     class = "allanvar_error_argument")
   expect_error(check_terms("Z"), "unknown term",
     class = "allanvar_error_argument")

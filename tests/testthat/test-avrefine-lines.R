@@ -1,0 +1,49 @@
+# The loop on lines it was not tuned to: a line near Nyquist whose Allan
+# signature sits at m = 1 only, and the harmonics of a square wave. Series
+# built here with base R (rnorm, cumsum, sin, sign), not the package's
+# simulator; references: the generating frequencies and the run without
+# the effect.
+
+gen_base <- function(n, freq) rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+loop <- function(x, freq) {
+  fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
+  suppressMessages(avrefine(fit, data = x))
+}
+n_reading <- function(r) {
+  cf <- coef(r)
+  if ("N" %in% names(cf)) cf[["N"]] else cf[["filter.Nf"]]
+}
+
+test_that("a line at 49.3 Hz (100 Hz sampling, amplitude the white sd) is named; no Q in its place", {
+  set.seed(2711)
+  freq <- 100
+  n <- 3e5
+  b <- gen_base(n, freq)
+  x <- b + 0.01 * sin(2 * pi * 49.3 * seq_len(n) / freq + 0.7)
+  r <- loop(x, freq)
+  cf <- coef(r)
+  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  expect_length(f0, 1L)
+  expect_equal(unname(f0), 49.3, tolerance = 0.03 / 49.3)
+  expect_equal(cf[[sub("f0", "amp", names(f0))]], 0.01, tolerance = 0.1)
+  expect_false("Q" %in% r$terms)
+  expect_false(any(r$steps$confirmed %in% FALSE))
+  r0 <- loop(b, freq)
+  expect_equal(n_reading(r), n_reading(r0), tolerance = 0.05)
+  expect_lt(r$chi2, 2)
+})
+
+test_that("a 0.8 Hz square wave: its lines 0.8, 2.4 and 4.0 Hz are named, no band or resonance", {
+  set.seed(2712)
+  freq <- 100
+  n <- 5e5
+  x <- gen_base(n, freq) + 0.004 * sign(sin(2 * pi * 0.8 * seq_len(n) / freq + 0.3))
+  r <- loop(x, freq)
+  cf <- coef(r)
+  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  for (h in c(1, 3, 5)) expect_lte(min(abs(f0 / (0.8 * h) - 1)), 0.03)
+  # only odd harmonics: the set's pattern
+  expect_true(all(abs(f0 / 0.8 - round(f0 / 0.8)) < 0.01 & round(f0 / 0.8) %% 2 == 1))
+  expect_false(any(grepl("^(band|resonance)", r$terms)))
+  expect_false(any(r$steps$confirmed %in% FALSE))
+})
