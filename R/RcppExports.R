@@ -37,12 +37,8 @@ avar_white_cov <- function(m, n, overlapping, threads) {
     .Call(`_allanvar_avar_white_cov`, m, n, overlapping, threads)
 }
 
-avfit_exact_edf <- function(m, M, overlapping, w, q, p, s2, phi) {
-    .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, w, q, p, s2, phi)
-}
-
-bz2_available_cpp <- function() {
-    .Call(`_allanvar_bz2_available_cpp`)
+avfit_exact_edf <- function(m, M, overlapping, shape, coef, phi) {
+    .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, shape, coef, phi)
 }
 
 first_nonfinite <- function(x) {
@@ -85,6 +81,18 @@ grid_stats <- function(x) {
     .Call(`_allanvar_grid_stats`, x)
 }
 
+gchisq_weights_cpp <- function(type, m, n, alpha) {
+    .Call(`_allanvar_gchisq_weights_cpp`, type, m, n, alpha)
+}
+
+gchisq_cdf_cpp <- function(lambda, q) {
+    .Call(`_allanvar_gchisq_cdf_cpp`, lambda, q)
+}
+
+gchisq_quantile_cpp <- function(lambda, p) {
+    .Call(`_allanvar_gchisq_quantile_cpp`, lambda, p)
+}
+
 line_sums <- function(y, f, freq) {
     .Call(`_allanvar_line_sums`, y, f, freq)
 }
@@ -93,16 +101,12 @@ lz4_decompress_cpp <- function(x, expected) {
     .Call(`_allanvar_lz4_decompress_cpp`, x, expected)
 }
 
-mcap_records <- function(buf, start, end) {
-    .Call(`_allanvar_mcap_records`, buf, start, end)
+mcap_index_cpp <- function(path) {
+    .Call(`_allanvar_mcap_index_cpp`, path)
 }
 
-mcap_chunk_raw <- function(buf, off, len) {
-    .Call(`_allanvar_mcap_chunk_raw`, buf, off, len)
-}
-
-mcap_imu <- function(buf, op, off, len, ids, enc) {
-    .Call(`_allanvar_mcap_imu`, buf, op, off, len, ids, enc)
+mcap_read_cpp <- function(path, pos, ids, enc, from, to) {
+    .Call(`_allanvar_mcap_read_cpp`, path, pos, ids, enc, from, to)
 }
 
 mle_kalman_sums <- function(y, R, T, Q, P0, diffuse) {
@@ -149,12 +153,20 @@ stamp_rel_seconds <- function(sec, nsec, origin) {
     .Call(`_allanvar_stamp_rel_seconds`, sec, nsec, origin)
 }
 
-rosbag_records <- function(buf, start, end) {
-    .Call(`_allanvar_rosbag_records`, buf, start, end)
+rosbag_index_cpp <- function(path) {
+    .Call(`_allanvar_rosbag_index_cpp`, path)
 }
 
-rosbag_imu <- function(buf, off, len, comp, size, conns, threads = 1L) {
-    .Call(`_allanvar_rosbag_imu`, buf, off, len, comp, size, conns, threads)
+rosbag_read_cpp <- function(path, pos, conns, from, to) {
+    .Call(`_allanvar_rosbag_read_cpp`, path, pos, conns, from, to)
+}
+
+rosbag_chunk_cpp <- function(path, pos) {
+    .Call(`_allanvar_rosbag_chunk_cpp`, path, pos)
+}
+
+rosbag_decode_cpp <- function(raw, conns, from, to) {
+    .Call(`_allanvar_rosbag_decode_cpp`, raw, conns, from, to)
 }
 
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {

@@ -34,7 +34,7 @@
 #'     `avrefine()$steps`.}
 #'   \item{`unexplained`}{the residual structure the loop left unexplained
 #'     per axis, with the columns of `avrefine()$unexplained`.}
-#'   \item{`check`}{issue 9's checks per axis (`data-raw/adis16405-check.R`):
+#'   \item{`check`}{the measured-data checks per axis (`bench/adis16405/adis16405-check.R`):
 #'     `acf1`, `filter` (a filter term was added), `enbw` (its
 #'     noise-equivalent bandwidth, Hz), `line_055` (a sinusoid at 0.5-0.6 Hz),
 #'     `sinusoids` (their frequencies), `contradicted` (accepted steps the raw

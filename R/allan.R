@@ -167,13 +167,33 @@
 #'   left out, as Stable32 and allantools' `gradev` do (see the section Gaps;
 #'   the count of missing values is printed and kept in the attribute
 #'   `missing`); or `"error"`: refuse them. `Inf` is always an error.
+#' @param ci `TRUE` (default): confidence limits, which need the noise type
+#'   identified at every tau and its EDF. `FALSE`: the values alone, without
+#'   noise identification (faster: for the standard type at octave taus the
+#'   one pass over the data is all): the columns stay, `lower`, `upper`,
+#'   `edf` and `alpha` are `NA` (the bias-corrected `"mtotdev"`,
+#'   `"ttotdev"`, `"htotdev"` and `"theo1"` still identify the type their
+#'   correction needs, and report it in `alpha`). `print()` says there are
+#'   no intervals and `plot()` draws no bars.
+#' @param unbiased `FALSE` (default): `adev` is the square root of the
+#'   unbiased variance estimate, which underestimates the deviation at small
+#'   EDF (its mean is \eqn{c_4(\nu)\sigma}). `TRUE`: `adev` is divided by
+#'   \eqn{c_4(\nu) = E\sqrt{\chi^2_\nu/\nu} = \sqrt{2/\nu}\,
+#'   \Gamma((\nu+1)/2)/\Gamma(\nu/2)} at the row's EDF \eqn{\nu}, an
+#'   unbiased estimate of the deviation (as SigmaTheta reports it); `avar`
+#'   is unchanged, and so are `lower` and `upper`: they are a confidence
+#'   interval for the true deviation, which the unbiased value estimates
+#'   (scaling them too would lower their coverage). Needs the EDF, so the
+#'   noise type is identified even with `ci = FALSE`. Statistics without an
+#'   EDF (`"mtie"`, `"tierms"`) ignore it.
 #' @return A data frame of class `c("allan", "data.frame")` with columns
 #'   `tau` (s), `m` (cluster size), `n` (number of terms), `avar`, `adev`,
 #'   `lower` and `upper` (confidence limits of `adev`), `edf`, then, when `x`
 #'   has several columns, `channel` (the column name; rows stacked channel by
 #'   channel), and last `alpha` (the integer noise exponent behind the EDF;
 #'   `NA` where too few points identify it).
-#'   Attributes: `freq`, `type`, `input`, `N` (samples per channel), `conf`.
+#'   Attributes: `freq`, `type`, `input`, `N` (samples per channel), `conf`;
+#'   `ci = FALSE` and `unbiased = TRUE` when those were asked for.
 #' @seealso [avar()], [avarn()] and [avari()] for the results of
 #'   'allanvar' 1.1.
 #' @export
@@ -186,7 +206,7 @@
 #' allan(cbind(x = y, z = 2 * y), type = "modified", taus = "decade")
 allan <- function(x, freq, taus = "octave", type = "overlapping",
                   input = "rate", conf = 0.683, gaps = "skip",
-                  debias = TRUE) {
+                  debias = TRUE, ci = TRUE, unbiased = FALSE) {
   check_present(missing(x), "x", "the samples")
   if (missing(freq)) {
     if (!stats::is.ts(x)) {
@@ -196,28 +216,33 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     freq <- stats::frequency(x)
   }
   freq <- check_freq(freq)
-  type <- allan_canonical_type(check_choice(type, allan_type_names(), "type"))
+  e <- stat_entry(check_choice(type, stat_names(), "type"))
+  type <- e$name
   input <- check_choice(input, c("rate", "integrated"), "input")
   conf <- check_number(conf, "conf", 0, 1, open = TRUE)
   gaps <- check_choice(gaps, c("skip", "error"), "gaps")
   debias <- check_true_false(debias, "debias")
-  if (type %in% allan_extra_types) {
-    return(allan_extra(x, freq, taus, type, input, conf, debias, gaps))
+  ci <- check_true_false(ci, "ci")
+  unbiased <- check_true_false(unbiased, "unbiased")
+  if (!identical(e$kernel, "sums")) {
+    return(allan_extra(x, freq, taus, e, input, conf, debias, gaps, ci,
+                       unbiased))
   }
   ch <- allan_channels(x, min_n = if (input == "rate") 2L else 3L)
   N <- ch$N
   rate <- input == "rate"
   L <- if (rate) N + 1 else N
-  maxm <- allan_max_m(type, L)
-  m <- allan_taus(taus, freq, maxm)
+  maxm <- e$max_m(L)
+  m <- e$taus(taus, freq, L, maxm)$m
   if (length(m) == 0L) {
     abort("No averaging time in `taus` has a term for type \"", type,
           "\" with ", N, " samples (largest cluster size: ", maxm, ").")
   }
-  nterms <- allan_nterms(type, m, L)
-  octave <- type == "standard" && rate && length(m) <= 64L &&
+  nterms <- e$nterms(m, L)
+  octave <- e$octave_pass && rate && length(m) <= 64L &&
     all(m == 2^round(log2(m)))
-  sub <- allan_subset(m)
+  # the noise type is identified only where the EDF is asked for
+  sub <- if (ci || unbiased) allan_subset(m) else integer(0)
   res <- allan_call_kernel(allan_sums_cpp(ch$values, N, m, nterms, m[sub],
                                           allan_opts(type, rate, octave)),
                            N, ch$nc)
@@ -225,7 +250,7 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     # the kernel finds NA/NaN in the pass it makes anyway (no anyNA() pass
     # over every call's data)
     if (gaps == "skip" && anyNA(ch$values)) {
-      return(allan_gaps(ch, freq, m, type, input, conf))
+      return(allan_gaps(ch, freq, m, e, input, conf, ci, unbiased))
     }
     col <- which(res$bad > 0)[1L]
     row <- res$bad[col]
@@ -238,8 +263,7 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
   }
   # the estimator's divisor: one vector (a long curve's temporaries cost
   # more in page faults than in arithmetic)
-  den <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
-                2 * m^2) * nterms
+  den <- e$divisor(m) * nterms
   # Sums that overflowed (or underflowed) in a channel of huge (tiny) but
   # finite numbers: that channel again on x 2^-e (exact), scaled back.
   sc <- rep(0, ch$nc)
@@ -248,16 +272,16 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     sj <- if (ch$nc == 1L) res$sums else res$sums[, j]
     if (is.finite(max(sj)) && min(sj) >= 2^-900) next
     xj <- if (ch$nc == 1L) ch$values else ch$values[(j - 1) * N + seq_len(N)]
-    e <- range_exponent(xj)
+    ex <- range_exponent(xj)
     # zero sums of a constant channel are right as they are
-    if (e == 0 || (all(sj == 0) && diff(range(xj)) == 0)) next
-    rj <- allan_call_kernel(allan_sums_cpp(times_pow2(as.double(xj), -e), N,
+    if (ex == 0 || (all(sj == 0) && diff(range(xj)) == 0)) next
+    rj <- allan_call_kernel(allan_sums_cpp(times_pow2(as.double(xj), -ex), N,
                                            m, nterms, m[sub],
                                            allan_opts(type, rate, octave)),
                             N, 1L)
     res$sums[, j] <- rj$sums[, 1L]
     res$alpha_int[, j] <- rj$alpha_int[, 1L]
-    sc[j] <- e
+    sc[j] <- ex
   }
   out <- vector("list", ch$nc)
   for (j in seq_len(ch$nc)) {
@@ -271,21 +295,27 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
       av <- times_pow2(av * a * a, 2 * sc[j] + 2 * b)
     }
     check_representable(av, nonzero = res$sums[, j] > 0)
-    e <- allan_edf(type, m, nterms, L, res$alpha_int[, j], sub)
-    ci <- allan_ci(av, e$edf, conf)
+    lim <- stat_limits(e, av, m, nterms, L, res$alpha_int[, j], sub, conf,
+                       ci, unbiased)
     d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
-              adev = ci$adev, lower = ci$lower, upper = ci$upper,
-              edf = e$edf)
+              adev = lim$adev, lower = lim$lower, upper = lim$upper,
+              edf = lim$edf)
     if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
-    d$alpha <- e$alpha
+    d$alpha <- lim$alpha
     out[[j]] <- structure(d, class = "data.frame",
                           row.names = .set_row_names(length(m)))
   }
   out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)
   if (ch$nc > 1L) rownames(out) <- NULL
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
-            input = input, N = N, conf = conf)
+            input = input, N = N, conf = conf, ci = allan_ci_attr(ci),
+            unbiased = allan_unbiased_attr(e, unbiased))
 }
+
+# The attributes `ci` and `unbiased`: present only where they differ from
+# the default (the default call's attributes stay as they were).
+allan_ci_attr <- function(ci) if (!ci) FALSE
+allan_unbiased_attr <- function(e, unbiased) if (unbiased && e$unbiased) TRUE
 
 # ---- gaps: allan(gaps = "skip") ----
 # NA/NaN are missing samples (rate) or phase points (integrated). A term is
@@ -293,15 +323,13 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
 # allan_gap_sums_cpp); `n` counts the kept terms. The noise type comes from
 # the longest run without a gap; the EDF from the kept terms and the
 # present points. Inf stays an error; the total type is not defined.
-allan_gaps <- function(ch, freq, m, type, input, conf) {
+allan_gaps <- function(ch, freq, m, e, input, conf, ci = TRUE,
+                       unbiased = FALSE) {
   N <- ch$N
   rate <- input == "rate"
   L <- if (rate) N + 1 else N
-  if (type == "total") {
-    abort("`gaps = \"skip\"` is not defined for type \"total\" (its ",
-          "reflected extension would carry a gap to the far end); use ",
-          "\"overlapping\" or fill the gaps.", class = "gaps")
-  }
+  type <- e$name
+  if (!identical(e$gaps, "sums")) abort(e$gaps, class = "gaps")
   inf <- which(is.infinite(ch$values))
   if (length(inf)) {
     col <- (inf[1] - 1L) %/% N + 1L
@@ -309,8 +337,7 @@ allan_gaps <- function(ch, freq, m, type, input, conf) {
           format(ch$values[[inf[1]]]), " at position ", (inf[1] - 1L) %% N + 1L,
           if (ch$nc > 1L) paste0(" of column ", col), ".", class = "values")
   }
-  norm <- switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2,
-                 2 * m^2)
+  norm <- e$divisor(m)
   opts <- allan_opts(type, rate, FALSE)
   out <- vector("list", ch$nc)
   missing <- integer(ch$nc)
@@ -334,23 +361,25 @@ allan_gaps <- function(ch, freq, m, type, input, conf) {
     best <- which.max(ifelse(r$values, r$lengths, -1L))
     run <- seq.int(end[best] - r$lengths[best] + 1L, end[best])
     alpha <- rep(NA_integer_, length(mj))
-    if (r$values[best] && length(run) >= (if (rate) 2L else 3L)) {
+    if ((ci || unbiased) && r$values[best] &&
+        length(run) >= (if (rate) 2L else 3L)) {
       Lr <- if (rate) length(run) + 1 else length(run)
-      ok <- mj <= allan_max_m(type, Lr)
+      ok <- mj <= e$max_m(Lr)
       if (any(ok)) {
         rr <- allan_call_kernel(allan_sums_cpp(
-          xj[run], length(run), mj[ok], allan_nterms(type, mj[ok], Lr),
+          xj[run], length(run), mj[ok], e$nterms(mj[ok], Lr),
           mj[ok], opts), length(run), 1L)
         alpha[ok] <- rr$alpha_int[, 1L]
       }
     }
-    e <- allan_edf(type, mj, nj, L - missing[j], alpha)
-    ci <- allan_ci(av, e$edf, conf)
+    lim <- stat_limits(e, av, mj, nj, L - missing[j], alpha,
+                       if (ci || unbiased) seq_along(mj) else integer(0),
+                       conf, ci, unbiased)
     d <- list(tau = mj / freq, m = as.integer(mj), n = nj, avar = av,
-              adev = sqrt(av), lower = ci$lower, upper = ci$upper,
-              edf = e$edf)
+              adev = lim$adev, lower = lim$lower, upper = lim$upper,
+              edf = lim$edf)
     if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(mj))
-    d$alpha <- e$alpha
+    d$alpha <- lim$alpha
     out[[j]] <- structure(d, class = "data.frame",
                           row.names = .set_row_names(length(mj)))
   }
@@ -364,7 +393,8 @@ allan_gaps <- function(ch, freq, m, type, input, conf) {
   if (ch$nc > 1L) rownames(out) <- NULL
   names(missing) <- ch$names
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
-            input = input, N = N, conf = conf, missing = missing)
+            input = input, N = N, conf = conf, missing = missing,
+            ci = allan_ci_attr(ci), unbiased = allan_unbiased_attr(e, unbiased))
 }
 
 # ---- range: series near 1e300 or 1e-300, sampling rates near 1e300 ----
@@ -491,23 +521,36 @@ print.allan <- function(x, digits = 4, ...) {
   invisible(x)
 }
 
+# The header line: the statistic's title, the input, the missing values,
+# the intervals (none for a statistic without limits or with ci = FALSE),
+# the unit of a time statistic, the bias convention.
 allan_header <- function(x) {
   a <- attributes(x)
-  if (a$type %in% allan_extra_types) return(allan_extra_header(x))
+  e <- stat_entry(a$type)
   nch <- if ("channel" %in% names(x)) length(unique(x$channel)) else 1L
-  sprintf("<allan> %s variance of %s input: N = %s at %s Hz%s%s; %s%% intervals",
-          a$type, a$input, format(a$N, big.mark = ","), format(a$freq),
+  sprintf("<allan> %s of %s input: N = %s at %s Hz%s%s%s%s%s%s",
+          e$title, a$input, format(a$N, big.mark = ","), format(a$freq),
           if (nch > 1L) sprintf(", %d channels", nch) else "",
           if (!is.null(a$missing)) sprintf(" (%s missing)",
                                            format(sum(a$missing), big.mark = ","))
           else "",
-          format(100 * a$conf))
+          if (!stat_has_limits(e)) "" else if (identical(a$ci, FALSE))
+            "; no intervals (ci = FALSE)" else
+            sprintf("; %s%% intervals", format(100 * a$conf)),
+          if (isTRUE(a$unbiased)) "; unbiased deviation" else "",
+          if (identical(e$unit, "time"))
+            paste0("; `adev` is a time in the phase unit (seconds ",
+                   "for phase in s or fractional-frequency input)")
+          else "",
+          if (isTRUE(a$debias)) "; bias-corrected (NIST SP 1065)" else
+            if (identical(a$debias, FALSE)) "; not bias-corrected" else "")
 }
 
 #' @export
 as.data.frame.allan <- function(x, ...) {
   attr(x, "freq") <- attr(x, "type") <- attr(x, "input") <- NULL
   attr(x, "N") <- attr(x, "conf") <- NULL
+  attr(x, "ci") <- attr(x, "unbiased") <- NULL
   class(x) <- "data.frame"
   x
 }
@@ -558,14 +601,10 @@ plot.allan <- function(x, col = NULL, main = NULL, xlab = "tau (s)",
   }
   col <- rep_len(col, length(chans))
   type <- attr(x, "type")
-  if (is.null(ylab)) {
-    ylab <- switch(type, standard = , overlapping = "Allan deviation",
-                   modified = "modified Allan deviation",
-                   hadamard = , ohadamard = "Hadamard deviation",
-                   total = "total deviation", allan_extra_ylab(type))
-  }
+  e <- stat_entry(type)
+  if (is.null(ylab)) ylab <- e$ylab
   if (is.null(main)) {
-    main <- if (type %in% c("mtie", "tierms")) type else
+    main <- if (!stat_has_limits(e) || identical(attr(x, "ci"), FALSE)) type else
       paste0(type, " (", 100 * attr(x, "conf"), "% CI)")
   }
   ok <- is.finite(d$adev) & d$adev > 0

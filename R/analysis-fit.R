@@ -1,6 +1,6 @@
 # A fit of a curve alone (another tool's curve, an allan() result, a table)
 # seen as a one-axis imu_analysis, so that datasheet(), imu_guidance(),
-# filter_params() and the exporters read it exactly as they read an axis of
+# kalman_params() and the exporters read it exactly as they read an axis of
 # analyze_imu(): the same readings, in the fit's unit when it is known.
 
 # The rate unit of a fit: `unit` when given, else the unit its curve carried

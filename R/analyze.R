@@ -55,7 +55,7 @@
 #' @param refine_args A list of further arguments for [avrefine()] (for
 #'   example `candidates` or `max_steps`).
 #' @param remove Non-stationary effects to take out of each axis before its
-#'   Allan deviation is computed (see [series_effects()]): e.g.
+#'   Allan deviation is computed (see [detect_series_effects()]): e.g.
 #'   `c("spikes", "steps")`, or `"all"`; none by default. What was found
 #'   and removed is kept in each channel's `series` (without its series `x`).
 #' @param ... Further arguments passed to [avfit()].
@@ -72,7 +72,7 @@
 #'   ([datasheet()]). For
 #'   several recordings, a list of those, of class `"imu_analysis_list"`.
 #' @seealso [plot.imu_analysis()], [datasheet()], [write_kalibr_yaml()],
-#'   [filter_params()], [allanvar_cli()].
+#'   [kalman_params()], [allanvar_cli()].
 #' @export
 #' @examples
 #' \donttest{
@@ -231,7 +231,7 @@ progress_handlers <- function() {
 analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
   # Effects the user asked to remove go before the curve (R/series.R).
-  series <- if (length(opts$remove)) series_effects(job$x, job$freq, remove = opts$remove)
+  series <- if (length(opts$remove)) detect_series_effects(job$x, job$freq, remove = opts$remove)
   if (!is.null(series)) job$x <- series$x
   curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
   if (!any(is.finite(curve$adev) & curve$adev > 0)) {

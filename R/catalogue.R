@@ -56,7 +56,7 @@
 #                 an instance that shows as part of another reading (a GM
 #                 with Tc well below 1 s is white noise at tau >= 1 s)
 #   discrete(par, dt, units, opts)  rows of a discrete-time filter model
-#                 (filter_params()), or NULL
+#                 (kalman_params()), or NULL
 #   describe(values)  datasheet text for the instances of this kind added by
 #                 the loop (values: data frame, one row per instance)
 #   detect(x, freq), remove(x, freq, par)  for "series" components
@@ -75,6 +75,22 @@
 #                 instance of this effect on this curve, else the reason it
 #                 is not (a sub-sample GM is a filter; a sinusoid outside
 #                 the band the curve can see)
+#   diagnose    NULL, or what the entry reads from the raw series once per
+#                 avrefine() call (R/refine-diagnostics.R): list(part (its
+#                 name in the diagnostics), reads ("raw" or "clean": the
+#                 series with the other parts' clean() applied), needs
+#                 (parts made first), make(x, freq, dg), clean(x, freq, part)
+#                 (the series without what the part describes) or NULL)
+#   family      NULL, or for an entry with variants that describe one thing
+#                 in different forms (the sensor filter's families), which
+#                 the loop chooses among again on the final model:
+#                 list(variants (the first is the bare kind's), start(raw,
+#                 variant): start values read from the raw diagnostics)
+#   exact_edf(amp, nl, tau0)  NULL, or how the term enters the exact EDF of
+#                 the model's AV estimates (src/avfit.cpp): a list of parts
+#                 list(shape, coef, phi) of its structure function, shape one
+#                 of "linear" (coef * l), "cubic" (-coef (l^3 - l) / 6),
+#                 "step" (2 coef for l > 0), "ar1" (coef = sigma^2, phi)
 
 .catalogue <- new.env(parent = emptyenv())
 
@@ -91,7 +107,7 @@ builtin_effects <- function() {
   list(effect_quantization(), effect_white(), effect_flicker(),
        effect_random_walk(), effect_ramp(), effect_gauss_markov(),
        effect_sinusoid(), effect_filter(), effect_resonance(), effect_band(),
-       # series effects, in the order series_effects() detects them
+       # series effects, in the order detect_series_effects() detects them
        effect_spike(), effect_warmup(), effect_bias_step(), effect_transient())
 }
 
@@ -151,7 +167,8 @@ new_effect <- function(name, title, params, component = "av",
                        discrete = NULL, describe = NULL, detect = NULL,
                        remove = NULL, replaces = character(),
                        admissible = NULL, proposed_only = FALSE,
-                       statespace = NULL) {
+                       statespace = NULL, diagnose = NULL, family = NULL,
+                       exact_edf = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -162,7 +179,8 @@ new_effect <- function(name, title, params, component = "av",
        reading = reading, fold = fold, discrete = discrete,
        describe = describe, detect = detect, remove = remove,
        replaces = replaces, admissible = admissible,
-       proposed_only = proposed_only, statespace = statespace)
+       proposed_only = proposed_only, statespace = statespace,
+       diagnose = diagnose, family = family, exact_edf = exact_edf)
 }
 
 validate_effect <- function(e) {
@@ -197,7 +215,7 @@ validate_effect <- function(e) {
   for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
               "nl_range", "nl_bounds", "trace", "propose", "evidence", "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible",
-              "statespace")) {
+              "statespace", "exact_edf")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
   if (!is.null(e$variants) && !is.function(e$variants)) {
@@ -229,6 +247,19 @@ validate_effect <- function(e) {
   if (!is.null(e$fold) && !all(c("into", "when", "amount") %in% names(e$fold))) {
     bad("`fold` needs into, when and amount.")
   }
+  d <- e$diagnose
+  if (!is.null(d) && !(is.list(d) && is.character(d$part) && length(d$part) == 1L &&
+                       isTRUE(d$reads %in% c("raw", "clean")) &&
+                       is.function(d$make) && (is.null(d$clean) || is.function(d$clean)) &&
+                       is.character(d$needs %||% character()))) {
+    bad("`diagnose` needs part, reads (\"raw\" or \"clean\") and make(), ",
+        "optionally needs and clean().")
+  }
+  f <- e$family
+  if (!is.null(f) && !(is.list(f) && is.character(f$variants) &&
+                       length(f$variants) >= 2L && is.function(f$start))) {
+    bad("`family` needs variants (at least two) and start().")
+  }
   if (is.null(e$replaces)) e$replaces <- character()
   if (!is.character(e$replaces) || anyNA(e$replaces)) {
     bad("`replaces` must name effect kinds.")
@@ -240,8 +271,6 @@ validate_effect <- function(e) {
     p$name == e$name
   e
 }
-
-`%||%` <- function(a, b) if (is.null(a)) b else a
 
 # ---- queries ----------------------------------------------------------------
 
@@ -272,6 +301,12 @@ effect_entry <- function(kind, variant = NULL) {
   e$variant <- variant
   e$bare <- FALSE
   validate_effect(e)
+}
+
+# The term naming variant `v` of a family whose variants are `variants`:
+# the bare kind for the first, else "kind:variant".
+family_term <- function(kind, variants, v) {
+  if (identical(v, variants[1L])) kind else paste0(kind, ":", v)
 }
 
 # The hard limits of nonlinear parameter `param` of entry `e` on a curve

@@ -12,7 +12,9 @@
 #' the options), analysed with [analyze_imu()], and the output directory
 #' receives the Allan deviation plot (`allan_deviation.png`), the datasheet
 #' table (`datasheet.csv`, also printed), the Kalibr `imu.yaml` and the
-#' discrete-time filter parameters (`filter_params.csv`). With several input
+#' discrete-time filter parameters (`filter_params.csv`) and the HTML report
+#' of the whole analysis (`report.html`, see [write_report()]; `--no-report`
+#' leaves it out). With several input
 #' files each output name is prefixed by the file's name.
 #'
 #' Outputs are all or nothing: they are written into a temporary directory
@@ -36,13 +38,14 @@
 #' * `--terms N,B,K` terms to fit (of [av_terms()]: Q, N, B, K, R, gm,
 #'   sinusoid); `--no-refine` skip [avrefine()];
 #' * `--remove spikes,steps` non-stationary effects to take out of each
-#'   axis first (see [series_effects()]; `all` for every kind);
+#'   axis first (see [detect_series_effects()]; `all` for every kind);
 #' * `--width PX`, `--height PX` size of the PNG (default 700 per sensor
 #'   by 600);
 #' * `--axis max|mean` which value goes into imu.yaml; `--average` adds the
 #'   mean of the axes to the datasheet;
 #' * `--workers N` analyse channels in N parallel R sessions
 #'   (`future::plan(multisession)`);
+#' * `--no-report` do not write `report.html`;
 #' * `--quiet` no progress messages; `--help`.
 #'
 #' @param args Character vector of command-line arguments (default: those
@@ -66,7 +69,7 @@ cli_usage <- function() {
   paste(
     "Usage: allanvar FILE [FILE2 ...] [options]",
     "Allan deviation analysis of IMU recordings (CSV, ROS1 .bag, ROS2 .db3, .mcap):",
-    "writes allan_deviation.png, datasheet.csv, imu.yaml (Kalibr) and filter_params.csv.",
+    "writes allan_deviation.png, datasheet.csv, imu.yaml (Kalibr), filter_params.csv and report.html.",
     "",
     "Options:",
     "  --out DIR              output directory (default allanvar-out)",
@@ -90,12 +93,14 @@ cli_usage <- function() {
     "  --width PX             PNG width (default 700 per sensor)",
     "  --height PX            PNG height (default 600)",
     "  --workers N            parallel R sessions (future multisession)",
+    "  --no-report            do not write report.html",
     "  --quiet                no progress messages",
     "  --help                 this text",
     sep = "\n")
 }
 
-cli_flags <- c("--no-time", "--no-refine", "--average", "--quiet", "--help")
+cli_flags <- c("--no-time", "--no-refine", "--average", "--quiet", "--help",
+               "--no-report")
 cli_valued <- c("--out", "--rate", "--time-col", "--time-unit", "--gyro-cols",
                 "--accel-cols", "--gyro-units", "--accel-units", "--sep", "--dec",
                 "--topic", "--gap", "--terms", "--remove", "--axis", "--workers", "--width",
@@ -295,7 +300,8 @@ cli_run <- function(args) {
       allanvar_guidance = function(w) invokeRestart("muffleWarning"))
     prefix <- if (several) paste0(sub("\\.[^.]*$", "", basename(f)), "_") else ""
     names_out <- paste0(prefix, c("allan_deviation.png", "datasheet.csv",
-                                  "imu.yaml", "filter_params.csv"))
+                                  "imu.yaml", "filter_params.csv",
+                                  if (!isTRUE(opt$`no-report`)) "report.html"))
     path <- function(k) file.path(stage, names_out[k])
     n_s <- length(unique(vapply(a$channels, function(cc) cc$sensor, "")))
     grDevices::png(path(1), width = if (is.null(width)) 700 * n_s else width,
@@ -309,7 +315,8 @@ cli_run <- function(args) {
                      sub("^`x`: ", "", conditionMessage(e)),
                      class = "record_too_short")
              })
-    utils::write.csv(filter_params(a), path(4), row.names = FALSE)
+    utils::write.csv(kalman_params(a), path(4), row.names = FALSE)
+    if (!isTRUE(opt$`no-report`)) write_report(a, path(5), record = rec)
     cat("\n", a$name, "\n", sep = "")
     print(ds)
     g <- imu_guidance(a)

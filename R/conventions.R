@@ -9,7 +9,7 @@
 #' 0.664 B}{sqrt(2 ln 2 / pi) B = 0.664 B}; a per-sample (discrete-time) white-noise standard deviation at
 #' sampling rate \eqn{f} is \eqn{\sigma_d = N\sqrt{f}}{sigma_d = N sqrt(f)}; a per-sample bias
 #' random-walk step is \eqn{\sigma_{bd} = K/\sqrt{f}}{sigma_bd = K / sqrt(f)} (see
-#' [filter_params()]). A two-sided power spectral density \eqn{N^2} is the
+#' [kalman_params()]). A two-sided power spectral density \eqn{N^2} is the
 #' one-sided density \eqn{2N^2}: one-sided amplitudes are \eqn{\sqrt{2}}{sqrt(2)}
 #' times the two-sided ones.
 #'
@@ -28,8 +28,8 @@
 #' | MATLAB `gyroparams`, `accelparams` | `NoiseDensity` | \eqn{N} (double-sided, MATLAB's default `NoiseType`); \eqn{\sqrt{2} N}{sqrt(2) N} single-sided | [tool_params()], [write_tool_params()] |
 #' | MATLAB | `BiasInstability` | \eqn{B} (min ADEV / 0.664) | same |
 #' | MATLAB | `RandomWalk` | \eqn{K}; \eqn{\sqrt{2} K}{sqrt(2) K} single-sided | same |
-#' | allan_variance_ros CSV curve | gyro columns | deg/s (rad/s x 180/pi) | [read_avr_curve()] |
-#' | allan_variance_ros `analysis.py` | white noise, random walk | \eqn{N} read at \eqn{\tau} = 1 s, \eqn{K} at \eqn{\tau} = 3 s on fixed-slope lines; bias instability = min ADEV (not / 0.664) | [read_avr_curve()] |
+#' | allan_variance_ros CSV curve | gyro columns | deg/s (rad/s x 180/pi) | [read_allan_variance_ros_curve()] |
+#' | allan_variance_ros `analysis.py` | white noise, random walk | \eqn{N} read at \eqn{\tau} = 1 s, \eqn{K} at \eqn{\tau} = 3 s on fixed-slope lines; bias instability = min ADEV (not / 0.664) | [read_allan_variance_ros_curve()] |
 #'
 #' Sources and reasons:
 #' * VINS-Mono's pre-integration (`integration_base.h`) adds, per IMU
@@ -56,7 +56,7 @@
 #' @name conventions
 #' @aliases allanvar_conventions
 #' @seealso [tool_params()], [write_tool_params()], [write_kalibr_yaml()],
-#'   [filter_params()], [av_units()].
+#'   [kalman_params()], [av_units()].
 #' @examples
 #' # N = 1e-4 rad/s/sqrt(Hz) at 200 Hz is an imu_utils / VINS gyr_n of
 #' 1e-4 * sqrt(200)

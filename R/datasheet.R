@@ -16,7 +16,7 @@
 #' A fit of a curve alone ([avfit()] of another tool's curve, of an
 #' [allan()] result or of a table) gets the same table, as one axis: its
 #' readings in SI when the unit of the curve is known (`unit`, or the unit a
-#' curve read by [read_avr_curve()] or [read_imu_utils_curve()] carries),
+#' curve read by [read_allan_variance_ros_curve()] or [read_imu_utils_curve()] carries),
 #' else in the input's unit u (`u*sqrt(s)` for N, ...).
 #'
 #' An axis whose analysis failed (a dead, constant channel) is listed with

@@ -167,24 +167,19 @@ dyn_opts <- function(type, rate, step, nwin, threads = allanvar_threads()) {
 # The noise exponents an estimator of difference order d resolves
 # (alpha + 2 d > 1).
 dyn_alphas <- function(type) {
-  tab <- allan_type_table()
-  if (tab$d[match(type, tab$name)] == 3L) -4:2 else -2:2
+  r <- stat_entry(type)$alpha_range
+  r[1L]:r[2L]
 }
 
 # Largest cluster size with a term in L phase points (the number of terms
 # at each m is allan_nterms(), R/taus.R).
-dyn_max_m <- function(type, L) {
-  switch(type, standard = , overlapping = floor((L - 1) / 2),
-         modified = floor(L / 3), floor((L - 1) / 3))
-}
+dyn_max_m <- function(type, L) stat_entry(type)$max_m(L)
 
-dyn_norm <- function(type, m) {
-  switch(type, modified = 2 * m^4, hadamard = , ohadamard = 6 * m^2, 2 * m^2)
-}
+dyn_norm <- function(type, m) stat_entry(type)$divisor(m)
 
 # Fewest samples a window needs for one term at m = 1.
 dyn_min_window <- function(type, rate) {
-  L <- if (type %in% c("hadamard", "ohadamard", "modified")) 4 else 3
+  L <- stat_entry(type)$min_points
   if (rate) L - 1 else L
 }
 
@@ -257,8 +252,9 @@ dyn_edf <- function(type, m, L, avar, alpha, conf) {
     a <- round(-dyn_slope(avar, m) - 1)
     a[!is.finite(a)] <- 0
     a <- as.integer(pmin(pmax(a, min(alphas)), 2))
-    if (type != "modified") {
-      # white and flicker phase noise share the slope: the smaller EDF
+    if (!stat_entry(type)$modified) {
+      # white and flicker phase noise share the slope (the modified
+      # statistic's tells them apart): the smaller EDF
       pick <- ifelse(is.na(tab[, "1"]) | tab[, "2"] <= tab[, "1"], 2L, 1L)
       a[a >= 1L] <- pick[a >= 1L]
     }

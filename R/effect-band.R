@@ -77,7 +77,7 @@ sim_band <- function(n, tau0, scale, f_lo, f_hi, s) {
 # gives the systematic spread. Returns list(f_lo, f_hi, s, u, power) or
 # NULL when the band has no measurable excess.
 measure_band <- function(x, freq, b, seg = 512L, knots = band_knots) {
-  w <- welch_psd_lin(x - mean(x), freq, seg)
+  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
   wd <- max(b$f_to - b$f_from, 4 * w$df)
   fl <- (w$f > b$f_from - wd & w$f < b$f_from & w$f > 0) |
     (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))
@@ -173,9 +173,9 @@ effect_band <- function() {
     # The bands of the raw data propose their own spectrum: the strongest
     # band the curve can see, every parameter but the scale pinned.
     propose = function(raw, tau, sig) {
-      mb <- raw$band_spectra
+      mb <- diag_part(raw, "band_spectra")
       if (!length(mb)) return(list())
-      hi <- min(0.5 / min(tau), 0.499 * raw$freq)
+      hi <- min(0.5 / min(tau), 0.499 * diag_value(raw, "freq"))
       ok <- vapply(mb, function(m) (m$f_lo + m$f_hi) / 2 > 1 / max(tau) &&
                      (m$f_lo + m$f_hi) / 2 < hi, NA)
       mb <- mb[ok]
@@ -204,6 +204,15 @@ effect_band <- function() {
            support = ok)
     },
     peak_tau = function(par) 0.371 * 2 / (par[["f_lo"]] + par[["f_hi"]]),
+    # each band of the raw periodogram's own spectrum, read once per call
+    diagnose = list(
+      part = "band_spectra", reads = "raw", needs = "bands",
+      make = function(x, freq, dg) {
+        bands <- diag_part(dg, "bands")
+        Filter(Negate(is.null), lapply(seq_len(nrow(bands)), function(j) {
+          measure_band(x, freq, bands[j, ])
+        }))
+      }),
     describe = function(values) {
       sprintf("measured band (%s Hz)", paste(sprintf("%s-%s", signif(values$f_lo, 3),
                                                      signif(values$f_hi, 3)),

@@ -64,6 +64,9 @@ filter_variant <- function(variant) {
   )
 }
 
+# The families the loop chooses among (the bare "filter" is the first).
+filter_family_variants <- c("ma", "lp1", "lp2")
+
 effect_filter <- function() {
   base <- filter_variant("ma")
   basis <- function(variant) {
@@ -90,8 +93,10 @@ effect_filter <- function() {
       evidence = function(par, raw, x, freq) {
         if (is.null(x)) return(list(text = "", support = NA))
         sp <- filter_spec_of(variant, par, 1 / freq)
-        # raw$filter: filter_evidence() of this same series, read once
-        filter_raw_support(sp, par[["Nf"]], raw$filter %||% filter_evidence(x, freq),
+        # the diagnostics' filter part: filter_evidence() of this same
+        # series, read once
+        filter_raw_support(sp, par[["Nf"]],
+                           diag_part(raw, "filter") %||% filter_evidence(x, freq),
                            stats::var(x), freq)
       }
     ))
@@ -123,14 +128,14 @@ effect_filter <- function() {
     # lag-1 excess can be inverted for (moving average, first- and
     # second-order low-pass); the criterion picks the family.
     propose = function(raw, tau, sig) {
-      fe <- raw$filter
+      fe <- diag_part(raw, "filter")
       if (is.null(fe) || !isTRUE(fe$filtered)) return(list())
       out <- list()
-      for (v in c("ma", "lp1", "lp2")) {
+      for (v in filter_family_variants) {
         st <- fe$start[[v]]
         if (is.null(st)) next
         out[[length(out) + 1L]] <- list(
-          effect = if (v == "ma") "filter" else paste0("filter:", v),
+          effect = family_term("filter", filter_family_variants, v),
           init = st, tau_from = min(tau), tau_to = 4 * min(tau), score = 2,
           note = sprintf(paste("proposed by the raw lag-1 autocorrelation beyond the",
                                "slow processes, %.3f (z = %.0f): %s family"),
@@ -144,6 +149,14 @@ effect_filter <- function() {
                 amount = function(par) par[["Nf"]]^2,
                 note = "white level of the filtered term"),
     describe = function(values) "filter (the sensor's averaging)",
+    # the short-lag ACF beyond the slow processes, of the series without
+    # lines and bands (a resonance raises the short-lag ACF too)
+    diagnose = list(part = "filter", reads = "clean",
+                    make = function(x, freq, dg) filter_evidence(x, freq)),
+    # the families describe one filter: the loop chooses among them again
+    # on the final model, each started from the raw lag-1 excess
+    family = list(variants = filter_family_variants,
+                  start = function(raw, variant) diag_part(raw, "filter")$start[[variant]]),
     # the filtered white term carries the white level itself (N^2 = S(0))
     replaces = "N"
   )
@@ -184,10 +197,10 @@ effect_resonance <- function() {
     },
     evidence = function(par, raw, x, freq) {
       if (is.null(x)) return(list(text = "", support = NA))
-      # the bands of the raw data (raw$bands), not of `x`, the series with
-      # the bands brought down to their background
+      # the bands of the raw data (the diagnostics' part), not of `x`, the
+      # series with the bands brought down to their background
       resonance_raw_support(par[["sigma"]], par[["fr"]], par[["tc"]],
-                            raw$bands %||% find_bands(x, freq))
+                            diag_part(raw, "bands") %||% find_bands(x, freq))
     },
     # A broad band of the periodogram proposes a resonance twice: its
     # centre and width pinned where find_bands() measures them (the curve
@@ -197,10 +210,10 @@ effect_resonance <- function() {
     # its AV-equivalent centre elsewhere). The criterion chooses; the
     # raw-data check still asks for the band within half its width of fr.
     propose = function(raw, tau, sig) {
-      b <- raw$bands
+      b <- diag_part(raw, "bands")
       out <- list()
       if (is.null(b) || !nrow(b)) return(out)
-      hi <- min(0.5 / min(tau), 0.499 * raw$freq)
+      hi <- min(0.5 / min(tau), 0.499 * diag_value(raw, "freq"))
       b <- b[b$f_center > 1 / max(tau) & b$f_center < hi, , drop = FALSE]
       b <- b[order(-b$power), , drop = FALSE]
       for (j in seq_len(min(2L, nrow(b)))) {
@@ -216,6 +229,11 @@ effect_resonance <- function() {
       out
     },
     peak_tau = function(par) 0.371 / par[["fr"]],
+    # the broad bands of the raw periodogram; the checks of the other
+    # effects see them brought down to their background
+    diagnose = list(part = "bands", reads = "raw",
+                    make = function(x, freq, dg) find_bands(x, freq),
+                    clean = function(x, freq, bands) remove_bands(x, freq, bands)),
     describe = function(values) {
       sprintf("resonance (%s Hz)", paste(signif(values$fr, 3), collapse = ", "))
     }

@@ -65,17 +65,18 @@ evidence_gm <- function(par, raw, x, freq) {
     # correlation itself; compare its lag-1 ACF with the raw one.
     phi <- exp(-1 / (tc * freq))
     pred <- if (is.finite(sigma)) sigma^2 * phi / stats::var(x) else NA_real_
-    ok <- is.finite(pred) && raw$acf1_z > 3 && raw$acf1 > pred / 3 &&
-      raw$acf1 < 3 * pred
+    r1 <- diag_value(raw, "acf1")
+    z1 <- diag_value(raw, "acf1_z")
+    ok <- is.finite(pred) && z1 > 3 && r1 > pred / 3 && r1 < 3 * pred
     return(list(text = sprintf(
       "raw lag-1 ACF %.3f (z = %.0f) against %.3f predicted by the fitted GM",
-      raw$acf1, raw$acf1_z, pred), support = ok))
+      r1, z1, pred), support = ok))
   }
   if (!is.finite(tc) || tc * freq * 40 / 8 > length(x)) {
     return(list(text = "record too short for an ACF check", support = NA))
   }
-  # raw$cache: avrefine()'s per-call store (NULL elsewhere)
-  a <- acf_exponential(x, freq, tc, cache = raw$cache)
+  # avrefine()'s per-call store (NULL elsewhere)
+  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw))
   if (is.finite(a$tc) && a$z > 5) {
     list(text = sprintf("exponential ACF of %s-sample means, Tc = %s s (z = %.1f)",
                         a$m, format_num(a$tc), a$z),
@@ -123,6 +124,10 @@ effect_gauss_markov <- function() {
       ifelse(tau < 0.5 * tc, -2, ifelse(tau < 3 * tc, -1, 0))
     },
     nl_range = function(tau, freq) list(tc = c(min(tau) / 4, max(tau) * 4)),
+    # an AR(1) part of the structure function, pole exp(-tau0 / tc)
+    exact_edf = function(amp, nl, tau0) {
+      list(list(shape = "ar1", coef = amp[[1L]]^2, phi = exp(-tau0 / nl[["tc"]])))
+    },
     trace = function(ctx) {
       if (ctx$sign <= 0 || !is.finite(ctx$emax) ||
           !ctx$kind %in% c("bump", "long_end", "short_end", "oscillation")) {

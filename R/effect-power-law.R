@@ -47,6 +47,8 @@ effect_quantization <- function() {
       diff(e) / tau0
     },
     edf_alpha = function(tau, tau0, nl) rep(2, length(tau)),
+    # white phase: the structure function of the phase is 2 Q^2 / tau0^2 for l > 0
+    exact_edf = function(amp, nl, tau0) list(list(shape = "step", coef = amp[[1L]]^2 / tau0^2)),
     trace = trace_edge("short", -1, "Q", basis),
     evidence = evidence_quantization
   )
@@ -69,6 +71,8 @@ effect_white <- function() {
     sim = function(n, tau0, amp, nl) stats::rnorm(n, sd = amp[[1L]] / sqrt(tau0)),
     statespace = function(amp, nl, tau0) list(R = amp[[1L]]^2 / tau0),
     edf_alpha = function(tau, tau0, nl) rep(0, length(tau)),
+    # random-walk phase: structure function (N^2 / tau0) l
+    exact_edf = function(amp, nl, tau0) list(list(shape = "linear", coef = amp[[1L]]^2 / tau0)),
     trace = trace_edge("short", -0.5, "N", basis),
     evidence = evidence_noise_id(0),
     reading = list(symbol = "N", role = "white", tau = 1, slope = -0.5,
@@ -159,7 +163,10 @@ effect_flicker <- function() {
     reading = list(symbol = "B", role = "flicker", tau = NA_real_, slope = 0,
                    anchor = "min", unit = "rate", bound = FALSE, resolve = FALSE,
                    pch = 24, legend = "B: flat minimum (ADEV = 0.664 B)",
-                   slope_method = "min ADEV / 0.664"),
+                   slope_method = "min ADEV / 0.664",
+                   # how kalman_params() may stand in for B (the first is
+                   # its default): one Gauss-Markov term, or left out
+                   approximations = c("gm", "omit")),
     # No finite-state model exists; optionally approximated by one GM whose
     # ADEV peak (0.6174 sigma at tau = 1.893 Tc) sits on the flat minimum.
     discrete = function(par, dt, unit, opts) {
@@ -197,6 +204,8 @@ effect_random_walk <- function() {
     # the walk's level (the sensor's bias) is unknown: a diffuse start
     statespace = function(amp, nl, tau0) list(T = 1, Q = amp[[1L]]^2 * tau0, P0 = Inf),
     edf_alpha = function(tau, tau0, nl) rep(-2, length(tau)),
+    # integrated random walk: structure function -K^2 tau0 (l^3 - l) / 6
+    exact_edf = function(amp, nl, tau0) list(list(shape = "cubic", coef = amp[[1L]]^2 * tau0)),
     trace = trace_edge("long", 0.5, "K", basis),
     evidence = evidence_noise_id(-2),
     reading = list(symbol = "K", role = "random_walk", tau = 3, slope = 0.5,
@@ -229,17 +238,18 @@ effect_ramp <- function() {
     edf_alpha = function(tau, tau0, nl) rep(NA_real_, length(tau)),
     trace = trace_edge("long", 1, "R", basis),
     propose = function(raw, tau, sig) {
-      if (!isTRUE(raw$trend$significant)) return(list())
-      list(list(init = list(R = abs(raw$trend$slope)), tau_from = max(tau) / 10,
+      tr <- diag_value(raw, "trend")
+      if (!isTRUE(tr$significant)) return(list())
+      list(list(init = list(R = abs(tr$slope)), tau_from = max(tau) / 10,
                 tau_to = max(tau), score = 1,
                 note = sprintf("proposed by a linear trend of %s /s",
-                               format_num(raw$trend$slope))))
+                               format_num(tr$slope))))
     },
     evidence = evidence_trend
   )
 }
 
-# One row of filter_params().
+# One row of kalman_params().
 discrete_row <- function(term, parameter, value, unit, continuous,
                          continuous_unit, convention) {
   data.frame(term = term, parameter = parameter, value = value, unit = unit,
@@ -252,18 +262,19 @@ discrete_row <- function(term, parameter, value, unit, continuous,
 # Quantization: the lag-1 ACF of differenced uniform noise is -1/2; an LSB
 # grid is reported when present.
 evidence_quantization <- function(par, raw, x, freq) {
-  g <- raw$grid
-  txt <- sprintf("raw lag-1 ACF %.3f (z = %.0f)", raw$acf1, raw$acf1_z)
+  g <- diag_value(raw, "grid")
+  z1 <- diag_value(raw, "acf1_z")
+  txt <- sprintf("raw lag-1 ACF %.3f (z = %.0f)", diag_value(raw, "acf1"), z1)
   if (isTRUE(g$quantized)) {
     txt <- paste0(txt, sprintf("; LSB grid step %s (%.0f%% on grid)",
                                format_num(g$step), 100 * g$on_grid))
   }
-  list(text = txt, support = raw$acf1_z < -3)
+  list(text = txt, support = z1 < -3)
 }
 
 # A ramp: a significant linear trend.
 evidence_trend <- function(par, raw, x, freq) {
-  tr <- raw$trend
+  tr <- diag_value(raw, "trend")
   list(text = sprintf("linear trend %s /s (t = %.1f)", format_num(tr$slope), tr$t),
        support = tr$significant)
 }
@@ -273,7 +284,7 @@ evidence_trend <- function(par, raw, x, freq) {
 evidence_noise_id <- function(alpha) {
   force(alpha)
   function(par, raw, x, freq) {
-    ni <- raw$noise_id
+    ni <- diag_value(raw, "noise_id")
     ni <- ni[is.finite(ni$alpha), , drop = FALSE]
     hit <- ni[round(ni$alpha) == alpha, , drop = FALSE]
     if (nrow(hit)) {

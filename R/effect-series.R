@@ -2,7 +2,7 @@
 # (component "series"): isolated spikes, bias steps, transients (a pulse
 # that returns) and an exponential warm-up. They are not terms of the Allan
 # variance: each entry's `detect(x, freq)` finds its instances in the
-# series and `remove(x, freq, par)` takes them out; series_effects()
+# series and `remove(x, freq, par)` takes them out; detect_series_effects()
 # (R/series.R) runs them in catalogue order. The detectors themselves are
 # in R/nonstationary.R.
 #
@@ -146,20 +146,18 @@ effect_warmup <- function() {
     params = rbind(
       effect_param("size", "amp", "u", "rate unit (offset at the first sample)"),
       effect_param("tc", "nonlinear", "s", "second (time constant)")),
+    repeatable = TRUE,
     signature = paste("a decaying offset at the start, size exp(-t / tc);",
                       "raises the Allan variance around tau = tc"),
     sim = function(n, tau0, amp, nl) {
       amp[[1L]] * exp(-(seq_len(n) - 1) * tau0 / nl[["tc"]])
     },
     detect = function(x, freq) {
-      w <- detect_warmup(x, freq)
-      if (!isTRUE(w$present)) {
-        return(series_rows(size = numeric(), tc = numeric(), time = numeric(),
-                           index = integer(), z = numeric()))
-      }
-      series_rows(size = w$amplitude, tc = w$tc, time = 0, index = 1L, z = w$z,
+      w <- detect_warmup(x, freq)$all
+      series_rows(size = w$amplitude, tc = w$tc, time = rep(0, nrow(w)),
+                  index = rep(1L, nrow(w)), z = w$z,
                   evidence = sprintf(
-                    "Allan difference of the first two windows of tc at z = %s",
+                    "GLS fit of exp(-t / tc) on block means under the series' own noise model (white, random walk, Gauss-Markov from its Allan variance) at z = %s",
                     format_num(w$z, 2)))
     },
     remove = function(x, freq, par) {
@@ -169,8 +167,9 @@ effect_warmup <- function() {
       x
     },
     describe = function(values) {
-      sprintf("warm-up of %s (time constant %s s)", format_num(values$size[1L]),
-              format_num(values$tc[1L]))
+      sprintf("warm-up of %s (time constant %s s)",
+              paste(format_num(values$size), collapse = ", "),
+              paste(format_num(values$tc), collapse = ", "))
     }
   )
 }

@@ -7,14 +7,14 @@ sin_peak_adev <- 0.7246       # ... where ADEV = 0.7246 A
 
 # Raw-data evidence: a periodogram line near f0.
 evidence_sinusoid <- function(par, raw, x, freq) {
-  l <- raw$lines
+  l <- diag_part(raw, "lines")
   f0 <- par[["f0"]] %||% NA_real_
   res <- attr(l, "resolution") %||% 0
   if (nrow(l) && is.finite(f0)) {
-    # within the periodogram's resolution (issue 9), not a fraction of f0
-    near <- which(abs(l$f0 - f0) <= 1.5 * res)
-    j <- near[which.max(l$ratio[near])]
-    if (length(near)) {
+    # the strongest line within 1.5 bins of the periodogram's resolution,
+    # not a fraction of f0
+    j <- match_line(f0, l, tol = 1.5, pick = "strongest")
+    if (!is.na(j)) {
       return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)",
                                  format_num(l$f0[j], 4), format_num(l$amp[j]),
                                  l$p_value[j]),
@@ -96,15 +96,15 @@ effect_sinusoid <- function() {
            score = if (ctx$kind == "oscillation") 3 else 1)
     },
     propose = function(raw, tau, sig) {
-      lines <- raw$lines
+      lines <- diag_part(raw, "lines")
       out <- list()
       if (is.null(lines) || !nrow(lines)) return(out)
       # only lines the curve can see; harmonics of one source say so
-      b <- visible_band(min(tau), max(tau), raw$freq)
-      lines <- harmonic_sets(lines)
+      lines <- visible_lines(harmonic_sets(lines), min(tau), max(tau),
+                             diag_value(raw, "freq"))
       for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
-        if (f0 < b[["lo"]] || f0 > b[["hi"]]) next
+        if (!lines$visible[j]) next
         t1 <- sin_peak_ratio / f0
         h <- lines$harmonic[j]
         src <- if (lines$pattern[j] != "single") {
@@ -123,6 +123,18 @@ effect_sinusoid <- function() {
       out
     },
     evidence = evidence_sinusoid,
+    # The periodogram's lines, less the bins of the broad bands (a
+    # resonance's bins are not sinusoids); the checks of the other effects
+    # see the series with them taken out (a line disturbs the ACF that
+    # confirms a Gauss-Markov process).
+    diagnose = list(
+      part = "lines", reads = "raw", needs = "bands",
+      make = function(x, freq, dg) {
+        lines_outside_bands(diag_value(dg, "lines"), diag_part(dg, "bands"))
+      },
+      clean = function(x, freq, lines) {
+        if (nrow(lines)) remove_lines(x, freq, lines$f0) else x
+      }),
     peak_tau = function(par) sin_peak_ratio / par[["f0"]],
     describe = function(values) {
       sprintf("sinusoid (f0 = %s Hz)", paste(signif(values$f0, 3), collapse = ", "))

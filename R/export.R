@@ -7,7 +7,7 @@
 #' * `accelerometer_noise_density`: accelerometer N, m/s^2/sqrt(Hz);
 #' * `accelerometer_random_walk`: accelerometer K, m/s^3/sqrt(Hz);
 #' * `update_rate`: the sampling rate in Hz, which Kalibr uses to discretize
-#'   (sigma_d = N / sqrt(dt), sigma_bd = K * sqrt(dt); see [filter_params()]).
+#'   (sigma_d = N / sqrt(dt), sigma_bd = K * sqrt(dt); see [kalman_params()]).
 #'
 #' Kalibr takes one number per sensor, so by default the worst (largest)
 #' axis is written (`axis = "max"`); the per-axis values and the axis used
@@ -208,7 +208,8 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
 #'   `gm1.tc`, ..., in the rate unit, e.g. SI).
 #' @param dt The filter step in seconds; default `1 / freq` of the analysis
 #'   (required for a plain vector without `freq`).
-#' @param bias_instability `"gm"` (default) or `"omit"`, see above.
+#' @param bias_instability `"gm"` or `"omit"`, see above; `NULL` (default)
+#'   for `"gm"`, the approximation the catalogue's flicker entry gives.
 #' @param tau_B For a vector or `avfit`: the tau (s) of the flat minimum,
 #'   used by `bias_instability = "gm"`.
 #' @param unit For an `avfit`: the rate unit of the fitted curve (see
@@ -219,11 +220,14 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
 #'   catalogue's order of the terms (N, B, K, then the Gauss-Markov terms).
 #' @export
 #' @examples
-#' filter_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
-filter_params <- function(x, dt = NULL, bias_instability = "gm",
+#' kalman_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
+kalman_params <- function(x, dt = NULL, bias_instability = NULL,
                           tau_B = NULL, unit = NULL) {
   check_present(missing(x), "x", "an imu_analysis, an avfit or coefficients")
-  bias_instability <- check_choice(bias_instability, c("gm", "omit"),
+  # how B may stand in a finite-state model: the catalogue's flicker entry
+  # says (its approximation first, the default)
+  approx <- reading_entry("flicker")$reading$approximations
+  bias_instability <- check_choice(bias_instability %||% approx[1L], approx,
                                    "bias_instability")
   if (!is.null(tau_B)) tau_B <- check_number(tau_B, "tau_B", lo = 0, open = TRUE)
   if (!is.null(dt)) dt <- check_number(dt, "dt", lo = 0, open = TRUE)

@@ -347,22 +347,6 @@ sim_circulant <- function(n, g) {
 
 # ---- raw-data evidence -------------------------------------------------------------
 
-# Sample autocorrelation at lags 0..max_lag by FFT (O(n log n)); zero
-# padding by max_lag is enough to keep the circular wrap off those lags.
-acf_lags <- function(x, max_lag) {
-  n <- length(x)
-  x <- x - mean(x)
-  # a few dozen lags: direct sums (src/evidence.cpp) beat two FFTs of n
-  if (max_lag <= 64L) {
-    a <- acf_sums(x, as.integer(max_lag))
-    return(a / a[1L])
-  }
-  nfft <- stats::nextn(n + max_lag + 1L)
-  f <- stats::fft(c(x, numeric(nfft - n)))
-  a <- Re(stats::fft(Mod(f)^2, inverse = TRUE))[seq_len(max_lag + 1L)] / nfft
-  a / a[1L]
-}
-
 # Lag-1 autocorrelation of the family as a function of its parameter, and
 # its inverse (the start value read from the raw ACF).
 filter_rho1 <- function(spec, tau0) {
@@ -443,7 +427,7 @@ filter_evidence <- function(x, freq, max_lag = 16L, base_lags = 24:48,
   # Roll-off of the periodogram: mean PSD in the top 5% of the band over the
   # mean PSD in [fs/25, fs/15] (white-dominated for sensors whose slow
   # processes sit below 1 Hz).
-  w <- welch_psd_lin(x, freq, seg = min(512L, 2^floor(log2(n / 8))))
+  w <- welch_psd(x, freq, seg = min(512L, 2^floor(log2(n / 8))), detrend = FALSE)
   top <- w$f > 0.95 * freq / 2
   mid <- w$f > freq / 25 & w$f < freq / 15
   ratio <- mean(w$psd[top]) / mean(w$psd[mid])
@@ -454,40 +438,6 @@ filter_evidence <- function(x, freq, max_lag = 16L, base_lags = 24:48,
                         excess = exc, se = sqrt(se^2 + se_base^2), z = z),
        base = base, r1 = r1, z1 = z[1L], length = len, psd_ratio = ratio,
        filtered = isTRUE(z[1L] > z_level), start = start)
-}
-
-# Welch periodogram (Hann, 50% overlap, segments demeaned), one-sided PSD in
-# u^2/Hz, in O(n log seg): the segments are the columns of one matrix and
-# mvfft transforms them together, two real segments per complex column.
-# The matrix is built and the squared moduli summed in C++
-# (src/evidence.cpp), one pass each; the PSD is the R expression in the
-# comments to rounding.
-welch_psd_lin <- function(x, freq, seg) {
-  n <- length(x)
-  seg <- as.integer(min(seg, 2^floor(log2(n))))
-  hop <- seg %/% 2L
-  starts <- seq.int(1L, n - seg + 1L, by = hop)
-  win <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
-  U <- sum(win^2)
-  half <- seg %/% 2L + 1L
-  acc <- numeric(half)
-  x <- as.double(x)
-  # Chunks of columns keep the memory bounded for long records.
-  chunk <- max(1L, (2^22) %/% seg)
-  for (c0 in seq.int(1L, length(starts), by = chunk)) {
-    st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
-    # X <- matrix(x[outer(seq_len(seg) - 1L, st, `+`)], nrow = seg)
-    # X <- (X - rep(colMeans(X), each = seg)) * win
-    X <- welch_segments(x, as.integer(st), win)
-    # acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
-    acc <- welch_accumulate(stats::mvfft(X), half, acc)
-  }
-  k <- length(starts)
-  p <- acc / k / (freq * U)
-  p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
-  nu <- 2 * k / (1 + 2 * 0.167^2 * (k - 1) / k)
-  list(f = (seq_len(half) - 1) * freq / seg, psd = p, nu = nu, seg = seg,
-       df = freq / seg, k = k)
 }
 
 # ---- reading the filter from a curve or checking it against the data ----------

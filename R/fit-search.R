@@ -107,8 +107,9 @@ check_control <- function(control) {
 # What every amplitude solve of the search needs and that does not change
 # between them is worked out here once: the amplitude coefficients, which
 # are fixed, their labels, and the basis columns of the terms without
-# nonlinear parameters (N, B, K...), which do not depend on the values
-# being searched.
+# free nonlinear parameters (N, B, K..., and the terms whose nonlinear
+# values are held, as the loop's screening holds the model's), which do not
+# depend on the values being searched.
 fit_problem <- function(data, tau0, lay, bias_correct, corr) {
   y <- log(data$avar) - if (bias_correct) log_bias(data$edf) else 0
   s <- log_sd(data$edf)
@@ -116,7 +117,8 @@ fit_problem <- function(data, tau0, lay, bias_correct, corr) {
   is_amp <- lay$role == "amp"
   amp <- list(name = lay$name[is_amp], fixed = lay$fixed[is_amp],
               label = lay$label[is_amp], value = lay$value[is_amp])
-  const <- vapply(plan, function(p) !length(p$nl), NA)
+  held <- stats::setNames(lay$fixed, lay$name)
+  const <- vapply(plan, function(p) !length(p$nl) || all(held[p$nl]), NA)
   basis0 <- plan_basis(plan[const], data$tau, tau0, stats::setNames(lay$value, lay$name))
   list(data = data, tau0 = tau0, lay = lay, plan = plan, y = y,
        s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct,

@@ -56,36 +56,32 @@ edf_model <- function(m, n, type, comp, alpha, L = n + 1) {
 }
 
 # EDF of a fitted model's AV estimates at the data taus: `lay` the layout
-# with values. When every stochastic term has a structure function in
-# src/avfit.cpp (N, K, Q, Gauss-Markov) and there is more than one of them
-# or a Gauss-Markov term, the EDF is exact for their sum (Greenhall &
+# with values. When every stochastic term says how it enters the exact EDF
+# (the catalogue's `exact_edf`: white, random-walk and white-phase
+# structure functions, AR(1) parts) and there is more than one of them or
+# one that is not a power law, the EDF is exact for their sum (Greenhall &
 # Riley 2003, cross terms included; the per-term combination overstates it
 # up to twofold where two terms are level); deterministic terms (ramp,
 # sinusoids) add to the AV only. Otherwise (a flicker or filter term, a
 # single power-law noise, which the engine of allan() already gives, or no
 # tau0) edf_model().
 edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
-  comp <- model_components(tau, tau0, lay)
-  alpha <- model_alpha(tau, tau0, lay)
-  labels <- colnames(comp)
-  kinds <- lay$kind[match(labels, lay$label)]
-  exact <- kinds %in% c("N", "K", "Q", "gm")
+  plan <- model_plan(lay)
+  comp <- model_components(tau, tau0, lay, plan)
+  alpha <- model_alpha(tau, tau0, lay, plan)
+  exact <- vapply(plan, function(p) is.function(p$entry$exact_edf), NA)
+  power_law <- vapply(plan, function(p) is.finite(p$entry$psd_alpha), NA)
   live <- colSums(comp) > 0
   stoch <- live & colSums(!is.na(alpha)) > 0
   use <- !is.null(tau0) && all(exact[stoch]) &&
-    (sum(stoch) > 1L || any(kinds[stoch] == "gm"))
+    (sum(stoch) > 1L || any(!power_law[stoch]))
   if (!use) return(edf_model(m, n, type, comp, alpha, L))
-  val <- stats::setNames(lay$value, lay$name)
-  amp2 <- function(kind) if (kind %in% kinds) val[[kind]]^2 else 0
-  gm <- labels[kinds == "gm"]
-  sig2 <- vapply(gm, function(g) val[[paste0(g, ".sigma")]]^2, 0)
-  phi <- vapply(gm, function(g) exp(-tau0 / val[[paste0(g, ".tc")]]), 0)
+  parts <- exact_edf_parts(plan[exact], stats::setNames(lay$value, lay$name), tau0)
   mm <- pmax(round(m), 1)
   nu_g <- avfit_exact_edf(as.double(mm),
                           as.double(allan_nterms(engine_type(type), mm, L)),
                           identical(type, "overlapping"),
-                          amp2("N") / tau0, amp2("K") * tau0, amp2("Q") / tau0^2,
-                          as.double(sig2), as.double(phi))
+                          parts$shape, parts$coef, parts$phi)
   av_g <- rowSums(comp[, exact, drop = FALSE])
   e <- rowSums(comp)^2 / (av_g^2 / nu_g)
   bad <- !(is.finite(e) & e > 0)
@@ -94,6 +90,20 @@ edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
                         alpha[bad, , drop = FALSE], L)
   }
   pmin(pmax(e, 1), n)
+}
+
+# The structure-function parts the terms of `plan` declare (each entry's
+# exact_edf(amp, nl, tau0)), as the kernel's shape codes, coefficients and
+# AR(1) poles.
+exact_edf_parts <- function(plan, values, tau0) {
+  shapes <- c("linear", "cubic", "step", "ar1")
+  parts <- unlist(lapply(plan, function(p) {
+    nl <- if (length(p$nl)) stats::setNames(values[p$nl], p$nl_param) else NULL
+    p$entry$exact_edf(values[p$amp], nl, tau0)
+  }), recursive = FALSE)
+  list(shape = match(vapply(parts, `[[`, "", "shape"), shapes) - 1L,
+       coef = vapply(parts, function(q) as.double(q$coef), 0),
+       phi = vapply(parts, function(q) as.double(q$phi %||% 0), 0))
 }
 
 # Correlation matrix of the AV estimates at cluster sizes m for white rate

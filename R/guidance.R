@@ -22,7 +22,7 @@
 #' * **any fitted term** whose relative standard error (from the fit's
 #'   `vcov`) exceeds 50% is reported as not resolvable.
 #' * **non-stationary effects** of the raw series (spikes/outliers, bias
-#'   steps, warm-up, transients; [series_effects()], run by [avrefine()]
+#'   steps, warm-up, transients; [detect_series_effects()], run by [avrefine()]
 #'   when it has the data, so by [analyze_imu()] with `refine = TRUE` or
 #'   `remove`) that were left in the series: one line per kind with the
 #'   count, the first times, the largest size in noise standard deviations,
@@ -31,7 +31,7 @@
 #' [analyze_imu()] runs these checks and warns when any fails.
 #'
 #' @param x An `imu_analysis` ([analyze_imu()]), or an [avfit()] of a curve
-#'   alone (for example another tool's curve, [read_avr_curve()]), read as
+#'   alone (for example another tool's curve, [read_allan_variance_ros_curve()]), read as
 #'   one axis.
 #' @param unit For an `avfit`: the rate unit of the fitted curve (`"rad/s"`,
 #'   `"deg/s"`, `"m/s^2"`, ...; see [av_units()]); `NULL` takes the unit the

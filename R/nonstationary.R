@@ -264,86 +264,253 @@ step_return <- function(x, steps, k, gap, alpha, tau0) {
 # sample after it (the level before the first step is kept).
 remove_steps <- function(x, steps) {
   if (!nrow(steps)) return(x)
-  adj <- numeric(length(x))
+  # one cumulative sum of the sizes placed at their indices: O(n)
+  jump <- numeric(length(x))
   for (k in seq_len(nrow(steps))) {
     i <- steps$index[k]
-    adj[i:length(x)] <- adj[i:length(x)] + steps$size[k]
+    jump[i] <- jump[i] + steps$size[k]
   }
-  x - adj
+  x - cumsum(jump)
 }
 
 #' Exponential warm-up (internal)
 #'
-#' A warm-up is a decaying offset at the start, y = c + A exp(-t / T). On a
-#' log grid of T (from `min_tc` to a quarter of the record), c and A are
-#' fitted by linear least squares to the block means over the first 6 T
-#' only (over the whole record a random walk's wander would be read as the
-#' exponential), and the amplitude is judged by
-#' z = |A| (1 - e^-1)^2 / sqrt(2 AV(T)): the numerator is the Allan
-#' difference the exponential makes between the first two windows of
-#' length T, the denominator the noise of that difference (the robust Allan
-#' variance of the series at T), so red noise is accounted for as in
-#' detect_steps(). T is the grid value of largest z, refined by least
-#' squares over its window. Present when z exceeds `z_level`.
+#' A warm-up is a decaying offset at the start, y = c + A exp(-t / T). It
+#' is estimated by generalised least squares on about `target_blocks`
+#' block means with the series' own noise model: white noise at the block
+#' scale, a random walk and Gauss-Markov components on a fixed grid of time
+#' constants (a flicker floor or the bumps of a real sensor), their
+#' variances fitted by NNLS to the Allan variance of the block means
+#' (`warmup_noise()`; the sensor's filter and quantization are inside a
+#' block and count as white). The Kalman filter of that model (level
+#' diffuse: the intercept c) whitens the block means and the exponential of
+#' every T on a log grid from 2 blocks to 40% of the record in one pass; T
+#' maximises the profile likelihood, refined by a parabola in log T. The
+#' noise model is fitted again with the warm-up found taken out (else its
+#' Gauss-Markov components would explain the warm-up) until T settles.
+#' z is the GLS estimate of A over its standard error, the error scaled by
+#' the whitened residual (a misfit noise model cannot make z larger than
+#' the data allow). Present when z exceeds `z_level`. A second exponential
+#' (an added warm-up on an axis that has one of its own) is looked for with
+#' the first in the regression, and kept when its own z also passes and
+#' the time constants are at least a factor 2 apart.
 #' @return list `present`, `amplitude` (rate unit, the offset at t = 0),
-#'   `tc` (s), `z`, `level` (the settled level c).
+#'   `tc` (s), `z`, `level` (the settled level c; `NA` from the GLS
+#'   fit), and `all`: a data.frame (`amplitude`, `tc`, `z`) of every
+#'   exponential found (none, one or two), strongest first.
 #' @noRd
-detect_warmup <- function(x, freq, z_level = 5, target_blocks = 5000L,
-                          min_tc = NULL) {
+detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1000L,
+                          min_tc = NULL, max_iter = 4L) {
   n <- length(x)
   tau0 <- 1 / freq
   b <- max(1L, n %/% target_blocks)
   y <- block_avg(x, b)
   nb <- length(y)
   dt <- b * tau0
-  t <- (seq_len(nb) - 0.5) * dt
-  if (is.null(min_tc)) min_tc <- 4 * dt
-  max_tc <- n * tau0 / 4
+  # fitted in units of the largest block mean: the GLS's variances would
+  # overflow for values beyond about 1e150 (amplitudes scaled back below)
+  s <- max(abs(y))
+  if (!is.finite(s) || s == 0) s <- 1
+  y <- y / s
   none <- list(present = FALSE, amplitude = 0, tc = NA_real_, z = 0,
-               level = mean(x))
-  if (max_tc <= min_tc || nb < 32L) return(none)
+               level = mean(x),
+               all = data.frame(amplitude = numeric(), tc = numeric(), z = numeric()))
+  if (is.null(min_tc)) min_tc <- 2 * dt
+  max_tc <- 0.4 * nb * dt
   # a constant series has no warm-up (and no noise to judge one by)
-  if (max(x) == min(x)) return(none)
-  fit_at <- function(tc, span) {
-    k <- seq_len(min(nb, max(8L, ceiling(span / dt))))
-    X <- cbind(1, exp(-t[k] / tc))
-    f <- stats::lm.fit(X, y[k])
-    list(A = unname(f$coefficients[2L]), c = unname(f$coefficients[1L]),
-         rss = sum(f$residuals^2))
+  if (max_tc <= min_tc || nb < 64L || max(x) == min(x)) return(none)
+  grid <- exp(seq(log(min_tc), log(max_tc), by = 0.07))
+  # exact block means of exp(-t / T), t from the first sample
+  expo <- function(tc) {
+    exp(-(seq_len(nb) - 1) * dt / tc) * (1 - exp(-tau0 * b / tc)) /
+      (b * (1 - exp(-tau0 / tc)))
   }
-  noise <- function(tc) {
-    bw <- max(1L, round(tc / dt))
-    d <- if (nb > 2L * bw + 10L) allan_differences(y, bw) else numeric(0)
-    if (length(d) > 10L) robust_d_scale(d) else stats::sd(y) * sqrt(2)
-  }
-  grid <- exp(seq(log(min_tc), log(max_tc), length.out = 60L))
-  zg <- vapply(grid, function(tc) {
-    abs(fit_at(tc, 6 * tc)$A) * (1 - exp(-1))^2 / noise(tc)
-  }, 0)
-  tc <- grid[which.max(zg)]
-  # least squares over the window 6 T, the window following T (a fixed
-  # point within a few passes)
-  for (pass in 1:4) {
-    span <- 6 * tc
-    o <- stats::optimize(function(lt) fit_at(exp(lt), span)$rss,
-                         log(tc) + c(-1, 1))
-    if (abs(o$minimum - log(tc)) < 0.01) {
-      tc <- exp(o$minimum)
+  X <- vapply(grid, expo, numeric(nb))
+  fixed <- NULL                      # regressors already found
+  found <- data.frame(amplitude = numeric(), tc = numeric(), z = numeric())
+  for (round in 1:2) {
+    tc <- NA_real_
+    clean <- y
+    if (!is.null(fixed)) clean <- y - fixed$X %*% fixed$A
+    for (it in seq_len(max_iter)) {
+      model <- warmup_noise(clean, dt)
+      # after the first pass, only the grid near the current T
+      near <- if (is.finite(tc)) which(abs(log(grid / tc)) <= 0.6) else seq_along(grid)
+      prof <- warmup_profile(y, X[, near, drop = FALSE], grid[near], model, fixed$X)
+      tc_new <- prof$tc
+      done <- is.finite(tc) && abs(log(tc_new / tc)) < 0.02
+      tc <- tc_new
+      # take the warm-up (and any found before) out before fitting the noise again
+      clean <- y - prof$fitted
+      if (done) break
+    }
+    if (!is.finite(prof$z) || abs(prof$z) <= z_level) break
+    if (nrow(found) && abs(log(tc / found$tc[1L])) < log(2)) break
+    found <- rbind(found, data.frame(amplitude = prof$A, tc = tc, z = abs(prof$z)))
+    if (nrow(found) == 2L) {
+      # each again given the other, alternately (the first was found with
+      # the second left in)
+      for (pass in 1:3) {
+        for (i in 1:2) {
+          o <- 3L - i
+          near <- which(abs(log(grid / found$tc[i])) <= 1)
+          pi <- warmup_profile(y, X[, near, drop = FALSE], grid[near], model,
+                               matrix(expo(found$tc[o]), nb))
+          if (!is.finite(pi$z) || abs(log(pi$tc / found$tc[o])) < log(2)) next
+          found[i, ] <- data.frame(amplitude = pi$A, tc = pi$tc, z = abs(pi$z))
+          found$amplitude[o] <- pi$A_fixed
+        }
+      }
       break
     }
-    tc <- exp(o$minimum)
+    fixed <- list(X = matrix(expo(tc), nb), A = prof$A)
   }
-  tc <- min(max(tc, min_tc), max_tc)
-  f <- fit_at(tc, 6 * tc)
-  z <- abs(f$A) * (1 - exp(-1))^2 / noise(tc)
-  list(present = is.finite(z) && z > z_level, amplitude = f$A, tc = tc, z = z,
-       level = f$c)
+  if (!nrow(found)) {
+    none$z <- if (exists("prof")) abs(prof$z) else 0
+    none$tc <- if (exists("prof")) prof$tc else NA_real_
+    none$amplitude <- if (exists("prof")) prof$A * s else 0
+    return(none)
+  }
+  found$amplitude <- found$amplitude * s
+  found <- found[order(-found$z), , drop = FALSE]
+  rownames(found) <- NULL
+  list(present = TRUE, amplitude = found$amplitude[1L], tc = found$tc[1L],
+       z = found$z[1L], level = NA_real_, all = found)
 }
 
-remove_warmup <- function(x, freq, warmup) {
-  if (!isTRUE(warmup$present)) return(x)
-  t <- (seq_along(x) - 1) / freq
-  x - warmup$amplitude * exp(-t / warmup$tc)
+# The block means' noise model for the warm-up's GLS: white (variance h per
+# block), a random walk (increment variance q per block) and AR(1)
+# components (the block means of Gauss-Markov processes) at time constants
+# 4^k blocks, variances by NNLS on the overlapping Allan variance of the
+# block means at octave m, each point weighted by its relative precision
+# (about sqrt(nb / m)).
+warmup_noise <- function(y, dt) {
+  nb <- length(y)
+  ms <- 2^(0:floor(log2(nb / 4)))
+  cs <- c(0, cumsum(y - mean(y)))
+  av <- vapply(ms, function(m) {
+    i <- seq_len(nb - 2 * m + 1)
+    d <- cs[i + 2 * m] - 2 * cs[i + m] + cs[i]
+    mean(d^2) / (2 * m^2)
+  }, 0)
+  tcs <- 4^(0:floor(log(nb / 4, 4)))             # in blocks
+  phis <- exp(-1 / tcs)
+  # AV at m of an AR(1) of unit variance: (4 V(m) - V(2m)) / (2 m^2), V(n)
+  # the variance of the sum of n consecutive values
+  V <- function(n, p) n * (1 + p) / (1 - p) - 2 * p * (1 - p^n) / (1 - p)^2
+  B <- cbind(1 / ms, (2 * ms^2 + 1) / (6 * ms),
+             vapply(phis, function(p) (4 * V(ms, p) - V(2 * ms, p)) / (2 * ms^2),
+                    numeric(length(ms))))
+  ok <- av > 0
+  w <- sqrt(nb / ms[ok]) / av[ok]
+  coef <- if (any(ok)) avfit_nnls(B[ok, , drop = FALSE] * w, w * av[ok]) else
+    c(stats::var(y), rep(0, ncol(B) - 1L))
+  coef <- pmax(as.numeric(coef), 0)
+  if (!(coef[1L] > 0)) coef[1L] <- max(av[1L], .Machine$double.eps) * 1e-3
+  # A random walk the fit set to 0 still wanders: one realisation's long-m
+  # points can lie low, and a model without the walk would read its wander
+  # as a slow exponential. The walk is at least what the two longest m
+  # leave over the other components.
+  top <- utils::tail(which(ok), 2L)
+  rest <- as.numeric(B[top, -2L, drop = FALSE] %*% coef[-2L])
+  coef[2L] <- max(coef[2L], (av[top] - rest) / B[top, 2L], 0)
+  keep <- which(coef[-(1:2)] > 0)
+  list(h = coef[1L], q = coef[2L], phi = phis[keep], s = coef[-(1:2)][keep],
+       dt = dt)
+}
+
+# Standardised innovations of the columns of Y under `model`: one Kalman
+# filter (the gains do not depend on the data) over a diffuse level (random
+# walk of increment variance q: the intercept), AR(1) states and white
+# noise h. The first row (the diffuse start) is dropped.
+warmup_whiten <- function(Y, model) {
+  Y <- as.matrix(Y)
+  nb <- nrow(Y)
+  phi <- c(1, model$phi)
+  Q <- c(model$q, model$s * (1 - model$phi^2))
+  m <- length(phi)
+  big <- 1e6 * (model$h + sum(model$s) + model$q * nb)
+  # the gains first (they do not depend on the data): m x m work only
+  P <- diag(c(big, model$s), m)
+  K <- matrix(0, m, nb)
+  sF <- numeric(nb)
+  PP <- phi %o% phi
+  for (j in seq_len(nb)) {
+    Pz <- rowSums(P)
+    F <- sum(Pz) + model$h
+    K[, j] <- phi * Pz / F
+    sF[j] <- sqrt(F)
+    # steady state: the remaining gains are this one
+    if (j > 2L && abs(sF[j] / sF[j - 1L] - 1) < 1e-12 &&
+        max(abs(K[, j] - K[, j - 1L])) < 1e-12 * max(abs(K[, j]))) {
+      K[, j:nb] <- K[, j]
+      sF[j:nb] <- sF[j]
+      break
+    }
+    P <- PP * (P - (Pz %o% Pz) / F)
+    diag(P) <- diag(P) + Q
+  }
+  # then every column at once: a(j+1) = phi a(j) + K(j) v(j)
+  a <- matrix(0, m, ncol(Y))
+  E <- matrix(0, nb, ncol(Y))
+  one <- rep(1, m)
+  for (j in seq_len(nb)) {
+    v <- Y[j, ] - as.vector(one %*% a)
+    E[j, ] <- v / sF[j]
+    a <- phi * a + tcrossprod(K[, j], v)
+  }
+  E[-1L, , drop = FALSE]
+}
+
+# Profile of the warm-up's time constant: GLS of the block means on each
+# column of X (with the columns `fixed`, exponentials found before, in the
+# regression), the T of largest explained sum of squares refined by a
+# parabola in log T, and its amplitude and z.
+warmup_profile <- function(y, X, grid, model, fixed = NULL) {
+  E <- warmup_whiten(cbind(y, fixed, X), model)
+  ey <- E[, 1L]
+  nf <- if (is.null(fixed)) 0L else ncol(fixed)
+  ef <- if (nf) E[, 1L + seq_len(nf), drop = FALSE] else NULL
+  EX <- E[, -seq_len(1L + nf), drop = FALSE]
+  if (nf) {
+    # project the fixed regressors out of y and of every candidate
+    qf <- qr(ef)
+    ey <- qr.resid(qf, ey)
+    EX <- qr.resid(qf, EX)
+  }
+  sxx <- colSums(EX^2)
+  sxy <- colSums(EX * ey)
+  gain <- ifelse(sxx > 0, sxy^2 / sxx, 0)
+  k <- which.max(gain)
+  lt <- log(grid[k])
+  if (k > 1L && k < length(grid)) {
+    g <- gain[(k - 1L):(k + 1L)]
+    den <- g[1L] - 2 * g[2L] + g[3L]
+    h <- diff(log(grid[1:2]))
+    if (den < 0) lt <- lt + h * 0.5 * (g[1L] - g[3L]) / den
+  }
+  tc <- exp(lt)
+  # the refined T's column, interpolated in log T (columns are smooth in T)
+  j <- k
+  wgt <- 0
+  if (lt != log(grid[k])) {
+    j <- if (lt > log(grid[k])) k + 1L else k - 1L
+    wgt <- (lt - log(grid[k])) / (log(grid[j]) - log(grid[k]))
+  }
+  ex <- (1 - wgt) * EX[, k] + wgt * EX[, j]
+  xt <- (1 - wgt) * X[, k] + wgt * X[, j]
+  A <- sum(ex * ey) / sum(ex^2)
+  res <- ey - A * ex
+  s2 <- sum(res^2) / max(1, length(res) - 2L - nf)
+  z <- A * sqrt(sum(ex^2)) / sqrt(max(s2, .Machine$double.eps))
+  A_fixed <- numeric(0)
+  fitted <- A * xt
+  if (nf) {
+    A_fixed <- qr.coef(qr(E[, 1L + seq_len(nf), drop = FALSE]), E[, 1L] - A * ex)
+    fitted <- fitted + fixed %*% A_fixed
+  }
+  list(best = k, tc = tc, A = A, z = z, fitted = as.numeric(fitted),
+       A_fixed = if (nf) unname(A_fixed[1L]) else NA_real_)
 }
 
 # Scale of a residual robust to a few outliers and to coarse quantization
@@ -362,27 +529,95 @@ robust_scale <- function(r, trim = 0.005) {
 #' Isolated spikes (internal)
 #'
 #' A spike stands out from its neighbours: the residual from a running
-#' median of `k` samples is compared with its robust scale, and samples
-#' beyond \eqn{\Phi^{-1}(1 - \alpha / (2n))} scales (Bonferroni over the
-#' record, at least `min_z`) are spikes. Runs of flagged samples shorter than
-#' k/2 are one spike each.
+#' median of `k` samples, standardised by its robust scale, beyond the
+#' Gaussian Bonferroni level over the record (at least `min_z`). The count
+#' must not hinge on where that level falls among values that lie near it:
+#' adding an unrelated effect changes the robust scale by a few percent
+#' and a fixed cut then moved a dozen real outliers across it. The
+#' threshold is therefore the log-midpoint of the gap of the sorted |z|
+#' that holds the level when it is at least `gap` wide in log (a scale
+#' change of `gap` / 2 moves nothing across), else of the first such gap
+#' above it (within zc / 1.15 and 1.1 zc), else the level itself. A candidate is kept only when it is also an additive
+#' outlier of the series' own AR(10) model at `ao_min` (`spike_ao_z()`):
+#' the running median's residual of a resonant or strongly filtered series
+#' has heavy tails without any outlier. (A tail fitted to the record's own
+#' |z| was tried and dropped: on coarsely quantized accelerometers it
+#' swung with any added dither.)
 #' @return data.frame `index`, `time` (s), `value` (the sample), `size`
-#'   (its excess over the running median), `z`.
+#'   (its excess over the running median), `z`; attribute `threshold` (in
+#'   robust sd).
 #' @noRd
-detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6) {
+detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6,
+                          gap = 0.04, ao_min = 4.5) {
   n <- length(x)
   med <- stats::runmed(x, k, endrule = "median", algorithm = "Turlach")
   r <- x - med
   s <- robust_scale(r)
-  zc <- max(min_z, stats::qnorm(1 - alpha / (2 * n)))
-  if (!(s > 0)) {
-    return(data.frame(index = integer(), time = numeric(), value = numeric(),
-                      size = numeric(), z = numeric()))
-  }
+  empty <- data.frame(index = integer(), time = numeric(), value = numeric(),
+                      size = numeric(), z = numeric())
+  attr(empty, "threshold") <- Inf
+  if (!(s > 0)) return(empty)
   z <- r / s
+  zc <- spike_threshold(abs(z), max(min_z, stats::qnorm(1 - alpha / (2 * n))), gap)
   i <- which(abs(z) > zc)
-  data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
-             z = z[i])
+  if (length(i)) {
+    # the local noise model's word: the candidate must also stand out from
+    # its neighbours as an additive outlier of the series' own AR model
+    # (a resonant or strongly filtered series gives the running median's
+    # residual heavy tails that are not outliers)
+    ao <- spike_ao_z(x, i, med + pmax(pmin(r, 4 * s), -4 * s))
+    i <- i[!(abs(ao) < ao_min)]
+  }
+  out <- data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
+                    z = z[i])
+  attr(out, "threshold") <- zc
+  out
+}
+
+# The additive-outlier statistic (Fox 1972; Chang, Tiao and Chen 1988) at
+# samples `at`: an AR(p) model a(B) x = e fitted by Yule-Walker to the
+# winsorised series `xw` (at most its first 2e5 samples), the outlier size
+# w = sum_j pi_j e(t + j) / sum pi_j^2 over its standard error sigma_e /
+# sqrt(sum pi_j^2); sigma_e the robust scale of the innovations. NA near
+# the ends.
+spike_ao_z <- function(x, at, xw, p = 10L) {
+  n <- length(x)
+  m <- min(n, 200000L)
+  mu <- mean(xw[seq_len(m)])
+  # Yule-Walker from the sample autocovariance (C, O(m p))
+  g <- as.numeric(stats::acf(xw[seq_len(m)] - mu, lag.max = p, type = "covariance",
+                             plot = FALSE, demean = FALSE)$acf)
+  ar <- tryCatch(solve(stats::toeplitz(g[seq_len(p)]), g[-1L]),
+                 error = function(e) numeric(0))
+  if (!all(is.finite(ar))) ar <- numeric(0)
+  pi <- c(1, -ar)
+  p <- length(pi) - 1L
+  e <- as.numeric(stats::filter(xw[seq_len(m)] - mu, pi, sides = 1L))
+  se <- robust_scale(e[-seq_len(p)])
+  vapply(at, function(t) {
+    if (t <= 2L * p || t + 2L * p > n || !(se > 0)) return(NA_real_)
+    win <- x[(t - p):(t + p)] - mu
+    et <- as.numeric(stats::filter(win, pi, sides = 1L))[(p + 1L):(2L * p + 1L)]
+    sum(pi * et) / (sqrt(sum(pi^2)) * se)
+  }, 0)
+}
+
+# The spike threshold: level zc moved into a gap of the sorted |z| `a`
+# (see detect_spikes()).
+spike_threshold <- function(a, zc, gap) {
+  # the gap of the sorted values that holds zc when it is at least `gap`
+  # wide in log, else the first such gap above, its midpoint within zc /
+  # 1.15 and 1.1 zc; zc itself when there is none (values spread densely:
+  # any cut moves them in proportion)
+  lo <- zc / 1.15
+  hi <- 1.1 * zc
+  v <- sort(a[a > lo & a < hi])
+  pts <- log(c(lo, v, hi))
+  w <- diff(pts)
+  from <- findInterval(log(zc), pts, rightmost.closed = TRUE)
+  ok <- which(w >= gap & seq_along(w) >= from)
+  if (!length(ok)) return(zc)
+  exp((pts[ok[1L]] + pts[ok[1L] + 1L]) / 2)
 }
 
 # The series with spikes replaced by the running median around them.

@@ -1,125 +1,109 @@
-# ROS1 bags, format 2.0 (wiki.ros.org/Bags/Format/2.0), without ROS. The
-# records are walked in C++ (src/rosbag.cpp); here: the few header fields
-# of connection, chunk and chunk-info records, and bz2 chunks through base
-# R's memDecompress().
+# ROS1 bags, format 2.0 (wiki.ros.org/Bags/Format/2.0), without ROS, read
+# from the file a chunk at a time (src/rosbag.cpp): the index at the end
+# says which chunks hold the topic and when; bz2 chunks are decompressed
+# here by R's own bzip2 (memDecompress), one at a time.
 
 bag_version <- "#ROSBAG V2.0\n"
 
-# Fields of a record header: a named list of raw values.
-bag_fields <- function(r) {
-  out <- list()
-  i <- 1L
-  n <- length(r)
-  while (i + 3L <= n) {
-    len <- raw_u32(r, i)
-    f <- r[i + 4L + seq_len(len) - 1L]
-    eq <- match(as.raw(0x3d), f)
-    if (!is.na(eq)) out[[rawToChar(f[seq_len(eq - 1L)])]] <- f[-seq_len(eq)]
-    i <- i + 4L + len
-  }
-  out
-}
-
-slice <- function(buf, off, len) buf[off + seq_len(len)]
-
-bag_scan <- function(file, buf = NULL) {
-  if (is.null(buf)) buf <- readBin(file, "raw", file.size(file))
-  recs <- rosbag_records(buf, nchar(bag_version), length(buf))
-  conns <- bag_conn_table(buf, recs, which(recs$op == 7L))
-  chunk <- which(recs$op == 5L)
-  chunks <- data.frame(off = recs$data[chunk], len = recs$data_len[chunk],
-                       compression = recs$compression[chunk],
-                       size = recs$size[chunk], stringsAsFactors = FALSE)
-  if (!nrow(conns) && nrow(chunks)) {
-    # An unindexed bag: connection records only inside the chunks.
-    parts <- lapply(seq_len(nrow(chunks)), function(k) {
-      raw <- bag_chunk_raw(buf, chunks[k, ], file)
-      inner <- rosbag_records(raw, 0, length(raw))
-      bag_conn_table(raw, inner, which(inner$op == 7L))
-    })
-    conns <- unique(do.call(rbind, parts))
-  }
-  # Message counts per connection from the chunk-info records.
-  counts <- numeric()
-  for (k in which(recs$op == 6L)) {
-    d <- slice(buf, recs$data[k], recs$data_len[k])
-    for (e in seq_len(length(d) %/% 8L)) {
-      id <- as.character(raw_u32(d, 8L * (e - 1L) + 1L))
-      counts[id] <- (if (is.na(counts[id])) 0 else counts[id]) +
-        raw_u32(d, 8L * (e - 1L) + 5L)
-    }
-  }
+# The index: connections, chunks and their time spans, topics with counts.
+bag_scan <- function(file) {
+  s <- rosbag_index_cpp(path.expand(file))
+  if (!s$indexed && s$bz2) s <- bag_bz2_conns(file, s)
+  conns <- s$conns
   topics <- if (nrow(conns)) {
-    u <- conns[!duplicated(conns$topic), , drop = FALSE]
-    n <- vapply(u$topic, function(tp) {
-      v <- counts[as.character(conns$conn[conns$topic == tp])]
-      if (anyNA(v)) NA_real_ else sum(v)
-    }, 0)
-    topic_table(u$topic, u$type, n, "ros1")
+    u <- !duplicated(conns$topic)
+    n <- vapply(conns$topic[u], function(tp) sum(conns$n[conns$topic == tp]), 0)
+    topic_table(conns$topic[u], conns$type[u], n, "ros1")
   } else {
     topic_table(character(), character(), numeric(), character())
   }
-  list(buf = buf, chunks = chunks, conns = conns, topics = topics)
+  s$topics <- topics
+  s
 }
 
-# Connection records (op 7): id from the record header, topic and type from
-# the connection header in the data.
-bag_conn_table <- function(buf, recs, idx) {
-  rows <- lapply(idx, function(k) {
-    h <- bag_fields(slice(buf, recs$hdr[k], recs$hdr_len[k]))
-    d <- bag_fields(slice(buf, recs$data[k], recs$data_len[k]))
-    data.frame(conn = raw_u32(h$conn, 1L), topic = rawToChar(h$topic),
-               type = if (is.null(d$type)) NA_character_ else rawToChar(d$type),
-               stringsAsFactors = FALSE)
-  })
-  if (!length(rows)) {
-    return(data.frame(conn = numeric(), topic = character(), type = character(),
-                      stringsAsFactors = FALSE))
+# Without an index, the connection records inside bz2 chunks (which the C++
+# pass leaves to R): each chunk decompressed in turn.
+bag_bz2_conns <- function(file, s) {
+  path <- path.expand(file)
+  for (pos in s$chunks$pos) {
+    d <- rosbag_chunk_cpp(path, pos)
+    if (d$compression != "bz2") next
+    raw <- memDecompress(d$data, type = "bzip2")
+    cn <- rosbag_decode_cpp(raw, integer(), -Inf, Inf)$conns
+    s$conns <- rbind(s$conns, cn[!cn$conn %in% s$conns$conn, , drop = FALSE])
   }
-  do.call(rbind, rows)
+  s$conns$n <- NA_real_
+  s
 }
 
-bag_chunk_raw <- function(buf, ch, file) {
-  d <- slice(buf, ch$off, ch$len)
-  switch(ch$compression,
-    none = d,
-    bz2 = memDecompress(d, type = "bzip2"),
-    lz4 = lz4_decompress_cpp(d, ch$size),
-    abort("\"", basename(file), "\" has chunks compressed with \"",
-          ch$compression, "\"; none, bz2 and lz4 are read.", class = "file_format"))
-}
-
-bag_read_imu <- function(file, topic, progress) {
+bag_read_imu <- function(file, topic, progress, range = NULL) {
+  path <- path.expand(file)
   if (!is.null(progress)) progress("scanning the bag")
   s <- bag_scan(file)
+  if (!s$indexed) {
+    warn("\"", basename(file), "\" has no index (a recording cut off?); ",
+         "its chunks were read one after the other.", class = "unindexed")
+  }
+  no_topics_before_fault(file, s)
   topic <- select_topic(s$topics, topic, file)
   ids <- as.integer(s$conns$conn[s$conns$topic == topic])
-  if (!is.null(progress)) progress("decoding chunks")
   ch <- s$chunks
-  comp <- match(ch$compression, c("none", "lz4", "bz2")) - 1L
-  if (anyNA(comp)) {
-    abort("\"", basename(file), "\" has chunks compressed with \"",
-          ch$compression[is.na(comp)][1L], "\"; none, bz2 and lz4 are read.",
-          class = "file_format")
+  keep <- rep(TRUE, nrow(ch))
+  if (s$indexed) {
+    # Chunks holding the topic's connections, overlapping the time range.
+    cc <- s$chunk_conns
+    keep <- seq_len(nrow(ch)) %in% (cc$chunk[cc$conn %in% ids & cc$n > 0] + 1)
   }
-  if (any(comp == 2L) && !bz2_available_cpp()) {
-    # No libbz2 to load: base R decompresses each bz2 chunk.
-    parts <- vector("list", nrow(ch))
-    bad <- 0
-    for (k in seq_len(nrow(ch))) {
-      res <- if (comp[k] == 2L) {
-        raw <- memDecompress(slice(s$buf, ch$off[k], ch$len[k]), type = "bzip2")
-        rosbag_imu(raw, 0, length(raw), 0L, length(raw), ids)
-      } else {
-        rosbag_imu(s$buf, ch$off[k], ch$len[k], comp[k], ch$size[k], ids)
+  from <- -Inf
+  to <- Inf
+  if (!is.null(range)) {
+    t0 <- bag_start_ns(s)
+    from <- t0 + range[1L] * 1e9
+    to <- t0 + range[2L] * 1e9
+    if (s$indexed) keep <- keep & !(ch$end < from | ch$start > to)
+  }
+  pos <- ch$pos[keep]
+  got <- ros_stream(file, length(pos), progress, function(k) {
+    out <- list(imu = matrix(numeric(), 0L, 10L), bad = 0, bytes = 0, fault = NULL)
+    while (length(k)) {
+      res <- rosbag_read_cpp(path, pos[k], ids, from, to)
+      out$imu <- rbind(out$imu, res$imu)
+      out$bad <- out$bad + res$bad
+      out$bytes <- out$bytes + res$bytes
+      if (length(res$fault)) {
+        out$fault <- res$fault
+        break
       }
-      parts[[k]] <- res$imu
-      bad <- bad + res$bad
+      if (!isTRUE(res$bz2)) break
+      # R's own bzip2 for the chunk the C++ reader stopped at.
+      at <- k[res$done + 1]
+      d <- rosbag_chunk_cpp(path, pos[at])
+      out$bytes <- out$bytes + length(d$data)
+      raw <- tryCatch(memDecompress(d$data, type = "bzip2"), error = function(e) NULL)
+      if (is.null(raw) || length(raw) != d$size) {
+        out$fault <- list(off = pos[at], what = "a bz2 chunk that does not decompress to its stated size")
+        break
+      }
+      one <- rosbag_decode_cpp(raw, ids, from, to)
+      out$imu <- rbind(out$imu, one$imu)
+      out$bad <- out$bad + one$bad
+      k <- k[-seq_len(res$done + 1)]
     }
-    imu <- if (length(parts)) do.call(rbind, parts) else matrix(numeric(), 0, 10)
-    return(list(imu = imu, bad = bad, topic = topic, format = "rosbag"))
+    out
+  }, s$fault)
+  if (!is.null(range) && is.na(bag_start_ns(s)) && nrow(got$imu)) {
+    # No index, no chunk times: the range from the first message received.
+    recv <- got$imu[, 9L] * 1e9 + got$imu[, 10L]
+    rel <- (recv - min(recv)) / 1e9
+    got$imu <- got$imu[rel >= range[1L] & rel <= range[2L], , drop = FALSE]
   }
-  # Every chunk in one C++ call (src/rosbag.cpp): no R work per chunk.
-  res <- rosbag_imu(s$buf, ch$off, ch$len, comp, ch$size, ids, allanvar_threads())
-  list(imu = res$imu, bad = res$bad, topic = topic, format = "rosbag")
+  got$topic <- topic
+  got$format <- "rosbag"
+  got
+}
+
+# The start of a bag in ns: its first chunk, or its first message.
+bag_start_ns <- function(s) {
+  st <- s$chunks$start
+  if (length(st) && !all(is.na(st))) min(st, na.rm = TRUE) else NA_real_
 }

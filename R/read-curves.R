@@ -8,7 +8,7 @@
 #' Reads the curves and parameter files written by other tools into R
 #' objects in SI units, keeping each tool's conventions with the values:
 #'
-#' * `read_avr_curve()`: the `allan_variance.csv` of allan_variance_ros
+#' * `read_allan_variance_ros_curve()`: the `allan_variance.csv` of allan_variance_ros
 #'   (ori-drs): space-separated, no header, one row per averaging time:
 #'   `period acc_x acc_y acc_z gyro_x gyro_y gyro_z`, Allan *deviations*,
 #'   accelerometers in m/s^2 and gyroscopes in **deg/s** (its C++ converts
@@ -60,7 +60,7 @@
 #' @param scaled Whether `gyr_n`/`acc_n` are `sqrt(freq)` times N (`TRUE`,
 #'   imu_utils since May 2018) or N (`FALSE`); `NULL` decides from `curve`,
 #'   else assumes `TRUE`. The choice is in `attr(, "scaled")`.
-#' @return `read_avr_curve()`, `read_imu_utils_curve()`: a `"tool_curve"` data
+#' @return `read_allan_variance_ros_curve()`, `read_imu_utils_curve()`: a `"tool_curve"` data
 #'   frame with columns `channel` (`gyro_x`, ..., `accel_z`), `sensor`,
 #'   `tau` (s), `adev` and `avar` (SI: rad/s, m/s^2) and `unit`, and
 #'   attributes `source` (the tool), `freq` (Hz or `NULL`), `file` and
@@ -81,14 +81,14 @@
 #' write.table(cbind(tau, 0.002 / sqrt(tau), 0.002 / sqrt(tau), 0.002 / sqrt(tau),
 #'                   0.01 / sqrt(tau), 0.01 / sqrt(tau), 0.01 / sqrt(tau)),
 #'             f, row.names = FALSE, col.names = FALSE)
-#' cv <- read_avr_curve(f)
+#' cv <- read_allan_variance_ros_curve(f)
 #' cv[cv$channel == "gyro_x", ]
 #' unlink(f)
 NULL
 
 #' @rdname read_other_tools
 #' @export
-read_avr_curve <- function(file) {
+read_allan_variance_ros_curve <- function(file) {
   check_present(missing(file), "file", "the path of allan_variance.csv")
   check_file(file)
   tab <- tryCatch(data.table::fread(file, header = FALSE, data.table = FALSE,

@@ -40,7 +40,7 @@ db3_topics <- function(file, con = NULL, count = TRUE) {
   out
 }
 
-db3_read_imu <- function(file, topic, progress) {
+db3_read_imu <- function(file, topic, progress, range = NULL) {
   con <- db3_connect(file)
   on.exit(DBI::dbDisconnect(con))
   tp <- db3_topics(file, con, count = FALSE)
@@ -53,12 +53,35 @@ db3_read_imu <- function(file, topic, progress) {
           tp$encoding[k], "\"; \"cdr\" is read.", class = "file_format")
   }
   if (!is.null(progress)) progress("reading messages")
-  res <- DBI::dbGetQuery(con, "SELECT timestamp, data FROM messages WHERE topic_id = ? ORDER BY id",
-                         params = list(attr(tp, "id")[k]))
-  ts <- res$timestamp
-  if (!inherits(ts, "integer64")) ts <- bit64::as.integer64(ts)
-  imu <- decode_imu_blobs(res$data, 1L, ts)
-  bad <- sum(is.na(imu[, 1L]))
-  list(imu = imu[!is.na(imu[, 1L]), , drop = FALSE], bad = bad, topic = topic,
-       format = "db3")
+  id <- attr(tp, "id")[k]
+  where <- "WHERE topic_id = ?"
+  params <- list(id)
+  if (!is.null(range)) {
+    # Seconds from the first message of the bag.
+    t0 <- DBI::dbGetQuery(con, "SELECT MIN(timestamp) AS t0 FROM messages")$t0
+    t0 <- bit64::as.integer64(t0)
+    where <- paste(where, "AND timestamp >= ?")
+    params <- c(params, list(t0 + bit64::as.integer64(round(range[1L] * 1e9))))
+    if (is.finite(range[2L])) {
+      where <- paste(where, "AND timestamp <= ?")
+      params <- c(params, list(t0 + bit64::as.integer64(round(range[2L] * 1e9))))
+    }
+  }
+  # Streamed in pages: one page of blobs in memory at a time.
+  q <- DBI::dbSendQuery(con, paste("SELECT timestamp, data FROM messages", where,
+                                   "ORDER BY id"), params = params)
+  on.exit(DBI::dbClearResult(q), add = TRUE, after = FALSE)
+  parts <- list()
+  bad <- 0
+  while (!DBI::dbHasCompleted(q)) {
+    res <- DBI::dbFetch(q, n = 50000L)
+    if (!nrow(res)) break
+    ts <- res$timestamp
+    if (!inherits(ts, "integer64")) ts <- bit64::as.integer64(ts)
+    imu <- decode_imu_blobs(res$data, 1L, ts)
+    bad <- bad + sum(is.na(imu[, 1L]))
+    parts[[length(parts) + 1L]] <- imu[!is.na(imu[, 1L]), , drop = FALSE]
+  }
+  imu <- do.call(rbind, c(list(matrix(numeric(), 0L, 10L)), parts))
+  list(imu = imu, bad = bad, topic = topic, format = "db3")
 }

@@ -72,12 +72,67 @@ select_topic <- function(topics, topic, file) {
   imu$topic
 }
 
-read_ros_imu <- function(file, fmt, topic, columns, units, progress) {
+read_ros_imu <- function(file, fmt, topic, columns, units, progress, range = NULL) {
   got <- ros_call(switch(fmt,
-    rosbag = bag_read_imu(file, topic, progress),
-    mcap = mcap_read_imu(file, topic, progress),
-    db3 = db3_read_imu(file, topic, progress)), file)
+    rosbag = bag_read_imu(file, topic, progress, range),
+    mcap = mcap_read_imu(file, topic, progress, range),
+    db3 = db3_read_imu(file, topic, progress, range)), file)
   ros_source(got, columns, units)
+}
+
+# A file damaged before its first connection or channel record.
+no_topics_before_fault <- function(file, s) {
+  if (length(s$fault) && !nrow(s$topics)) {
+    abort("\"", basename(file), "\" is damaged at byte ",
+          format(s$fault$off, scientific = FALSE), " (", s$fault$what,
+          ") and no topic is described before it.", class = "file_format")
+  }
+}
+
+# Chunks read in batches of `batch` (one C++ call each: `read_batch(k)`
+# returns imu, bad, done, fault, bytes), with progress between batches
+# (progressr, bytes read) and the first fault turned into a classed warning
+# that keeps the messages before it, or an error when there are none.
+ros_stream <- function(file, n_chunks, progress, read_batch, scan_fault = NULL,
+                       batch = 64L) {
+  if (!is.null(progress)) progress("decoding chunks")
+  starts <- seq(1L, n_chunks, by = batch)
+  if (!n_chunks) starts <- integer()
+  pr <- if (length(starts) > 4L && requireNamespace("progressr", quietly = TRUE)) {
+    progressr::progressor(steps = length(starts))
+  }
+  parts <- vector("list", length(starts))
+  bad <- 0
+  bytes <- 0
+  fault <- NULL
+  for (b in seq_along(starts)) {
+    k <- starts[b]:min(n_chunks, starts[b] + batch - 1L)
+    res <- read_batch(k)
+    parts[[b]] <- res$imu
+    bad <- bad + res$bad
+    bytes <- bytes + res$bytes
+    if (!is.null(pr)) pr(sprintf("%.0f MB read", bytes / 1e6))
+    if (length(res$fault)) {
+      fault <- res$fault
+      break
+    }
+  }
+  if (is.null(fault) && length(scan_fault)) fault <- scan_fault
+  imu <- do.call(rbind, c(list(matrix(numeric(), 0L, 10L)), parts))
+  if (!is.null(fault)) {
+    if (grepl("no zstd support", fault$what, fixed = TRUE)) stop(fault$what, call. = FALSE)
+    size <- file.size(file)
+    if (!nrow(imu)) {
+      abort("\"", basename(file), "\" is damaged at byte ", format(fault$off, scientific = FALSE),
+            " (", fault$what, ") and no message of the topic precedes it.",
+            class = "file_format")
+    }
+    warn("\"", basename(file), "\" is damaged at byte ", format(fault$off, scientific = FALSE),
+         " (", fault$what, "): the ", nrow(imu), " messages before it are ",
+         "returned; the last ", format(size - fault$off, scientific = FALSE),
+         " bytes of the file are not read.", class = "damaged_file")
+  }
+  list(imu = imu, bad = bad, bytes = bytes)
 }
 
 # Malformed files: the decoders' messages (which say what and where) as

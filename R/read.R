@@ -103,6 +103,10 @@
 #' @param topic For bags: the topic of the `sensor_msgs/Imu` messages.
 #' @param dec Decimal mark of a text file: `"."` (default) or `","` (then
 #'   `sep` must be another character, e.g. `";"`).
+#' @param from,to For bags: the time range to read, in seconds from the
+#'   start of the recording (its first chunk, or first message), by the
+#'   time each message was recorded. Only the chunks overlapping the range
+#'   are read from the file. `NULL`: from the start, to the end.
 #' @param ... Unused; an error if given, to catch misspelled arguments.
 #' @return An object of class `"imu_record"`: a list with `data` (numeric
 #'   matrix, one column per channel, SI units), `time` (seconds since the
@@ -141,7 +145,7 @@ read_imu <- function(file, time = NULL,
                      columns = NULL, units = NULL, sep = ",",
                      gap = c("segments", "error", "ignore"),
                      freq = NULL, sensors = NULL, topic = NULL, dec = ".",
-                     ...) {
+                     from = NULL, to = NULL, ...) {
   check_present(missing(file), "file", "the path of a recording")
   if (...length()) {
     abort("unknown argument(s) to read_imu(): ",
@@ -178,13 +182,18 @@ read_imu <- function(file, time = NULL,
     abort("`topic` must be a single topic name, not ", describe_type(topic),
           ".", class = "argument")
   }
+  range <- check_read_range(from, to)
   p <- read_progress(4L)
   fmt <- detect_format(file)
+  if (!is.null(range) && fmt == "text") {
+    abort("`from` and `to` select a time range of a ROS bag, db3 or MCAP ",
+          "file; \"", basename(file), "\" is a text file.", class = "argument")
+  }
   src <- if (fmt == "text") {
     read_csv_imu(file, time, time_unit, columns, units, sep, dec, sensors,
                  freq, p)
   } else {
-    read_ros_imu(file, fmt, topic, columns, units, p)
+    read_ros_imu(file, fmt, topic, columns, units, p, range)
   }
   p("checking stamps and units")
   rec <- new_imu_record(src$x, time = src$time, time_unit = "s", freq = freq,
@@ -199,6 +208,26 @@ read_imu <- function(file, time = NULL,
   rec$layout <- src$layout
   if (!is.null(src$topic)) rec$topic <- src$topic
   rec
+}
+
+# `from`, `to`: seconds from the start of a ROS recording, or NULL.
+check_read_range <- function(from, to) {
+  if (is.null(from) && is.null(to)) return(NULL)
+  one <- function(x, arg, default) {
+    if (is.null(x)) return(default)
+    if (!is.numeric(x) || length(x) != 1L || is.na(x) || x < 0 || is.object(x)) {
+      abort("`", arg, "` must be a single non-negative number of seconds from ",
+            "the start of the recording, not ", if (length(x) == 1L && is.atomic(x))
+              format_value(x) else describe_type(x), ".", class = "argument")
+    }
+    as.numeric(x)
+  }
+  r <- c(one(from, "from", 0), one(to, "to", Inf))
+  if (r[2L] <= r[1L]) {
+    abort("`to` must be after `from`; they are ", r[1L], " and ", r[2L], ".",
+          class = "argument")
+  }
+  r
 }
 
 # A file path that exists and is a regular, non-empty file.
@@ -243,8 +272,6 @@ choice_arg <- function(x, choices, arg) {
   if (identical(x, choices)) return(choices[1L])
   check_choice(x, choices, arg)
 }
-
-`%||%` <- function(a, b) if (is.null(a)) b else a
 
 # progressr's progressor for long reads: silent unless handlers are set
 # (progressr::handlers()), as everywhere in the package.

@@ -16,7 +16,13 @@
 #' Each detector sees the series with the instances found before it taken
 #' out (a spike does not disturb the step search). Thresholds are
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
-#' steps) standard deviations.
+#' steps) standard deviations; the spike threshold sits in a gap of the
+#' sorted residuals near that level (so the count does not flip when the
+#' noise scale moves a little) and a spike must also be an additive outlier
+#' of the series' own AR model. The warm-up is fitted by generalised least
+#' squares under the series' own noise model (white, random walk and
+#' Gauss-Markov components from its Allan variance); up to two
+#' exponentials are named.
 #'
 #' The Allan deviation of the series as given is compared with that of the
 #' series with every effect found taken out, on the octave grid of
@@ -50,7 +56,10 @@
 #'     `before`, `after`, `change`: only that kind taken out);
 #'   * `x`: the series with the `removed` kinds taken out (the input
 #'     unchanged when nothing was removed; a `ts` when `x` was);
-#'   * `removed`: the kinds removed; `kinds`, `freq` and `n`.
+#'   * `removed`: the kinds removed; `kinds`, `freq` and `n`;
+#'   * `reading_bias`: [series_reading_bias()] at its default taus: per
+#'     kind left in, the relative change of N, B and K it causes (e.g.
+#'     what genuine outliers left in do to N).
 #' @seealso [avrefine()] (its `remove` argument), [avdiagnose()]
 #' @export
 #' @examples
@@ -58,10 +67,10 @@
 #' x <- rnorm(1e5, sd = 0.1) + cumsum(rnorm(1e5, sd = 1e-4))
 #' x[60001:1e5] <- x[60001:1e5] + 0.05        # a bias step at 600 s
 #' x[c(1000, 42000)] <- x[c(1000, 42000)] + 2  # two spikes
-#' se <- series_effects(x, 100, remove = "spikes")
+#' se <- detect_series_effects(x, 100, remove = "spikes")
 #' se
 #' se$table[, c("kind", "time", "size", "z", "removed")]
-series_effects <- function(x, freq, remove = character(), ..., kinds = NULL) {
+detect_series_effects <- function(x, freq, remove = character(), ..., kinds = NULL) {
   check_dots_empty(...)
   check_present(missing(x), "x", "a rate series")
   was_ts <- stats::is.ts(x)
@@ -87,10 +96,12 @@ series_effects <- function(x, freq, remove = character(), ..., kinds = NULL) {
   y <- remove_series(x, freq, table[table$removed, , drop = FALSE])
   if (was_ts) y <- stats::ts(y, start = start, frequency = freq)
   adev <- series_adev(x, freq, table)
-  structure(list(table = table, adev = adev$all, adev_kinds = adev$kinds,
-                 x = y, removed = removed, kinds = kinds, freq = freq,
-                 n = length(x)),
-            class = "series_effects")
+  out <- structure(list(table = table, adev = adev$all, adev_kinds = adev$kinds,
+                        x = y, removed = removed, kinds = kinds, freq = freq,
+                        n = length(x)),
+                   class = "series_effects")
+  out$reading_bias <- series_reading_bias(out)
+  out
 }
 
 # `x`: a character vector of kinds among `allowed` (character() allowed).
@@ -199,4 +210,81 @@ print.series_effects <- function(x, ...) {
   cat(if (length(x$removed)) paste0("  removed: ", paste(x$removed, collapse = ", "))
       else "  nothing removed (see `remove`)", "\n", sep = "")
   invisible(x)
+}
+
+#' What the series effects left in do to the readings
+#'
+#' For each kind of series effect found and left in the series (not
+#' removed), the relative change it makes to each reading (N, B, K): the
+#' Allan deviation with the kind left in over that without it, minus 1, at
+#' the tau where the reading is read (interpolated in log-log between the
+#' pass's octave taus). A reading's coefficient scales with the Allan
+#' deviation in its own region, so this is the change of the reading to
+#' first order (a fit with the effect left in moves its coefficient by
+#' about as much). The row `kind = "all"` takes every kind left in out
+#' together.
+#'
+#' @param pass A [detect_series_effects()] result (also the `$series` of an
+#'   [avrefine()] fit or of an analysis channel).
+#' @param readings `NULL`, or readings with columns `term` and `tau` (s),
+#'   e.g. an analysis channel's `$readings`: the taus where N, B and K are
+#'   read. By default N at 1 s, B at the least Allan deviation without the
+#'   effects, K at the longest tau of the pass.
+#' @return A data.frame with columns `kind`, `term` ("N", "B", "K"), `tau`
+#'   (s) and `bias_change` (relative change of the reading caused by
+#'   leaving the kind in: 0.06 is +6%); no rows when nothing is left in.
+#' @export
+#' @examples
+#' set.seed(1)
+#' x <- rnorm(1e5, sd = 0.1)
+#' x[sample.int(1e5, 200)] <- 3                  # 200 outliers
+#' se <- detect_series_effects(x, 100)
+#' series_reading_bias(se)
+series_reading_bias <- function(pass, readings = NULL) {
+  if (!inherits(pass, "series_effects")) {
+    abort("`pass` must be a detect_series_effects() result, not ", describe_type(pass),
+          ".", class = "argument")
+  }
+  out <- data.frame(kind = character(), term = character(), tau = numeric(),
+                    bias_change = numeric(), stringsAsFactors = FALSE)
+  tab <- pass$table
+  left <- unique(tab$kind[!tab$removed])
+  if (!length(left) || !NROW(pass$adev)) return(out)
+  tau <- pass$adev$tau
+  at <- c(N = 1, B = tau[which.min(pass$adev$after)], K = max(tau))
+  if (!is.null(readings)) {
+    if (!is.data.frame(readings) || !all(c("term", "tau") %in% names(readings))) {
+      abort("`readings` must be a data frame with columns `term` and `tau`, or NULL.",
+            class = "argument")
+    }
+    for (tm in names(at)) {
+      v <- readings$tau[readings$term == tm]
+      if (length(v) && is.finite(v[1L]) && v[1L] > 0) at[[tm]] <- v[1L]
+    }
+  }
+  at <- pmin(pmax(at, min(tau)), max(tau))
+  change_at <- function(before, after) {
+    ok <- before > 0 & after > 0
+    if (sum(ok) < 2L) return(rep(NA_real_, length(at)))
+    exp(stats::approx(log(tau[ok]), log(before[ok] / after[ok]), log(at), rule = 2)$y) - 1
+  }
+  rows <- list()
+  for (k in left) {
+    # only this kind out, the rest as given: from the table of that kind
+    ch <- pass$adev_kinds[pass$adev_kinds$kind == k, , drop = FALSE]
+    if (!nrow(ch)) next
+    rows[[k]] <- data.frame(kind = k, term = names(at), tau = unname(at),
+                            bias_change = change_at(ch$before, ch$after),
+                            stringsAsFactors = FALSE)
+  }
+  # every kind together, when the pass removed none (else `adev` compares
+  # the raw series with one that lacks the removed kinds too)
+  if (length(left) > 1L && !any(tab$removed)) {
+    rows[["all"]] <- data.frame(kind = "all", term = names(at), tau = unname(at),
+                                bias_change = change_at(pass$adev$before, pass$adev$after),
+                                stringsAsFactors = FALSE)
+  }
+  out <- do.call(rbind, rows)
+  rownames(out) <- NULL
+  out
 }

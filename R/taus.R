@@ -1,13 +1,10 @@
 # Cluster-size grids for allan(). A curve is computed at cluster sizes m
 # (tau = m / freq); every estimator has a largest m with at least one term.
 
-# The types allan() offers, in the order its documentation lists them
-# (overlapping, the default, first).
-allan_types <- c("overlapping", "standard", "modified", "hadamard",
-                 "ohadamard", "total")
-
 # The estimator table defined once in src/types.h (name, code, d,
-# overlapping, modified), read from C++ on first use.
+# overlapping, modified) for the Allan-family types of the sums kernel, read
+# from C++ on first use (the catalogue of statistics joins every type's row
+# to its entry: R/stat-catalogue.R).
 allan_type_table <- local({
   table <- NULL
   function() {
@@ -17,10 +14,7 @@ allan_type_table <- local({
 })
 
 # The C++ kernels' code for each type.
-allan_type_code <- function(type) {
-  tab <- allan_type_table()
-  tab$code[match(type, tab$name)]
-}
+allan_type_code <- function(type) stat_entry(type)$code
 
 # The options the sums kernel reads (src/opts-allan.h), built once per call.
 allan_opts <- function(type, rate, octave = FALSE,
@@ -56,36 +50,19 @@ noise_id_rules <- function(rule = getOption("allanvar.noise_id", "default"),
           paste0("\"", known, "\"", collapse = ", "), "; not ",
           paste(format(rule), collapse = " "), ".", class = "option")
   }
-  list(acf_min = if (rule == "stable32") 30L else 64L,
-       b1_rw_own = rule == "coverage" || (rule == "default" && type == "total"),
-       rn_stable32 = rule == "stable32",
-       rn_check_wfm = rule == "default" && type != "total")
+  # the type-dependent switches (b1_rw_own, rn_check_wfm) are the
+  # statistic's (its catalogue entry's `noise_id`)
+  c(list(acf_min = if (rule == "stable32") 30L else 64L,
+         rn_stable32 = rule == "stable32"),
+    stat_entry(type)$noise_id(rule))
 }
 
 # Largest cluster size with at least one term, for L phase points (L = N + 1
-# for rate input, N for integrated input).
-allan_max_m <- function(type, L) {
-  switch(type,
-    standard = ,
-    overlapping = floor((L - 1) / 2),
-    modified = floor(L / 3),
-    hadamard = ,
-    ohadamard = floor((L - 1) / 3),
-    total = if (L >= 3) L - 1 else 0
-  )
-}
+# for rate input, N for integrated input): the statistic's entry.
+allan_max_m <- function(type, L) stat_entry(type)$max_m(L)
 
 # Number of terms (squared differences) of each estimator at cluster size m.
-allan_nterms <- function(type, m, L) {
-  switch(type,
-    standard = floor((L - 1) / m) - 1,
-    overlapping = L - 2 * m,
-    modified = L - 3 * m + 1,
-    hadamard = floor((L - 1) / m) - 2,
-    ohadamard = L - 3 * m,
-    total = rep(L - 2, length(m))
-  )
-}
+allan_nterms <- function(type, m, L) stat_entry(type)$nterms(m, L)
 
 # The cluster sizes m (sorted, unique, as doubles) requested by `taus`.
 allan_taus <- function(taus, freq, maxm) {

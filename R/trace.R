@@ -39,8 +39,8 @@ trace_context <- function(s, tau, excess) {
 }
 
 # `tau`, `avar`, `fitted`: the curve and the current model; `sig` from
-# residual_signatures(); `present`: terms already in the model; `raw`: an
-# avdiagnose object or NULL. Returns a data.frame of candidates: effect,
+# residual_signatures(); `present`: terms already in the model; `raw`: the
+# loop's raw diagnostics (refine_diagnostics()) or NULL. Returns a data.frame of candidates: effect,
 # tau_from, tau_to, init (list column of named start values), signature
 # (character), score (how well the signature matches, larger is better).
 trace_candidates <- function(tau, avar, fitted, sig, present,
@@ -51,17 +51,19 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
     e$name %in% candidates && addable_kind(e$name, present)
   }, catalogue()[effect_kinds()])
   out <- list()
-  add <- function(effect, from, to, init, signature, score, pin = NULL) {
-    out[[length(out) + 1L]] <<- list(effect = effect, tau_from = from, tau_to = to,
-                                     init = init, signature = signature,
-                                     score = score, pin = pin)
+  one <- function(effect, from, to, init, signature, score, pin = NULL) {
+    list(effect = effect, tau_from = from, tau_to = to, init = init,
+         signature = signature, score = score, pin = pin)
   }
   for (i in seq_len(nrow(sig))) {
     ctx <- trace_context(sig[i, ], tau, excess)
     for (e in usable) {
       if (is.null(e$trace)) next
       t <- e$trace(ctx)
-      if (!is.null(t)) add(e$name, ctx$tau_from, ctx$tau_to, t$init, ctx$text, t$score)
+      if (!is.null(t)) {
+        out[[length(out) + 1L]] <- one(e$name, ctx$tau_from, ctx$tau_to, t$init,
+                                       ctx$text, t$score)
+      }
     }
   }
   # Raw-series evidence proposes candidates by itself too.
@@ -69,10 +71,11 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
     for (e in usable) {
       if (is.null(e$propose)) next
       for (p in e$propose(raw, tau, sig)) {
-        # a proposal may name a variant of its entry ("filter:lp2")
-        add(p$effect %||% e$name, p$tau_from, p$tau_to, p$init,
-            paste0(overlapping_signature(sig, p$tau_from, p$tau_to), "; ", p$note),
-            p$score, p$pin)
+        # a proposal may name a variant of its entry (a filter family)
+        out[[length(out) + 1L]] <- one(
+          p$effect %||% e$name, p$tau_from, p$tau_to, p$init,
+          paste0(overlapping_signature(sig, p$tau_from, p$tau_to), "; ", p$note),
+          p$score, p$pin)
       }
     }
   }

@@ -20,6 +20,9 @@ describe_type <- function(x) {
   )
 }
 
+# `a`, or `b` when `a` is NULL (the package's one definition).
+`%||%` <- function(a, b) if (is.null(a)) b else a
+
 format_value <- function(x) {
   if (is.null(x)) return("NULL")
   if (length(x) != 1L) return(paste0("of length ", length(x)))
@@ -174,21 +177,6 @@ check_string <- function(x, arg, empty_ok = TRUE) {
   x
 }
 
-# An output file path: a single non-empty string that is not a directory and
-# whose directory exists.
-check_out_file <- function(file, arg = "file") {
-  check_string(file, arg, empty_ok = FALSE)
-  if (dir.exists(file)) {
-    abort("`", arg, "` must name a file, but \"", file, "\" is a directory.",
-          class = "argument")
-  }
-  if (!dir.exists(dirname(file))) {
-    abort("`", arg, "`: the directory \"", dirname(file), "\" does not exist.",
-          class = "argument")
-  }
-  file
-}
-
 # An IMU sampling rate: check_freq() and at most 1 GHz (beyond that the
 # per-sample arithmetic of the readers loses its integers).
 check_imu_freq <- function(freq, arg = "freq") {
@@ -216,16 +204,4 @@ check_diagnosable <- function(x, arg) {
           "1e-150 and 1e150.", class = "argument")
   }
   invisible(x)
-}
-
-# A string as a YAML scalar: plain when it is safe, else double-quoted with
-# escapes (YAML 1.2, section 5.7), so that copied text cannot add keys.
-yaml_scalar <- function(s) {
-  if (grepl("^[A-Za-z0-9_/.~+-]+$", s)) return(s)
-  esc <- c("\\" = "\\\\", "\"" = "\\\"", "\n" = "\\n", "\r" = "\\r",
-           "\t" = "\\t")
-  chars <- strsplit(s, "", fixed = TRUE)[[1L]]
-  hit <- chars %in% names(esc)
-  chars[hit] <- esc[chars[hit]]
-  paste0("\"", paste(chars, collapse = ""), "\"")
 }

@@ -33,7 +33,6 @@ time_med <- function(f, r) {
 cases <- list(
   "sum(x) (yardstick)" = function(x) sum(x),
   "allan(x) octave" = function(x) allan(x, freq),
-  "find_lines (Welch + sparse median)" = function(x) ns_fun("find_lines")(x, freq),
   "find_bands" = function(x) ns_fun("find_bands")(x, freq),
   "filter_evidence" = function(x) ns_fun("filter_evidence")(x, freq),
   "detect_spikes" = function(x) ns_fun("detect_spikes")(x, freq),
@@ -43,8 +42,8 @@ cases <- list(
   "remove_lines (one line)" = function(x) ns_fun("remove_lines")(x, freq, 1.3),
   "acf_exponential (Tc = 0.05 s)" = function(x) ns_fun("acf_exponential")(x, freq, 0.05),
   "quantization_grid (radix sort)" = function(x) ns_fun("quantization_grid")(x),
-  "welch_psd_lin (seg 512)" = function(x) ns_fun("welch_psd_lin")(x, freq, 512L),
-  "series_effects" = function(x) series_effects(x, freq),
+  "welch_psd (seg 512)" = function(x) ns_fun("welch_psd")(x, freq, 512L, detrend = FALSE),
+  "series_effects" = function(x) detect_series_effects(x, freq),
   "avdiagnose (today)" = function(x) avdiagnose(x, freq),
   "avrefine(fit, data = x) (today's loop)" = function(x) {
     fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))

@@ -13,7 +13,7 @@
 #
 # Run from the package root:  Rscript data-raw/adis16405.R
 # (about 10 minutes on one core), or, after
-#   ADIS_SAVE=/tmp/refs Rscript data-raw/adis16405-check.R
+#   ADIS_SAVE=/tmp/refs Rscript bench/adis16405/adis16405-check.R
 # as  ADIS_REFS=/tmp/refs Rscript data-raw/adis16405.R  to reuse its fits.
 
 pkgload::load_all(".", quiet = TRUE)
@@ -28,7 +28,7 @@ check_rows <- list()
 
 # check_axis(): issue 9's Done-when checks for one axis.
 adis_check_define_only <- TRUE
-source("data-raw/adis16405-check.R")
+source("bench/adis16405/adis16405-check.R")
 av_rows <- list(); diag_rows <- list(); line_rows <- list()
 coef_rows <- list(); step_rows <- list(); fit_rows <- list(); noise_rows <- list()
 fits <- list(); unexpl_rows <- list()
@@ -43,7 +43,7 @@ for (k in 1:3) {
     id <- sprintf("unit%d/%s", k, axis)
     av <- allan(x, freq, taus = 10, type = "overlapping")
     dg <- avdiagnose(x, freq)
-    # ADIS_REFS=dir reuses the fits data-raw/adis16405-check.R kept
+    # ADIS_REFS=dir reuses the fits bench/adis16405/adis16405-check.R kept
     # (ADIS_SAVE=dir there): the same calls, not run twice on a loaded machine
     saved <- file.path(Sys.getenv("ADIS_REFS", ""), sprintf("fits_%d_%s.rds", k, axis))
     if (nzchar(Sys.getenv("ADIS_REFS")) && file.exists(saved)) {
@@ -111,7 +111,7 @@ writeLines(capture.output({
   bw <- tapply(check$enbw, check$sensor, function(v) diff(range(v, na.rm = TRUE)) /
                  mean(v, na.rm = TRUE) * 100)
   cat("\nENBW spread per sensor type (range / mean, %):\n"); print(round(bw, 1))
-}), "data-raw/adis16405-check-summary.txt")
+}), "bench/adis16405/adis16405-check-summary.txt")
 adis16405_av <- list(
   av = bind(av_rows), diagnostics = bind(diag_rows), lines = bind(line_rows),
   noise_id = bind(noise_rows), fits = bind(fit_rows), coef = bind(coef_rows),

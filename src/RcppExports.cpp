@@ -127,28 +127,17 @@ BEGIN_RCPP
 END_RCPP
 }
 // avfit_exact_edf
-Rcpp::NumericVector avfit_exact_edf(const Rcpp::NumericVector& m, const Rcpp::NumericVector& M, bool overlapping, double w, double q, double p, const Rcpp::NumericVector& s2, const Rcpp::NumericVector& phi);
-RcppExport SEXP _allanvar_avfit_exact_edf(SEXP mSEXP, SEXP MSEXP, SEXP overlappingSEXP, SEXP wSEXP, SEXP qSEXP, SEXP pSEXP, SEXP s2SEXP, SEXP phiSEXP) {
+Rcpp::NumericVector avfit_exact_edf(const Rcpp::NumericVector& m, const Rcpp::NumericVector& M, bool overlapping, const Rcpp::IntegerVector& shape, const Rcpp::NumericVector& coef, const Rcpp::NumericVector& phi);
+RcppExport SEXP _allanvar_avfit_exact_edf(SEXP mSEXP, SEXP MSEXP, SEXP overlappingSEXP, SEXP shapeSEXP, SEXP coefSEXP, SEXP phiSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type M(MSEXP);
     Rcpp::traits::input_parameter< bool >::type overlapping(overlappingSEXP);
-    Rcpp::traits::input_parameter< double >::type w(wSEXP);
-    Rcpp::traits::input_parameter< double >::type q(qSEXP);
-    Rcpp::traits::input_parameter< double >::type p(pSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type s2(s2SEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type shape(shapeSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type coef(coefSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phi(phiSEXP);
-    rcpp_result_gen = Rcpp::wrap(avfit_exact_edf(m, M, overlapping, w, q, p, s2, phi));
-    return rcpp_result_gen;
-END_RCPP
-}
-// bz2_available_cpp
-bool bz2_available_cpp();
-RcppExport SEXP _allanvar_bz2_available_cpp() {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    rcpp_result_gen = Rcpp::wrap(bz2_available_cpp());
+    rcpp_result_gen = Rcpp::wrap(avfit_exact_edf(m, M, overlapping, shape, coef, phi));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -275,6 +264,41 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gchisq_weights_cpp
+Rcpp::NumericVector gchisq_weights_cpp(int type, double m, double n, int alpha);
+RcppExport SEXP _allanvar_gchisq_weights_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP alphaSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< int >::type type(typeSEXP);
+    Rcpp::traits::input_parameter< double >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type n(nSEXP);
+    Rcpp::traits::input_parameter< int >::type alpha(alphaSEXP);
+    rcpp_result_gen = Rcpp::wrap(gchisq_weights_cpp(type, m, n, alpha));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gchisq_cdf_cpp
+Rcpp::NumericVector gchisq_cdf_cpp(const Rcpp::NumericVector& lambda, const Rcpp::NumericVector& q);
+RcppExport SEXP _allanvar_gchisq_cdf_cpp(SEXP lambdaSEXP, SEXP qSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type lambda(lambdaSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type q(qSEXP);
+    rcpp_result_gen = Rcpp::wrap(gchisq_cdf_cpp(lambda, q));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gchisq_quantile_cpp
+Rcpp::NumericVector gchisq_quantile_cpp(const Rcpp::NumericVector& lambda, const Rcpp::NumericVector& p);
+RcppExport SEXP _allanvar_gchisq_quantile_cpp(SEXP lambdaSEXP, SEXP pSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type lambda(lambdaSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type p(pSEXP);
+    rcpp_result_gen = Rcpp::wrap(gchisq_quantile_cpp(lambda, p));
+    return rcpp_result_gen;
+END_RCPP
+}
 // line_sums
 Rcpp::NumericVector line_sums(const Rcpp::NumericVector& y, double f, double freq);
 RcppExport SEXP _allanvar_line_sums(SEXP ySEXP, SEXP fSEXP, SEXP freqSEXP) {
@@ -298,42 +322,28 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// mcap_records
-Rcpp::List mcap_records(const Rcpp::RawVector& buf, double start, double end);
-RcppExport SEXP _allanvar_mcap_records(SEXP bufSEXP, SEXP startSEXP, SEXP endSEXP) {
+// mcap_index_cpp
+Rcpp::List mcap_index_cpp(std::string path);
+RcppExport SEXP _allanvar_mcap_index_cpp(SEXP pathSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
-    Rcpp::traits::input_parameter< double >::type start(startSEXP);
-    Rcpp::traits::input_parameter< double >::type end(endSEXP);
-    rcpp_result_gen = Rcpp::wrap(mcap_records(buf, start, end));
+    Rcpp::traits::input_parameter< std::string >::type path(pathSEXP);
+    rcpp_result_gen = Rcpp::wrap(mcap_index_cpp(path));
     return rcpp_result_gen;
 END_RCPP
 }
-// mcap_chunk_raw
-Rcpp::RawVector mcap_chunk_raw(const Rcpp::RawVector& buf, double off, double len);
-RcppExport SEXP _allanvar_mcap_chunk_raw(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP) {
+// mcap_read_cpp
+Rcpp::List mcap_read_cpp(std::string path, const Rcpp::NumericVector& pos, const Rcpp::IntegerVector& ids, const Rcpp::IntegerVector& enc, double from, double to);
+RcppExport SEXP _allanvar_mcap_read_cpp(SEXP pathSEXP, SEXP posSEXP, SEXP idsSEXP, SEXP encSEXP, SEXP fromSEXP, SEXP toSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
-    Rcpp::traits::input_parameter< double >::type off(offSEXP);
-    Rcpp::traits::input_parameter< double >::type len(lenSEXP);
-    rcpp_result_gen = Rcpp::wrap(mcap_chunk_raw(buf, off, len));
-    return rcpp_result_gen;
-END_RCPP
-}
-// mcap_imu
-Rcpp::List mcap_imu(const Rcpp::RawVector& buf, const Rcpp::IntegerVector& op, const Rcpp::NumericVector& off, const Rcpp::NumericVector& len, const Rcpp::IntegerVector& ids, const Rcpp::IntegerVector& enc);
-RcppExport SEXP _allanvar_mcap_imu(SEXP bufSEXP, SEXP opSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP idsSEXP, SEXP encSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type op(opSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type off(offSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type len(lenSEXP);
+    Rcpp::traits::input_parameter< std::string >::type path(pathSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type pos(posSEXP);
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type ids(idsSEXP);
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type enc(encSEXP);
-    rcpp_result_gen = Rcpp::wrap(mcap_imu(buf, op, off, len, ids, enc));
+    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< double >::type to(toSEXP);
+    rcpp_result_gen = Rcpp::wrap(mcap_read_cpp(path, pos, ids, enc, from, to));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -467,31 +477,51 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// rosbag_records
-Rcpp::List rosbag_records(const Rcpp::RawVector& buf, double start, double end);
-RcppExport SEXP _allanvar_rosbag_records(SEXP bufSEXP, SEXP startSEXP, SEXP endSEXP) {
+// rosbag_index_cpp
+Rcpp::List rosbag_index_cpp(std::string path);
+RcppExport SEXP _allanvar_rosbag_index_cpp(SEXP pathSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
-    Rcpp::traits::input_parameter< double >::type start(startSEXP);
-    Rcpp::traits::input_parameter< double >::type end(endSEXP);
-    rcpp_result_gen = Rcpp::wrap(rosbag_records(buf, start, end));
+    Rcpp::traits::input_parameter< std::string >::type path(pathSEXP);
+    rcpp_result_gen = Rcpp::wrap(rosbag_index_cpp(path));
     return rcpp_result_gen;
 END_RCPP
 }
-// rosbag_imu
-Rcpp::List rosbag_imu(const Rcpp::RawVector& buf, const Rcpp::NumericVector& off, const Rcpp::NumericVector& len, const Rcpp::IntegerVector& comp, const Rcpp::NumericVector& size, const Rcpp::IntegerVector& conns, int threads);
-RcppExport SEXP _allanvar_rosbag_imu(SEXP bufSEXP, SEXP offSEXP, SEXP lenSEXP, SEXP compSEXP, SEXP sizeSEXP, SEXP connsSEXP, SEXP threadsSEXP) {
+// rosbag_read_cpp
+Rcpp::List rosbag_read_cpp(std::string path, const Rcpp::NumericVector& pos, const Rcpp::IntegerVector& conns, double from, double to);
+RcppExport SEXP _allanvar_rosbag_read_cpp(SEXP pathSEXP, SEXP posSEXP, SEXP connsSEXP, SEXP fromSEXP, SEXP toSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type buf(bufSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type off(offSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type len(lenSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type comp(compSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type size(sizeSEXP);
+    Rcpp::traits::input_parameter< std::string >::type path(pathSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type pos(posSEXP);
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type conns(connsSEXP);
-    Rcpp::traits::input_parameter< int >::type threads(threadsSEXP);
-    rcpp_result_gen = Rcpp::wrap(rosbag_imu(buf, off, len, comp, size, conns, threads));
+    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< double >::type to(toSEXP);
+    rcpp_result_gen = Rcpp::wrap(rosbag_read_cpp(path, pos, conns, from, to));
+    return rcpp_result_gen;
+END_RCPP
+}
+// rosbag_chunk_cpp
+Rcpp::List rosbag_chunk_cpp(std::string path, double pos);
+RcppExport SEXP _allanvar_rosbag_chunk_cpp(SEXP pathSEXP, SEXP posSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< std::string >::type path(pathSEXP);
+    Rcpp::traits::input_parameter< double >::type pos(posSEXP);
+    rcpp_result_gen = Rcpp::wrap(rosbag_chunk_cpp(path, pos));
+    return rcpp_result_gen;
+END_RCPP
+}
+// rosbag_decode_cpp
+Rcpp::List rosbag_decode_cpp(const Rcpp::RawVector& raw, const Rcpp::IntegerVector& conns, double from, double to);
+RcppExport SEXP _allanvar_rosbag_decode_cpp(SEXP rawSEXP, SEXP connsSEXP, SEXP fromSEXP, SEXP toSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::RawVector& >::type raw(rawSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type conns(connsSEXP);
+    Rcpp::traits::input_parameter< double >::type from(fromSEXP);
+    Rcpp::traits::input_parameter< double >::type to(toSEXP);
+    rcpp_result_gen = Rcpp::wrap(rosbag_decode_cpp(raw, conns, from, to));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -616,8 +646,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_log_nnls", (DL_FUNC) &_allanvar_avfit_log_nnls, 7},
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
-    {"_allanvar_avfit_exact_edf", (DL_FUNC) &_allanvar_avfit_exact_edf, 8},
-    {"_allanvar_bz2_available_cpp", (DL_FUNC) &_allanvar_bz2_available_cpp, 0},
+    {"_allanvar_avfit_exact_edf", (DL_FUNC) &_allanvar_avfit_exact_edf, 6},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
@@ -628,11 +657,13 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_welch_segments", (DL_FUNC) &_allanvar_welch_segments, 3},
     {"_allanvar_welch_accumulate", (DL_FUNC) &_allanvar_welch_accumulate, 3},
     {"_allanvar_grid_stats", (DL_FUNC) &_allanvar_grid_stats, 1},
+    {"_allanvar_gchisq_weights_cpp", (DL_FUNC) &_allanvar_gchisq_weights_cpp, 4},
+    {"_allanvar_gchisq_cdf_cpp", (DL_FUNC) &_allanvar_gchisq_cdf_cpp, 2},
+    {"_allanvar_gchisq_quantile_cpp", (DL_FUNC) &_allanvar_gchisq_quantile_cpp, 2},
     {"_allanvar_line_sums", (DL_FUNC) &_allanvar_line_sums, 3},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
-    {"_allanvar_mcap_records", (DL_FUNC) &_allanvar_mcap_records, 3},
-    {"_allanvar_mcap_chunk_raw", (DL_FUNC) &_allanvar_mcap_chunk_raw, 3},
-    {"_allanvar_mcap_imu", (DL_FUNC) &_allanvar_mcap_imu, 6},
+    {"_allanvar_mcap_index_cpp", (DL_FUNC) &_allanvar_mcap_index_cpp, 1},
+    {"_allanvar_mcap_read_cpp", (DL_FUNC) &_allanvar_mcap_read_cpp, 6},
     {"_allanvar_mle_kalman_sums", (DL_FUNC) &_allanvar_mle_kalman_sums, 6},
     {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 5},
     {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
@@ -644,8 +675,10 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_stamp_repeats", (DL_FUNC) &_allanvar_stamp_repeats, 1},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
-    {"_allanvar_rosbag_records", (DL_FUNC) &_allanvar_rosbag_records, 3},
-    {"_allanvar_rosbag_imu", (DL_FUNC) &_allanvar_rosbag_imu, 7},
+    {"_allanvar_rosbag_index_cpp", (DL_FUNC) &_allanvar_rosbag_index_cpp, 1},
+    {"_allanvar_rosbag_read_cpp", (DL_FUNC) &_allanvar_rosbag_read_cpp, 5},
+    {"_allanvar_rosbag_chunk_cpp", (DL_FUNC) &_allanvar_rosbag_chunk_cpp, 2},
+    {"_allanvar_rosbag_decode_cpp", (DL_FUNC) &_allanvar_rosbag_decode_cpp, 4},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},

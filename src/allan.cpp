@@ -11,6 +11,7 @@
 // drift or length of the record.
 #include "buffer.h"
 #include "checks.h"
+#include "dd.h"
 #include "local-phase.h"
 #include "noise_id.h"
 #include "scratch.h"
@@ -39,25 +40,12 @@ using allanvar::HADAMARD;
 using allanvar::OHADAMARD;
 using allanvar::TOTAL;
 
-// a + b = s + e exactly (Knuth's TwoSum).
-inline void two_sum(double a, double b, double& s, double& e) {
-  s = a + b;
-  const double bb = s - a;
-  e = (a - (s - bb)) + (b - bb);
-}
+// a + b = s + e exactly (Knuth's TwoSum, src/dd.h).
+using allanvar::two_sum;
 
 // Sum of many squares: four interleaved chains, folded into a compensated
 // total block by block, keep the rounding far below 1e-15 relative.
-struct Acc {
-  double s = 0, c = 0;
-  void add(double v) {
-    double t, e;
-    two_sum(s, v, t, e);
-    s = t;
-    c += e;
-  }
-  double value() const { return s + c; }
-};
+using Acc = allanvar::CompSum;
 
 // Runs f(i) for i in [0, n): from the main thread through parallel_for
 // (which polls for interrupts between items), serially and without any R

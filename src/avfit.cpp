@@ -411,25 +411,34 @@ double exact_edf_one(const StructureFn& V, double m, double M, bool overlapping,
 }  // namespace
 
 // EDF of the AV estimates at cluster sizes m (M second differences each)
-// for the model w, q, p and AR(1) terms (s2, phi); NA where undefined.
+// for a model given as parts of its structure function, one per entry of
+// `shape` (0: coef * l, 1: -coef (l^3 - l) / 6, 2: 2 coef for l > 0,
+// 3: an AR(1) part, coef = sigma^2 with its `phi`), as the catalogue's
+// entries describe their terms; NA where undefined.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector avfit_exact_edf(const Rcpp::NumericVector& m,
                                     const Rcpp::NumericVector& M,
-                                    bool overlapping, double w, double q,
-                                    double p, const Rcpp::NumericVector& s2,
+                                    bool overlapping,
+                                    const Rcpp::IntegerVector& shape,
+                                    const Rcpp::NumericVector& coef,
                                     const Rcpp::NumericVector& phi) {
   StructureFn V;
-  V.w = w;
-  V.q = q;
-  V.p = p;
   double tail = 0.0;
-  for (R_xlen_t g = 0; g < s2.size(); ++g) {
-    if (!(s2[g] > 0) || !(phi[g] > 0 && phi[g] < 1)) continue;
-    V.s2.push_back(s2[g]);
-    V.phi.push_back(phi[g]);
-    V.lphi.push_back(std::log(phi[g]));
-    // the AR(1) part of R(k) decays as phi^k beyond 2m: e^-12 of its size
-    tail = std::max(tail, std::ceil(12.0 / -std::log(phi[g])));
+  for (R_xlen_t g = 0; g < shape.size(); ++g) {
+    switch (shape[g]) {
+    case 0: V.w += coef[g]; break;
+    case 1: V.q += coef[g]; break;
+    case 2: V.p += coef[g]; break;
+    case 3:
+      if (!(coef[g] > 0) || !(phi[g] > 0 && phi[g] < 1)) break;
+      V.s2.push_back(coef[g]);
+      V.phi.push_back(phi[g]);
+      V.lphi.push_back(std::log(phi[g]));
+      // the AR(1) part of R(k) decays as phi^k beyond 2m: e^-12 of its size
+      tail = std::max(tail, std::ceil(12.0 / -std::log(phi[g])));
+      break;
+    default: break;
+    }
   }
   const R_xlen_t J = m.size();
   Rcpp::NumericVector out(J);

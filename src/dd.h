@@ -16,16 +16,37 @@ struct DD {
   double value() const { return hi + lo; }
 };
 
-inline void dd_two_sum(double a, double b, double& s, double& e) {
+// a + b = s + e exactly (Knuth's TwoSum): the one TwoSum of the kernels
+// (allan.cpp, dynamic.cpp, local-phase.h and the double-double sums here).
+inline void two_sum(double a, double b, double& s, double& e) {
   s = a + b;
   const double bb = s - a;
   e = (a - (s - bb)) + (b - bb);
 }
 
-inline void dd_fast_two_sum(double a, double b, double& s, double& e) {
+// a + b = s + e exactly when |a| >= |b| (Dekker's FastTwoSum).
+inline void fast_two_sum(double a, double b, double& s, double& e) {
   s = a + b;
   e = b - (s - a);
 }
+
+// A running sum kept unevaluated as s + c: each addition's rounding error
+// (TwoSum) collected in c (allan.cpp's sums of squares, dynamic.cpp's
+// windowed sums).
+struct CompSum {
+  double s = 0, c = 0;
+  void add(double v) {
+    double t, e;
+    two_sum(s, v, t, e);
+    s = t;
+    c += e;
+  }
+  void add(const CompSum& p) {
+    add(p.s);
+    c += p.c;
+  }
+  double value() const { return s + c; }
+};
 
 // a = ah + al with ah holding the upper 26 bits (Veltkamp's split).
 inline void dd_split(double a, double& ah, double& al) {
@@ -45,12 +66,12 @@ inline void dd_two_prod(double a, double b, double& p, double& e) {
 
 inline DD operator+(const DD& a, const DD& b) {
   double s, e, t, f;
-  dd_two_sum(a.hi, b.hi, s, e);
-  dd_two_sum(a.lo, b.lo, t, f);
+  two_sum(a.hi, b.hi, s, e);
+  two_sum(a.lo, b.lo, t, f);
   e += t;
-  dd_fast_two_sum(s, e, s, e);
+  fast_two_sum(s, e, s, e);
   e += f;
-  dd_fast_two_sum(s, e, s, e);
+  fast_two_sum(s, e, s, e);
   return DD(s, e);
 }
 
@@ -61,7 +82,7 @@ inline DD operator*(const DD& a, const DD& b) {
   double p, e;
   dd_two_prod(a.hi, b.hi, p, e);
   e += a.hi * b.lo + a.lo * b.hi;
-  dd_fast_two_sum(p, e, p, e);
+  fast_two_sum(p, e, p, e);
   return DD(p, e);
 }
 

@@ -17,6 +17,7 @@
 // (sum, compensation), so a quiet window after a loud stretch keeps its
 // digits.
 #include "buffer.h"
+#include "dd.h"
 #include "opts-dynamic.h"
 #include "parallel.h"
 #include "types.h"
@@ -34,27 +35,11 @@ using allanvar::Buffer;
 
 namespace {
 
-// a + b = s + e exactly (Knuth's TwoSum).
-inline void two_sum(double a, double b, double& s, double& e) {
-  s = a + b;
-  const double bb = s - a;
-  e = (a - (s - bb)) + (b - bb);
-}
+// a + b = s + e exactly (Knuth's TwoSum, src/dd.h).
+using allanvar::two_sum;
 
 // A running sum kept unevaluated as s + c.
-struct Pair {
-  double s = 0, c = 0;
-  void add(double v) {
-    double t, e;
-    two_sum(s, v, t, e);
-    s = t;
-    c += e;
-  }
-  void add(const Pair& p) {
-    add(p.s);
-    c += p.c;
-  }
-};
+using Pair = allanvar::CompSum;
 
 // (a - b) evaluated once, to the last bit of the difference.
 inline double pair_diff(const Pair& a, const Pair& b) {

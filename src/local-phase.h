@@ -10,6 +10,7 @@
 #define ALLANVAR_LOCAL_PHASE_H
 
 #include <Rcpp.h>
+#include "dd.h"
 #include "scratch.h"
 #include <algorithm>
 #include <cmath>
@@ -18,13 +19,6 @@
 
 namespace allanvar {
 
-// a + b = s + e exactly (Knuth's TwoSum).
-inline void phase_two_sum(double a, double b, double& s, double& e) {
-  s = a + b;
-  const double bb = s - a;
-  e = (a - (s - bb)) + (b - bb);
-}
-
 // Per-tau totals of partial sums (one per work item), each compensated
 // (TwoSum), so that the order of the items does not matter beyond 1e-16.
 class TauSums {
@@ -32,7 +26,7 @@ class TauSums {
   explicit TauSums(size_t nt) : s_(nt, 0.0), e_(nt, 0.0), any_(nt, false) {}
   void add(size_t t, double v) {
     double s, e;
-    phase_two_sum(s_[t], v, s, e);
+    two_sum(s_[t], v, s, e);
     s_[t] = s;
     e_[t] += e;
     any_[t] = true;
@@ -71,7 +65,7 @@ struct PhaseInput {
       hi = v[i];
       lo = 0;
     } else {
-      phase_two_sum(v[i + 1], -v[i], hi, lo);
+      two_sum(v[i + 1], -v[i], hi, lo);
     }
   }
 };
@@ -90,7 +84,7 @@ inline double local_phase(const PhaseInput& in, R_xlen_t a, R_xlen_t len,
     for (R_xlen_t l = 0; l < len - 1; ++l) {
       double h, lo, t, te;
       in.increment(a + l, h, lo);
-      phase_two_sum(s, h, t, te);
+      two_sum(s, h, t, te);
       s = t;
       e += te + lo;
     }
@@ -101,8 +95,8 @@ inline double local_phase(const PhaseInput& in, R_xlen_t a, R_xlen_t len,
   for (R_xlen_t l = 0; l < len - 1; ++l) {
     double h, lo, r, re, t, te;
     in.increment(a + l, h, lo);
-    phase_two_sum(h, -c, r, re);
-    phase_two_sum(s, r, t, te);
+    two_sum(h, -c, r, re);
+    two_sum(s, r, t, te);
     s = t;
     e += te + re + lo;
     out[l + 1] = s + e;
@@ -134,7 +128,7 @@ inline double split_phase_each(const PhaseInput& in, F f) {
     in.increment(l, h, lo);
     if (l == 0 || h < bmin) bmin = h;
     if (l == 0 || h > bmax) bmax = h;
-    phase_two_sum(s, h, t, te);
+    two_sum(s, h, t, te);
     s = t;
     e += te + lo;
   }
@@ -150,8 +144,8 @@ inline double split_phase_each(const PhaseInput& in, F f) {
   for (R_xlen_t l = 0; l < L - 1; ++l) {
     double h, lo, r, re, t, te;
     in.increment(l, h, lo);
-    phase_two_sum(h, -c, r, re);
-    phase_two_sum(s, r, t, te);
+    two_sum(h, -c, r, re);
+    two_sum(s, r, t, te);
     s = t;
     e += te + re + lo;
     const double g = (s + C) - C;

@@ -1,8 +1,9 @@
 // LZ4 frame decoder written from the LZ4 Frame Format Description 1.6.x
 // and the LZ4 Block Format Description (github.com/lz4/lz4, doc/). Blocks
 // are decoded into one contiguous buffer, so linked blocks (matches that
-// reach into the previous block) need nothing extra. Checksums (xxHash32)
-// are skipped: the bag and MCAP layers check the record structure.
+// reach into the previous block) need nothing extra. The frame's checksums
+// (xxHash32 of the header, of each block if flagged, of the content if
+// flagged) are verified: a damaged chunk is an error, not silent garbage.
 #include "lz4.h"
 #include "bytes.h"
 
@@ -16,6 +17,37 @@ namespace allanvar {
 namespace {
 
 const std::uint32_t kFrameMagic = 0x184D2204u;
+
+// xxHash32 (github.com/Cyan4973/xxHash, doc/xxhash_spec.md), seed 0.
+inline std::uint32_t rotl(std::uint32_t x, int r) { return (x << r) | (x >> (32 - r)); }
+
+std::uint32_t xxh32(const unsigned char* p, std::size_t n) {
+  const std::uint32_t P1 = 2654435761u, P2 = 2246822519u, P3 = 3266489917u,
+                      P4 = 668265263u, P5 = 374761393u;
+  std::size_t i = 0;
+  std::uint32_t h;
+  if (n >= 16) {
+    std::uint32_t v1 = P1 + P2, v2 = P2, v3 = 0, v4 = 0u - P1;
+    for (; i + 16 <= n; i += 16) {
+      v1 = rotl(v1 + rd_u32(p + i) * P2, 13) * P1;
+      v2 = rotl(v2 + rd_u32(p + i + 4) * P2, 13) * P1;
+      v3 = rotl(v3 + rd_u32(p + i + 8) * P2, 13) * P1;
+      v4 = rotl(v4 + rd_u32(p + i + 12) * P2, 13) * P1;
+    }
+    h = rotl(v1, 1) + rotl(v2, 7) + rotl(v3, 12) + rotl(v4, 18);
+  } else {
+    h = P5;
+  }
+  h += static_cast<std::uint32_t>(n);
+  for (; i + 4 <= n; i += 4) h = rotl(h + rd_u32(p + i) * P3, 17) * P4;
+  for (; i < n; ++i) h = rotl(h + p[i] * P5, 11) * P1;
+  h ^= h >> 15;
+  h *= P2;
+  h ^= h >> 13;
+  h *= P3;
+  h ^= h >> 16;
+  return h;
+}
 
 // Output buffer written through a raw pointer; grows geometrically.
 struct sink {
@@ -110,7 +142,11 @@ void lz4_frame_decode(const unsigned char* src, std::size_t n,
     if (dict_id) throw format_error("lz4: frames with a dictionary are not supported");
     std::size_t hdr = 2 + (content_size ? 8 : 0) + 1;  // FLG BD [size] HC
     if (n - i < hdr) throw format_error("lz4: truncated frame header");
+    if (((xxh32(src + i, hdr - 1) >> 8) & 0xFFu) != src[i + hdr - 1]) {
+      throw format_error("lz4: frame header checksum mismatch");
+    }
     i += hdr;
+    const std::size_t frame_start = out.pos;
     for (;;) {
       if (n - i < 4) throw format_error("lz4: truncated block");
       const std::uint32_t word = rd_u32(src + i);
@@ -125,11 +161,19 @@ void lz4_frame_decode(const unsigned char* src, std::size_t n,
       } else {
         block_decode(src + i, size, out);
       }
+      if (block_checksum) {
+        if (n - i - size < 4) throw format_error("lz4: truncated block checksum");
+        if (xxh32(src + i, size) != rd_u32(src + i + size)) {
+          throw format_error("lz4: block checksum mismatch");
+        }
+      }
       i += size + (block_checksum ? 4 : 0);
-      if (i > n) throw format_error("lz4: truncated block checksum");
     }
     if (content_checksum) {
       if (n - i < 4) throw format_error("lz4: truncated content checksum");
+      if (xxh32(dst.data() + frame_start, out.pos - frame_start) != rd_u32(src + i)) {
+        throw format_error("lz4: content checksum mismatch");
+      }
       i += 4;
     }
   }

@@ -48,20 +48,20 @@ void build_pp(const allanvar::SplitPhase& X, Grid& G) {
     if ((j & 0xFFFFF) == 0xFFFFF && allanvar::interrupted()) return;
     double t, te;
     // PP(j + 1) = PP(j) + P(j)
-    allanvar::phase_two_sum(s2, s1, t, te);
+    allanvar::two_sum(s2, s1, t, te);
     s2 = t;
     e2 += te + e1;
     G.hi[j + 1] = s2;
     G.lo[j + 1] = e2;
     big = std::max(big, std::fabs(s2));
     // P(j + 1) = P(j) + x(j)
-    allanvar::phase_two_sum(s1, X.hi[j], t, te);
+    allanvar::two_sum(s1, X.hi[j], t, te);
     s1 = t;
     e1 += te + X.lo[j];
   }
   {
     double t, te;
-    allanvar::phase_two_sum(s2, s1, t, te);
+    allanvar::two_sum(s2, s1, t, te);
     G.hi[L + 1] = t;
     G.lo[L + 1] = e2 + te + e1;
     big = std::max(big, std::fabs(t));
@@ -278,7 +278,7 @@ void level0(const allanvar::PhaseInput& in, double c, R_xlen_t i0,
     for (R_xlen_t i = i0; i < i1; ++i) {
       double h, lo, r, re;
       in.increment(i, h, lo);
-      allanvar::phase_two_sum(h, -c, r, re);
+      allanvar::two_sum(h, -c, r, re);
       out[i - i0] = -(r + (re + lo));
     }
   }

@@ -485,7 +485,7 @@ void tilde_phase(const allanvar::SplitPhase& X, TildePhase& T) {
     for (R_xlen_t i = 0; i < N; ++i) {
       const double u = static_cast<double>(i) - T.i0;
       double s, e;
-      allanvar::dd_two_sum(T.h[i], -T.c * u * u, s, e);
+      allanvar::two_sum(T.h[i], -T.c * u * u, s, e);
       T.h[i] = s;
       T.l[i] += e;
     }

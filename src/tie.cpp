@@ -28,7 +28,7 @@ struct Total {
   double s = 0, c = 0;
   void add(double v) {
     double t, e;
-    allanvar::phase_two_sum(s, v, t, e);
+    allanvar::two_sum(s, v, t, e);
     s = t;
     c += e;
   }

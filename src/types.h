@@ -16,7 +16,7 @@ enum Estimator {
   OHADAMARD = 4,
   TOTAL = 5,
   N_ESTIMATORS = 6,  // the Allan-family types of the sums kernel (allan.cpp)
-  // The further statistics of issue 10, with kernels of their own
+  // The further statistics, with kernels of their own
   // (src/tie.cpp, src/pdev.cpp, src/totals.cpp, src/theo.cpp; R side in
   // R/allan-types.R).
   TDEV = 6,

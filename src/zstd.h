@@ -1,4 +1,4 @@
-// zstd decompression through the system libzstd, loaded at run time.
+// zstd decompression by the vendored reference library (src/zstd/).
 #ifndef ALLANVAR_ZSTD_H
 #define ALLANVAR_ZSTD_H
 

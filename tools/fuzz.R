@@ -1,4 +1,4 @@
-# Fuzz battery (issue 12): bad and extreme inputs to every exported function,
+# Fuzz battery: bad and extreme inputs to every exported function,
 # the S3 methods, the CLI (in process and through inst/bin/allanvar) and
 # malformed files. Each call is classified:
 #   OK       a finite, sane result (or a clean return from a plot/print);
@@ -321,11 +321,11 @@ fuzz_cases <- function(quick = FALSE) {
     "print.summary.allan_dynamic" = q(print(summary(dyn))),
     "print.summary.allan_sources" = q(print(summary(hat))),
     "print.summary.avfit" = q(print(summary(fit))),
-    "print.tool_curve" = q(print(read_avr_curve(f_avr))),
+    "print.tool_curve" = q(print(read_allan_variance_ros_curve(f_avr))),
     "predict.avfit" = q(predict(fit, c(0.1, 1))),
     "[.allan" = q(av[av$tau > 0.05, ]),
     "[.allan_sources" = q(hat[hat$source == hat$source[1], ]),
-    "[.tool_curve" = q(read_avr_curve(f_avr)[1:2, ]))
+    "[.tool_curve" = q(read_allan_variance_ros_curve(f_avr)[1:2, ]))
   for (m in names(methods)) add(m, "valid", methods[[m]])
   add("[.allan", "columns", q(print(av[, c("tau", "adev")])))
   add("[.allan", "no rows", q(print(av[av$tau < 0, ])))
@@ -343,11 +343,11 @@ fuzz_cases <- function(quick = FALSE) {
   for (f in c("print", "plot", "summary")) add(paste0(f, ".imu_analysis"), "valid", S(f, q(ana)))
   add("as.data.frame.imu_datasheet", "valid", q(as.data.frame(ds)))
   sub_arg("imu_guidance", q(imu_guidance(x = ana)), "x")
-  sub_arg("filter_params", q(filter_params(x = c(N = 1e-3, K = 1e-5, B = 1e-4), dt = 0.01)),
+  sub_arg("kalman_params", q(kalman_params(x = c(N = 1e-3, K = 1e-5, B = 1e-4), dt = 0.01)),
           c("x", "dt", "bias_instability", "tau_B"))
-  add("filter_params", "tau_B = -1", q(filter_params(c(N = 1, B = 1), dt = 0.01, tau_B = -1)))
-  add("filter_params", "negative N", q(filter_params(c(N = -1, K = 1), dt = 0.01)))
-  add("filter_params", "gm tc = 0", q(filter_params(c(N = 1, gm1.sigma = 1, gm1.tc = 0), dt = 0.01)))
+  add("kalman_params", "tau_B = -1", q(kalman_params(c(N = 1, B = 1), dt = 0.01, tau_B = -1)))
+  add("kalman_params", "negative N", q(kalman_params(c(N = -1, K = 1), dt = 0.01)))
+  add("kalman_params", "gm tc = 0", q(kalman_params(c(N = 1, gm1.sigma = 1, gm1.tc = 0), dt = 0.01)))
   sub_arg("write_datasheet", q(write_datasheet(x = ana, file = file.path(dir, "ds.csv"))),
           c("x", "file", "format"))
   add("write_datasheet", "file is a directory", q(write_datasheet(ana, dir)))
@@ -359,14 +359,27 @@ fuzz_cases <- function(quick = FALSE) {
                                                    file = file.path(dir, "kalibr_imu_chain.yaml"))),
           c("x", "tool", "file", "axis", "noise_type", "rostopic"))
   add("write_tool_params", "file is a directory", q(write_tool_params(ana, "imu_utils", dir)))
+  sub_arg("write_report", q(write_report(x = ana, file = file.path(dir, "report.html"))),
+          c("x", "file", "record", "title"))
+  add("write_report", "file is a directory", q(write_report(ana, dir)))
   sub_arg("datasheet.avfit", q(datasheet(x = fit)), c("average", "unit"))
   add("datasheet.default", "a number", q(datasheet(1)))
-  sub_arg("series_effects", q(series_effects(x = x, freq = 100)), c("x"), series)
-  sub_arg("series_effects", q(series_effects(x = x, freq = 100)), c("freq", "remove", "kinds"))
-  add("print.series_effects", "valid", q(print(series_effects(x, 100))))
+  sub_arg("detect_series_effects", q(detect_series_effects(x = x, freq = 100)), c("x"), series)
+  sub_arg("detect_series_effects", q(detect_series_effects(x = x, freq = 100)), c("freq", "remove", "kinds"))
+  add("series_reading_bias", "valid", q(series_reading_bias(detect_series_effects(x, 100))))
+  sub_arg("series_reading_bias",
+          q(series_reading_bias(pass = detect_series_effects(x, 100), readings = NULL)),
+          c("pass", "readings"))
+  # the deprecated names still answer, with their deprecation warning
+  add("series_effects", "deprecated alias", q(suppressWarnings(series_effects(x, 100))))
+  add("filter_params", "deprecated alias",
+      q(suppressWarnings(filter_params(c(N = 1e-3, K = 1e-5), dt = 0.01))))
+  add("read_avr_curve", "deprecated alias, missing file",
+      q(suppressWarnings(read_avr_curve(file.path(dir, "none.csv")))))
+  add("print.series_effects", "valid", q(print(detect_series_effects(x, 100))))
   sub_arg("write_kalibr_yaml", q(write_kalibr_yaml(x = ana, file = file.path(dir, "imu.yaml"))),
           c("x", "file", "axis", "rostopic", "inflate"))
-  # what is copied from the user must come back as written (issue 12 item 3)
+  # what is copied from the user must come back as written
   add("write_kalibr_yaml", "rostopic with newline",
       q({
         f <- write_kalibr_yaml(ana, file.path(dir, "imu2.yaml"), rostopic = "a\nb: evil")
@@ -387,7 +400,7 @@ fuzz_cases <- function(quick = FALSE) {
              "f_binary", "f_fakebag", "f_fakemcap", "f_fakedb3", "f_missing", "f_dir")
   for (f in files) add("read_imu", paste("file =", f), S("read_imu", as.name(f)))
   # a malformed file that is read must report the fault with its line and
-  # column (issue 12 item 2); otherwise the case counts as GARBAGE
+  # column; otherwise the case counts as GARBAGE
   faults <- c(f_extra = "line 11.*column 8", f_short = "line 11.*column 6",
               f_inf = "line 11, column accel_z", f_nan = "line 11, column accel_z",
               f_abc = "line 11, column 7", f_empty_cell = "line 11, column accel_z",
@@ -402,7 +415,7 @@ fuzz_cases <- function(quick = FALSE) {
   for (f in c("f_binary", "f_fakebag", "f_fakemcap", "f_fakedb3", "f_missing", "f_dir", "f_good"))
     add("imu_topics", paste("file =", f), S("imu_topics", as.name(f)))
   sub_arg("imu_topics", q(imu_topics(file = f_good)), "file")
-  for (f in c("read_kalibr_yaml", "read_avr_curve")) {
+  for (f in c("read_kalibr_yaml", "read_allan_variance_ros_curve")) {
     for (g in c("f_yaml_bad", "f_yaml_neg", "f_curve_bad", "f_binary", "f_missing", "f_dir", "f_empty"))
       add(f, paste("file =", g), S(f, as.name(g)))
     sub_arg(f, S(f, file = q(f_good)), "file")
@@ -465,7 +478,7 @@ fuzz_cases <- function(quick = FALSE) {
   }
   if (quick) {
     # a deterministic subset: every function keeps at least its first cases
-    # the faults issue 12 names, plus a deterministic subset spread over
+    # the faults the battery was built for, plus a deterministic subset spread over
     # each function's arguments
     keys <- c("integrated input, freq 1e300", "huge coef", "Inf coef", "tau 1e-300",
               "tau Inf", "fixed gm1.tc = -1", "tau_B = -1", "negative N",

@@ -2,7 +2,7 @@
 # Installs what the package needs and is missing: Debian's prebuilt r-cran-*
 # packages first (seconds), CRAN for anything Debian lacks.
 set -euo pipefail
-pkgs="Rcpp RcppEigen gplots future future.apply knitr rmarkdown yaml testthat callr vdiffr data.table bit64 DBI RSQLite progressr cli"
+pkgs="Rcpp RcppEigen gplots future future.apply knitr rmarkdown yaml testthat callr vdiffr data.table bit64 DBI RSQLite progressr cli htmltools svglite png CompQuadForm"
 missing=$(Rscript --vanilla -e "p <- strsplit('$pkgs', ' ')[[1]]; cat(p[!vapply(p, requireNamespace, logical(1), quietly = TRUE)])")
 if [ -n "$missing" ]; then
   echo "setup: installing $missing"
@@ -19,12 +19,12 @@ if [ -n "$missing" ]; then
     Rscript --vanilla -e "install.packages(strsplit('$still', ' ')[[1]], repos = 'https://cloud.r-project.org')"
   fi
 fi
-# MCAP zstd chunks are decoded by the system's libzstd.so.1, loaded at run
-# time (part of every Debian base system; installed here if a slim image
-# lacks it).
-if ! ldconfig -p 2>/dev/null | grep -q 'libzstd\.so\.1' \
+# Headless Chromium opens the HTML reports in the tests (test-report.R skips
+# without it).
+if ! command -v chromium >/dev/null 2>&1 && ! command -v chromium-browser >/dev/null 2>&1 \
    && command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
-  apt-get install -y -qq --no-install-recommends libzstd1 >/dev/null || true
+  apt-get update -qq >/dev/null || true
+  apt-get install -y -qq --no-install-recommends chromium >/dev/null || true
 fi
 # pandoc builds the vignettes (main job only; the tests do not need it).
 if [ "${ALLANVAR_NEED_PANDOC:-0}" = 1 ] && ! command -v pandoc >/dev/null 2>&1 \

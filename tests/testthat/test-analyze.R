@@ -14,6 +14,7 @@ test_that("every axis gets its own curve on one tau grid, fit and readings", {
 })
 
 test_that("several recordings through future multisession equal the sequential run", {
+  skip_on_cran()
   skip_if_not(installed_allanvar(), "needs the installed package on the workers")
   skip_if_not_installed("future")
   recs <- two_records()
@@ -39,7 +40,8 @@ test_that("progress is reported per axis and can be silenced", {
   expect_match(msg[1], "analysing \\[1/2\\] rec1: gyro_x")
   expect_match(msg[2], "analysing \\[2/2\\] rec1: accel_x")
   expect_silent(suppressWarnings(analyze_imu(r, progress = FALSE)))
-  expect_error(analyze_imu(r, progress = NA), "`progress`")
+  expect_error(analyze_imu(r, progress = NA), "`progress`",
+    class = "allanvar_error_argument")
 })
 
 test_that("segments: the longest by default, or each on its own", {
@@ -52,7 +54,7 @@ test_that("segments: the longest by default, or each on its own", {
   al <- suppressWarnings(analyze_imu(r, segment = "each", progress = FALSE))
   expect_s3_class(al, "imu_analysis_list")
   expect_equal(vapply(al, function(z) z$n, 0), c(1000, 1900), ignore_attr = TRUE)
-  expect_error(analyze_imu(r, segment = 5), "segment")
+  expect_error(analyze_imu(r, segment = 5), "segment", class = "allanvar_error")
 })
 
 test_that("file paths are read and analysed; bad input is refused", {
@@ -61,8 +63,9 @@ test_that("file paths are read and analysed; bad input is refused", {
   on.exit(unlink(f))
   a <- suppressWarnings(analyze_imu(f, progress = FALSE))
   expect_length(a$channels, 6)
-  expect_error(analyze_imu(1), "imu_record")
-  expect_error(analyze_imu(two_records()[[1]], channels = "gyro_q"), "not in")
+  expect_error(analyze_imu(1), "imu_record", class = "allanvar_error_argument")
+  expect_error(analyze_imu(two_records()[[1]], channels = "gyro_q"), "not in",
+    class = "allanvar_error_argument")
 })
 
 test_that("effects the closed loop adds reach the datasheet", {
@@ -73,7 +76,7 @@ test_that("effects the closed loop adds reach the datasheet", {
   expect_true("gm" %in% st$effect)
   expect_match(a$datasheet$gyro$effects, "gm \\(Tc = ")
   # the GM (Tc near 2 s, not white-like) goes to the filter as phi, q_d
-  fp <- filter_params(a)
+  fp <- kalman_params(a)
   tc <- a$channels$gyro_x$coef[["gm1.tc"]]
   sig <- a$channels$gyro_x$coef[["gm1.sigma"]]
   expect_equal(fp$value[fp$term == "gm1" & fp$parameter == "phi"], exp(-0.01 / tc))
@@ -142,7 +145,7 @@ test_that("a dead (constant) axis is reported and the others analysed", {
   expect_match(ds$method[ds$axis == "gyro_y"], "dead axis")
   g <- imu_guidance(a)
   expect_match(g$message[g$channel == "gyro_y"], "dead axis")
-  fp <- filter_params(a)
+  fp <- kalman_params(a)
   expect_false("gyro_y" %in% fp$channel)
   expect_true(all(is.finite(fp$value)))
   # Kalibr: the worst live axis, the dead one listed in the comment

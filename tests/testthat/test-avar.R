@@ -74,36 +74,62 @@ test_that("avar() sums large integer counts without overflow", {
 })
 
 test_that("avar() rejects bad values with a message naming `values`", {
-  expect_error(avar(NULL, 1), "`values` must be a numeric vector, not NULL")
-  expect_error(avar(numeric(), 1), "`values` must have at least 2 samples, not 0")
-  expect_error(avar(1, 1), "`values` must have at least 2 samples, not 1")
-  expect_error(avar(c("a", "b"), 1), "`values` must be a numeric vector, not a character vector")
-  expect_error(avar(factor(1:3), 1), "`values` must be a numeric vector, not a factor")
-  expect_error(avar(list(1, 2, 3), 1), "`values` must be a numeric vector, not a list")
-  expect_error(avar(c(TRUE, FALSE, TRUE), 1), "`values` must be a numeric vector, not a logical vector")
-  expect_error(avar(c(1i, 2i, 3i), 1), "`values` must be a numeric vector, not a complex vector")
-  expect_error(avar(c(1, NA, 3), 1), "`values` must contain only finite numbers; found NA at position 2")
-  expect_error(avar(c(1, NaN, 3), 1), "`values` .*found NaN at position 2")
-  expect_error(avar(c(1, 2, Inf), 1), "`values` .*found Inf at position 3")
-  expect_error(avar(c(-Inf, 2, 3), 1), "`values` .*found -Inf at position 1")
-  expect_error(avar(matrix(1:10, 5), 1), "`values` must be a single series")
-  expect_error(avar(data.frame(a = 1:5, b = 1:5), 1), "`values` must be a single series")
-  expect_error(avar(freq = 1), "`values` is missing")
+  expect_error(avar(NULL, 1), "`values` must be a numeric vector, not NULL",
+    class = "allanvar_error_argument")
+  expect_error(avar(numeric(), 1), "`values` must have at least 2 samples, not 0",
+    class = "allanvar_error_argument")
+  expect_error(avar(1, 1), "`values` must have at least 2 samples, not 1",
+    class = "allanvar_error_argument")
+  expect_error(avar(c("a", "b"), 1), "`values` must be a numeric vector, not a character vector",
+    class = "allanvar_error_argument")
+  expect_error(avar(factor(1:3), 1), "`values` must be a numeric vector, not a factor",
+    class = "allanvar_error_argument")
+  expect_error(avar(list(1, 2, 3), 1), "`values` must be a numeric vector, not a list",
+    class = "allanvar_error_argument")
+  expect_error(avar(c(TRUE, FALSE, TRUE), 1), "`values` must be a numeric vector, not a logical vector",
+    class = "allanvar_error_argument")
+  expect_error(avar(c(1i, 2i, 3i), 1), "`values` must be a numeric vector, not a complex vector",
+    class = "allanvar_error_argument")
+  expect_error(avar(c(1, NA, 3), 1), "`values` must contain only finite numbers; found NA at position 2",
+    class = "allanvar_error_argument")
+  expect_error(avar(c(1, NaN, 3), 1), "`values` .*found NaN at position 2",
+    class = "allanvar_error_argument")
+  expect_error(avar(c(1, 2, Inf), 1), "`values` .*found Inf at position 3",
+    class = "allanvar_error_argument")
+  expect_error(avar(c(-Inf, 2, 3), 1), "`values` .*found -Inf at position 1",
+    class = "allanvar_error_argument")
+  expect_error(avar(matrix(1:10, 5), 1), "`values` must be a single series",
+    class = "allanvar_error_argument")
+  expect_error(avar(data.frame(a = 1:5, b = 1:5), 1), "`values` must be a single series",
+    class = "allanvar_error_argument")
+  expect_error(avar(freq = 1), "`values` is missing",
+    class = "allanvar_error_missing_argument")
 })
 
 test_that("avar() rejects bad freq with a message naming `freq`", {
   x <- rnorm(10)
-  expect_error(avar(x), "`freq` is missing")
-  expect_error(avar(x, NULL), "`freq` must be a single positive number.*not NULL")
-  expect_error(avar(x, "10"), "`freq` must be a single positive number.*not a character vector")
-  expect_error(avar(x, NA), "`freq` must be a single positive number.*not a logical vector")
-  expect_error(avar(x, NA_real_), "`freq` must be a single positive number.*not NA")
-  expect_error(avar(x, 0), "`freq` must be a single positive number.*not 0")
-  expect_error(avar(x, -1), "`freq` must be a single positive number.*not -1")
-  expect_error(avar(x, Inf), "`freq` must be a single positive number.*not Inf")
-  expect_error(avar(x, c(1, 2)), "`freq` must be a single positive number.*not of length 2")
-  expect_error(avar(x, factor(10)), "`freq` must be a single positive number.*not a factor")
-  expect_error(avar(x, 1i), "`freq` must be a single positive number.*not a complex vector")
+  expect_error(avar(x), "`freq` is missing",
+    class = "allanvar_error_missing_argument")
+  expect_error(avar(x, NULL), "`freq` must be a single positive number.*not NULL",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, "10"), "`freq` must be a single positive number.*not a character vector",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, NA), "`freq` must be a single positive number.*not a logical vector",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, NA_real_), "`freq` must be a single positive number.*not NA",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, 0), "`freq` must be a single positive number.*not 0",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, -1), "`freq` must be a single positive number.*not -1",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, Inf), "`freq` must be a single positive number.*not Inf",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, c(1, 2)), "`freq` must be a single positive number.*not of length 2",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, factor(10)), "`freq` must be a single positive number.*not a factor",
+    class = "allanvar_error_argument")
+  expect_error(avar(x, 1i), "`freq` must be a single positive number.*not a complex vector",
+    class = "allanvar_error_argument")
 })
 
 test_that("avar() does not print", {

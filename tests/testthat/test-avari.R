@@ -40,9 +40,14 @@ test_that("avari() of integrated white noise is sigma^2 / c", {
 })
 
 test_that("avari() needs at least 4 samples and checks its arguments", {
-  expect_error(avari(1:3, 1), "`values` must have at least 4 samples, not 3")
-  expect_error(avari("a", 1), "`values` must be a numeric vector")
-  expect_error(avari(c(1, 2, NaN, 4), 1), "`values` .*found NaN at position 3")
-  expect_error(avari(1:10, 0), "`freq` must be a single positive number.*not 0")
-  expect_error(avari(1:10), "`freq` is missing")
+  expect_error(avari(1:3, 1), "`values` must have at least 4 samples, not 3",
+    class = "allanvar_error_argument")
+  expect_error(avari("a", 1), "`values` must be a numeric vector",
+    class = "allanvar_error_argument")
+  expect_error(avari(c(1, 2, NaN, 4), 1), "`values` .*found NaN at position 3",
+    class = "allanvar_error_argument")
+  expect_error(avari(1:10, 0), "`freq` must be a single positive number.*not 0",
+    class = "allanvar_error_argument")
+  expect_error(avari(1:10), "`freq` is missing",
+    class = "allanvar_error_missing_argument")
 })

@@ -43,10 +43,16 @@ test_that("avarn() of white noise is sigma^2 / c at every cluster size", {
 })
 
 test_that("avarn() checks its arguments", {
-  expect_error(avarn(NULL, 1), "`values` must be a numeric vector, not NULL")
-  expect_error(avarn(1, 1), "`values` must have at least 2 samples")
-  expect_error(avarn(c(1, NA), 1), "`values` must contain only finite numbers")
-  expect_error(avarn(1:10, -2), "`freq` must be a single positive number.*not -2")
-  expect_error(avarn(1:10, 1, exact = NA), "`exact` must be TRUE or FALSE")
-  expect_error(avarn(1:10, 1, exact = "yes"), "`exact` must be TRUE or FALSE")
+  expect_error(avarn(NULL, 1), "`values` must be a numeric vector, not NULL",
+    class = "allanvar_error_argument")
+  expect_error(avarn(1, 1), "`values` must have at least 2 samples",
+    class = "allanvar_error_argument")
+  expect_error(avarn(c(1, NA), 1), "`values` must contain only finite numbers",
+    class = "allanvar_error_argument")
+  expect_error(avarn(1:10, -2), "`freq` must be a single positive number.*not -2",
+    class = "allanvar_error_argument")
+  expect_error(avarn(1:10, 1, exact = NA), "`exact` must be TRUE or FALSE",
+    class = "allanvar_error")
+  expect_error(avarn(1:10, 1, exact = "yes"), "`exact` must be TRUE or FALSE",
+    class = "allanvar_error")
 })

@@ -64,13 +64,18 @@ test_that("seed gives reproducible output and leaves the RNG state alone", {
 })
 
 test_that("avsim checks its arguments", {
-  expect_error(avsim(1, 10, N = 1), "`n`")
-  expect_error(avsim(100, 0, N = 1), "`freq`")
-  expect_error(avsim(100, 10, N = -1), "`N`")
-  expect_error(avsim(100, 10, gm = list(sigma = 1)), "`gm`")
-  expect_error(avsim(100, 10, gm = list(sigma = 1, tc = -1)), "gm\\$tc")
-  expect_error(avsim(100, 10, sinusoid = list(amp = 1, f0 = 6)), "Nyquist")
-  expect_error(avsim(100, 10, seed = "a"), "`seed`")
+  expect_error(avsim(1, 10, N = 1), "`n`", class = "allanvar_error_argument")
+  expect_error(avsim(100, 0, N = 1), "`freq`",
+    class = "allanvar_error_argument")
+  expect_error(avsim(100, 10, N = -1), "`N`", class = "allanvar_error_argument")
+  expect_error(avsim(100, 10, gm = list(sigma = 1)), "`gm`",
+    class = "allanvar_error_argument")
+  expect_error(avsim(100, 10, gm = list(sigma = 1, tc = -1)), "gm\\$tc",
+    class = "allanvar_error_argument")
+  expect_error(avsim(100, 10, sinusoid = list(amp = 1, f0 = 6)), "Nyquist",
+    class = "allanvar_error_argument")
+  expect_error(avsim(100, 10, seed = "a"), "`seed`",
+    class = "allanvar_error_argument")
   expect_equal(length(avsim(100, 10)), 100)
 })
 

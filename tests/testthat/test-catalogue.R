@@ -96,11 +96,15 @@ test_that("registration validates entries and protects the built-ins", {
                class = "allanvar_error_catalogue")
   e <- telegraph_entry()
   e$params$profile <- NA
-  expect_error(allanvar:::register_effect(e), "profile")
+  expect_error(allanvar:::register_effect(e), "profile",
+    class = "allanvar_error_catalogue")
   expect_error(allanvar:::register_effect(allanvar:::effect_white()),
-               "already has an effect \"N\"")
-  expect_error(allanvar:::unregister_effect("N"), "built-in")
-  expect_error(allanvar:::unregister_effect("nothing"), "no effect")
+               "already has an effect \"N\"",
+               class = "allanvar_error_catalogue")
+  expect_error(allanvar:::unregister_effect("N"), "built-in",
+    class = "allanvar_error_catalogue")
+  expect_error(allanvar:::unregister_effect("nothing"), "no effect",
+    class = "allanvar_error_catalogue")
 })
 
 test_that("a non-stationary effect corrected in the series fits the schema", {
@@ -124,7 +128,7 @@ test_that("a non-stationary effect corrected in the series fits the schema", {
     expect_identical(tt$component[tt$term == "step"], c("series", "series"))
     expect_false("step" %in% allanvar:::effect_kinds())
     expect_error(avfit(data.frame(tau = 1:3, avar = 1:3), "step", n = 100, freq = 1),
-                 "unknown term")
+                 "unknown term", class = "allanvar_error_argument")
     y <- avsim(1000, 10, step = list(size = 5, time = 30))
     expect_equal(sum(diff(y) != 0), 1)
     e <- allanvar:::effect_entry("step")
@@ -178,7 +182,9 @@ test_that("families (variants) and harmonic sets with a variable number of compo
     fit <- avfit(data.frame(tau = tau, avar = ref), c("N", "harm:3"), n = 1e6,
                  freq = 100, bias_correct = FALSE, start = c(harm1_3.f0 = 0.28))
     expect_equal(coef(fit), cf, tolerance = 1e-4)
-    expect_error(allanvar:::coef_layout("harm:x"), "no variant \"x\"")
-    expect_error(allanvar:::coef_layout("N:2"), "has no variants")
+    expect_error(allanvar:::coef_layout("harm:x"), "no variant \"x\"",
+      class = "allanvar_error_model")
+    expect_error(allanvar:::coef_layout("N:2"), "has no variants",
+      class = "allanvar_error_model")
   })
 })

@@ -57,7 +57,7 @@ test_that("a Kalibr CSV of a measured ADIS16405 gives plot, datasheet and imu.ya
   # the filter step of the yaml's rate: sigma_d = N / sqrt(0.01)
   sd <- o$fp$value[o$fp$parameter == "sigma_d" & o$fp$channel == "gyro_x"]
   expect_equal(sd, n_gyro[1] / sqrt(0.01), tolerance = 1e-6)
-  expect_length(res$files, 4)
+  expect_length(res$files, 5)  # with report.html
 })
 
 test_that("the same outputs come from one shell command", {
@@ -122,10 +122,14 @@ test_that("options describe other layouts; bad options are refused", {
   expect_equal(a$channels$gyro_x$readings, b$channels$gyro_x$readings)
   ds <- utils::read.csv(file.path(out, "datasheet.csv"))
   expect_true("mean of axes" %in% ds$axis)
-  expect_error(allanvar:::cli_run("--bogus"), "unknown option --bogus")
-  expect_error(allanvar:::cli_run(c(f, "--rate")), "needs a value")
-  expect_error(allanvar:::cli_run(c(f, "--rate", "fast")), "--rate must be a number")
-  expect_error(allanvar:::cli_run(character()), "no input file")
+  expect_error(allanvar:::cli_run("--bogus"), "unknown option --bogus",
+    class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(c(f, "--rate")), "needs a value",
+    class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(c(f, "--rate", "fast")), "--rate must be a number",
+    class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(character()), "no input file",
+    class = "allanvar_error_cli")
   expect_output(allanvar_cli("--help"), "Usage: allanvar")
 })
 
@@ -187,11 +191,15 @@ test_that("--terms, --axis, --gap and units are validated, naming the flag", {
   on.exit(unlink(f))
   expect_error(allanvar:::cli_run(c(f, "--terms", "N,X")),
                "--terms: unknown term\\(s\\) X", class = "allanvar_error_cli")
-  expect_error(allanvar:::cli_run(c(f, "--axis", "worst")), "--axis must be one of")
-  expect_error(allanvar:::cli_run(c(f, "--gap", "skip")), "--gap must be one of")
+  expect_error(allanvar:::cli_run(c(f, "--axis", "worst")), "--axis must be one of",
+    class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(c(f, "--gap", "skip")), "--gap must be one of",
+    class = "allanvar_error_cli")
   expect_error(allanvar:::cli_run(c(f, "--gyro-units", "furlong/s")),
-               "--gyro-units \"furlong/s\" is not a known gyro unit")
-  expect_error(allanvar:::cli_run(c(f, "--width", "-3")), "--width must be")
+               "--gyro-units \"furlong/s\" is not a known gyro unit",
+               class = "allanvar_error_cli")
+  expect_error(allanvar:::cli_run(c(f, "--width", "-3")), "--width must be",
+    class = "allanvar_error_cli")
   expect_identical(allanvar:::cli_terms("n,b,K,gm"), c("N", "B", "K", "gm"))
 })
 
@@ -210,12 +218,14 @@ test_that("--out is validated and a failed run writes nothing", {
   out <- tempfile("cli")
   on.exit(unlink(c(two, out), recursive = TRUE), add = TRUE)
   expect_error(suppressMessages(capture.output(
-    allanvar:::cli_run(c(two, "--out", out, "--quiet", "--no-refine")))))
+    allanvar:::cli_run(c(two, "--out", out, "--quiet", "--no-refine")))),
+    class = "allanvar_error_record_too_short")
   expect_false(dir.exists(out) && length(list.files(out)) > 0)
   # with a good file first and the bad one second: still nothing written
   expect_error(suppressMessages(capture.output(suppressWarnings(
     allanvar:::cli_run(c(f, two, "--out", out, "--quiet", "--no-refine",
-                         "--gyro-cols", "p,q,r"))))))
+                         "--gyro-cols", "p,q,r"))))),
+                         class = "allanvar_error_argument")
   expect_length(list.files(out), 0L)
 })
 
@@ -233,7 +243,7 @@ test_that("--width/--height size the PNG; --topic reads a bag", {
   # PNG IHDR: width and height as big-endian 32-bit integers at bytes 17-24
   be32 <- function(r) sum(as.numeric(r) * 256^(3:0))
   expect_identical(c(be32(png[17:20]), be32(png[21:24])), c(900, 450))
-  expect_length(res$files, 4L)
+  expect_length(res$files, 5L)  # with report.html
   expect_equal(res$analyses[[1]]$freq, 200, tolerance = 1e-9)
 })
 

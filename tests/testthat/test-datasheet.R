@@ -41,7 +41,8 @@ test_that("average = TRUE appends the mean of the axes, and only then", {
   g <- ds$gyro
   expect_identical(g$axis, c("gyro_x", "gyro_y", "mean of axes"))
   expect_equal(g[["N [deg/sqrt(h)]"]][3], mean(g[["N [deg/sqrt(h)]"]][1:2]))
-  expect_error(datasheet(a, average = NA), "`average`")
+  expect_error(datasheet(a, average = NA), "`average`",
+    class = "allanvar_error_argument")
 })
 
 test_that("the effects the closed loop added are listed", {
@@ -64,7 +65,8 @@ test_that("write_datasheet() writes the long and wide CSV", {
   expect_equal(d$value, datasheet(a)$long$value)
   write_datasheet(datasheet(a), f, format = "wide")
   expect_true(any(grepl("N \\[deg/sqrt\\(h\\)\\]", readLines(f))))
-  expect_error(write_datasheet(1, f), "imu_datasheet")
+  expect_error(write_datasheet(1, f), "imu_datasheet",
+    class = "allanvar_error_argument")
 })
 
 test_that("datasheet() and write_datasheet() errors are classed and worded", {
@@ -90,7 +92,7 @@ test_that("a fit of a curve alone gets a datasheet, guidance and filter paramete
   Na <- 0.003
   utils::write.table(cbind(tau, Na / sqrt(tau), Na / sqrt(tau), Na / sqrt(tau),
                            ad, ad, ad), f, row.names = FALSE, col.names = FALSE)
-  cv <- read_avr_curve(f)
+  cv <- read_allan_variance_ros_curve(f)
   fit <- avfit(cv[cv$channel == "gyro_x", ], n = 4e6, freq = 400)
   ds <- datasheet(fit)
   expect_s3_class(ds, "imu_datasheet")
@@ -105,7 +107,7 @@ test_that("a fit of a curve alone gets a datasheet, guidance and filter paramete
   # (the fit's flicker term is not exactly flat at large tau: K within 5%)
   expect_equal(g[["K [deg/h/sqrt(h)]"]], K * 3600 * 60, tolerance = 0.05)
   # filter parameters in rad/s: sigma_d = N / sqrt(dt), dt = 1 / freq
-  fp <- filter_params(fit)
+  fp <- kalman_params(fit)
   sd <- fp[fp$parameter == "sigma_d", ]
   expect_identical(sd$unit, "rad/s")
   expect_identical(sd$continuous_unit, "rad/s/sqrt(Hz)")
@@ -123,7 +125,7 @@ test_that("a fit of a curve alone gets a datasheet, guidance and filter paramete
   expect_equal(du$long$value[du$long$term == "N"], unname(coef(fa)["N"]))
   dg <- datasheet(fa, unit = "deg/s")
   expect_equal(dg$gyro[["N [deg/sqrt(h)]"]], unname(coef(fa)["N"]) * 60)
-  fu <- filter_params(fa)
+  fu <- kalman_params(fa)
   expect_identical(fu$unit[fu$parameter == "sigma_d"], "u")
   expect_identical(fu$continuous_unit[fu$parameter == "sigma_d"], "u*sqrt(s)")
   expect_error(datasheet(fa, unit = "furlong"), class = "allanvar_error_units")

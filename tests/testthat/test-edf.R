@@ -73,6 +73,7 @@ test_that("Greenhall's EDF agrees with NIST SP 1065 Table 5 where that is accura
 })
 
 test_that("the exact discrete EDF matches Monte Carlo variances", {
+  skip_on_cran()
   set.seed(21)
   N <- 400
   for (rw in c(FALSE, TRUE)) {
@@ -125,6 +126,10 @@ test_that("Riley's lag-1 autocorrelation identifies power-law noise", {
 })
 
 test_that("the chi-square interval of the deviation (NIST SP 1065 eq. 45)", {
+  # every row chi-square (at N/m <= 16 the default is the exact interval,
+  # R/ci-exact.R, tested in test-ci-exact.R)
+  old <- options(allanvar.ci_exact = 0)
+  on.exit(options(old))
   set.seed(23)
   a <- allan(rnorm(2000), 1, conf = 0.9)
   expect_equal(a$lower, sqrt(a$edf * a$avar / qchisq(0.95, a$edf)))
@@ -147,6 +152,7 @@ test_that("the chi-square interval of the deviation (NIST SP 1065 eq. 45)", {
 })
 
 test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
+  skip_on_cran()
   # 1000 replicates each of white rate noise (AV = 1/m) and random-walk rate
   # noise y = cumsum(w) (AV = (2m^2 + 1)/(6m)), N = 1024: 65-72%, except
   # random walk below 64 averaged frequencies, where the default follows
@@ -183,7 +189,10 @@ test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
       expect_gte(length(cw$cov), 7)
       for (g in c("white", "walk")) {
         r <- if (g == "white") cw else cr
-        long <- rule == "default" & g == "walk" & N %/% r$m < 64
+        # N/m <= 16: the exact limits (R/ci-exact.R), whose union over the
+        # plausible noise types is held to the issue's band 0.60-0.76
+        long <- (rule == "default" & g == "walk" & N %/% r$m < 64) |
+          N / r$m <= 16
         expect_gte(sum(!long), 5)
         expect_true(all(r$cov[!long] >= 0.65 & r$cov[!long] <= 0.72),
                     info = paste(rule, type, g, toString(r$cov)))
@@ -273,6 +282,7 @@ test_that("random walk at long tau: Stable32's B1 rule, except for the total typ
 })
 
 test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows), TDEV and TOTDEV", {
+  skip_on_cran()
   # Own generators as above; rows with fewer than 64 averaged frequencies
   # (identified by B1 and R(n)) and the further statistics. 400 replicates:
   # the standard error of a coverage is 0.023, so a row at 0.68 leaves
@@ -304,6 +314,7 @@ test_that("68% coverage 0.60-0.76 at long tau (B1 and R(n) rows), TDEV and TOTDE
 })
 
 test_that("68% coverage of white and flicker PM where B1 reads a few averaged frequencies", {
+  skip_on_cran()
   # B1 from <= 16 averaged frequencies reads PM as white FM in 21-60% of
   # replicates (N = 1024), whose EDF is far below PM's: the overlapping
   # Allan and Hadamard intervals covered 0.77-0.89 at N/m = 4-16. R(n) over
@@ -329,8 +340,10 @@ test_that("68% coverage of white and flicker PM where B1 reads a few averaged fr
       info <- paste(type, g, toString(round(r$cov, 3)), "true type:",
                     toString(round(r$cov_alpha, 3)))
       if (g == "fpm") {
-        expect_true(all(r$cov >= 0.60 & abs(r$cov - r$cov_alpha) <= 0.03),
-                    info = info)
+        # the exact limits (N/m <= 16, R/ci-exact.R) cover closer to 0.683
+        # than the true type's chi-square interval (`cov_alpha`, 0.75-0.76)
+        expect_true(all(r$cov >= 0.60 & r$cov <= 0.76 &
+                          r$cov <= r$cov_alpha + 0.03), info = info)
       } else {
         expect_true(all(r$cov >= 0.60 & r$cov <= 0.76), info = info)
       }
@@ -339,6 +352,7 @@ test_that("68% coverage of white and flicker PM where B1 reads a few averaged fr
 })
 
 test_that("MTOT/TTOT at m = 1, 2 and HTOT at m = 1: the EDF of the estimator they are", {
+  skip_on_cran()
   # SP 1065 Table 11's b N/m - c claims 1950 (white PM) and 1230 (flicker
   # PM) at m = 1, N = 1024, where Monte Carlo gives ~520 and ~600: MTOT
   # coverage 0.40-0.60 there; the modified Allan EDF (526, 651) fits. HTOT
@@ -367,6 +381,7 @@ test_that("MTOT/TTOT at m = 1, 2 and HTOT at m = 1: the EDF of the estimator the
 })
 
 test_that("HTOT under white and flicker PM: coverage 0.60-0.76, EDF as Monte Carlo's", {
+  skip_on_cran()
   # No published EDF; the overlapping Allan one (Stable32's) is 0.47-0.89 of
   # the Monte Carlo EDF: these rows covered 0.72-0.78 (white) and 0.72-0.82
   # (flicker), now 0.67-0.71 and 0.66-0.69. The fits in
@@ -403,6 +418,7 @@ test_that("HTOT under white and flicker PM: coverage 0.60-0.76, EDF as Monte Car
 })
 
 test_that("bias-corrected Theo1 covers 0.60-0.76 at N/m 8-64 for the five noise types", {
+  skip_on_cran()
   # The correction AVAR/Theo1 changes up to 2.7-fold between adjacent
   # types; with the Allan variance's type at 0.75 m (misreading flicker FM
   # in up to 79% of records, random walk in 93-100% from m = 32) coverage
@@ -436,6 +452,7 @@ test_that("bias-corrected Theo1 covers 0.60-0.76 at N/m 8-64 for the five noise 
 })
 
 test_that("Theo1's EDF (Howe & Peppler, SP 1065) matches Monte Carlo at a known noise type", {
+  skip_on_cran()
   # The uncorrected Theo1 with the EDF of the generator's noise type: the
   # formula alone, apart from noise identification (whose misreadings at
   # long tau, multiplied by the type-dependent bias correction, are what
@@ -490,7 +507,7 @@ test_that("the further types' noise type (identification without sums) is allan(
   }
 })
 
-test_that("limits agree with Stable32's on >= 95% of its reference rows (issue 10)", {
+test_that("limits agree with Stable32's on >= 95% of its reference rows", {
   # Both limits within 25% of Stable32's half-width, over every Stable32 run
   # of allantools' and allantoolkit's test suites (tools/check-stable32.R,
   # the Allan types, and tools/check-stable32-types.R, the further types),

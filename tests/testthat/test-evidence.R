@@ -123,10 +123,14 @@ test_that("exponential ACF gives Tc; trend and lag-1 noise id are right", {
 })
 
 test_that("avdiagnose validates its arguments and prints", {
-  expect_error(avdiagnose(), "`x` is missing")
-  expect_error(avdiagnose(rnorm(1000), -1), "`freq` must be a single positive")
-  expect_error(avdiagnose(letters, 1), "`x` must be a numeric vector")
-  expect_error(avdiagnose(rnorm(10), 1), "at least 256")
+  expect_error(avdiagnose(), "`x` is missing",
+    class = "allanvar_error_missing_argument")
+  expect_error(avdiagnose(rnorm(1000), -1), "`freq` must be a single positive",
+    class = "allanvar_error_argument")
+  expect_error(avdiagnose(letters, 1), "`x` must be a numeric vector",
+    class = "allanvar_error_argument")
+  expect_error(avdiagnose(rnorm(10), 1), "at least 256",
+    class = "allanvar_error_argument")
   x <- stats::ts(round(rnorm(5000) / 0.1) * 0.1, frequency = 50)
   d <- avdiagnose(x)
   expect_equal(d$freq, 50)

@@ -1,6 +1,6 @@
-test_that("filter_params() follows the stated discrete-time conventions", {
+test_that("kalman_params() follows the stated discrete-time conventions", {
   dt <- 0.01
-  fp <- filter_params(c(N = 0.01, K = 1e-4, B = 0.002, gm1.sigma = 0.5,
+  fp <- kalman_params(c(N = 0.01, K = 1e-4, B = 0.002, gm1.sigma = 0.5,
                         gm1.tc = 10), dt = dt, tau_B = 50)
   get <- function(term, par) fp$value[fp$term == term & fp$parameter == par]
   expect_equal(get("N", "sigma_d"), 0.1)               # 0.01 / sqrt(0.01)
@@ -17,10 +17,12 @@ test_that("filter_params() follows the stated discrete-time conventions", {
                "sigma^2 * (1 - phi^2)", fixed = TRUE)
   expect_true(all(fp$dt == dt))
   expect_equal(fp$continuous[fp$parameter == "sigma_d"], 0.01)
-  fp2 <- filter_params(c(N = 0.01, B = 0.002), dt = dt, bias_instability = "omit")
+  fp2 <- kalman_params(c(N = 0.01, B = 0.002), dt = dt, bias_instability = "omit")
   expect_identical(fp2$parameter, "sigma_d")
-  expect_error(filter_params(c(N = 1)), "`dt`")
-  expect_error(filter_params(c(N = 1), dt = -1), "`dt`")
+  expect_error(kalman_params(c(N = 1)), "`dt`",
+    class = "allanvar_error_missing_argument")
+  expect_error(kalman_params(c(N = 1), dt = -1), "`dt`",
+    class = "allanvar_error_argument")
 })
 
 test_that("simulating the discrete parameters gives back the continuous model", {
@@ -30,7 +32,7 @@ test_that("simulating the discrete parameters gives back the continuous model", 
   dt <- 0.01
   N <- 2e-3
   K <- 5e-4
-  fp <- filter_params(c(N = N, K = K, gm1.sigma = 0.3, gm1.tc = 0.5), dt = dt)
+  fp <- kalman_params(c(N = N, K = K, gm1.sigma = 0.3, gm1.tc = 0.5), dt = dt)
   get <- function(term, par) fp$value[fp$term == term & fp$parameter == par]
   set.seed(11)
   n <- 4e5
@@ -69,8 +71,10 @@ test_that("write_kalibr_yaml() writes Kalibr's keys with units in comments", {
   y2 <- yaml::read_yaml(f)
   expect_equal(y2$gyroscope_random_walk, 4e-5)
   expect_equal(y2$update_rate, 200)
-  expect_error(write_kalibr_yaml(vals[-1], f), "lacks gyroscope_noise_density")
-  expect_error(write_kalibr_yaml(vals, f, inflate = 0.5), "`inflate`")
+  expect_error(write_kalibr_yaml(vals[-1], f), "lacks gyroscope_noise_density",
+    class = "allanvar_error_argument")
+  expect_error(write_kalibr_yaml(vals, f, inflate = 0.5), "`inflate`",
+    class = "allanvar_error_argument")
 })
 
 test_that("write_kalibr_yaml() takes the worst axis of an analysis and says so", {
@@ -104,14 +108,14 @@ test_that("write_kalibr_yaml() takes the worst axis of an analysis and says so",
   expect_equal(y2$gyroscope_noise_density, mean(c(val("gyro_x", "N"), val("gyro_y", "N"))),
                tolerance = 1e-6)
   # filter parameters of the same analysis: sigma_d = N / sqrt(dt) per axis
-  fp <- filter_params(a)
+  fp <- kalman_params(a)
   expect_equal(fp$value[fp$channel == "gyro_y" & fp$parameter == "sigma_d"],
                val("gyro_y", "N") / sqrt(0.01))
   expect_identical(unique(fp$unit[fp$sensor == "accel" & fp$parameter == "sigma_d"]),
                    "m/s^2")
 })
 
-test_that("write_kalibr_yaml() and filter_params() errors are classed and worded", {
+test_that("write_kalibr_yaml() and kalman_params() errors are classed and worded", {
   f <- tempfile(fileext = ".yaml")
   on.exit(unlink(f))
   vals <- list(gyroscope_noise_density = 1.7e-4, gyroscope_random_walk = 2e-5,
@@ -123,13 +127,13 @@ test_that("write_kalibr_yaml() and filter_params() errors are classed and worded
     write_kalibr_yaml(vals, f, inflate = 0.5)
     write_kalibr_yaml(vals, f, axis = "min")
     write_kalibr_yaml("x", f)
-    filter_params()
-    filter_params(c(N = 1))
-    filter_params(c(N = 1), dt = -1)
-    filter_params("x", dt = 1)
-    filter_params(c(N = 1), dt = 1, bias_instability = "none")
+    kalman_params()
+    kalman_params(c(N = 1))
+    kalman_params(c(N = 1), dt = -1)
+    kalman_params("x", dt = 1)
+    kalman_params(c(N = 1), dt = 1, bias_instability = "none")
   })
-  expect_error(filter_params(c(N = 1)), class = "allanvar_error_missing_argument")
+  expect_error(kalman_params(c(N = 1)), class = "allanvar_error_missing_argument")
 })
 
 test_that("YAML output quotes what it copies from the user", {
@@ -185,7 +189,7 @@ test_that("writers refuse bad output paths and leave no half file", {
   expect_error(write_atomic(f, function(path) {
     writeLines("half", path)
     stop("disk full")
-  }), "disk full")
+  }), "disk full", class = "simpleError")
   expect_identical(readLines(f), "old")
   expect_identical(list.files(d, all.files = TRUE, no.. = TRUE), "imu.yaml")
   # a success replaces it whole
@@ -194,24 +198,24 @@ test_that("writers refuse bad output paths and leave no half file", {
   expect_identical(list.files(d, all.files = TRUE, no.. = TRUE), "imu.yaml")
 })
 
-test_that("filter_params() refuses garbage instead of returning it", {
+test_that("kalman_params() refuses garbage instead of returning it", {
   # tau_B = -1 gave q_d < 0 and phi > 1; "a" silently dropped the B row
   cf <- c(N = 1e-3, B = 1e-4, K = 1e-5)
   for (tb in list(-1, 0, "a", NA_real_, Inf, c(1, 2))) {
-    expect_error(filter_params(cf, dt = 0.01, tau_B = tb),
+    expect_error(kalman_params(cf, dt = 0.01, tau_B = tb),
                  "`tau_B`", class = "allanvar_error_argument")
   }
   for (x in list(c(N = -1e-3), c(N = NaN), c(N = Inf), c(N = 1e-3, K = -1),
                  c(N = 1e-3, N = 2e-3),
                  stats::setNames(1e-3, ""), c(1e-3))) {
-    expect_error(filter_params(x, dt = 0.01), class = "allanvar_error_argument")
+    expect_error(kalman_params(x, dt = 0.01), class = "allanvar_error_argument")
   }
-  expect_error(filter_params(cf, dt = 0), "`dt`", class = "allanvar_error_argument")
-  expect_error(filter_params(cf, dt = 0.01, unit = "furlong"),
+  expect_error(kalman_params(cf, dt = 0), "`dt`", class = "allanvar_error_argument")
+  expect_error(kalman_params(cf, dt = 0.01, unit = "furlong"),
                class = "allanvar_error_units")
   # a valid tau_B: phi = exp(-dt / Tc) with Tc = tau_B / 1.893, in (0, 1),
   # and q_d = sigma^2 (1 - phi^2) > 0 with sigma = 0.664 B / 0.6174
-  fp <- filter_params(cf, dt = 0.01, tau_B = 20)
+  fp <- kalman_params(cf, dt = 0.01, tau_B = 20)
   phi <- fp$value[fp$parameter == "phi"]
   expect_equal(phi, exp(-0.01 / (20 / 1.893)))
   expect_equal(fp$value[fp$parameter == "q_d"],

@@ -1,4 +1,4 @@
-# The fuzz battery of tools/fuzz.R (issue 12), quick subset: bad and extreme
+# The fuzz battery of tools/fuzz.R, quick subset: bad and extreme
 # input to every exported function, S3 method and the CLI must give a result
 # or a classed error naming the argument; never R's own wording, NaN/Inf/
 # negative variances, or a dead R. The full battery: Rscript tools/fuzz.R.

@@ -9,7 +9,8 @@ test_that("plot() draws both sensors with units and reading markers", {
   plot(a, sensor = "gyro", units = "datasheet")
   grDevices::dev.off()
   expect_gt(file.size(f), 1000)
-  expect_error(plot(a, sensor = "mag"), "`sensor`")
+  expect_error(plot(a, sensor = "mag"), "`sensor`",
+    class = "allanvar_error_argument")
 })
 
 test_that("plot() errors are classed and worded", {

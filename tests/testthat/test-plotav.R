@@ -29,13 +29,17 @@ test_that("plotav() draws all three compatibility results and returns them invis
 })
 
 test_that("plotav() rejects what it cannot plot, naming `avdf`", {
-  expect_error(plotav(), "`avdf` is missing")
-  expect_error(plotav(1:3), "`avdf` must be the data frame returned by avar")
-  expect_error(plotav(data.frame(time = 1, av = 1)), "lacks `error`")
+  expect_error(plotav(), "`avdf` is missing",
+    class = "allanvar_error_missing_argument")
+  expect_error(plotav(1:3), "`avdf` must be the data frame returned by avar",
+    class = "allanvar_error_argument")
+  expect_error(plotav(data.frame(time = 1, av = 1)), "lacks `error`",
+    class = "allanvar_error_argument")
   expect_error(plotav(data.frame(time = 1, av = "a", error = 1)),
-               "`avdf\\$av` must be numeric")
+               "`avdf\\$av` must be numeric", class = "allanvar_error_argument")
   expect_error(plotav(data.frame(time = 1, av = 0, error = 1)),
-               "no row with positive, finite")
+               "no row with positive, finite",
+               class = "allanvar_error_argument")
 })
 
 test_that("plotav() draws allan() results and bars that reach below zero", {

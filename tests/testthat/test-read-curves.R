@@ -102,7 +102,7 @@ test_that("allan_variance_ros' CSV curve: deg/s gyro columns back to rad/s, fit 
   utils::write.table(cbind(tau, N_a / sqrt(tau), N_a / sqrt(tau), N_a / sqrt(tau),
                            N_g / sqrt(tau), N_g / sqrt(tau), N_g / sqrt(tau)),
                      f, row.names = FALSE, col.names = FALSE)
-  cv <- read_avr_curve(f)
+  cv <- read_allan_variance_ros_curve(f)
   expect_identical(unique(cv$channel), c("accel_x", "accel_y", "accel_z",
                                          "gyro_x", "gyro_y", "gyro_z"))
   g <- cv[cv$channel == "gyro_x", ]
@@ -111,7 +111,7 @@ test_that("allan_variance_ros' CSV curve: deg/s gyro columns back to rad/s, fit 
   expect_equal(unname(coef(fit)["N"]), N_g * pi / 180, tolerance = 1e-3)
   bad <- tempfile()
   writeLines(c("1 2 3", "4 5 6"), bad)
-  expect_error(read_avr_curve(bad), "7 numeric columns", class = "allanvar_error_file_format")
+  expect_error(read_allan_variance_ros_curve(bad), "7 numeric columns", class = "allanvar_error_file_format")
 })
 
 test_that("the published imu_utils files read back within 1% (optional)", {
@@ -155,7 +155,7 @@ test_that("another tool's curve is fitted one channel at a time", {
   N <- c(0.002, 0.003, 0.004, 0.01, 0.02, 0.03)  # accel m/s^2, gyro deg/s
   write.table(cbind(tau, outer(1 / sqrt(tau), N)), f, row.names = FALSE,
               col.names = FALSE)
-  cv <- read_avr_curve(f)
+  cv <- read_allan_variance_ros_curve(f)
   expect_error(avfit(cv, "N", n = 1e6, freq = 100), "choose one with `channel`",
                class = "allanvar_error_argument")
   fit <- avfit(cv, "N", channel = "gyro_y", n = 1e6, freq = 100)

@@ -67,17 +67,22 @@ test_that("other layouts: columns, units and time unit by argument", {
   expect_equal(r2$freq, 100)
   # no time column: freq required
   expect_error(read_imu(f, time = FALSE, sep = ";", columns = 3:4,
-                        sensors = c("gyro", "gyro")), "freq")
+                        sensors = c("gyro", "gyro")), "freq",
+                        class = "allanvar_error_no_time")
   expect_warning(
     expect_message(r3 <- read_imu(f, time = FALSE, sep = ";", columns = 3:4,
                                   sensors = c("gyro", "gyro"), freq = 50),
                    "assuming rad/s"),
     class = "allanvar_warning_gyro_units")
   expect_equal(r3$freq, 50)
-  expect_error(read_imu(f, time = 2, sep = ";", columns = "nope"), "not found")
-  expect_error(read_imu(f, time = 2, sep = ";", columns = "temp"), "sensor type")
-  expect_error(read_imu(f, sep = ";"), "no timestamp column")
-  expect_error(read_imu(tempfile()), "does not exist")
+  expect_error(read_imu(f, time = 2, sep = ";", columns = "nope"), "not found",
+    class = "allanvar_error_argument")
+  expect_error(read_imu(f, time = 2, sep = ";", columns = "temp"), "sensor type",
+    class = "allanvar_error_sensors")
+  expect_error(read_imu(f, sep = ";"), "no timestamp column",
+    class = "allanvar_error_no_time")
+  expect_error(read_imu(tempfile()), "does not exist",
+    class = "allanvar_error_file")
 })
 
 test_that("out-of-order stamps are sorted and reported", {
@@ -120,7 +125,8 @@ test_that("gaps split the record, stop it, or are ignored, always reported", {
   expect_match(g$detail, "longest 0.51 s at t = 2.99 s")
   expect_match(g$action, "split into 2 segments")
   expect_equal(r$sampling$gaps$length, 0.51, tolerance = 1e-12)
-  expect_error(read_imu(f, gap = "error"), "gap = \"segments\"")
+  expect_error(read_imu(f, gap = "error"), "gap = \"segments\"",
+    class = "allanvar_error_gap")
   expect_warning(r2 <- read_imu(f, gap = "ignore"), "ignored")
   expect_equal(nrow(r2$segments), 1L)
   expect_equal(nrow(r2$data), 950L)
@@ -153,8 +159,9 @@ test_that("imu_record() builds records from memory with unit conversion", {
   r <- imu_record(m, freq = 10, units = c(gyro = "deg/h", accel = "g"))
   expect_equal(unname(r$data[, 1]), c(1, 2, 3) * pi / 180 / 3600)
   expect_equal(unname(r$data[, 2]), c(1, 0, -1) * 9.80665)
-  expect_error(imu_record(m), "freq")
-  expect_error(imu_record(cbind(foo = 1:3), freq = 1), "sensor type")
+  expect_error(imu_record(m), "freq", class = "allanvar_error_no_time")
+  expect_error(imu_record(cbind(foo = 1:3), freq = 1), "sensor type",
+    class = "allanvar_error_sensors")
   r2 <- imu_record(cbind(foo = c(1, 2, 3)), freq = 1, sensors = "gyro")
   expect_identical(unname(r2$sensors), "gyro")
 })

@@ -49,8 +49,8 @@ test_that("readings are typed columns; rewording the method text changes no expo
   for (i in seq_along(b$channels)) {
     b$channels[[i]]$readings$method <- paste("reworded", seq_len(3))
   }
-  expect_identical(filter_params(b), filter_params(a))
-  fp <- filter_params(a)
+  expect_identical(kalman_params(b), kalman_params(a))
+  fp <- kalman_params(a)
   expect_identical(unique(fp$term[fp$channel == "gyro_x"]), c("N", "B", "K", "gm1"))
   expect_equal(fp$continuous[fp$channel == "gyro_x" & fp$term == "gm1"], c(20, 1e-3))
   expect_match(fp$convention[fp$channel == "gyro_x" & fp$term == "K"], "upper bound")

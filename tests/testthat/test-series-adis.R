@@ -1,5 +1,5 @@
-# series_effects() on the measured ADIS16405 recordings (../shared/data;
-# skipped without them). data-raw/adis16405-study.md: the gyros y carry one
+# detect_series_effects() on the measured ADIS16405 recordings (../shared/data;
+# skipped without them). bench/adis16405/adis16405-study.md: the gyros y carry one
 # spike of 2.05 deg/s; unit 1's accelerometers show transients (a knock, a
 # tilt that returns) at 2154, 6817 and 7027 s on all three axes; no gyro has
 # a bias step.
@@ -9,7 +9,7 @@ test_that("ADIS16405 unit 1 gyros: the 2.05 deg/s spike, no bias step", {
   m <- readRDS(shared_file("adis16405_unit1.rds"))
   freq <- attr(m, "freq")
   for (axis in c("gyro_x", "gyro_y", "gyro_z")) {
-    se <- series_effects(m[, axis], freq)
+    se <- detect_series_effects(m[, axis], freq)
     expect_false(any(se$table$kind %in% c("steps", "warmup")), label = axis)
     if (axis == "gyro_y") {
       big <- se$table[se$table$kind == "spikes" & abs(se$table$size) > 1, ]
@@ -22,7 +22,7 @@ test_that("ADIS16405 unit 1 gyros: the 2.05 deg/s spike, no bias step", {
 test_that("ADIS16405 unit 1 accel_z: the transient at 2154 s", {
   skip_if_no_shared()
   m <- readRDS(shared_file("adis16405_unit1.rds"))
-  se <- series_effects(m[, "accel_z"], attr(m, "freq"), remove = "spikes")
+  se <- detect_series_effects(m[, "accel_z"], attr(m, "freq"), remove = "spikes")
   tr <- se$table[se$table$kind == "transients", ]
   expect_gte(nrow(tr), 1L)
   expect_true(any(abs(tr$time - 2154) < 10))
@@ -36,4 +36,18 @@ test_that("ADIS16405 unit 1 accel_z: the transient at 2154 s", {
   expect_lt(stats::median(abs(sp$size)), 12 * 0.00333)
   expect_true(all(sp$removed))
   expect_false(any(se$table$kind %in% c("steps", "warmup")))
+})
+
+test_that("ADIS16405 unit 2 gyro_z: an added warm-up of tc 5% of the record is named within 25%", {
+  skip_if_no_shared()
+  skip_on_cran()
+  m <- readRDS(shared_file("adis16405_unit2.rds"))
+  freq <- attr(m, "freq")
+  x <- m[, "gyro_z"]
+  t <- (seq_along(x) - 1) / freq
+  tc <- 0.05 * length(x) / freq
+  amp <- 50 * allan(x, freq, taus = I(tc))$adev
+  w <- detect_series_effects(x + amp * exp(-t / tc), freq, kinds = "warmup")$table
+  expect_equal(nrow(w), 1L)
+  expect_lt(abs(w$tc / tc - 1), 0.25)
 })

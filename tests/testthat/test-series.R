@@ -1,4 +1,4 @@
-# series_effects(): the catalogue's series entries in one pass. Series built
+# detect_series_effects(): the catalogue's series entries in one pass. Series built
 # here with base R (white noise, a random walk by cumsum, a Gauss-Markov by
 # stats::filter) plus the deterministic effect, never with avsim().
 
@@ -9,7 +9,7 @@ test_that("a bias step: time within 1% of the record, size within 20%; removed o
     x <- gen_white_walk(n, seed = 10 + seed)
     at <- 123457
     x[at:n] <- x[at:n] + 0.03
-    se <- series_effects(x, freq)
+    se <- detect_series_effects(x, freq)
     st <- se$table[se$table$kind == "steps", ]
     expect_identical(se$table$kind, "steps")
     expect_lt(abs(st$time - (at - 1) / freq), 0.01 * n / freq)
@@ -23,10 +23,10 @@ test_that("a bias step: time within 1% of the record, size within 20%; removed o
     expect_true(all(se$adev$before[big] > se$adev$after[big]))
     expect_true(all(abs(se$adev$change[se$adev$tau <= 0.1]) < 1e-3))
     # removed when asked: nothing left to find
-    rm <- series_effects(x, freq, remove = "steps")
+    rm <- detect_series_effects(x, freq, remove = "steps")
     expect_true(rm$table$removed)
     expect_identical(rm$removed, "steps")
-    expect_equal(nrow(series_effects(rm$x, freq)$table), 0L)
+    expect_equal(nrow(detect_series_effects(rm$x, freq)$table), 0L)
     expect_lt(abs(mean(rm$x[(at - 5000):(at - 1)]) - mean(rm$x[at:(at + 4999)])), 0.01)
   }
 })
@@ -38,7 +38,7 @@ test_that("an exponential warm-up: time constant within 30%", {
   for (seed in 1:2) {
     for (tc in c(30, 120)) {
       x <- gen_white_walk(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / tc)
-      se <- series_effects(x, freq, remove = "warmup")
+      se <- detect_series_effects(x, freq, remove = "warmup")
       w <- se$table[se$table$kind == "warmup", ]
       expect_equal(nrow(w), 1L)
       expect_equal(w$tc, tc, tolerance = 0.3)
@@ -60,7 +60,7 @@ test_that("spikes: all found, none invented; removal restores the short-tau ADEV
     size <- sample(c(-1, 1), 12, replace = TRUE) * runif(12, 1, 3)  # 10-30 sd
     x <- clean
     x[at] <- x[at] + size
-    se <- series_effects(x, freq, remove = "spikes")
+    se <- detect_series_effects(x, freq, remove = "spikes")
     sp <- se$table[se$table$kind == "spikes", ]
     expect_identical(sp$index, as.integer(at))
     expect_equal(sp$size, size, tolerance = 0.1)
@@ -84,7 +84,7 @@ test_that("controls: red noise, a slow Gauss-Markov and a sinusoid add nothing (
                                    method = "recursive"))
     x <- rnorm(n, sd = 0.1) + cumsum(rnorm(n, sd = 5e-4)) + gm +
       0.05 * sin(2 * pi * 0.01 * t + seed)
-    added <- added + nrow(series_effects(x, freq)$table)
+    added <- added + nrow(detect_series_effects(x, freq)$table)
   }
   expect_lte(added, 1L)
 })
@@ -96,7 +96,7 @@ test_that("the effects together: each kind found once, `all` removes every one",
   x <- gen_white_walk(n, rw = 2e-5, seed = 61) + 0.1 * exp(-t / 50)
   x[150001:n] <- x[150001:n] - 0.04
   x[c(20000, 90000)] <- x[c(20000, 90000)] + c(2, -2.5)
-  se <- series_effects(x, freq, remove = "all")
+  se <- detect_series_effects(x, freq, remove = "all")
   expect_setequal(se$table$kind, c("spikes", "warmup", "steps"))
   expect_equal(sum(se$table$kind == "spikes"), 2L)
   expect_equal(se$table$time[se$table$kind == "steps"], 1500, tolerance = 0.01 * n / freq / 1500)
@@ -104,7 +104,7 @@ test_that("the effects together: each kind found once, `all` removes every one",
   expect_identical(se$removed, c("spikes", "warmup", "steps"))
   expect_setequal(se$adev_kinds$kind, c("spikes", "warmup", "steps"))
   # looking only for spikes leaves the rest alone
-  only <- series_effects(x, freq, kinds = "spikes")
+  only <- detect_series_effects(x, freq, kinds = "spikes")
   expect_identical(unique(only$table$kind), "spikes")
   expect_identical(only$kinds, "spikes")
 })
@@ -112,36 +112,36 @@ test_that("the effects together: each kind found once, `all` removes every one",
 test_that("a ts comes back as a ts; freq is taken from it", {
   x <- stats::ts(gen_white_walk(5000, seed = 71), start = 3, frequency = 50)
   x[1000] <- x[1000] + 2
-  se <- series_effects(x, remove = "spikes")
+  se <- detect_series_effects(x, remove = "spikes")
   expect_true(stats::is.ts(se$x))
   expect_equal(stats::tsp(se$x), stats::tsp(x))
   expect_equal(se$freq, 50)
   expect_equal(se$table$index, 1000L)
 })
 
-test_that("series_effects() prints what it found and what it removed", {
+test_that("detect_series_effects() prints what it found and what it removed", {
   x <- gen_white_walk(2e4, seed = 81)
   x[5000] <- x[5000] + 2
   x[12001:2e4] <- x[12001:2e4] + 0.08
   expect_snapshot({
-    print(series_effects(x, 100, remove = "spikes"))
-    print(series_effects(gen_white_walk(2e4, seed = 82), 100))
+    print(detect_series_effects(x, 100, remove = "spikes"))
+    print(detect_series_effects(gen_white_walk(2e4, seed = 82), 100))
   })
 })
 
-test_that("series_effects() errors are classed and worded", {
+test_that("detect_series_effects() errors are classed and worded", {
   x <- gen_white_walk(1000, seed = 91)
   expect_snapshot(error = TRUE, {
-    series_effects()
-    series_effects(x)
-    series_effects(x, 100, remove = "bumps")
-    series_effects(x, 100, remove = TRUE)
-    series_effects(x, 100, kinds = 1)
-    series_effects(x, 100, 1)
-    series_effects(stats::ts(x, frequency = 10), 100)
-    series_effects(x[1:100], 100)
+    detect_series_effects()
+    detect_series_effects(x)
+    detect_series_effects(x, 100, remove = "bumps")
+    detect_series_effects(x, 100, remove = TRUE)
+    detect_series_effects(x, 100, kinds = 1)
+    detect_series_effects(x, 100, 1)
+    detect_series_effects(stats::ts(x, frequency = 10), 100)
+    detect_series_effects(x[1:100], 100)
   })
-  expect_error(series_effects(x, 100, remove = "x"),
+  expect_error(detect_series_effects(x, 100, remove = "x"),
                class = "allanvar_error_argument")
 })
 
@@ -165,7 +165,7 @@ test_that("avrefine(series =) takes an earlier pass instead of running it again"
   freq <- 100
   x <- gen_white_walk(n, rw = 1e-5, seed = 102)
   x[c(7000, 33000)] <- x[c(7000, 33000)] + 2
-  se <- series_effects(x, freq, remove = "spikes")
+  se <- detect_series_effects(x, freq, remove = "spikes")
   fit <- avfit(allan(se$x, freq), terms = c("N", "K"))
   again <- avrefine(fit, data = se$x, max_steps = 1)
   given <- avrefine(fit, data = se$x, series = se, max_steps = 1)
@@ -224,11 +224,11 @@ test_that("analyze_imu(remove =) and the CLI's --remove take the effects out bef
 })
 
 test_that("degenerate series: a constant has nothing, a noiseless step is one step", {
-  s <- series_effects(rep(1, 5000), 100)
+  s <- detect_series_effects(rep(1, 5000), 100)
   expect_equal(nrow(s$table), 0L)
   expect_true(all(s$adev$change == 0))
   x <- c(rep(0, 3000), rep(1, 3000))
-  s <- series_effects(x, 100, remove = "all")
+  s <- detect_series_effects(x, 100, remove = "all")
   expect_identical(s$table$kind, "steps")
   expect_identical(s$table$index, 3001L)
   expect_equal(s$table$size, 1)
@@ -242,7 +242,7 @@ test_that("a transient whose return is weak is paired, and a bias step stays a s
     set.seed(seed)
     x <- rnorm(2e4, sd = 0.1)
     x[5001:7000] <- x[5001:7000] + 0.05        # 20 s at 50 s
-    tb <- series_effects(x, 100, kinds = c("steps", "transients"))$table
+    tb <- detect_series_effects(x, 100, kinds = c("steps", "transients"))$table
     expect_false("steps" %in% tb$kind)
     if (identical(tb$kind, "transients")) {
       found <- found + 1L
@@ -252,8 +252,35 @@ test_that("a transient whose return is weak is paired, and a bias step stays a s
     set.seed(seed + 100)
     y <- rnorm(2e4, sd = 0.1)
     y[12001:2e4] <- y[12001:2e4] + 0.08
-    expect_identical(series_effects(y, 100, kinds = c("steps", "transients"))$table$kind,
+    expect_identical(detect_series_effects(y, 100, kinds = c("steps", "transients"))$table$kind,
                      "steps")
   }
   expect_gte(found, 5L)
+})
+
+test_that("series_reading_bias(): what outliers left in do to N, against the clean series' Allan deviation", {
+  n <- 1e5
+  freq <- 100
+  clean <- gen_white_walk(n, rw = 1e-5, seed = 121)
+  set.seed(121)
+  at <- sample.int(n, 200)
+  x <- clean
+  x[at] <- x[at] + sample(c(-1, 1), 200, TRUE) * 1.5
+  se <- detect_series_effects(x, freq, kinds = "spikes")
+  b <- series_reading_bias(se)
+  expect_identical(b, se$reading_bias)
+  expect_setequal(b$term, c("N", "B", "K"))
+  expect_identical(unique(b$kind), "spikes")
+  # independent reference: ADEV at 1 s with the outliers over the clean series'
+  ref <- allan(x, freq, taus = I(1))$adev / allan(clean, freq, taus = I(1))$adev - 1
+  expect_gt(ref, 0.02)
+  expect_equal(b$bias_change[b$term == "N"], ref, tolerance = 0.05)
+  # readings' own taus are used
+  rb <- series_reading_bias(se, data.frame(term = c("N", "K"), tau = c(0.1, 100)))
+  expect_equal(rb$tau[rb$term == "N"], 0.1)
+  # removed kinds bias nothing
+  expect_equal(nrow(series_reading_bias(detect_series_effects(x, freq, kinds = "spikes",
+                                                       remove = "spikes"))), 0L)
+  expect_error(series_reading_bias(list()), class = "allanvar_error_argument")
+  expect_error(series_reading_bias(se, readings = 1), class = "allanvar_error_argument")
 })

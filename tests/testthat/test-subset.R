@@ -53,7 +53,7 @@ test_that("three_cornered_hat() and a read curve keep their attributes under a r
   tau <- c(0.1, 1, 10)
   utils::write.table(cbind(tau, matrix(0.01 / sqrt(tau), 3, 6)), f,
                      row.names = FALSE, col.names = FALSE)
-  cv <- read_avr_curve(f)
+  cv <- read_allan_variance_ros_curve(f)
   g <- cv[cv$channel == "gyro_x", ]
   expect_s3_class(g, "tool_curve")
   expect_identical(attr(g, "conventions"), attr(cv, "conventions"))

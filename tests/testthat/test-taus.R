@@ -37,10 +37,11 @@ test_that("points per decade and taus in seconds", {
   expect_equal(a$m, c(1L, 3L, 10L))
   expect_equal(a$tau, c(0.1, 0.3, 1))
   expect_equal(allan(y, 10, taus = I(2.5))$m, 25L)
-  expect_error(allan(y, 10, taus = 2.5), "points per decade")
+  expect_error(allan(y, 10, taus = 2.5), "points per decade",
+    class = "allanvar_error")
   expect_warning(allan(y, 10, taus = c(0.01, 1)), "were dropped")
   expect_error(suppressWarnings(allan(rnorm(4), 1, taus = I(10), type = "hadamard")),
-               "No averaging time")
+               "No averaging time", class = "allanvar_error")
 })
 
 test_that("the estimator table is defined once (src/types.h) and mirrored in R", {
@@ -60,10 +61,13 @@ test_that("the sums kernel validates its options struct once", {
   expect_type(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, ok), "list")
   bad <- ok
   bad$type <- 99L
-  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "unknown estimator")
+  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "unknown estimator",
+    class = "Rcpp::exception")
   bad <- ok
   bad$rate <- NA
-  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "TRUE or FALSE")
+  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "TRUE or FALSE",
+    class = "Rcpp::exception")
   bad <- allan_opts("overlapping", rate = TRUE, octave = TRUE)
-  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "octave")
+  expect_error(allan_sums_cpp(rnorm(10), 10, 1, 9, 1, bad), "octave",
+    class = "Rcpp::exception")
 })

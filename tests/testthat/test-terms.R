@@ -113,17 +113,24 @@ test_that("catalogue listing and argument checks", {
   expect_setequal(unique(tt$component), c("av", "series"))
   expect_equal(tt$unit[tt$parameter == "N"], "u*sqrt(s)")
   expect_equal(tt$slope[tt$term == "K"], 0.5)
-  expect_error(av_model(-1, c(N = 1)), "`tau`")
-  expect_error(av_model(1, c(N = 1), freq = -1), "`freq`")
-  expect_error(av_model(1, c(X = 1)), "unknown term")
-  expect_error(av_model(1, c(gm1.sigma = 1)), "gm1.tc")
-  expect_error(av_model(1, c(N = -1)), "non-negative")
-  expect_error(av_model(1, 1), "`coef`")
+  expect_error(av_model(-1, c(N = 1)), "`tau`",
+    class = "allanvar_error_argument")
+  expect_error(av_model(1, c(N = 1), freq = -1), "`freq`",
+    class = "allanvar_error_argument")
+  expect_error(av_model(1, c(X = 1)), "unknown term",
+    class = "allanvar_error_argument")
+  expect_error(av_model(1, c(gm1.sigma = 1)), "gm1.tc",
+    class = "allanvar_error_argument")
+  expect_error(av_model(1, c(N = -1)), "non-negative",
+    class = "allanvar_error_argument")
+  expect_error(av_model(1, 1), "`coef`", class = "allanvar_error_argument")
   expect_equal(coef_layout(c("gm", "N", "sinusoid", "gm"))$name,
                c("N", "gm1.sigma", "gm1.tc", "gm2.sigma", "gm2.tc",
                  "sinusoid1.amp", "sinusoid1.f0"))
-  expect_error(check_terms(c("N", "N")), "only gm and sinusoid")
-  expect_error(check_terms("Z"), "unknown term")
+  expect_error(check_terms(c("N", "N")), "only gm and sinusoid",
+    class = "allanvar_error_argument")
+  expect_error(check_terms("Z"), "unknown term",
+    class = "allanvar_error_argument")
 })
 
 test_that("av_model() errors are classed and worded", {

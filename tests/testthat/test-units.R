@@ -52,11 +52,16 @@ test_that("spellings are normalised and conversions round-trip", {
 })
 
 test_that("bad units and mismatched kinds stop with a clear message", {
-  expect_error(convert_units(1, "deg/s", "m/s^2"), "same quantity")
-  expect_error(convert_units(1, "deg/sqrt(h)", "deg/h"), "same quantity")
-  expect_error(convert_units(1, "furlong", "rad/s"), "`from`.*not a known")
-  expect_error(convert_units("1", "g", "mg"), "`x` must be numeric")
-  expect_error(av_units("magnetometer"), "`sensor`")
+  expect_error(convert_units(1, "deg/s", "m/s^2"), "same quantity",
+    class = "allanvar_error_units")
+  expect_error(convert_units(1, "deg/sqrt(h)", "deg/h"), "same quantity",
+    class = "allanvar_error_units")
+  expect_error(convert_units(1, "furlong", "rad/s"), "`from`.*not a known",
+    class = "allanvar_error_units")
+  expect_error(convert_units("1", "g", "mg"), "`x` must be numeric",
+    class = "allanvar_error_argument")
+  expect_error(av_units("magnetometer"), "`sensor`",
+    class = "allanvar_error_argument")
 })
 
 test_that("av_units() lists every unit with its SI unit", {

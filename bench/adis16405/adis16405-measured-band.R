@@ -13,8 +13,8 @@
 # only; this is an evaluation, not a catalogue entry.
 #
 # Run from the package root (installed build, fast):
-#   ADIS_LIB=/tmp/libadis Rscript data-raw/adis16405-measured-band.R
-# Output: data-raw/adis16405-measured-band.txt
+#   ADIS_LIB=/tmp/libadis Rscript bench/adis16405/adis16405-measured-band.R
+# Output: bench/adis16405/adis16405-measured-band.txt
 
 lib <- Sys.getenv("ADIS_LIB", "")
 if (nzchar(lib)) library(allanvar, lib.loc = lib) else pkgload::load_all(".", quiet = TRUE)
@@ -24,7 +24,7 @@ options(allanvar.threads = 1L)
 
 F4 <- function(x) 3 * x / 8 - sin(2 * x) / 4 + sin(4 * x) / 32
 measured_band <- function(x, freq, b, seg = 512L, degree = 2L) {
-  w <- welch_psd_lin(x - mean(x), freq, seg)
+  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
   wd <- b$f_to - b$f_from
   fl <- (w$f > b$f_from - wd & w$f < b$f_from) |
     (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))
@@ -40,7 +40,7 @@ band_av <- function(mm, tau0, mb) vapply(mm, function(m) {
   2 * sum(mb$S * I / (m * sin(pi * mb$f * tau0))^2)
 }, 0)
 
-out <- "data-raw/adis16405-measured-band.txt"
+out <- "bench/adis16405/adis16405-measured-band.txt"
 cat("Measured-band evaluation on the ADIS16405 z gyros (", format(Sys.time(), "%Y-%m-%d"), ")\n",
     sep = "", file = out)
 for (k in 1:3) {

@@ -1,10 +1,10 @@
 # Issue 9's Done-when checks on the 18 measured ADIS16405 axes, one axis at
 # a time: the loop from N, B, K with the raw data given, and one row per
-# axis appended to data-raw/adis16405-check.txt as soon as it is done (so
+# axis appended to bench/adis16405/adis16405-check.txt as soon as it is done (so
 # that a partial run on a loaded machine still reports what it measured).
 # Derived figures only; the recordings stay in ../shared/data.
 #
-# Run from the package root:  Rscript data-raw/adis16405-check.R
+# Run from the package root:  Rscript bench/adis16405/adis16405-check.R
 # (data-raw/adis16405.R sources this file for check_axis() alone).
 
 # Issue 9's Done-when checks for one axis: contradicted steps, the filter
@@ -54,7 +54,7 @@ if (!exists("adis_check_define_only")) {
   shared <- Sys.getenv("ALLANVAR_SHARED_DATA", "../shared/data")
   if (!dir.exists(shared)) shared <- "/work/shared/data"
   options(allanvar.threads = 1L)
-  out <- "data-raw/adis16405-check.txt"
+  out <- "bench/adis16405/adis16405-check.txt"
   # every sensor type early, then the rest
   order <- expand.grid(unit = 1:3, axis = c("gyro_x", "accel_z", "gyro_z",
                                             "accel_x", "gyro_y", "accel_y"),

@@ -2,8 +2,8 @@
 # with the datasheet model N + B + K and with the sensor's filter in place
 # of N (issue 9, phase 2 start): filter + B + K + gm, plus a resonance on
 # the z gyroscopes and a sinusoid on the accelerometers (the effects the raw
-# data show, data-raw/adis16405-study.md). No raw data needed.
-#   Rscript data-raw/adis16405-filter-fits.R     (about 3 minutes)
+# data show, bench/adis16405/adis16405-study.md). No raw data needed.
+#   Rscript bench/adis16405/adis16405-filter-fits.R     (about 3 minutes)
 pkgload::load_all(".", quiet = TRUE)
 data(adis16405_av)
 rows <- list()
@@ -43,4 +43,4 @@ for (k in 1:3) for (axis in c("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y"
 tab <- do.call(rbind, rows)
 print(tab, row.names = FALSE)
 writeLines(utils::capture.output(print(tab, row.names = FALSE)),
-           "data-raw/adis16405-filter-fits.txt")
+           "bench/adis16405/adis16405-filter-fits.txt")

@@ -1,4 +1,4 @@
-# Spectral lines and harmonic sets. Series built here with base R (sin,
+# Spectral lines and harmonic sets (R/spectrum.R). Series built here with base R (sin,
 # sign, rnorm, cumsum), not with the package's simulator.
 
 test_that("a square wave is one source: f, 3f, 5f, each within the resolution", {
@@ -9,7 +9,7 @@ test_that("a square wave is one source: f, 3f, 5f, each within the resolution", 
   f <- 0.73
   x <- rnorm(n, sd = 0.5) + 0.1 * sign(sin(2 * pi * f * t + 1)) +
     cumsum(rnorm(n, sd = 1e-3))
-  l <- harmonic_sets(find_lines(x, freq))
+  l <- harmonic_sets(spectral_lines(x, freq))
   res <- attr(l, "resolution")
   for (k in c(1, 3, 5)) {
     j <- match_line(k * f, l)
@@ -39,14 +39,14 @@ test_that("a resonance (a broad band) is not read as a line", {
   u <- rnorm(n)
   z <- as.numeric(stats::filter(u, c(2 * r * cos(w0), -r^2), method = "recursive"))
   x <- rnorm(n) + z / stats::sd(z) * 0.8
-  l <- find_lines(x, freq)
+  l <- spectral_lines(x, freq)
   expect_false(any(l$kind == "line" & abs(l$f0 - 20) < 3))
   b <- find_bands(x, freq)
   expect_equal(nrow(b), 1L)
   expect_equal(b$f_center, 20, tolerance = 0.05)
   # a real line beside the band survives; bins of the band do not
   y <- x + 0.1 * sin(2 * pi * 7.3 * seq_len(n) / freq)
-  l <- lines_outside_bands(find_lines(y, freq), find_bands(y, freq))
+  l <- lines_outside_bands(spectral_lines(y, freq), find_bands(y, freq))
   expect_false(is.na(match_line(7.3, l)))
   expect_false(any(l$f0 > b$f_from & l$f0 < b$f_to))
 })
@@ -57,7 +57,7 @@ test_that("white plus random walk shows no line in 10 seeds (at most one false a
     set.seed(100 + seed)
     n <- 5e4
     x <- rnorm(n) + cumsum(rnorm(n, sd = 0.01))
-    hits <- hits + (nrow(find_lines(x, 100)) > 0L)
+    hits <- hits + (nrow(spectral_lines(x, 100)) > 0L)
   }
   expect_lte(hits, 1L)
 })
@@ -94,7 +94,7 @@ test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinu
   x <- rnorm(n, sd = 0.1) + gm + 0.03 * sin(2 * pi * 0.2 * t + 0.4)
   # the line hides the exponential ACF ...
   expect_true(is.na(acf_exponential(x, freq, 5)$tc))
-  l <- find_lines(x, freq)
+  l <- spectral_lines(x, freq)
   expect_false(is.na(match_line(0.2, l)))
   y <- remove_lines(x, freq, l$f0[l$kind == "line"])
   # ... which shows once the line is taken out
@@ -102,7 +102,7 @@ test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinu
   expect_equal(a$tc, 5, tolerance = 0.3)
   expect_gt(a$z, 5)
   # and the line is gone from the periodogram
-  expect_true(is.na(match_line(0.2, find_lines(y, freq))))
+  expect_true(is.na(match_line(0.2, spectral_lines(y, freq))))
 })
 
 test_that("line_sums() (phase rotation in blocks) equals the sums of sin and cos", {

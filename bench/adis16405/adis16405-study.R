@@ -6,8 +6,8 @@
 # decide which effects the catalogue needs.
 #
 # Reads ../shared/data (not shipped) at run time; writes only derived
-# figures to data-raw/adis16405-study.txt.
-#   Rscript data-raw/adis16405-study.R        (about 2 minutes)
+# figures to bench/adis16405/adis16405-study.txt.
+#   Rscript bench/adis16405/adis16405-study.R        (about 2 minutes)
 pkgload::load_all(".", quiet = TRUE)
 shared <- Sys.getenv("ALLANVAR_SHARED_DATA", "../shared/data")
 if (!dir.exists(shared)) shared <- "/work/shared/data"
@@ -34,13 +34,13 @@ white_level <- function(av) {
 
 rows <- list()
 line_rows <- list()
-out <- file("data-raw/adis16405-study.txt", "w")
+out <- file("bench/adis16405/adis16405-study.txt", "w")
 say <- function(...) {
   txt <- sprintf(...)
   cat(txt, "\n", sep = "")
   writeLines(txt, out)
 }
-say("# ADIS16405: what the raw data show (data-raw/adis16405-study.R, %s)", format(Sys.Date()))
+say("# ADIS16405: what the raw data show (bench/adis16405/adis16405-study.R, %s)", format(Sys.Date()))
 for (k in 1:3) {
   mat <- readRDS(file.path(shared, sprintf("adis16405_unit%d.rds", k)))
   freq <- attr(mat, "freq")
@@ -53,7 +53,7 @@ for (k in 1:3) {
     bw_ma <- if (!is.null(fe$start$ma)) filter_bandwidth(filter_spec("ma", L = fe$start$ma$L), 1 / freq) else NULL
     bw_lp1 <- if (!is.null(fe$start$lp1)) filter_bandwidth(filter_spec("lp1", fc = fe$start$lp1$fc, freq = freq), 1 / freq) else NULL
     bd <- find_bands(x, freq)
-    ln <- harmonic_sets(lines_outside_bands(find_lines(x, freq), bd))
+    ln <- harmonic_sets(lines_outside_bands(spectral_lines(x, freq, max_lines = 20L), bd))
     ln <- visible_lines(ln, 1 / freq, max(av$tau), freq)
     sp <- detect_spikes(x, freq)
     st <- detect_steps(remove_spikes(x, sp), freq)
@@ -109,7 +109,7 @@ writeLines(utils::capture.output(print(tab, row.names = FALSE)), out)
 print(tab, row.names = FALSE)
 say("")
 say("## Spectral lines (Welch, resolution %.4f Hz; kind line/band; source = harmonic set)",
-    attr(find_lines(rnorm(1e6), 100), "resolution"))
+    attr(spectral_lines(rnorm(1e6), 100), "resolution"))
 ls <- lines[, c("unit", "axis", "f0", "amp", "ratio", "kind", "source", "harmonic",
                 "pattern", "visible")]
 ls$f0 <- signif(ls$f0, 4)

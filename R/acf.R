@@ -1,0 +1,76 @@
+# Autocorrelation of a raw rate series, in one place: the sample ACF at a
+# few lags or many, block means, the least-squares line taken out, and the
+# exponential ACF of a Gauss-Markov process read from block means.
+
+# Sample autocorrelation of x (mean removed) at lags 0..max_lag: direct
+# sums (C++, src/evidence.cpp) for a few dozen lags, which beat two FFTs of
+# n, otherwise an FFT zero-padded to n + max_lag (enough for lags up to
+# max_lag: the circular products never wrap into them). O(n log n).
+acf_lags <- function(x, max_lag) {
+  n <- length(x)
+  x <- x - mean(x)
+  if (max_lag <= 64L) {
+    a <- acf_sums(x, as.integer(max_lag))
+    return(a / a[1L])
+  }
+  nfft <- stats::nextn(n + max_lag + 1L)
+  f <- stats::fft(c(x, numeric(nfft - n)))
+  a <- Re(stats::fft(Mod(f)^2, inverse = TRUE))[seq_len(max_lag + 1L)] / nfft
+  a / a[1L]
+}
+
+# Means of consecutive blocks of m samples (the last partial block dropped).
+block_means <- function(x, m) {
+  m <- as.integer(m)
+  nb <- length(x) %/% m
+  if (m <= 1L) return(x)
+  # .colMeans reads the first nb * m values in place (no copy, no matrix)
+  .colMeans(x, m, nb)
+}
+
+# x minus its least-squares line on 1..n (the residuals of
+# lm.fit(cbind(1, t), x) in closed form: centred t is orthogonal to 1), in
+# two passes over x in C++ (src/evidence.cpp) instead of five vectors of n.
+detrend_linear <- function(x) detrend_line(as.double(x))
+
+# Exponential ACF (a Gauss-Markov process) near a correlation time `tc` (s):
+# block-average so that white noise shrinks and the GM stays, detrend, and
+# fit log ACF on lag. Returns tc estimate, the lag-1 ACF and its z-score.
+# `cache`: NULL or an environment (avrefine()'s, one per call and series)
+# in which the ACF of the block means is kept by block size m, so that the
+# checks of many candidate Tc that share m read the series once.
+acf_exponential <- function(x, freq, tc, cache = NULL) {
+  m <- max(1L, floor(tc * freq / 8))
+  key <- paste0("acf_exponential.", m)
+  hit <- if (!is.null(cache)) cache[[key]]
+  if (is.null(hit)) {
+    b <- block_means(x, m)
+    nb <- length(b)
+    r <- NULL
+    if (nb >= 40L) {
+      b <- detrend_linear(b)
+      r <- acf_lags(b, min(nb - 2L, 48L))[-1L]
+    }
+    hit <- list(nb = nb, r = r)
+    if (!is.null(cache)) cache[[key]] <- hit
+  }
+  nb <- hit$nb
+  if (nb < 40L) return(list(tc = NA_real_, r1 = NA_real_, z = NA_real_, m = m))
+  r <- hit$r
+  max_lag <- length(r)
+  lag <- seq_len(max_lag)
+  # ACF = a exp(-lag m tau0 / Tc) + (c + d lag): the linear part absorbs the
+  # slowly falling ACF of flicker and random walk over a few Tc. Tc is
+  # profiled on a grid within a factor 5 of the hint; a minimum on the
+  # grid's edge means Tc is not identified.
+  grid <- tc * 10^seq(-0.7, 0.7, by = 0.02)
+  rss <- vapply(grid, function(g) {
+    X <- cbind(exp(-lag * m / (freq * g)), 1, lag)
+    sum(stats::lm.fit(X, r)$residuals^2)
+  }, 0)
+  k <- which.min(rss)
+  X <- cbind(exp(-lag * m / (freq * grid[k])), 1, lag)
+  a <- unname(stats::lm.fit(X, r)$coefficients[1L])
+  est <- if (k > 1L && k < length(grid) && is.finite(a) && a > 0) grid[k] else NA_real_
+  list(tc = est, r1 = r[1L], amp = a, z = a * sqrt(nb), m = m)
+}

@@ -1,0 +1,89 @@
+# The loop's refits: the arguments of a refit (explicit settings, start and
+# held values), one refit with its conditions kept, and the refit of a
+# model with one more term from two starts.
+
+# The arguments of a refit of `fit` with `terms`: the settings, start values
+# (given ones first, then the fit's nonlinear estimates) and held values.
+refit_args <- function(fit, terms, settings, start = NULL, hold = NULL) {
+  args <- c(list(av = fit, terms = terms), settings)
+  names_new <- coef_layout(terms)$name
+  st <- c(settings$start, start)
+  prev <- stats::coef(fit)[fit$layout$role == "nonlinear"]
+  prev <- prev[names(prev) %in% names_new & !names(prev) %in% names(st)]
+  st <- c(st, prev)
+  args$start <- if (length(st)) st else NULL
+  if (length(hold)) args$fixed <- c(settings$fixed, hold)
+  # values pinned for a term the new model no longer has (a replaced one)
+  if (length(args$fixed)) args$fixed <- args$fixed[names(args$fixed) %in% names_new]
+  if (!length(args$fixed)) args$fixed <- NULL
+  if (length(args$fixed)) {
+    args$fixed <- args$fixed[!duplicated(names(args$fixed))]
+    if (length(args$start)) {
+      args$start <- args$start[!names(args$start) %in% names(args$fixed)]
+      if (!length(args$start)) args$start <- NULL
+    }
+  }
+  args
+}
+
+# Run one refit. Returns list(fit, conditions): `fit` is NULL when the refit
+# failed or has no degrees of freedom left; `conditions` lists, in the order
+# they came, each error or (muffled) warning as list(condition, stage), for
+# the caller to record (record_conditions()).
+try_refit <- function(args, stage) {
+  log <- new.env(parent = emptyenv())
+  log$conditions <- list()
+  keep <- function(cnd) {
+    log$conditions[[length(log$conditions) + 1L]] <- list(condition = cnd, stage = stage)
+  }
+  res <- withCallingHandlers(
+    tryCatch(do.call(avfit, args), error = function(e) {
+      keep(e)
+      NULL
+    }),
+    warning = function(w) {
+      keep(w)
+      invokeRestart("muffleWarning")
+    })
+  if (!is.null(res) && !is.finite(res$chi2)) {
+    keep(simpleCondition("no degrees of freedom left for chi2"))
+    res <- NULL
+  }
+  list(fit = res, conditions = log$conditions)
+}
+
+# Refit the curve with one more term. avfit() profiles the nonlinear
+# parameters on its own grid; when the tracing gives a start value for the
+# new term's nonlinear parameters the refit is also tried from there, and
+# the better of the two is kept (`fit` NULL when both fail). Returns
+# list(fit, conditions) as try_refit() does.
+refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
+                       good_enough = NULL) {
+  one <- function(start, stage) {
+    try_refit(refit_args(fit, terms, settings, start = start, hold = hold), stage)
+  }
+  first <- one(NULL, "screen")
+  best <- first$fit
+  conditions <- first$conditions
+  if (!is.null(best) && !is.null(good_enough) && good_enough(best)) {
+    return(list(fit = best, conditions = conditions))
+  }
+  lab <- new_label(fit$terms, effect)
+  sp <- split_term(effect)
+  e <- effect_entry(sp$kind, sp$variant)
+  nl <- e$params$name[e$params$role == "nonlinear"]
+  ok <- vapply(nl, function(p) {
+    v <- init[[p]]
+    is.numeric(v) && length(v) == 1L && is.finite(v) && v > 0
+  }, logical(1))
+  if (any(ok)) {
+    st <- unlist(init[nl[ok]])
+    names(st) <- coef_names(e, lab)[match(nl[ok], e$params$name)]
+    alt <- one(st, "screen from the traced start")
+    conditions <- c(conditions, alt$conditions)
+    if (!is.null(alt$fit) && (is.null(best) || alt$fit$objective < best$objective)) {
+      best <- alt$fit
+    }
+  }
+  list(fit = best, conditions = conditions)
+}

@@ -1,0 +1,178 @@
+# One candidate trial of a step: the refit with the candidate added, the
+# rules it must pass (it pays by the criterion and chi2, explains something,
+# is a valid instance, is not contradicted by the raw data, leaves the
+# effects accepted earlier as the raw data confirmed them), the free and
+# held refits that may rescue a screened instance, and its score.
+
+# Returns list(st, cand): the state (failures and rejections recorded) and
+# the candidate (NULL when the trial does not pay or is rejected).
+# `nl_now`: the current model's free nonlinear values.
+screen_trial <- function(st, tr, nl_now) {
+  cur <- st$current
+  hold_now <- st$hold
+  c0 <- st$c0
+  min_gain <- st$args$min_gain
+  pen <- refine_penalty(st)
+  crit <- function(f) refine_crit(st, f)
+  crit_s <- function(f) crit(f) + pen * length(hold_now)
+  # Parameters the raw data measure better than the curve (a line's
+  # frequency from the periodogram) are pinned there; a value already
+  # pinned in the model (that line is in it) is not proposed twice.
+  pin <- pin_values(cur$terms, tr$effect, tr$pin[[1L]])
+  if (length(pin) && any(vapply(pin, function(v) any(abs(st$settings$fixed - v) <=
+        1e-9 * abs(v)), logical(1)))) {
+    return(list(st = st, cand = NULL))
+  }
+  r <- refit_with(cur, model_terms(cur$terms, tr$effect), tr$effect,
+                  tr$init[[1L]], st$settings, hold = c(hold_now, pin),
+                  good_enough = function(f) crit_s(f) < c0 - min_gain)
+  st$failures <- record_conditions(st$failures, r$conditions, st$step, tr$effect)
+  new <- r$fit
+  if (is.null(new)) return(list(st = st, cand = NULL))
+  c1 <- crit_s(new)
+  pays <- is.finite(c1) && c1 < c0 - min_gain && new$chi2 < 0.9 * cur$chi2
+  if (!pays) return(list(st = st, cand = NULL))
+  lab <- new_label(cur$terms, tr$effect)
+  # An added term that explains (almost) nothing anywhere is a refit
+  # artefact, not an effect.
+  if (max_share(new, lab) < 0.02) return(list(st = st, cand = NULL))
+  tau <- cur$data$tau
+  jd <- judge_instance(st, new, tr$effect, lab, tau)
+  # A screened instance (others held) that fails is refitted once with
+  # everything free before it is rejected: held at the one-term
+  # compromise, a second GM lands at the wrong Tc.
+  if (!is.null(jd$why) && length(hold_now)) {
+    args <- refit_args(cur, new$terms, st$settings,
+                       start = stats::coef(new)[new$layout$role == "nonlinear"],
+                       hold = pin)
+    r <- state_refit(st, args, "free refit of a rejected screen", tr$effect)
+    st <- r$st
+    free <- r$fit
+    if (!is.null(free) && is.finite(crit(free)) && crit(free) < c0 - min_gain &&
+        free$chi2 < 0.9 * cur$chi2) {
+      jf <- judge_instance(st, free, tr$effect, lab, tau)
+      if (is.null(jf$why)) {
+        new <- free
+        c1 <- crit(free)
+        jd <- jf
+      }
+    }
+  }
+  # A refit that moves effects accepted earlier to values the raw data
+  # contradict is tried once more with those effects' nonlinear values held
+  # where they were accepted (the rest free): the new effect is judged
+  # beside the earlier ones as the raw data confirmed them, charged for the
+  # held values as a screen is.
+  if (isTRUE(jd$moved)) {
+    broken <- earlier_broken(st, new)
+    keep <- nl_now[vapply(names(nl_now), function(nm) {
+      any(startsWith(nm, paste0(broken, ".")))
+    }, NA)]
+    if (length(keep)) {
+      args <- refit_args(cur, new$terms, st$settings,
+                         start = stats::coef(new)[new$layout$role == "nonlinear"],
+                         hold = c(keep, pin))
+      r <- state_refit(st, args, "refit with earlier effects held", tr$effect)
+      st <- r$st
+      held <- r$fit
+      c_held <- if (is.null(held)) Inf else crit(held) + pen * length(keep)
+      if (is.finite(c_held) && c_held < c0 - min_gain &&
+          held$chi2 < 0.9 * cur$chi2 && max_share(held, lab) >= 0.02) {
+        jh <- judge_instance(st, held, tr$effect, lab, tau)
+        if (is.null(jh$why)) {
+          new <- held
+          c1 <- c_held
+          jd <- jh
+        }
+      }
+    }
+  }
+  if (!is.null(jd$why)) {
+    st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, jd$why)
+    return(list(st = st, cand = NULL))
+  }
+  # raw-data support counts as a gain of min_gain
+  adj <- c1 - min_gain * isTRUE(jd$ev$support)
+  list(st = st, cand = list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
+                            params = jd$par, ev = jd$ev, pin = pin))
+}
+
+# An instance that is not a valid instance of its effect on this curve (a
+# sub-sample GM, a sinusoid the curve cannot see) is never accepted, however
+# well it bends the curve; nor one the raw data contradict, nor one whose
+# refit moves an effect accepted earlier to values the raw data contradict.
+# Returns list(par, why (NULL when it holds), ev, moved).
+judge_instance <- function(st, f, effect, label, tau) {
+  freq <- st$args$freq
+  par <- instance_params(stats::coef(f), f$layout, label)
+  why <- inadmissible(effect, par, tau, freq)
+  ev <- if (is.null(why)) raw_evidence(effect, as.list(par), st$raw,
+                                       diag_series(st$raw), freq)
+  if (is.null(why) && isFALSE(ev$support)) {
+    why <- paste("contradicted by the raw data:", ev$text)
+  }
+  moved <- FALSE
+  if (is.null(why) && !earlier_hold(st, f)) {
+    why <- "moves an effect accepted earlier to values the raw data contradict"
+    moved <- TRUE
+  }
+  list(par = par, why = why, ev = ev, moved = moved)
+}
+
+# A family's form (the sensor filter's moving average, first- or
+# second-order low-pass) was chosen against the model of the step it
+# entered at; the effects added since can change which form describes the
+# curve (a first-order low-pass chosen before the 0.55 Hz line ran to its
+# Nyquist bound). So it is chosen again: each other variant of the entry's
+# `family` refitted with everything free, started from the raw data's
+# values; the criterion chooses, and the new form must be admissible and
+# not contradicted by the raw data, nor move an effect accepted earlier to
+# values the raw data contradict. Returns list(st, swapped).
+rechoose_families <- function(st) {
+  if (!length(st$steps)) return(list(st = st, swapped = FALSE))
+  for (e in entries_with("family")) {
+    cur <- st$current
+    variants <- e$family$variants
+    fi <- cur$terms[split_term(cur$terms)$kind == e$name]
+    if (length(fi) != 1L) next
+    rest <- cur$terms[cur$terms != fi]
+    old_lab <- term_labels(cur$terms)[cur$terms == fi]
+    nl_cur <- stats::coef(cur)[cur$layout$role == "nonlinear"]
+    stage <- paste(e$name, "family chosen again")
+    swap <- NULL
+    for (j in seq_along(variants)) {
+      v <- family_term(e$name, variants, variants[j])
+      if (v == fi) next
+      lab <- new_label(rest, v)
+      s0 <- e$family$start(st$raw, variants[j])
+      start <- c(nl_cur[!startsWith(names(nl_cur), paste0(old_lab, "."))],
+                 if (length(s0)) stats::setNames(unlist(s0), paste0(lab, ".", names(s0))))
+      start <- start[names(start) %in% coef_layout(c(rest, v))$name]
+      args <- refit_args(cur, c(rest, v), st$settings, start = start)
+      r <- state_refit(st, args, stage, v, length(st$steps) + 1L)
+      st <- r$st
+      g <- r$fit
+      if (is.null(g) || !is.finite(refine_crit(st, g)) ||
+          refine_crit(st, g) >= min(refine_crit(st, cur), swap$crit %||% Inf) -
+            st$args$min_gain) next
+      par <- instance_params(stats::coef(g), g$layout, lab)
+      if (!is.null(inadmissible(v, par, g$data$tau, st$args$freq))) next
+      ev <- raw_evidence(v, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
+      if (isFALSE(ev$support) || !earlier_hold(st, g)) next
+      swap <- list(fit = g, crit = refine_crit(st, g), effect = v, label = lab,
+                   par = par, ev = ev)
+    }
+    if (!is.null(swap)) {
+      loc <- locate_signature(st$sig, swap$fit, swap$label)
+      evidence <- paste0("the ", e$name, " family chosen again on the final model (was ",
+                         fi, "); ", loc$text)
+      if (nzchar(swap$ev$text)) evidence <- paste0(evidence, "; raw data: ", swap$ev$text)
+      st$steps[[length(st$steps) + 1L]] <- step_row(
+        swap$effect, swap$label, loc, swap$par, evidence, swap$ev$support,
+        cur, swap$fit, refine_crit(st, cur), swap$crit)
+      st$current <- swap$fit
+      return(list(st = st, swapped = TRUE))
+    }
+  }
+  list(st = st, swapped = FALSE)
+}

@@ -1,0 +1,242 @@
+# The closed loop as named stages. avrefine() runs refine_stages() in
+# order on one state (R/refine-state.R); the `steps` stage runs
+# step_stages() once per step until a stage stops it. A new ability is one
+# more stage (or step stage) here: it takes the state and returns it.
+
+refine_stages <- function() {
+  list(prepare = stage_prepare,      # series pass, raw-data diagnostics
+       steps = stage_steps,          # add effects, one step at a time
+       rechoose = stage_rechoose,    # families chosen again on the final model
+       remaining = stage_remaining,  # residual structure no effect explains
+       trim = stage_trim,            # leave out a short end nothing describes
+       assemble = stage_assemble)    # the refined avfit object
+}
+
+step_stages <- function() {
+  list(trace = step_trace,           # signatures -> candidate trials
+       screen = step_screen,         # each trial refitted, judged, scored
+       settle = step_settle,         # none paid: choose families again or stop
+       refit = step_refit_winner,    # the winner with everything free
+       record = step_record)         # the accepted step
+}
+
+# ---- stages -------------------------------------------------------------------
+
+# Non-stationary effects (steps, warm-up, spikes) are read from the series
+# first (R/series.R); what the user asks to remove is taken out of the data
+# the loop then sees. Then the raw-data diagnostics, once per call.
+stage_prepare <- function(st) {
+  if (is.null(st$data)) return(st)
+  a <- st$args
+  if (is.null(a$series)) {
+    st$series <- detect_series_effects(st$data, a$freq, remove = a$remove)
+    if (length(st$series$removed)) st$data <- st$series$x
+  } else {
+    st$series <- a$series
+  }
+  st$raw <- refine_diagnostics(st$data, a$freq)
+  st
+}
+
+stage_steps <- function(st) {
+  for (step in seq_len(st$args$max_steps)) {
+    st$step <- step
+    st$flow <- "go"
+    for (s in step_stages()) {
+      st <- s(st)
+      if (st$flow != "go") break
+    }
+    if (st$flow == "stop") break
+  }
+  st
+}
+
+# The loop may have ended on a step that chose a family again.
+stage_rechoose <- function(st) rechoose_families(st)$st
+
+# What is left: residual structure no catalogue effect explained.
+stage_remaining <- function(st) {
+  cur <- st$current
+  st$remaining <- residual_signatures(cur$data$tau, stats::residuals(cur),
+                                      level = st$args$level)
+  st$unexplained <- unexplained_table(st$remaining, cur)
+  st
+}
+
+# Short tau cannot hijack the fit: when the model still cannot describe a
+# run of first points, they are left out of the fit (an automatic tau
+# range, with a message) so that they do not drive N to 0 or bend the
+# long-tau terms; the run stays listed as unexplained.
+stage_trim <- function(st) {
+  u <- st$unexplained
+  short <- u[u$kind == "short_end", , drop = FALSE]
+  if (!nrow(short)) return(st)
+  cur <- st$current
+  tau_all <- cur$data$tau
+  keep_from <- min(tau_all[tau_all > short$tau_to[1L]], Inf)
+  if (sum(tau_all >= keep_from) < length(cur$coefficients) + 3L) return(st)
+  step <- length(st$steps) + 1L
+  args <- refit_args(cur, cur$terms, st$settings,
+                     start = stats::coef(cur)[cur$layout$role == "nonlinear"])
+  args$tau_range <- c(keep_from, Inf)
+  r <- state_refit(st, args, "refit without the first points", "tau_range", step)
+  st <- r$st
+  trimmed <- r$fit
+  # without the first points a free nonlinear parameter may run off to
+  # values the raw data contradict (a resonance's tc to a pure tone); then
+  # the effects keep the nonlinear values the full curve gave them and only
+  # the amplitudes are refitted
+  if (is.null(trimmed) || !earlier_hold(st, trimmed)) {
+    nl <- stats::coef(cur)[cur$layout$role == "nonlinear"]
+    nl <- nl[!names(nl) %in% names(st$settings$fixed)]
+    if (length(nl)) {
+      args_h <- refit_args(cur, cur$terms, st$settings, hold = nl)
+      args_h$tau_range <- c(keep_from, Inf)
+      r <- state_refit(st, args_h, "refit without the first points, nonlinear held",
+                       "tau_range", step)
+      st <- r$st
+      trimmed <- r$fit
+    }
+  }
+  if (!is.null(trimmed) && earlier_hold(st, trimmed)) {
+    st$tau_range <- c(keep_from, max(tau_all))
+    message(sprintf(paste(
+      "avrefine(): no catalogue effect describes the first points (tau %s-%s s);",
+      "the model is fitted from tau = %s s on (see $unexplained)."),
+      format_num(short$tau_from[1L]), format_num(short$tau_to[1L]),
+      format_num(keep_from)))
+    st$current <- trimmed
+  }
+  st
+}
+
+stage_assemble <- function(st) {
+  fit <- st$fit
+  out <- st$current
+  all_steps <- Reduce(bind_steps, st$steps, fit$steps)
+  out$steps <- all_steps
+  out$unexplained <- st$unexplained
+  # Curve only: the accepted effects the raw data could not confirm.
+  new_steps_df <- all_steps[seq_len(nrow(all_steps)) > NROW(fit$steps), , drop = FALSE]
+  unconfirmed <- if (is.null(st$data)) new_steps_df$label else character()
+  out$series <- series_kept(st$series)
+  a <- st$args
+  out$refine <- list(candidates = a$candidates, criterion = a$criterion,
+                     min_gain = a$min_gain, level = a$level,
+                     diagnostics = diag_report(st$raw),
+                     remaining = st$remaining, start_terms = fit$terms,
+                     failures = st$failures, rejected = st$rejected,
+                     unconfirmed = unconfirmed, tau_range = st$tau_range,
+                     removed = if (is.null(st$series)) character() else st$series$removed)
+  class(out) <- unique(c("avrefine", class(out)))
+  st$result <- validate_avfit(out)
+  st
+}
+
+# ---- step stages ----------------------------------------------------------------
+
+# No residual threshold gates the search: with no signature every candidate
+# is still asked, and only the criterion decides (two GMs a decade apart
+# leave no run reaching `level` for the second one).
+step_trace <- function(st) {
+  cur <- st$current
+  tau <- cur$data$tau
+  st$sig <- residual_signatures(tau, stats::residuals(cur), level = st$args$level)
+  traced <- trace_candidates(tau, cur$data$avar, cur$data$fitted, st$sig,
+                             present = cur$terms, candidates = st$args$candidates,
+                             raw = st$raw)
+  st$trials <- candidate_trials(traced, cur$terms, st$args$candidates, st$sig)
+  if (!nrow(st$trials)) st$flow <- "stop"
+  st
+}
+
+# Screening: the model's existing nonlinear parameters are held at their
+# current values while candidates are compared (one 1-D profile each); the
+# winner is then refitted with everything free. The criterion of a screened
+# fit is put on the all-free scale by charging the held ones. When
+# screening finds nothing, the candidates are tried once more with all
+# nonlinear parameters free (slower, but catches effects that only pay
+# once the others may move). Traced candidates first; the others only when
+# none of those pays. (Without any residual signature, only the screening
+# pass is run.)
+step_screen <- function(st) {
+  cur <- st$current
+  st$c0 <- refine_crit(st, cur)
+  st$best <- NULL
+  nl_now <- stats::coef(cur)[cur$layout$role == "nonlinear"]
+  nl_now <- nl_now[!names(nl_now) %in% names(st$settings$fixed)]
+  holds <- if (length(nl_now) && nrow(st$sig)) list(nl_now, numeric(0))
+    else if (length(nl_now)) list(nl_now) else list(numeric(0))
+  trials <- st$trials
+  for (h in holds) {
+    st$hold <- h
+    for (tier in list(which(trials$traced), which(!trials$traced))) {
+      for (i in tier) {
+        r <- screen_trial(st, trials[i, ], nl_now)
+        st <- r$st
+        if (!is.null(r$cand) && (is.null(st$best) || r$cand$adj < st$best$adj)) {
+          st$best <- r$cand
+        }
+      }
+      if (!is.null(st$best)) return(st)
+    }
+  }
+  st
+}
+
+# Nothing paid: choose the families again on the current model; after a
+# change the loop goes on (the effects that pay may differ), else stops.
+step_settle <- function(st) {
+  if (!is.null(st$best)) return(st)
+  r <- rechoose_families(st)
+  st <- r$st
+  st$flow <- if (r$swapped) "next" else "stop"
+  st
+}
+
+# Refit the winner with the held nonlinear parameters free again (the new
+# one starts where screening put it); the evidence is read again at the
+# values the free refit gives, and a refit the raw data contradict is not
+# taken.
+step_refit_winner <- function(st) {
+  best <- st$best
+  if (length(best$pin)) st$settings$fixed <- c(st$settings$fixed, best$pin)
+  if (!length(st$hold)) return(st)
+  lay <- best$fit$layout
+  args <- refit_args(st$current, best$fit$terms, st$settings,
+                     start = stats::coef(best$fit)[lay$role == "nonlinear"])
+  effect <- best$trial$effect
+  r <- state_refit(st, args, "refit of the winner", effect)
+  st <- r$st
+  full <- r$fit
+  if (!is.null(full) && refine_crit(st, full) <= best$crit + 1e-6) {
+    p2 <- instance_params(stats::coef(full), full$layout, best$label)
+    ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)
+    if (!isFALSE(ev2$support) &&
+        is.null(inadmissible(effect, p2, st$current$data$tau, st$args$freq)) &&
+        earlier_hold(st, full)) {
+      st$best$fit <- full
+      st$best$crit <- refine_crit(st, full)
+      st$best$params <- p2
+      st$best$ev <- ev2
+    }
+  }
+  st
+}
+
+# Describe the effect where the fitted term actually sits, which may differ
+# from where the trial started.
+step_record <- function(st) {
+  best <- st$best
+  loc <- locate_signature(st$sig, best$fit, best$label)
+  evidence <- loc$text
+  if (nzchar(best$ev$text)) {
+    evidence <- paste0(evidence, "; raw data: ", best$ev$text,
+                       if (isFALSE(best$ev$support)) " (NOT supported by the raw data)")
+  }
+  st$steps[[length(st$steps) + 1L]] <- step_row(
+    best$trial$effect, best$label, loc, best$params, evidence, best$ev$support,
+    st$current, best$fit, st$c0, best$crit)
+  st$current <- best$fit
+  st
+}

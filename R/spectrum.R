@@ -1,0 +1,510 @@
+# The spectrum of a raw rate series, in one place: the Welch periodogram,
+# the running-median backgrounds, spectral lines (significant bins, their
+# harmonic sets, the band an Allan deviation curve can see, matching within
+# the resolution, removal from the series) and broad bands (a resonance's
+# bump: detection, Lorentzian fit, removal). Periodic disturbances and
+# narrow-band processes are read here for the catalogue's sinusoid,
+# resonance and band entries (R/effect-*.R).
+
+# ---- Welch periodogram --------------------------------------------------------
+
+# Welch periodogram (Hann, 50% overlap, segments demeaned), one-sided PSD
+# in u^2/Hz, in O(n log seg): the segments are the columns of one matrix
+# and mvfft transforms them together, two real segments per complex column
+# z = fft(a + i b), whose periodograms sum to (|z_k|^2 + |z_(seg-k)|^2) / 2.
+# The matrix is built and the squared moduli summed in C++
+# (src/evidence.cpp), one pass each, in chunks of columns that bound the
+# memory; the PSD is the R expression in the comments to rounding.
+# `detrend`: take the least-squares line out of x first (a linear trend
+# leaks into the lowest bins). Default `seg`: an eighth of the record, a
+# power of 2, at least 64.
+welch_psd <- function(x, freq, seg = NULL, detrend = TRUE) {
+  n <- length(x)
+  if (is.null(seg)) seg <- 2^floor(log2(max(n / 8, 64)))
+  seg <- as.integer(min(seg, 2^floor(log2(n))))
+  x <- if (detrend) detrend_linear(x) else as.double(x)
+  hop <- seg %/% 2L
+  starts <- seq.int(1L, n - seg + 1L, by = hop)
+  win <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
+  U <- sum(win^2)
+  half <- seg %/% 2L + 1L
+  acc <- numeric(half)
+  # an even number of columns per chunk keeps the pairs of segments
+  chunk <- 2L * max(1L, (2^21) %/% seg)
+  for (c0 in seq.int(1L, length(starts), by = chunk)) {
+    st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
+    # X <- matrix(x[outer(seq_len(seg) - 1L, st, `+`)], nrow = seg)
+    # X <- (X - rep(colMeans(X), each = seg)) * win
+    X <- welch_segments(x, st, win)
+    # acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
+    acc <- welch_accumulate(stats::mvfft(X), half, acc)
+  }
+  k <- length(starts)
+  p <- acc / k / (freq * U)
+  p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
+  # Welch EDF for Hann with 50% overlap (Percival & Walden): about 1.89 K
+  # for many segments.
+  nu <- 2 * k / (1 + 2 * 0.167^2 * (k - 1) / k)
+  list(f = (seq_len(half) - 1) * freq / seg, psd = p, nu = nu, seg = seg,
+       df = freq / seg, k = k)
+}
+
+# ---- backgrounds ----------------------------------------------------------------
+
+# Background of a log periodogram for line detection: a running median
+# with a window ~20% of the frequency (stats::runmed(lp, k, endrule =
+# "median") per octave band). Each band's median runs over the band and 2k
+# bins either side only, and the end rule is applied only at the ends of
+# the whole vector, in O(k) by smooth_ends(): the same values as a runmed()
+# of the whole vector per band, at O(nb) in all instead of O(nb) per band
+# plus smoothEnds()'s O(k^2).
+octave_background <- function(lp) {
+  nb <- length(lp)
+  bg <- rep(NA_real_, nb)
+  bands <- unique(c(2^(0:floor(log2(nb))), nb + 1))
+  for (b in seq_len(length(bands) - 1L)) {
+    lo <- bands[b]
+    hi <- bands[b + 1L] - 1L
+    k <- max(11L, 2L * floor(0.1 * lo) + 1L)
+    k <- min(k, 2L * floor((nb - 1L) / 2L) - 1L)
+    from <- max(1L, lo - 2L * k)
+    to <- min(nb, hi + 2L * k)
+    rm <- stats::runmed(lp[from:to], k, endrule = "keep")
+    rm <- smooth_ends(rm, k, left = from == 1L, right = to == nb)
+    bg[lo:hi] <- rm[(lo:hi) - from + 1L]
+  }
+  bg
+}
+
+# stats::smoothEnds(y, k) (Tukey's end-point rule, the runmed() end rule
+# "median") at the chosen ends, in O(k log k) instead of O(k^2): the medians
+# of the growing windows y[1:j] (j = 3, 5, ..., k - 2) come from one sort
+# and a linked list from which the window's elements are removed, longest
+# window first, moving the median pointer by a step or two each time.
+smooth_ends <- function(y, k, left = TRUE, right = TRUE) {
+  k2 <- as.integer(k) %/% 2L
+  n <- length(y)
+  if (k2 < 1L) return(y)
+  sm <- y
+  med3 <- function(a, b, c) sort(c(a, b, c))[2L]
+  if (k2 >= 2L) {
+    J <- 2L * k2 - 1L
+    if (left) sm[2:k2] <- growing_medians(y[seq_len(J)])
+    if (right) sm[n - (2:k2) + 1L] <- growing_medians(y[n - seq_len(J) + 1L])
+  }
+  if (left) sm[1L] <- med3(y[1L], sm[2L], sm[2L] - 2L * (sm[3L] - sm[2L]))
+  if (right) sm[n] <- med3(y[n], sm[n - 1L], sm[n - 1L] - 2L * (sm[n - 2L] - sm[n - 1L]))
+  sm
+}
+
+# Medians of e[1:j] for j = 3, 5, ..., length(e) (odd), in that order.
+growing_medians <- function(e) {
+  J <- length(e)
+  o <- order(e)
+  rk <- integer(J)
+  rk[o] <- seq_len(J)
+  nxt <- c(seq_len(J - 1L) + 1L, NA_integer_)
+  prv <- c(NA_integer_, seq_len(J - 1L))
+  m <- (J + 1L) %/% 2L
+  lower <- m - 1L
+  out <- numeric((J - 1L) %/% 2L)
+  out[length(out)] <- e[o[m]]
+  L <- J
+  while (L > 3L) {
+    for (x in c(rk[L], rk[L - 1L])) {
+      if (x < m) {
+        lower <- lower - 1L
+      } else if (x == m) {
+        if (!is.na(nxt[m])) m <- nxt[m] else {
+          m <- prv[m]
+          lower <- lower - 1L
+        }
+      }
+      p <- prv[x]
+      q <- nxt[x]
+      if (!is.na(p)) nxt[p] <- q
+      if (!is.na(q)) prv[q] <- p
+    }
+    L <- L - 2L
+    target <- (L - 1L) %/% 2L
+    while (lower > target) { m <- prv[m]; lower <- lower - 1L }
+    while (lower < target) { m <- nxt[m]; lower <- lower + 1L }
+    out[(L - 1L) %/% 2L] <- e[o[m]]
+  }
+  out
+}
+
+# Running median of `v` with a window of `k(i)` bins centred on bin i, in
+# linear time: the median is taken exactly at anchor bins spaced a quarter
+# window apart (each costs O(window) by partial sorting) and interpolated
+# linearly between anchors. `width(i)` gives the (odd) window at bin i.
+sparse_running_median <- function(v, width) {
+  nb <- length(v)
+  anchors <- integer(0)
+  i <- 1L
+  while (i <= nb) {
+    anchors <- c(anchors, i)
+    i <- i + max(1L, width(i) %/% 4L)
+  }
+  if (anchors[length(anchors)] != nb) anchors <- c(anchors, nb)
+  med <- vapply(anchors, function(a) {
+    h <- width(a) %/% 2L
+    lo <- max(1L, a - h)
+    hi <- min(nb, a + h)
+    # keep the window full at the ends
+    if (hi - lo < 2L * h) {
+      if (lo == 1L) hi <- min(nb, lo + 2L * h) else lo <- max(1L, hi - 2L * h)
+    }
+    stats::median(v[lo:hi])
+  }, 0)
+  stats::approx(anchors, med, xout = seq_len(nb), rule = 2)$y
+}
+
+# ---- lines ------------------------------------------------------------------------
+
+#' Spectral lines of a rate series (internal)
+#'
+#' A Welch periodogram (Hann, 50% overlap; `seg` samples per segment,
+#' resolution `freq / seg`) is compared bin by bin with a running-median
+#' background (octave_background()); under the null a bin is
+#' \eqn{\chi^2_\nu/\nu} times the background (\eqn{\nu} the Welch EDF)
+#' and the p-value is Bonferroni-corrected over the bins. Adjacent
+#' significant bins form one line; its frequency is the parabolic
+#' interpolation of the log peak, its amplitude \eqn{\sqrt{2P}} from the
+#' power \eqn{P} above the background within +-3 bins. A narrow-band
+#' process (a resonance) raises many neighbouring bins instead: each line
+#' reports the share of the excess power within +-`band_bins` bins that
+#' sits in its main lobe (+-2 bins), `concentration`; a line has most of it
+#' (a Hann main lobe holds all of a sinusoid's power), a band very little.
+#' `kind` is "band" when the excess outside the lobe is significant and
+#' larger than the lobe's. The `max_lines` strongest are kept.
+#' @return data.frame f0, amp, ratio (peak over background), p_value,
+#'   significance, concentration, kind ("line"/"band"), with attributes
+#'   `resolution` (Hz) and `nyquist`.
+#' @noRd
+spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 5L,
+                           band_bins = 64L) {
+  w <- welch_psd(x, freq, seg)
+  p <- w$psd
+  nb <- length(p)
+  lp <- log(p)
+  nu <- w$nu
+  # Median of log(chi2_nu/nu) differs from log of the mean.
+  bg <- exp(octave_background(lp) - log(stats::qchisq(0.5, nu) / nu))
+  ratio <- p / bg
+  pval <- stats::pchisq(ratio * nu, nu, lower.tail = FALSE)
+  padj <- pmin(1, pval * (nb - 2))
+  cand <- which(padj < alpha)
+  # The lowest bins carry the red-noise roll-off, not resolvable lines.
+  cand <- cand[cand > 4 & cand < nb - 1]
+  lines <- data.frame(f0 = numeric(), amp = numeric(), ratio = numeric(),
+                      p_value = numeric(), significance = numeric(),
+                      concentration = numeric(), kind = character(),
+                      stringsAsFactors = FALSE)
+  if (length(cand)) {
+    groups <- split(cand, cumsum(c(1, diff(cand) > 3)))
+    rows <- lapply(groups, function(g) {
+      i <- g[which.max(p[g])]
+      # Parabolic interpolation of the log peak for a sub-bin f0.
+      a <- lp[i - 1L]; b <- lp[i]; c <- lp[i + 1L]
+      d <- 0.5 * (a - c) / (a - 2 * b + c)
+      if (!is.finite(d) || abs(d) > 0.5) d <- 0
+      f0 <- (i - 1 + d) * w$df
+      j <- max(2L, i - 3L):min(nb, i + 3L)
+      power <- sum(pmax(p[j] - bg[j], 0)) * w$df
+      sh <- line_shape(p, lp, i, nu, band_bins)
+      data.frame(f0 = f0, amp = sqrt(2 * power), ratio = ratio[i],
+                 p_value = padj[i], significance = -log10(max(padj[i], 1e-300)),
+                 concentration = sh$concentration, kind = sh$kind,
+                 stringsAsFactors = FALSE)
+    })
+    lines <- do.call(rbind, rows)
+    lines <- lines[order(-lines$ratio), , drop = FALSE]
+    lines <- utils::head(lines, max_lines)
+  }
+  rownames(lines) <- NULL
+  attr(lines, "resolution") <- w$df
+  attr(lines, "nyquist") <- freq / 2
+  lines
+}
+
+# Is the peak at bin i a line or the top of a band? The excess over the
+# median of a wide window (a band lifts the local running median, so that
+# one is not used) in the main lobe (+-2 bins) against the excess within
+# +-band_bins. Signed sums: the noise averages out. Outside the lobe, a
+# band's excess is significant (sd of a sum of Welch bins, inflated by 1.5
+# for the correlation of overlapping Hann segments) and larger than the
+# lobe's; a line's is not.
+line_shape <- function(p, lp, i, nu, band_bins) {
+  nb <- length(p)
+  lobe <- max(2L, i - 2L):min(nb, i + 2L)
+  wide <- max(2L, i - band_bins):min(nb, i + band_bins)
+  wbg <- exp(stats::median(lp[max(2L, i - 8L * band_bins):min(nb, i + 8L * band_bins)]) -
+               log(stats::qchisq(0.5, nu) / nu))
+  e_lobe <- sum(p[lobe] - wbg)
+  e_wide <- sum(p[wide] - wbg)
+  e_out <- e_wide - e_lobe
+  sd_out <- 1.5 * wbg * sqrt(2 * (length(wide) - length(lobe)) / nu)
+  band <- e_out > 3 * sd_out && e_out > e_lobe
+  list(concentration = if (e_wide > 0) min(1, max(0, e_lobe / e_wide)) else 1,
+       kind = if (band) "band" else "line")
+}
+
+# The frequencies an Allan deviation curve over [tau_min, tau_max] can see:
+# a sinusoid's first ADEV peak sits at 0.371/f0 and its nulls at k/f0, so
+# a line below 1/tau_max leaves no feature on the curve and one above
+# 1/(2 tau_min) is averaged away within the first cluster; never above the
+# Nyquist frequency.
+visible_band <- function(tau_min, tau_max, freq = NULL) {
+  hi <- 1 / (2 * tau_min)
+  if (!is.null(freq)) hi <- min(hi, freq / 2)
+  c(lo = 1 / tau_max, hi = hi)
+}
+
+# Index of the line in `lines` matching f0 within the periodogram's
+# resolution (`tol` bins of it), or NA: the nearest, or with `pick =
+# "strongest"` the one standing highest above its background.
+match_line <- function(f0, lines, tol = 1, pick = c("nearest", "strongest")) {
+  pick <- match.arg(pick)
+  if (!nrow(lines) || !is.finite(f0)) return(NA_integer_)
+  res <- attr(lines, "resolution")
+  if (is.null(res)) res <- 0
+  d <- abs(lines$f0 - f0)
+  j <- which(d <= tol * res)
+  if (!length(j)) return(NA_integer_)
+  if (pick == "strongest") j[which.max(lines$ratio[j])] else j[which.min(d[j])]
+}
+
+#' Harmonic sets of spectral lines (internal)
+#'
+#' Lines whose frequencies are whole multiples of a fundamental (within the
+#' periodogram's resolution, widened with the harmonic number since the
+#' fundamental's error multiplies) are one source. The fundamental is the
+#' lowest line that explains the most others; a set of odd harmonics only
+#' (f, 3f, 5f) is the signature of a square or triangle wave.
+#' @return `lines` with columns `source` (integer id), `harmonic` (the
+#'   multiple of the source's fundamental, 1 for the fundamental itself)
+#'   and `pattern` ("single", "odd", "all") per source.
+#' @noRd
+harmonic_sets <- function(lines, max_harmonic = 15L) {
+  n <- nrow(lines)
+  lines$source <- integer(n)
+  lines$harmonic <- integer(n)
+  lines$pattern <- character(n)
+  if (!n) return(lines)
+  res <- attr(lines, "resolution")
+  if (is.null(res)) res <- 0
+  free <- rep(TRUE, n)
+  ord <- order(lines$f0)
+  src <- 0L
+  for (i in ord) {
+    if (!free[i]) next
+    f1 <- lines$f0[i]
+    k <- lines$f0 / f1
+    kr <- round(k)
+    tol <- res * (0.75 + 0.25 * kr)
+    hit <- free & kr >= 1L & kr <= max_harmonic &
+      abs(lines$f0 - kr * f1) <= tol
+    hit[i] <- TRUE
+    src <- src + 1L
+    lines$source[hit] <- src
+    lines$harmonic[hit] <- kr[hit]
+    free[hit] <- FALSE
+    h <- kr[hit]
+    lines$pattern[hit] <- if (length(h) == 1L) "single" else
+      if (all(h %% 2L == 1L)) "odd" else "all"
+  }
+  # A harmonic number may be taken twice when two lines are within the
+  # tolerance of the same multiple; keep the stronger as that harmonic.
+  lines
+}
+
+# Lines an Allan-deviation curve over [tau_min, tau_max] can see (the
+# sinusoid entry's proposals): adds column `visible`.
+visible_lines <- function(lines, tau_min, tau_max, freq) {
+  b <- visible_band(tau_min, tau_max, freq)
+  lines$visible <- lines$f0 >= b[["lo"]] & lines$f0 <= b[["hi"]] &
+    lines$f0 < freq / 2
+  attr(lines, "visible_band") <- b
+  lines
+}
+
+# Lines that sit inside a broad band (find_bands()) are bins of that band,
+# not sinusoids: drop them.
+lines_outside_bands <- function(lines, bands) {
+  if (!nrow(lines) || !nrow(bands)) return(lines)
+  inside <- vapply(lines$f0, function(f) any(f >= bands$f_from & f <= bands$f_to), NA)
+  out <- lines[!inside, , drop = FALSE]
+  attr(out, "resolution") <- attr(lines, "resolution")
+  attr(out, "nyquist") <- attr(lines, "nyquist")
+  out
+}
+
+# The series with the given lines taken out: for each line, the least
+# squares sinusoid near its frequency (amplitude, phase and frequency fitted
+# over the whole record; the frequency refined within +-2 Fourier bins of
+# the record, 1/T, since a periodogram's f0 is good to a fraction of its
+# own coarser bin only) is subtracted. O(n) per evaluation, about 20 per
+# line. Raw-data checks of other effects (a Gauss-Markov process's
+# exponential ACF) then see no line.
+remove_lines <- function(x, freq, f0) {
+  if (!length(f0)) return(x)
+  n <- length(x)
+  t <- (seq_len(n) - 1) / freq
+  xc <- x - mean(x)
+  # least-squares amplitudes on sin and cos at f from their sums (C++,
+  # src/lines.cpp: no trig per sample, no n x 2 matrix); the fitted power
+  # sum(fitted^2) is b'X'y
+  amps <- function(f, y) {
+    m <- line_sums(y, f, freq)
+    xy <- m[4:5]
+    b <- solve(matrix(m[c(1L, 3L, 3L, 2L)], 2L), xy)
+    list(b = b, power = sum(b * xy))
+  }
+  bin <- freq / n
+  for (f in f0) {
+    o <- stats::optimize(function(g) -amps(g, xc)$power,
+                         c(max(bin / 2, f - 2 * bin), f + 2 * bin),
+                         tol = bin * 1e-3)
+    b <- amps(o$minimum, xc)$b
+    xc <- xc - b[1L] * sin(2 * pi * o$minimum * t) - b[2L] * cos(2 * pi * o$minimum * t)
+  }
+  as.numeric(xc) + mean(x)
+}
+
+# ---- bands ------------------------------------------------------------------------
+
+#' Spectral bands of a rate series (internal)
+#'
+#' Narrow-band processes found at a coarse resolution (`seg` samples per
+#' Welch segment, default 512). Pass 1: bins standing above a wide (about
+#' an octave) running-median background significantly (the Welch
+#' estimate's chi-square with its EDF, false-alarm rate `alpha` over the
+#' bins searched), in contiguous runs of at least `min_bins` bins. Pass 2: those runs, widened by their own width on each side, are
+#' masked and the background is re-read from the bins around them (a band
+#' lifts the median of its own window). Each band is then described by the
+#' resonance model fitted to the excess over the background by least
+#' squares (relative to the background): centre `f_center`, `tc` (its
+#' Lorentzian FWHM is 1/(pi tc), given as `width`), `power` (its variance,
+#' sigma^2) and `share` of the series' variance.
+#' Cost O(n log seg).
+#' @noRd
+find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
+  n <- length(x)
+  tau0 <- 1 / freq
+  seg <- as.integer(min(seg, 2^floor(log2(n / 8))))
+  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
+  p <- w$psd
+  nb <- length(p)
+  lp <- log(pmax(p, .Machine$double.xmin))
+  corr <- log(stats::qchisq(0.5, w$nu) / w$nu)
+  octave <- function(i) 2L * as.integer(max(8, 0.35 * i)) + 1L
+  edge <- octave(1L) %/% 2L + 1L
+  runs <- function(bg) {
+    ratio <- p / bg
+    pval <- stats::pchisq(ratio * w$nu, w$nu, lower.tail = FALSE)
+    # significant against the Welch estimate's chi-square (EDF nu), with a
+    # false-alarm rate alpha over the nb bins searched (Bonferroni); no
+    # fixed power ratio (a weak band over a long record is still a band)
+    hot <- ratio > 1 & pval * nb < alpha
+    # only where the background window is centred: at the low end it slides
+    # up in frequency and under-reads a falling spectrum (RW, GM, roll-off)
+    hot[seq_len(min(nb, edge))] <- FALSE
+    # one band is one run: a gap between hot runs shorter than min_bins, or
+    # than a quarter of the wider neighbour (a broad band's tail broken up
+    # by the noise), is closed, so one band is not fitted as two
+    r <- rle(hot)
+    nr <- length(r$values)
+    nbr <- pmax(c(0L, r$lengths[-nr]), c(r$lengths[-1L], 0L))
+    gap <- !r$values & (r$lengths < min_bins | 4L * r$lengths < nbr) &
+      seq_len(nr) > 1L & seq_len(nr) < nr
+    r$values[gap] <- TRUE
+    r <- rle(inverse.rle(r))
+    ends <- cumsum(r$lengths)
+    starts <- ends - r$lengths + 1L
+    keep <- which(r$values & r$lengths >= min_bins)
+    list(from = starts[keep], to = ends[keep], ratio = ratio)
+  }
+  bg <- exp(sparse_running_median(lp, octave) - corr)
+  r1 <- runs(bg)
+  if (length(r1$from)) {
+    mask <- rep(FALSE, nb)
+    for (k in seq_along(r1$from)) {
+      wd <- r1$to[k] - r1$from[k] + 1L
+      mask[max(1L, r1$from[k] - wd):min(nb, r1$to[k] + wd)] <- TRUE
+    }
+    keep <- which(!mask)
+    if (length(keep) > 10L) {
+      bg2 <- exp(sparse_running_median(lp[keep], octave) - corr)
+      bg <- exp(stats::approx(keep, log(bg2), xout = seq_len(nb), rule = 2)$y)
+    }
+  }
+  r2 <- runs(bg)
+  total <- stats::var(x)
+  rows <- lapply(seq_along(r2$from), function(k) {
+    j <- r2$from[k]:r2$to[k]
+    ex <- pmax(p[j] - bg[j], 0)
+    fc <- sum(w$f[j] * ex) / sum(ex)
+    sdf <- sqrt(sum((w$f[j] - fc)^2 * ex) / sum(ex))
+    wd <- length(j)
+    # the fit region stops short of the neighbouring bands (else a weak
+    # band's fit slides onto a strong neighbour)
+    lo <- if (k > 1L) r2$to[k - 1L] + 1L else 2L
+    hi <- if (k < length(r2$from)) r2$from[k + 1L] - 1L else nb
+    reg <- max(2L, lo, r2$from[k] - 2L * wd):min(nb, hi, r2$to[k] + 2L * wd)
+    fit <- fit_lorentz(w$f[reg], p[reg] - bg[reg], bg[reg], tau0,
+                       fc, sum(ex) * w$df, max(sdf, w$df))
+    data.frame(f_center = fit$fr, f_from = w$f[j[1L]], f_to = w$f[j[length(j)]],
+               width = 1 / (pi * fit$tc), tc = fit$tc, power = fit$sigma^2,
+               share = fit$sigma^2 / total, peak_ratio = max(r2$ratio[j]))
+  })
+  out <- if (length(rows)) do.call(rbind, rows) else
+    data.frame(f_center = numeric(), f_from = numeric(), f_to = numeric(),
+               width = numeric(), tc = numeric(), power = numeric(),
+               share = numeric(), peak_ratio = numeric())
+  attr(out, "resolution") <- w$df
+  out
+}
+
+# Least-squares fit of the resonance's one-sided PSD (2 x two-sided) to the
+# excess `ex` over a background `bg` at frequencies f, relative to the
+# background; starts from the band's moments.
+fit_lorentz <- function(f, ex, bg, tau0, fc, power, sdf) {
+  model <- function(q) 2 * resonance_psd(f, tau0, exp(q[1L]), q[2L], exp(q[3L]))
+  obj <- function(q) sum(((ex - model(q)) / bg)^2)
+  q0 <- c(log(sqrt(power)), fc, log(1 / (2 * pi * sdf)))
+  o <- stats::optim(q0, obj, control = list(maxit = 500L, reltol = 1e-10))
+  list(sigma = exp(o$par[1L]), fr = o$par[2L], tc = exp(o$par[3L]))
+}
+
+# The series with each broad band of find_bands() brought down to its
+# background: every FFT bin is scaled by sqrt(bg / (bg + M(f))), where M is
+# the band's fitted Lorentzian (one-sided PSD) and bg the background PSD
+# read 3-6 band widths away (M taken off), so that the expected power of
+# each bin becomes the background's. Phases are kept, so the white noise
+# and the filter's roll-off under the band stay; only the band's excess
+# goes. Used for the raw-data checks of the other effects (the filter's
+# short-lag ACF, a Gauss-Markov ACF), which a resonance disturbs.
+remove_bands <- function(x, freq, bands) {
+  if (is.null(bands) || !nrow(bands)) return(x)
+  n <- length(x)
+  m <- mean(x)
+  tau0 <- 1 / freq
+  X <- stats::fft(x - m)
+  f <- (seq_len(n) - 1) * freq / n
+  fa <- pmin(f, freq - f)
+  P <- 2 * Mod(X)^2 / (n * freq)
+  for (k in seq_len(nrow(bands))) {
+    b <- bands[k, ]
+    M <- 2 * resonance_psd(fa, tau0, sqrt(b$power), b$f_center, b$tc)
+    w <- max(b$width, b$f_to - b$f_from)
+    d <- abs(fa - b$f_center)
+    near <- d > 3 * w & d < 6 * w
+    bg <- mean(P[near] - M[near])
+    if (!is.finite(bg) || bg <= 0) next
+    g <- sqrt(bg / (bg + M))
+    X <- X * g
+    P <- P * g^2
+  }
+  Re(stats::fft(X, inverse = TRUE)) / n + m
+}

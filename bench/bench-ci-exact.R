@@ -1,0 +1,35 @@
+# Cost of allan()'s exact limits at few averages (R/ci-exact.R): a curve
+# with chi-square limits only (options(allanvar.ci_exact = 0)), with the
+# exact ones in a fresh session (every problem computed), and again (the
+# session's cache). Each in its own callr process; medians of `reps`.
+#   Rscript bench/bench-ci-exact.R [reps]
+args <- commandArgs(TRUE)
+reps <- if (length(args)) as.integer(args[1]) else 3L
+lib <- Sys.getenv("ALLANVAR_LIB", .libPaths()[1])
+one <- function(N, type, taus, exact) {
+  callr::r(function(N, type, taus, exact, lib) {
+    library(allanvar, lib.loc = lib)
+    options(allanvar.threads = 1, allanvar.ci_exact = exact)
+    set.seed(1)
+    y <- cumsum(rnorm(N)) * 1e-3 + rnorm(N)
+    t1 <- system.time(allan(y, 1, type = type, taus = taus))[["elapsed"]]
+    t2 <- system.time(allan(y, 1, type = type, taus = taus))[["elapsed"]]
+    c(first = t1, again = t2)
+  }, list(N, type, taus, exact, lib))
+}
+rows <- list()
+for (N in c(1e4, 1e6)) for (type in c("standard", "overlapping", "modified",
+                                       "hadamard", "ohadamard")) {
+  for (taus in c("octave", "decade")) {
+    t0 <- replicate(reps, one(N, type, taus, 0))
+    t1 <- replicate(reps, one(N, type, taus, 16))
+    rows[[length(rows) + 1L]] <- data.frame(
+      N = N, type = type, taus = taus,
+      chisq = stats::median(t0["first", ]),
+      exact_first = stats::median(t1["first", ]),
+      exact_again = stats::median(t1["again", ]))
+  }
+}
+cat(format(Sys.time(), "%Y-%m-%d %H:%M UTC", tz = "UTC"), "load",
+    readLines("/proc/loadavg"), "\n")
+print(do.call(rbind, rows), row.names = FALSE, digits = 3)

@@ -1,0 +1,135 @@
+test_that("Greenhall's EDF agrees with allantools' edf_greenhall on a grid", {
+  # tools/make-greenhall-fixture.py: allantools 599dc9e, five types, alpha
+  # 2..-4, m 1..1000, N 10..1e5 (every case of the algorithm)
+  ref <- utils::read.csv(test_path("fixtures", "edf-greenhall.csv"),
+                         stringsAsFactors = FALSE)
+  expect_gt(nrow(ref), 1400)
+  mine <- mapply(function(t, a, m, N) {
+    allan_edf_cpp(allan_type_code(t), m, 1, N, as.integer(a), FALSE)
+  }, ref$type, ref$alpha, ref$m, ref$N)
+  expect_equal(unname(mine), ref$edf, tolerance = 1e-8)
+})
+
+test_that("the terms' eigenvalues give the exact discrete EDF", {
+  # 1 / sum(lambda^2) is the EDF 2 E^2 / Var; the engine's Isserlis sums
+  # (src/edf.cpp) are an independent computation for white and random-walk
+  # FM; non-overlapping white FM has 2 n^2 / (3 n - 1) in closed form
+  for (n in c(2, 5, 15)) {
+    l <- gchisq_weights_cpp(0L, 4, n, 0L)
+    expect_equal(sum(l), 1)
+    expect_equal(1 / sum(l^2), 2 * n^2 / (3 * n - 1), tolerance = 1e-10)
+  }
+  for (type in c("standard", "overlapping", "modified", "hadamard",
+                 "ohadamard")) {
+    for (a in c(0L, -2L)) for (m in c(1, 3, 8)) {
+      L <- 12 * m + 1
+      n <- allan_nterms(type, m, L)
+      l <- gchisq_weights_cpp(allan_type_code(type), m, n, a)
+      expect_equal(1 / sum(l^2),
+                   allan_edf_cpp(allan_type_code(type), m, n, L, a, TRUE),
+                   tolerance = 1e-9)
+    }
+  }
+})
+
+test_that("the term covariance matches a dense covariance under flicker noise", {
+  # phase x = (1 - B)^(-delta) e from time 0 over a long burn-in: its dense
+  # covariance (the MA weights' cross products), the standard AV's terms
+  # at stride m, their correlation against the kernel's eigenvalues
+  set.seed(1)
+  for (alpha in c(1L, -1L)) {
+    delta <- (2 - alpha) / 2
+    burn <- 6000
+    len <- burn + 40
+    psi <- cumprod(c(1, (seq_len(len - 1) - 1 + delta) / seq_len(len - 1)))
+    m <- 4; n <- 6
+    idx <- burn + seq(0, (n + 1) * m, by = 1)
+    # x_t = sum_{j <= t} psi_j e_{t-j}
+    X <- outer(idx, seq_len(len), function(t, s) {
+      ifelse(s <= t, psi[pmax(1, t - s + 1)], 0)
+    })
+    W <- matrix(0, n, length(idx))
+    for (k in seq_len(n)) {
+      W[k, (k - 1) * m + c(1, m + 1, 2 * m + 1)] <- c(1, -2, 1)
+    }
+    C <- W %*% X %*% t(X) %*% t(W)
+    ev <- sort(eigen(C, symmetric = TRUE, only.values = TRUE)$values,
+               decreasing = TRUE)
+    expect_equal(gchisq_weights_cpp(0L, m, n, alpha), ev / sum(ev),
+                 tolerance = 2e-3)
+  }
+})
+
+test_that("Imhof quantiles agree with CompQuadForm and the chi-square", {
+  p <- c(0.025, 0.16, 0.84, 0.975)
+  expect_equal(gchisq_quantile_cpp(rep(0.1, 10), p), qchisq(p, 10) / 10,
+               tolerance = 1e-5)
+  # two weights: Imhof's integrand decays as u^-2 only (dqagi's error
+  # about 1e-4 in the 97.5% quantile)
+  expect_equal(gchisq_quantile_cpp(c(0.5, 0.5), p), qchisq(p, 2) / 2,
+               tolerance = 1e-3)
+  skip_if_not_installed("CompQuadForm")
+  lam <- c(0.6, 0.25, 0.1, 0.05)
+  q <- c(0.05, 0.3, 1, 2.5)
+  ref <- vapply(q, function(x) {
+    1 - CompQuadForm::imhof(x, lam, epsabs = 1e-10, epsrel = 1e-10,
+                            limit = 10000)$Qq
+  }, 0)
+  expect_equal(gchisq_cdf_cpp(lam, q), ref, tolerance = 1e-6)
+  # 300 weights, compressed beyond the 40 largest
+  l <- gchisq_weights_cpp(1L, 25, 300, -1L)
+  qq <- gchisq_quantile_cpp(l, p)
+  back <- vapply(qq, function(x) {
+    1 - CompQuadForm::imhof(x, l, epsabs = 1e-10, epsrel = 1e-10,
+                            limit = 10000)$Qq
+  }, 0)
+  expect_equal(back, p, tolerance = 1e-4)
+})
+
+test_that("allan() uses the exact limits at N/m <= 16 only", {
+  set.seed(3)
+  y <- rnorm(1024)
+  old <- options(allanvar.ci_exact = 0)
+  on.exit(options(old))
+  a0 <- allan(y, 1, type = "overlapping")
+  options(allanvar.ci_exact = 16)
+  a1 <- allan(y, 1, type = "overlapping")
+  few <- 1024 / a0$m <= 16
+  expect_identical(a1$adev, a0$adev)
+  expect_identical(a1$lower[!few], a0$lower[!few])
+  many <- few & a1$n > 1
+  expect_true(all(a1$upper[many] != a0$upper[many]))
+  # a row's factors: the union over its plausible types (white FM read at
+  # N/m >= 8: white and flicker FM)
+  i <- which(many)[1]
+  f <- sapply(c(-1L, 0L), function(a) {
+    exact_factors_one(allan_type_code("overlapping"), a1$m[i], a1$n[i], a,
+                      0.683)
+  })
+  if (identical(a1$alpha[i], 0L)) {
+    expect_equal(a1$upper[i] / a1$adev[i], max(f[2, ]))
+    expect_equal(a1$lower[i] / a1$adev[i], min(f[1, ]))
+  }
+  # one term: chi-square(1) whatever the type
+  one <- which(a1$n == 1)
+  expect_equal(a1$upper[one],
+               a1$adev[one] / sqrt(qchisq((1 - 0.683) / 2, 1)))
+  options(allanvar.ci_exact = "a")
+  expect_error(allan(y, 1), class = "allanvar_error_argument")
+})
+
+test_that("exact 95% intervals cover under random-walk FM (quick Monte Carlo)", {
+  skip_on_cran()
+  # own generator; truth (2 m^2 + 1) / (6 m) for unit innovations
+  set.seed(29)
+  m <- c(64, 128, 256)
+  hits <- replicate(200, {
+    a <- allan(cumsum(rnorm(1024)), 1, taus = I(m), type = "overlapping",
+               conf = 0.95)
+    truth <- sqrt((2 * m^2 + 1) / (6 * m))
+    a$lower <= truth & truth <= a$upper
+  })
+  cover <- rowMeans(hits)
+  # 200 draws: binomial sd 0.015 at 0.95
+  expect_true(all(cover >= 0.90 & cover <= 0.995))
+})
