@@ -53,7 +53,7 @@ av_information <- function(model, n, freq = NULL) {
   im <- info_model(model, freq)
   n <- check_number(n, "n", lo = 3, hi = 1e15)
   n <- floor(n)
-  acc <- info_accumulate(im, n)
+  acc <- info_accumulate(im, n - 1)
   info_result(im, info_at(acc, n), n)
 }
 
@@ -102,8 +102,12 @@ av_plan <- function(model, freq = NULL, target = 0.1, n = NULL, max_n = 1e12) {
           paste(pn, collapse = ", "), ".", class = "argument")
   }
   if (!is.null(n)) n <- floor(check_number(n, "n", lo = 3, hi = 1e15))
-  acc <- info_accumulate(im, max(c(n, 16)))
-  rel <- function(m) info_result(im, info_at(acc, m), m)$bound$rel_se
+  # the filter settles within a few million steps unless the model has no
+  # term that makes the differences invertible (no K); past the cap, the
+  # last increment carries on
+  cap <- min(max(c(n, max_n)), 4e6)
+  acc <- info_accumulate(im, cap, keep = max(1, ceiling(cap / 2e5)))
+  rel <- function(m) info_result(im, info_at(acc, m, extend = TRUE), m)$bound$rel_se
   need <- vapply(names(target), function(p) {
     j <- match(p, pn)
     ok <- function(m) isTRUE(rel(m)[j] <= target[[p]])
@@ -212,98 +216,48 @@ info_system <- function(p, im) {
   list(T = Tm, Q = Qm, H = m$Q[dif], P = P, Z = rep(c(1, -1), k))
 }
 
-# Runs the filter of the differences at the parameters and at each log
-# parameter +-h, with the stacked covariance of (state, filter error,
-# derivatives of the predicted state), until the information increment is
-# stationary or n - 1 differences are taken. Returns the cumulative
-# information per step and the stationary increment.
-info_accumulate <- function(im, n, h = 1e-5) {
+# The filter of the differences (src/information.cpp) at the parameters,
+# with the system's derivatives in the log parameters by central
+# differences of the closed-form system matrices. Runs until the
+# information increment is stationary or `steps` differences are taken;
+# keeps the cumulative information every `keep` steps.
+info_accumulate <- function(im, steps, keep = steps, h = 1e-5) {
   p0 <- im$values
-  np <- length(p0)
-  sys0 <- info_system(p0, im)
-  sysp <- lapply(seq_len(np), function(j) info_system(replace(p0, j, p0[[j]] * exp(h)), im))
-  sysm <- lapply(seq_len(np), function(j) info_system(replace(p0, j, p0[[j]] * exp(-h)), im))
-  s <- nrow(sys0$T)
-  Z <- sys0$Z
-  dT <- lapply(seq_len(np), function(j) (sysp[[j]]$T - sysm[[j]]$T) / (2 * h))
-  Tm <- sys0$T
-  # the filter's P at the parameters (1) and at +-h (2j, 2j + 1)
-  Ps <- c(list(sys0$P), unlist(lapply(seq_len(np), function(j) list(sysp[[j]]$P, sysm[[j]]$P)),
-                               recursive = FALSE))
-  sy <- c(list(sys0), unlist(lapply(seq_len(np), function(j) list(sysp[[j]], sysm[[j]])),
-                             recursive = FALSE))
-  ds <- s * (2L + np)
-  ix <- seq_len(s); ie <- s + ix
-  ia <- lapply(seq_len(np), function(j) 2L * s + (j - 1L) * s + ix)
-  Sig <- matrix(0, ds, ds)
-  Sig[ix, ix] <- Sig[ix, ie] <- Sig[ie, ix] <- Sig[ie, ie] <- sys0$P
-  W <- matrix(0, s + 1L, s + 1L)
-  W[seq_len(s), seq_len(s)] <- sys0$Q
-  W[s + 1L, s + 1L] <- sys0$H
-  steps <- n - 1
-  cum <- matrix(0, 0, np * np)
-  I <- matrix(0, np, np)
-  inc_old <- NULL
-  stationary <- NULL
-  out <- vector("list", 1024L)
-  t <- 0
-  A <- matrix(0, ds, ds); B <- matrix(0, ds, s + 1L)
-  B[ix, seq_len(s)] <- diag(s); B[ie, seq_len(s)] <- diag(s)
-  while (t < steps) {
-    t <- t + 1
-    F <- Kg <- vector("list", length(Ps))
-    for (r in seq_along(Ps)) {
-      PZ <- drop(Ps[[r]] %*% Z)
-      F[[r]] <- sum(Z * PZ) + sy[[r]]$H
-      Kg[[r]] <- drop(sy[[r]]$T %*% PZ) / F[[r]]
-    }
-    F0 <- F[[1]]
-    dF <- vapply(seq_len(np), function(j) (F[[2 * j]] - F[[2 * j + 1]]) / (2 * h), 0)
-    ZS <- matrix(0, np, np)
-    for (i in seq_len(np)) for (j in i:np) {
-      ZS[i, j] <- ZS[j, i] <- sum(Z * (Sig[ia[[i]], ia[[j]]] %*% Z))
-    }
-    inc <- outer(dF, dF) / (2 * F0^2) + ZS / F0
-    I <- I + inc
-    if (t > length(out)) length(out) <- 2L * length(out)
-    out[[t]] <- as.vector(I)
-    if (t %% 25 == 0) {
-      if (!is.null(inc_old) &&
-          max(abs(inc - inc_old) / sqrt(outer(diag(inc), diag(inc)))) < 1e-12) {
-        stationary <- inc
-        break
-      }
-      inc_old <- inc
-    }
-    TGZ <- Tm - outer(Kg[[1]], Z)
-    A[] <- 0
-    A[ix, ix] <- Tm
-    A[ie, ie] <- TGZ
-    B[ie, s + 1L] <- -Kg[[1]]
-    for (j in seq_len(np)) {
-      dK <- (Kg[[2 * j]] - Kg[[2 * j + 1]]) / (2 * h)
-      A[ia[[j]], ix] <- dT[[j]]
-      A[ia[[j]], ie] <- -dT[[j]] + outer(dK, Z)
-      A[ia[[j]], ia[[j]]] <- TGZ
-      B[ia[[j]], s + 1L] <- dK
-    }
-    Sig <- A %*% Sig %*% t(A) + B %*% W %*% t(B)
-    for (r in seq_along(Ps)) {
-      P <- Ps[[r]]; Tr <- sy[[r]]$T
-      TP <- Tr %*% P
-      Ps[[r]] <- TP %*% t(Tr) + sy[[r]]$Q - F[[r]] * outer(Kg[[r]], Kg[[r]])
-    }
-  }
-  list(cum = do.call(rbind, out[seq_len(t)]), stationary = stationary, np = np)
+  sys <- info_system(p0, im)
+  deriv <- lapply(seq_along(p0), function(j) {
+    up <- info_system(replace(p0, j, p0[[j]] * exp(h)), im)
+    dn <- info_system(replace(p0, j, p0[[j]] * exp(-h)), im)
+    list(T = (up$T - dn$T) / (2 * h), Q = (up$Q - dn$Q) / (2 * h),
+         P1 = (up$P - dn$P) / (2 * h), H = (up$H - dn$H) / (2 * h))
+  })
+  # T entries that do not depend on a parameter are exact zeros
+  deriv <- lapply(deriv, function(d) { d$T[abs(d$T) < 1e-12] <- 0; d })
+  r <- info_kalman(list(T = sys$T, Q = sys$Q, P1 = sys$P, Z = sys$Z, H = sys$H),
+                   deriv, list(max_steps = max(1, steps), tol = 1e-12, every = 25,
+                               keep = max(1, keep)))
+  r$np <- length(p0)
+  r
 }
 
-# Information of n samples (n - 1 differences) from an accumulation.
-info_at <- function(acc, n) {
+# Information of n samples (n - 1 differences) from an accumulation: the
+# kept step at or below, the stationary increment beyond the last, linear
+# between kept steps.
+info_at <- function(acc, n, extend = FALSE) {
   d <- n - 1
-  k <- nrow(acc$cum)
-  I <- if (d <= k) acc$cum[d, ] else {
-    if (is.null(acc$stationary)) stop("internal: information not run far enough")
-    acc$cum[k, ] + (d - k) * as.vector(acc$stationary)
+  k <- length(acc$at)
+  last <- acc$at[k]
+  I <- if (d >= last) {
+    inc <- acc$stationary
+    if (d > last && is.null(inc)) {
+      if (!extend || k < 2) stop("internal: information not run far enough")
+      inc <- (acc$cum[, k] - acc$cum[, k - 1]) / (last - acc$at[k - 1])
+    }
+    acc$cum[, k] + if (d > last) (d - last) * as.vector(inc) else 0
+  } else {
+    j <- findInterval(d, acc$at)
+    lo <- if (j == 0) 0 else acc$at[j]
+    clo <- if (j == 0) 0 else acc$cum[, j]
+    clo + (d - lo) / (acc$at[j + 1] - lo) * (acc$cum[, j + 1] - clo)
   }
   matrix(I, acc$np, acc$np)
 }
