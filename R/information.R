@@ -279,3 +279,34 @@ info_result <- function(im, I, n) {
   structure(list(bound = bound, information = I, n = n, freq = im$freq),
             class = "av_information")
 }
+
+# Seconds of record for the Cramer-Rao bound of `param`'s relative SD to
+# reach `target`, for the model of the coefficients `coef` with the values
+# `set` put in (added or replaced). NA when the model has a term at a
+# positive value without a state-space form (flicker B, quantization, ...):
+# leaving it out would make the answer optimistic. Terms at 0 are left out.
+# Used by imu_guidance().
+plan_record_length <- function(coef, freq, set, param, target, max_n = 1e12) {
+  coef <- coef[setdiff(names(coef), names(set))]
+  coef <- c(coef, set)
+  lay <- tryCatch(check_coef(coef), error = function(e) NULL)
+  if (is.null(lay) || !is.finite(freq) || freq <= 0) return(NA_real_)
+  sp <- split_term(layout_terms(lay))
+  has_ss <- vapply(seq_along(sp$kind), function(i) {
+    is.function(effect_entry(sp$kind[i], sp$variant[i])$statespace)
+  }, NA)
+  labels <- unique(lay$label)
+  ok_label <- has_ss & vapply(labels, function(l) {
+    v <- lay$value[lay$label == l]
+    all(is.finite(v) & v > 0)
+  }, NA)
+  positive <- vapply(labels, function(l) any(lay$value[lay$label == l & lay$role == "amp"] > 0), NA)
+  if (any(positive & !has_ss)) return(NA_real_)
+  keep <- lay$label %in% labels[ok_label]
+  if (!param %in% lay$name[keep]) return(NA_real_)
+  model <- stats::setNames(lay$value[keep], lay$name[keep])
+  pl <- tryCatch(av_plan(model, freq = freq, target = stats::setNames(target, param),
+                         max_n = max_n),
+                 allanvar_error = function(e) NULL)
+  if (is.null(pl)) NA_real_ else pl$duration
+}
