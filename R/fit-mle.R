@@ -297,7 +297,7 @@ mle_profile_upper <- function(x, par, i, ok, lay, model, p0, llmax) {
     }
     o <- tryCatch(stats::optim(lp_warm, f, method = "L-BFGS-B",
                                lower = lp_start + box[1], upper = lp_start + box[2],
-                               control = list(maxit = 100, factr = 1e7)),
+                               control = list(maxit = 300, factr = 1e3)),
                   error = function(e) NULL)
     if (is.null(o)) return(NA_real_)
     lp_warm <<- o$par
