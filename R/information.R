@@ -23,7 +23,10 @@
 #' filter is stationary every further sample adds the same increment, so
 #' the cost is O(min(n, t*)) for the t* steps the filter takes to settle
 #' (about 3e5 in the slowest case of the examples, well under a second), and
-#' the information of any longer record follows in O(1). The derivatives of
+#' the information of any longer record follows in O(1). (A model without
+#' `K` has differences that are not invertible and a filter that settles
+#' only slowly; past 4e6 steps its last increment carries on, an
+#' approximation.) The derivatives of
 #' the system matrices in the log parameters are central differences of
 #' closed forms (relative error about 1e-10). The tests check the result
 #' against the dense \eqn{\frac12 \mathrm{tr}(\Sigma^{-1}\Sigma_i\Sigma^{-1}\Sigma_j)}
@@ -56,8 +59,8 @@ av_information <- function(model, n, freq = NULL) {
   im <- info_model(model, freq)
   n <- check_number(n, "n", lo = 3, hi = 1e15)
   n <- floor(n)
-  acc <- info_accumulate(im, n - 1)
-  info_result(im, info_at(acc, n), n)
+  acc <- info_accumulate(im, min(n - 1, info_cap))
+  info_result(im, info_at(acc, n, extend = TRUE), n)
 }
 
 #' Record length for a target precision
@@ -108,7 +111,7 @@ av_plan <- function(model, freq = NULL, target = 0.1, n = NULL, max_n = 1e12) {
   # the filter settles within a few million steps unless the model has no
   # term that makes the differences invertible (no K); past the cap, the
   # last increment carries on
-  cap <- min(max(c(n, max_n)), 4e6)
+  cap <- min(max(c(n, max_n)), info_cap)
   acc <- info_accumulate(im, cap, keep = max(1, ceiling(cap / 2e5)))
   rel <- function(m) info_result(im, info_at(acc, m, extend = TRUE), m)$bound$rel_se
   need <- vapply(names(target), function(p) {
@@ -222,6 +225,11 @@ info_system <- function(p, im) {
   }
   list(T = Tm, Q = Qm, H = m$Q[dif], P = P, Z = rep(c(1, -1), k))
 }
+
+# Steps of the filter at most: it settles long before in models with K;
+# without K (the differences not invertible) it settles only slowly, and
+# past the cap the last increment carries on.
+info_cap <- 4e6
 
 # The filter of the differences (src/information.cpp) at the parameters,
 # with the system's derivatives in the log parameters by central
