@@ -90,6 +90,10 @@ for (cell in names(cells)) for (j in 1:2) {
       present = if (k == "gmwm") NA else 100 * mean(present[ok]),
       stringsAsFactors = FALSE)
   }
+  # each cell as it finishes (a long run can be read before its end)
+  cur <- do.call(rbind, rows[vapply(rows, function(r) r$cell == cell && r$n == n, NA)])
+  cur[vapply(cur, is.numeric, NA)] <- lapply(cur[vapply(cur, is.numeric, NA)], signif, 3)
+  print(cur, row.names = FALSE)
   if (has_gmwm) for (p in pn) {
     rm <- E[, p, "avmle"] / truth[[p]] - 1
     rg <- E[, p, "gmwm"] / truth[[p]] - 1

@@ -85,7 +85,7 @@ InfoTrace info_run(const InfoSystem& m, const InfoOptions& opt) {
   InfoMatrix I = InfoMatrix::Zero(p, p), inc(p, p), inc_old;
   VectorXd PZ(s), M(s), K(s), dPZ(s);
   Eigen::VectorXd dF(p);
-  std::vector<VectorXd> dK(p, VectorXd(s)), dM(p, VectorXd(s));
+  std::vector<VectorXd> dK(p, VectorXd::Zero(s)), dM(p, VectorXd::Zero(s));
   MatrixXd G(s, s), TP(s, s), tmp(s, s);
   std::vector<MatrixXd> nSai(p), nSij(p * p), GSia(p), dTSaa(p);
   for (R_xlen_t t = 0; t < opt.max_steps; ++t) {
