@@ -93,6 +93,10 @@ gchisq_quantile_cpp <- function(lambda, p) {
     .Call(`_allanvar_gchisq_quantile_cpp`, lambda, p)
 }
 
+info_kalman <- function(sys, deriv, opts) {
+    .Call(`_allanvar_info_kalman`, sys, deriv, opts)
+}
+
 line_sums <- function(y, f, freq) {
     .Call(`_allanvar_line_sums`, y, f, freq)
 }

@@ -382,8 +382,12 @@ check_dots_empty <- function(...) {
 #' [avfit()]; `type = "log"` gives \eqn{\ln\widehat{AV}_j - \ln AV_j} minus
 #' the chi-square log bias, `type = "relative"` gives
 #' \eqn{\sqrt{\widehat{AV}_j/AV_j} - 1}, the relative ADEV error).
-#' `confint()` gives Wald intervals: for amplitudes on the linear scale,
-#' truncated at 0; for `tc` and `f0` on the log scale.
+#' `confint()` gives Wald intervals on the log scale; for an amplitude at
+#' 0 a one-sided interval `[0, upper]` (from the profile likelihood for
+#' [avmle()] fits, at level 0.95; for curve fits from the quadratic
+#' approximation of the objective in the variance coefficient c = amp^2,
+#' c <= qnorm(level) SE(c)); for the time constant of a term at 0, `(0, Inf)`
+#' (not identified).
 #' `logLik()` is the Gaussian log-likelihood of \eqn{\ln\widehat{AV}_j}
 #' (bias-corrected) with variances \eqn{\psi'(\nu_j/2)} (and the
 #' white-noise correlation when the fit used `correlation = TRUE`); its `df` is the
@@ -472,8 +476,24 @@ confint.avfit <- function(object, parm, level = 0.95, ...) {
   role <- lay$role[match(parm, lay$name)]
   est <- cf[parm]
   s <- se[parm]
-  lo <- ifelse(role == "amp", pmax(est - zq * s, 0), est * exp(-zq * s / est))
-  hi <- ifelse(role == "amp", est + zq * s, est * exp(zq * s / est))
+  # Wald on the log scale; an amplitude at 0: one-sided [0, upper], from
+  # the profile likelihood where the fit has it (avmle(), at 95%), else
+  # from the quadratic approximation of the objective in c = amp^2 (whose
+  # SE is se^2): c <= qnorm(level) se^2; a nonlinear parameter whose term
+  # is at 0 is not identified: (0, Inf)
+  zero <- role == "amp" & est == 0
+  lo <- est * exp(-zq * s / est)
+  hi <- est * exp(zq * s / est)
+  bu <- object$bound_upper
+  bu <- if (is.null(bu)) rep(NA_real_, length(parm)) else unname(bu[parm])
+  lo[zero] <- 0
+  hi[zero] <- ifelse(is.finite(bu[zero]), if (abs(level - 0.95) < 1e-12) bu[zero] else NA_real_,
+                     sqrt(stats::qnorm(level)) * s[zero])
+  lab <- lay$label[match(parm, lay$name)]
+  dead <- role == "nonlinear" & lab %in% lay$label[lay$role == "amp" & cf[lay$name] == 0] &
+    !is.finite(s)
+  lo[dead] <- 0
+  hi[dead] <- Inf
   pct <- paste(format(100 * c((1 - level) / 2, (1 + level) / 2), trim = TRUE,
                       digits = 3), "%")
   out <- cbind(lo, hi)

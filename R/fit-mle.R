@@ -24,10 +24,24 @@
 #' as 0.
 #'
 #' @section Uncertainty:
-#' `vcov` is the inverse of the observed information (the numerical Hessian
-#' of the log-likelihood at the estimate) in the reported parameters; an
-#' amplitude at 0, and the time constant of a Gauss-Markov term whose
-#' amplitude is 0, get `NA`.
+#' Every parameter of a converged fit gets an SE or an interval
+#' (`confint()`):
+#' * identified parameters: the inverse of the observed information (the
+#'   numerical Hessian of the log-likelihood in the log parameters; where it
+#'   is not positive definite, the exact expected information of
+#'   [av_information()] at the estimate). `confint()` gives Wald intervals
+#'   on the log scale; `se` is the delta-method SE on the linear scale and
+#'   `vcov` the covariance on that scale.
+#' * an amplitude at its boundary (the likelihood is highest at 0; an
+#'   estimate whose removal costs less than 0.01 in log-likelihood is set to
+#'   0): no Wald SE (`NA`); `bound_upper` holds its one-sided 95% upper
+#'   bound from the profile likelihood (the amplitude where the likelihood,
+#'   maximised over the other parameters, has dropped by
+#'   `qchisq(0.90, 1) / 2`, the boundary's half chi-square), and
+#'   `confint()` gives `[0, bound_upper]`.
+#' * the time constant of a Gauss-Markov term at 0 is not identified:
+#'   interval `(0, Inf)`.
+#' `interval` names the method used for each parameter.
 #'
 #' @param x The rate series (numeric vector, no missing values).
 #' @param freq Sampling frequency in Hz.
@@ -41,7 +55,8 @@
 #'   overlapping curve of `x`. Extra elements: `method = "mle"`, `loglik`
 #'   (the exact log-likelihood of `x[-1]` given `x[1]`: the sensor's bias is
 #'   unknown, a diffuse level, or the random walk's start when there is a
-#'   `K` term) and `avfit` (the curve fit it started from).
+#'   `K` term), `avfit` (the curve fit it started from), `bound_upper` and
+#'   `interval` (see Uncertainty).
 #' @seealso [avfit()], [avsim()]
 #' @export
 #' @examples
@@ -81,17 +96,14 @@ avmle <- function(x, freq, terms = c("N", "K", "gm"), start = NULL) {
           class = "argument")
   }
   est <- mle_optimise(x, p0, lay, model)
-  # steps relative to each parameter (an amplitude at 0: to its start)
-  H <- tryCatch(stats::optimHess(est$par, function(p) -mle_loglik(x, model(p)),
-                                 control = list(parscale = ifelse(est$par > 0, est$par, p0),
-                                                ndeps = rep(1e-4, length(p0)))),
-                error = function(e) NULL)
-  vc <- mle_vcov(H, est$par, lay)
+  est <- mle_collapse(x, est, lay, model)
+  unc <- mle_uncertainty(x, est, lay, model, p0, freq)
   fit <- quiet_fit_warnings(avfit(fit0$input, terms, fixed = est$par))
-  fit$se <- stats::setNames(sqrt(pmax(diag(vc), 0)), lay$name)
-  fit$se[is.na(diag(vc))] <- NA_real_
-  check_fit_finite(fit$coefficients, fit$se)
-  fit$vcov <- vc
+  fit$se <- unc$se
+  # (a zero amplitude's SE is NA by design: it has its bound_upper)
+  fit$vcov <- unc$vcov
+  fit$bound_upper <- unc$bound_upper
+  fit$interval <- unc$interval
   fit$layout$fixed <- FALSE
   fit$npar <- nrow(lay)
   fit$df.residual <- fit$nobs - nrow(lay)
@@ -194,20 +206,123 @@ mle_optimise <- function(x, p0, lay, model) {
                           message = best$message %||% ""))
 }
 
-# Inverse observed information; NA for amplitudes at 0 and the nonlinear
-# parameters of their terms (not identified).
-mle_vcov <- function(H, par, lay) {
-  k <- nrow(lay)
-  vc <- matrix(NA_real_, k, k, dimnames = list(lay$name, lay$name))
-  zero_lab <- lay$label[lay$role == "amp" & par == 0]
-  ok <- !(lay$label %in% zero_lab & lay$role == "nonlinear") & !(lay$role == "amp" & par == 0)
-  if (!is.null(H) && any(ok)) {
-    inv <- tryCatch(solve(H[ok, ok, drop = FALSE]), error = function(e) NULL)
-    if (!is.null(inv) && all(is.finite(diag(inv))) && all(diag(inv) >= 0)) {
-      vc[ok, ok] <- inv
+# An amplitude the optimiser left just above its lower limit (the
+# likelihood flat towards 0) is at the boundary: set to 0 when that costs
+# less than 0.01 in log-likelihood.
+mle_collapse <- function(x, est, lay, model) {
+  p <- est$par
+  ll <- mle_loglik(x, model(p))
+  amp <- which(lay$role == "amp" & p > 0)
+  for (i in amp[order(p[amp] / max(p[amp]))]) {
+    if (sum(p[lay$role == "amp"] > 0) <= 1L) break
+    ll0 <- mle_loglik(x, model(replace(p, i, 0)))
+    if (is.finite(ll0) && ll0 >= ll - 0.01) {
+      p[i] <- 0
+      ll <- max(ll, ll0)
     }
   }
-  vc
+  est$par <- p
+  est$loglik <- ll
+  est
+}
+
+# Uncertainty of every parameter. Identified parameters: the inverse of the
+# observed information in the log parameters (the numerical Hessian; where
+# it is not positive definite, the exact expected information of
+# av_information() at the estimate), so Wald intervals on the log scale
+# (`se` is the delta-method SE on the linear scale). An amplitude at 0: no
+# Wald SE, a one-sided 95% upper bound from the profile likelihood
+# (2 * drop = qchisq(0.90, 1), the boundary's half chi-square). The
+# nonlinear parameters of a term at 0: not identified, interval (0, Inf).
+mle_uncertainty <- function(x, est, lay, model, p0, freq) {
+  par <- est$par
+  k <- nrow(lay)
+  zero_lab <- lay$label[lay$role == "amp" & par == 0]
+  ok <- !(lay$label %in% zero_lab & lay$role == "nonlinear") & !(lay$role == "amp" & par == 0)
+  nll <- function(lp) {
+    v <- -mle_loglik(x, model(replace(par, ok, exp(lp))))
+    if (is.finite(v)) v else .Machine$double.xmax
+  }
+  lp <- log(par[ok])
+  H <- tryCatch(stats::optimHess(lp, nll, control = list(ndeps = rep(1e-3, length(lp)))),
+                error = function(e) NULL)
+  V <- mle_inverse(H)
+  source <- "observed"
+  if (is.null(V)) {
+    I <- tryCatch(av_information(par[ok], n = length(x), freq = freq)$information,
+                  allanvar_error = function(e) NULL)
+    V <- mle_inverse(I)
+    source <- "expected"
+  }
+  vc <- matrix(NA_real_, k, k, dimnames = list(lay$name, lay$name))
+  se <- stats::setNames(rep(NA_real_, k), lay$name)
+  interval <- stats::setNames(rep("not identified", k), lay$name)
+  if (!is.null(V)) {
+    vc[ok, ok] <- V * outer(par[ok], par[ok])
+    se[ok] <- par[ok] * sqrt(diag(V))
+    interval[ok] <- paste0("Wald, log scale (", source, " information)")
+  }
+  bound <- stats::setNames(rep(NA_real_, k), lay$name)
+  for (i in which(lay$role == "amp" & par == 0)) {
+    bound[i] <- mle_profile_upper(x, par, i, ok, lay, model, p0, est$loglik)
+    interval[i] <- "one-sided, profile likelihood"
+  }
+  list(se = se, vcov = vc, bound_upper = bound, interval = interval)
+}
+
+mle_inverse <- function(H) {
+  if (is.null(H) || !all(is.finite(H))) return(NULL)
+  ch <- tryCatch(chol((H + t(H)) / 2), error = function(e) NULL)
+  if (is.null(ch)) return(NULL)
+  V <- chol2inv(ch)
+  dimnames(V) <- dimnames(H)
+  V
+}
+
+# One-sided 95% upper bound of the amplitude `i` at 0: the a > 0 where the
+# log-likelihood, maximised over the other identified parameters (and the
+# term's own nonlinear ones), has dropped by qchisq(0.90, 1) / 2.
+mle_profile_upper <- function(x, par, i, ok, lay, model, p0, llmax) {
+  drop <- stats::qchisq(0.90, 1) / 2
+  own <- lay$label == lay$label[i] & lay$role == "nonlinear"
+  free <- ok | own
+  start <- par
+  start[own] <- p0[own]
+  lp_start <- log(start[free])
+  box <- c(-1, 1) * log(1e3)
+  lp_warm <- lp_start
+  # each profile point starts from the last one's nuisance parameters
+  prof <- function(la) {
+    f <- function(lp) {
+      v <- -mle_loglik(x, model(replace(replace(par, free, exp(lp)), i, exp(la))))
+      if (is.finite(v)) v else .Machine$double.xmax
+    }
+    o <- tryCatch(stats::optim(lp_warm, f, method = "L-BFGS-B",
+                               lower = lp_start + box[1], upper = lp_start + box[2],
+                               control = list(maxit = 300, factr = 1e3)),
+                  error = function(e) NULL)
+    if (is.null(o)) return(NA_real_)
+    lp_warm <<- o$par
+    -o$value
+  }
+  # negative while the profile is within `drop` of the maximum
+  g <- function(la) llmax - prof(la) - drop
+  # bracket: from a tenth of the start upwards by decades
+  ref <- if (p0[i] > 0) p0[i] else max(par[lay$role == "amp"])
+  lo <- log(ref) - log(1e4)
+  hi <- log(ref) - log(10)
+  glo <- g(lo)
+  if (!is.finite(glo)) return(NA_real_)
+  if (glo > 0) return(exp(lo))
+  for (step in 1:10) {
+    gh <- g(hi)
+    if (!is.finite(gh)) return(NA_real_)
+    if (gh > 0) break
+    lo <- hi; glo <- gh
+    hi <- hi + log(10)
+  }
+  if (!(gh > 0)) return(Inf)
+  exp(stats::uniroot(g, c(lo, hi), f.lower = glo, f.upper = gh, tol = 0.01)$root)
 }
 
 # `expr` without the warnings of fits whose SEs are not reported.

@@ -8,13 +8,17 @@
 #'   handful of terms").
 #' * **K** (rate random walk, the +1/2 region): call `tau_x` the tau where
 #'   the +1/2 line meets the rest of the model, i.e. where
-#'   K^2 tau / 3 = N^2 / tau + (2 ln 2 / pi) B^2. K is resolved when
-#'   `tau_rel >= 3 tau_x` (there the K term is at least 3/4 of the Allan
-#'   variance). Since `tau_rel` grows in proportion to the record length T,
-#'   the record needed is `T * 3 tau_x / tau_rel`. When no +1/2 region is
-#'   seen at all, K is bounded by min over tau of upper(tau) * sqrt(3 / tau)
-#'   and the record needed to resolve a K that large is given (smaller K need
-#'   longer records).
+#'   K^2 tau / 3 = N^2 / tau + (2 ln 2 / pi) B^2. K is read within the
+#'   reliable range when `tau_rel >= 3 tau_x`. When it is not, and the record
+#'   does not already give K to 25% by the exact bound, the record
+#'   needed is the one whose exact Cramer-Rao bound gives K to 25% (relative
+#'   standard deviation; [av_plan()] on the fitted model when all its terms
+#'   have a state-space form: N, K, Gauss-Markov). Where the planner cannot
+#'   run (no N, or a B, Q or other term without a state-space form in the
+#'   model), the scaling `T * 3 tau_x / tau_rel` is given. When no +1/2
+#'   region is seen at all, K is bounded by min over tau of upper(tau) *
+#'   sqrt(3 / tau) and the record needed to resolve a K that large is given
+#'   (smaller K need longer records).
 #' * **B**: the flat minimum must lie inside the reliable range, at
 #'   `tau_B <= tau_rel / 3`; otherwise the curve may still fall and B is an
 #'   upper bound; a record at least `T * 3 tau_B / tau_rel` long is needed.
@@ -124,14 +128,15 @@ channel_guidance <- function(ch) {
     tx <- tau_cross(n2, b2, K)
     msg <- c(msg, sprintf(
       "the +1/2 (rate random walk) region is never reached up to tau = %s: K <= %.3g %s only; resolving a K that large needs a record of at least %s (this one is %s), a smaller K a longer one.",
-      hours(tau_rel), K, walk$unit, hours(need(tx)), hours(T)))
+      hours(tau_rel), K, walk$unit, hours(need_k(ch, white, walk, tx, need)), hours(T)))
   } else if (isTRUE(is.finite(K) && K > 0)) {
     tx <- tau_cross(n2, b2, K)
-    if (tau_rel < 3 * tx) {
+    nk <- need_k(ch, white, walk, tx, need)
+    # the exact bound says when this record already gives K to 25%
+    if (tau_rel < 3 * tx && !isTRUE(nk <= T)) {
       msg <- c(msg, sprintf(
         "K = %.3g %s is read beyond the reliable range: the +1/2 line meets the rest at tau = %s, so tau up to %s (a record of %s) is needed; this record is %s.",
-        K, walk$unit, hours(tx), hours(3 * tx), hours(need(tx)),
-        hours(T)))
+        K, walk$unit, hours(tx), hours(3 * tx), hours(nk), hours(T)))
     }
   }
   tau_b <- flat$tau
@@ -175,6 +180,22 @@ channel_guidance <- function(ch) {
                          "): values read from the slope lines."))
   }
   msg
+}
+
+# The record (s) that gives K to 25% by the exact Cramer-Rao bound
+# (av_plan() on the fitted model, N and K taken from the readings); the
+# scaling of the reliable range where the model has a term without a
+# state-space form (B, Q, ...) or no N.
+need_k <- function(ch, white, walk, tx, need) {
+  set <- c(white$value, walk$value)
+  names(set) <- c(white$term, walk$term)
+  rd <- ch$readings
+  others <- rd$value[!rd$term %in% names(set)]
+  s <- if (length(set) == 2L && all(is.finite(set) & set > 0) && length(ch$freq) == 1L &&
+           !any(is.finite(others) & others > 0)) {
+    plan_record_length(ch$coef %||% numeric(), ch$freq, set, walk$term, 0.25)
+  } else NA_real_
+  if (is.finite(s)) s else need(tx)
 }
 
 # One line per kind of non-stationary effect (spikes, steps, ...) found in

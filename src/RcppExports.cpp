@@ -299,6 +299,19 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// info_kalman
+Rcpp::List info_kalman(Rcpp::List sys, Rcpp::List deriv, Rcpp::List opts);
+RcppExport SEXP _allanvar_info_kalman(SEXP sysSEXP, SEXP derivSEXP, SEXP optsSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::RNGScope rcpp_rngScope_gen;
+    Rcpp::traits::input_parameter< Rcpp::List >::type sys(sysSEXP);
+    Rcpp::traits::input_parameter< Rcpp::List >::type deriv(derivSEXP);
+    Rcpp::traits::input_parameter< Rcpp::List >::type opts(optsSEXP);
+    rcpp_result_gen = Rcpp::wrap(info_kalman(sys, deriv, opts));
+    return rcpp_result_gen;
+END_RCPP
+}
 // line_sums
 Rcpp::NumericVector line_sums(const Rcpp::NumericVector& y, double f, double freq);
 RcppExport SEXP _allanvar_line_sums(SEXP ySEXP, SEXP fSEXP, SEXP freqSEXP) {
@@ -660,6 +673,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_gchisq_weights_cpp", (DL_FUNC) &_allanvar_gchisq_weights_cpp, 4},
     {"_allanvar_gchisq_cdf_cpp", (DL_FUNC) &_allanvar_gchisq_cdf_cpp, 2},
     {"_allanvar_gchisq_quantile_cpp", (DL_FUNC) &_allanvar_gchisq_quantile_cpp, 2},
+    {"_allanvar_info_kalman", (DL_FUNC) &_allanvar_info_kalman, 3},
     {"_allanvar_line_sums", (DL_FUNC) &_allanvar_line_sums, 3},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
     {"_allanvar_mcap_index_cpp", (DL_FUNC) &_allanvar_mcap_index_cpp, 1},

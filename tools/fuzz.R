@@ -284,6 +284,11 @@ fuzz_cases <- function(quick = FALSE) {
           c("x", "freq", "terms", "start"))
   add("avmle", "term without a state-space form", q(avmle(x, 100, terms = c("N", "B"))))
   add("avmle", "constant series", q(avmle(rep(1, 1000), 100, terms = c("N", "K"))))
+  sub_arg("av_information", q(av_information(model = c(N = 0.01, K = 1e-3), n = 1000, freq = 100)),
+          c("model", "n", "freq"))
+  add("av_information", "zero amplitude", q(av_information(c(N = 0.01, K = 0), 1000, 100)))
+  sub_arg("av_plan", q(av_plan(model = c(N = 0.01, K = 1e-3), freq = 100, target = 0.2, n = 1000)),
+          c("model", "freq", "target", "n", "max_n"))
   sub_arg("avfit_control", q(avfit_control()), c("tol", "maxit", "cycles"))
   sub_arg("as_av_curve", q(as_av_curve(av = av)), c("av", "n", "freq", "type", "channel"))
   add("as_av_curve", "df negative avar", q(as_av_curve(data.frame(tau = 1:3, avar = c(1, -1, 1)), n = 100, freq = 1)))
@@ -318,6 +323,7 @@ fuzz_cases <- function(quick = FALSE) {
   methods <- list(
     "print.av_curve" = q(as_av_curve(av)), "print.avdiagnose" = q(avdiagnose(x, 100)),
     "print.avfit_control" = q(avfit_control()), "print.avrefine" = q(ref),
+    "print.av_information" = q(print(av_information(c(N = 0.01, K = 1e-3), 1000, 100))),
     "print.imu_analysis_list" = q(ana2), "plot.imu_analysis_list" = q(plot(ana2)),
     "datasheet.imu_analysis_list" = q(datasheet(ana2)),
     "datasheet.imu_analysis" = q(datasheet(ana)),

@@ -498,3 +498,20 @@ test_that("model_error = TRUE: a discrepancy estimated where the model departs, 
   # the loop judges candidates on the points' own scatter
   expect_false(refit_settings(f1, list())$control$model_error)
 })
+
+test_that("confint(): log-scale Wald, one-sided at a zero amplitude, (0, Inf) for a dead tc", {
+  # white noise alone (generated here): K and the GM amplitude go to 0
+  set.seed(5)
+  x <- rnorm(2^15, sd = 0.1)
+  fit <- avfit(allan(x, 100), c("N", "K"))
+  expect_identical(coef(fit)[["K"]], 0)
+  ci <- confint(fit)
+  expect_equal(unname(ci["K", ]), c(0, sqrt(qnorm(0.95)) * fit$se[["K"]]))
+  expect_gt(ci["K", 2], 0)
+  # the 90% bound: c <= qnorm(0.90) SE(c), SE(c) = se^2
+  expect_equal(unname(confint(fit, "K", level = 0.9)[, 2]), sqrt(qnorm(0.9)) * fit$se[["K"]])
+  cf <- coef(fit)[["N"]]
+  expect_equal(unname(ci["N", ]), cf * exp(c(-1, 1) * qnorm(0.975) * fit$se[["N"]] / cf))
+  g <- avfit(allan(x, 100), c("N", "gm"), fixed = c(gm1.sigma = 0))
+  expect_equal(unname(confint(g)["gm1.tc", ]), c(0, Inf))
+})

@@ -100,3 +100,54 @@ test_that("avmle() rejects terms without a state-space form and bad input", {
   expect_error(avmle(y, -1), class = "allanvar_error")
   expect_error(avmle(c(y, NA), 100), class = "allanvar_error")
 })
+
+test_that("a collapsed amplitude is 0 with a profile-likelihood upper bound", {
+  # no rate random walk in the series: K's likelihood is highest at 0
+  y <- gen_series(5000, 0.01, 0.01, 0, 0.02, 0.5, seed = 2)
+  fit <- avmle(y, 100)
+  expect_identical(coef(fit)[["K"]], 0)
+  expect_true(is.na(fit$se[["K"]]))
+  up <- fit$bound_upper[["K"]]
+  expect_true(is.finite(up) && up > 0)
+  expect_equal(unname(confint(fit)["K", ]), c(0, up))
+  expect_match(fit$interval[["K"]], "profile")
+  # the other parameters: Wald on the log scale
+  ci <- confint(fit)[c("N", "gm1.sigma", "gm1.tc"), ]
+  cf <- coef(fit)[c("N", "gm1.sigma", "gm1.tc")]
+  expect_equal(ci[, 2] / cf, cf / ci[, 1], tolerance = 1e-12)
+  expect_true(all(is.finite(fit$se[c("N", "gm1.sigma", "gm1.tc")])))
+  # the bound is where the profile log-likelihood (the others re-fitted
+  # here by optim() on the Kalman likelihood) has dropped by
+  # qchisq(0.90, 1) / 2
+  lay <- allanvar:::coef_layout(c("N", "K", "gm"))
+  entries <- lapply(c("N", "K", "gm"), allanvar:::effect_entry)
+  ll <- function(p) allanvar:::mle_loglik(y, allanvar:::mle_model(p, lay, entries, 0.01))
+  prof <- function(k) {
+    o <- optim(log(cf), function(lp) -ll(c(N = exp(lp[[1]]), K = k, gm1.sigma = exp(lp[[2]]),
+                                             gm1.tc = exp(lp[[3]]))),
+               control = list(reltol = 1e-12, maxit = 2000))
+    -o$value
+  }
+  llmax <- ll(coef(fit))
+  expect_equal(fit$loglik, llmax, tolerance = 1e-8)
+  expect_equal(2 * (llmax - prof(up)), qchisq(0.90, 1), tolerance = 0.03)
+  expect_lt(2 * (llmax - prof(up / 3)), qchisq(0.90, 1))
+})
+
+test_that("95% intervals of avmle() cover the truth (small Monte Carlo)", {
+  skip_on_cran()
+  # N + K at 10 Hz, 2000 samples, 100 series from the generator above; the
+  # full check (>= 400 seeds per cell) is bench/mle-coverage.R
+  truth <- c(N = 0.05, K = 0.02)
+  hit <- matrix(NA, 100, 2, dimnames = list(NULL, names(truth)))
+  for (s in 1:100) {
+    y <- gen_series(2000, 0.1, truth[["N"]], truth[["K"]], 0, 1, seed = 1000 + s)
+    fit <- avmle(y, 10, c("N", "K"))
+    ci <- confint(fit)
+    # an interval for every parameter of every converged fit
+    expect_true(!fit$convergence$converged || all(is.finite(ci[, 1]) & !is.na(ci[, 2])))
+    hit[s, ] <- ci[, 1] <= truth & truth <= ci[, 2]
+  }
+  # 95% coverage: P(<= 88 of 100) = 0.6%
+  expect_true(all(colSums(hit) >= 89), label = paste(colSums(hit), collapse = " "))
+})
