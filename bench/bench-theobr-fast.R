@@ -32,44 +32,44 @@ gens <- list("white PM" = function(N) rnorm(N),
              "random-walk FM" = function(N) cumsum(cumsum(rnorm(N))))
 
 if (part %in% c("both", "error")) {
-rows <- list()
-set.seed(2029)
-for (N in c(1e4, 3e4, 1e5)) for (nm in names(gens)) {
-  e <- vapply(seq_len(reps), function(i) {
-    x <- gens[[nm]](N)
-    ex <- ns$theobr_factor(x, 1, FALSE, N, 2L)
-    al <- ns$theobr_ladder_alpha(x, 1, "integrated", N)
-    f4 <- ns$theobr_factor_fast(x, FALSE, N, 4L, al, 2L)
-    f16 <- ns$theobr_factor_fast(x, FALSE, N, 16L, al, 2L)
-    u16 <- ns$theobr_factor_fast(x, FALSE, N, 16L, NA, 2L)
-    100 * (sqrt(c(f4, f16, u16) / ex) - 1)
-  }, numeric(3))
-  ms <- function(j) sprintf("%+.3f (%.3f)", mean(e[j, ]), stats::sd(e[j, ]))
-  rows[[length(rows) + 1L]] <- data.frame(
-    N = format(N, scientific = TRUE), noise = nm, `r=4` = ms(1),
-    `r=16` = ms(2), `r=16 uncorrected` = ms(3), check.names = FALSE)
-  cat(".")
+  rows <- list()
+  set.seed(2029)
+  for (N in c(1e4, 3e4, 1e5)) for (nm in names(gens)) {
+    e <- vapply(seq_len(reps), function(i) {
+      x <- gens[[nm]](N)
+      ex <- ns$theobr_factor(x, 1, FALSE, N, 2L)
+      al <- ns$theobr_ladder_alpha(x, 1, "integrated", N)
+      f4 <- ns$theobr_factor_fast(x, FALSE, N, 4L, al, 2L)
+      f16 <- ns$theobr_factor_fast(x, FALSE, N, 16L, al, 2L)
+      u16 <- ns$theobr_factor_fast(x, FALSE, N, 16L, NA, 2L)
+      100 * (sqrt(c(f4, f16, u16) / ex) - 1)
+    }, numeric(3))
+    ms <- function(j) sprintf("%+.3f (%.3f)", mean(e[j, ]), stats::sd(e[j, ]))
+    rows[[length(rows) + 1L]] <- data.frame(
+      N = format(N, scientific = TRUE), noise = nm, `r=4` = ms(1),
+      `r=16` = ms(2), `r=16 uncorrected` = ms(3), check.names = FALSE)
+    cat(".")
 }
 cat("\nTheoBR deviation, fast vs exact: error in % (mean (sd) of", reps,
     "records)\n")
 print(do.call(rbind, rows), row.names = FALSE)
 }
 if (part %in% c("both", "speed")) {
-tm <- list()
-set.seed(1)
-for (N in c(1e5, 1e6)) {
-  y <- rnorm(N)
-  for (type in c("theobr", "theoh")) for (method in c("auto", "exact")) {
-    gc(FALSE)
-    t <- system.time(suppressMessages(
-      allan(y, 1, type = type, theo = list(method = method))))
-    tm[[length(tm) + 1L]] <- data.frame(
-      N = format(N, scientific = TRUE), type = type,
-      path = if (method == "auto") "fast (auto)" else "exact",
-      elapsed_s = round(t[["elapsed"]], 2),
-      cpu_s = round(t[["user.self"]] + t[["sys.self"]], 2))
-    cat(".")
-  }
+  tm <- list()
+  set.seed(1)
+  for (N in c(1e5, 1e6)) {
+    y <- rnorm(N)
+    for (type in c("theobr", "theoh")) for (method in c("auto", "exact")) {
+      gc(FALSE)
+      t <- system.time(suppressMessages(
+        allan(y, 1, type = type, theo = list(method = method))))
+      tm[[length(tm) + 1L]] <- data.frame(
+        N = format(N, scientific = TRUE), type = type,
+        path = if (method == "auto") "fast (auto)" else "exact",
+        elapsed_s = round(t[["elapsed"]], 2),
+        cpu_s = round(t[["user.self"]] + t[["sys.self"]], 2))
+      cat(".")
+    }
 }
 cat("\nallan(type = \"theobr\" / \"theoh\"), white FM, octave taus, 2 threads\n")
 print(do.call(rbind, tm), row.names = FALSE)
