@@ -444,13 +444,29 @@ plot.allan_sources <- function(x, col = NULL, comparisons = TRUE,
   vals <- vals[is.finite(vals) & vals > 0]
   yl <- if (length(vals)) range(vals) else c(1, 10)
   yl[1] <- yl[1] / 1.5  # room for the markers of negative estimates
-  if (is.null(ylab)) {
-    ylab <- switch(attr(x, "type"), standard = , overlapping = "Allan deviation",
-                   modified = "modified Allan deviation",
-                   hadamard = , ohadamard = "Hadamard deviation",
-                   total = "total deviation", "deviation")
-  }
+  if (is.null(ylab)) ylab <- stat_entry(attr(x, "type"))$ylab %||% "deviation"
   if (is.null(main)) main <- attr(x, "method")
+  if (legend) {
+    lab <- srcs
+    lc <- col
+    lt <- rep(1, length(srcs))
+    pc <- rep(20, length(srcs))
+    if (comparisons) {
+      lab <- c(lab, "comparisons")
+      lc <- c(lc, "grey55")
+      lt <- c(lt, 2)
+      pc <- c(pc, NA)
+    }
+    if (any(d$status != "ok")) {
+      lab <- c(lab, "not positive")
+      lc <- c(lc, "grey30")
+      lt <- c(lt, NA)
+      pc <- c(pc, 25)
+    }
+    leg <- list(legend = lab, col = lc, lty = lt, pch = pc, pt.bg = lc)
+    op <- reserve_legend(leg, cex = 0.8)
+    on.exit(graphics::par(op))
+  }
   graphics::plot(range(d$tau), yl, type = "n", log = "xy", xlab = xlab,
                  ylab = ylab, main = main, ...)
   graphics::grid(equilogs = FALSE)
@@ -474,26 +490,6 @@ plot.allan_sources <- function(x, col = NULL, comparisons = TRUE,
                        col = col[k], bg = col[k])
     }
   }
-  if (legend) {
-    lab <- srcs
-    lc <- col
-    lt <- rep(1, length(srcs))
-    pc <- rep(20, length(srcs))
-    if (comparisons) {
-      lab <- c(lab, "comparisons")
-      lc <- c(lc, "grey55")
-      lt <- c(lt, 2)
-      pc <- c(pc, NA)
-    }
-    if (any(d$status != "ok")) {
-      lab <- c(lab, "not positive")
-      lc <- c(lc, "grey30")
-      lt <- c(lt, NA)
-      pc <- c(pc, 25)
-    }
-    graphics::legend("topright", legend = lab, col = lc, lty = lt, pch = pc,
-                     pt.bg = lc, bg = "white", box.col = NA, inset = 0.01,
-                     cex = 0.8)
-  }
+  if (legend) legend_beside(leg, cex = 0.8)
   invisible(x)
 }
