@@ -233,7 +233,10 @@ analyze_channel <- function(job, opts) {
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
   # The series pass runs on every axis: its effects mark the readings they
   # change; those the user asked to remove go before the curve (R/series.R).
-  series <- if (length(job$x) >= 256L) detect_series_effects(job$x, job$freq, remove = opts$remove)
+  # (a record too short for the pass skips it, unless effects are to be
+  # removed: then the pass's own error says why it cannot)
+  series <- if (length(job$x) >= 256L || length(opts$remove))
+    detect_series_effects(job$x, job$freq, remove = opts$remove)
   if (!is.null(series)) job$x <- series$x
   curve <- allan(job$x, job$freq, taus = opts$taus, type = opts$type)
   if (!any(is.finite(curve$adev) & curve$adev > 0)) {
