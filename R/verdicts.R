@@ -24,8 +24,8 @@ verdict_levels <- c("measured", "upper_bound", "lower_bound", "not_determined")
 # upper bound").
 verdict_label <- function(v) gsub("_", " ", v, fixed = TRUE)
 verdict_phrase <- function(v) {
-  ifelse(v %in% c("upper_bound", "lower_bound"), paste("an", verdict_label(v)),
-         verdict_label(v))
+  ifelse(v == "upper_bound", "an upper bound",
+         ifelse(v == "lower_bound", "a lower bound", verdict_label(v)))
 }
 
 # The verdict columns of readings `rd` (one row per reading) from `curve`
