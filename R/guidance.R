@@ -124,8 +124,12 @@ channel_guidance <- function(ch) {
   n2 <- if (isTRUE(is.finite(N))) N^2 else 0
   b2 <- if (isTRUE(is.finite(B))) B^2 else 0
   need <- function(tau) T * 3 * tau / tau_rel
+  # readings whose record-length note below already says why they are not
+  # measured (their verdict line is not repeated)
+  said <- character()
   if (identical(walk$source, "bound")) {
     tx <- tau_cross(n2, b2, K)
+    said <- c(said, walk$term)
     msg <- c(msg, sprintf(
       "the +1/2 (rate random walk) region is never reached up to tau = %s: K <= %.3g %s only; resolving a K that large needs a record of at least %s (this one is %s), a smaller K a longer one.",
       hours(tau_rel), K, walk$unit, hours(need_k(ch, white, walk, tx, need)), hours(T)))
@@ -134,17 +138,13 @@ channel_guidance <- function(ch) {
     nk <- need_k(ch, white, walk, tx, need)
     # the exact bound says when this record already gives K to 25%
     if (tau_rel < 3 * tx && !isTRUE(nk <= T)) {
+      said <- c(said, walk$term)
       msg <- c(msg, sprintf(
         "K = %.3g %s is read beyond the reliable range: the +1/2 line meets the rest at tau = %s, so tau up to %s (a record of %s) is needed; this record is %s.",
         K, walk$unit, hours(tx), hours(3 * tx), hours(nk), hours(T)))
     }
   }
   tau_b <- flat$tau
-  said <- character()
-  if (identical(walk$source, "bound") ||
-      (isTRUE(is.finite(K) && K > 0) && tau_rel < 3 * tau_cross(n2, b2, K))) {
-    said <- c(said, walk$term)
-  }
   if (isTRUE(is.finite(tau_b) && tau_b > tau_rel / 3)) {
     said <- c(said, flat$term)
     msg <- c(msg, sprintf(
