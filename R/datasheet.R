@@ -98,7 +98,7 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
         unit = us, tau = r$tau, method = r$method, effects = eff,
         verdict = r$verdict, why = r$why, tau_lo = r$tau_lo, tau_hi = r$tau_hi,
         biased_by = r$biased_by, bias_change = r$bias_change, removed = r$removed,
-        warning = paste(uw$warning[uw$channel == ch$channel], collapse = "; "),
+        warning = channel_unit_warning(uw, ch$channel),
         stringsAsFactors = FALSE)
     }
   }
@@ -115,9 +115,7 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
     avg$effects <- ""
     # the mean is measured only where every axis is
     worst <- stats::aggregate(verdict ~ record + sensor + term + unit, data = long,
-                              FUN = function(v) if (all(v == "measured")) "measured"
-                                                else if (all(v == "upper_bound")) "upper_bound"
-                                                else "not_determined")
+                              FUN = mean_verdict)
     avg$verdict <- worst$verdict
     avg$why <- ifelse(avg$verdict == "measured", "",
                       "not every axis is measured: see each axis")

@@ -145,8 +145,7 @@ combine_axes <- function(d, how, label = how) {
     } else {
       out[[k]] <- mean(v, na.rm = TRUE)
       ok <- all(vk == "measured")
-      out[[paste0(k, "_verdict")]] <- if (ok) "measured" else
-        if (all(vk == "upper_bound")) "upper_bound" else "not_determined"
+      out[[paste0(k, "_verdict")]] <- mean_verdict(vk)
       out[[paste0(k, "_note")]] <- if (ok) nk[1L] else
         paste0(toupper(verdict_label(out[[paste0(k, "_verdict")]])),
                ": mean of axes not all measured (",

@@ -255,6 +255,7 @@ kalman_params <- function(x, dt = NULL, bias_instability = NULL,
   if (inherits(x, "imu_analysis")) {
     check_analysis(x)
     if (is.null(dt)) dt <- 1 / x$freq
+    uw <- unit_warnings(x)
     rows <- lapply(x$channels, function(ch) {
       rd <- ch$readings
       # the readings replace the fitted values; terms folded into a reading
@@ -271,9 +272,7 @@ kalman_params <- function(x, dt = NULL, bias_instability = NULL,
       i <- match(d$term, rd$term)
       d$verdict <- ifelse(is.na(i), "", rd$verdict[i])
       d$why <- ifelse(is.na(i), "", rd$why[i])
-      uw <- unit_warnings(x)
-      d$warning <- rep(paste(uw$warning[uw$channel == ch$channel], collapse = "; "),
-                       nrow(d))
+      d$warning <- rep(channel_unit_warning(uw, ch$channel), nrow(d))
       d
     })
     out <- do.call(rbind, rows)

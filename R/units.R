@@ -401,6 +401,11 @@ unit_warnings <- function(a) {
   data.frame(channel = uc$channel, warning = uc$warning, stringsAsFactors = FALSE)
 }
 
+# The failed unit checks of one channel as one text ("" when none).
+channel_unit_warning <- function(uw, channel) {
+  paste(uw$warning[uw$channel == channel], collapse = "; ")
+}
+
 # The failed unit checks as comment lines for a written file ("" prefix).
 unit_warning_lines <- function(a) {
   w <- unit_warnings(a)

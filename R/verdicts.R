@@ -23,6 +23,14 @@ verdict_levels <- c("measured", "upper_bound", "lower_bound", "not_determined")
 # Verdict display: "measured", "upper bound", ...; in a sentence ("is an
 # upper bound").
 verdict_label <- function(v) gsub("_", " ", v, fixed = TRUE)
+# The verdict of a mean of axes: measured only where every axis is; an
+# upper bound where every axis is one; otherwise not determined.
+mean_verdict <- function(v) {
+  if (all(v == "measured")) "measured"
+  else if (all(v == "upper_bound")) "upper_bound"
+  else "not_determined"
+}
+
 verdict_phrase <- function(v) {
   ifelse(v == "upper_bound", "an upper bound",
          ifelse(v == "lower_bound", "a lower bound", verdict_label(v)))
