@@ -1,7 +1,11 @@
 # The uncertainty of a fit: the covariance of the free parameters from the
 # Gauss-Newton information of the standardized log residuals, in the
 # reported parameterisation (amplitudes; nonlinear parameters in their own
-# units), scaled by max(1, chi2/dof).
+# units), scaled by max(1, chi2/dof). A fit that weighed correlated points
+# as independent gets the sandwich covariance with their correlation: the
+# estimate is unchanged, its spread is not (octave points of one record
+# share most of their data, and ignoring it gave 95% intervals that
+# covered 78-87%).
 
 # Jacobian of ln AV with respect to the free parameters (amplitudes, or c =
 # a^2 for amplitudes at 0; nonlinear parameters in their own units).
@@ -63,14 +67,18 @@ pinv_raw <- function(A) {
 }
 
 # Covariance matrix (all coefficients; fixed ones 0) of a fit with layout
-# `lay` at the taus `tau`, whitening W and chi2 per dof `chi2`. An
+# `lay` at the taus `tau`, whitening W and chi2 per dof `chi2`; `corr`, when
+# given, the correlation of the points that a diagonal W left out
+# (sandwich: A^-1 J'W R W J A^-1 with A = J'W W J). An
 # amplitude at its bound 0 gets sqrt(SE(c)) as its standard error and no
 # covariance; a nonlinear parameter of a term whose amplitudes are all 0 is
 # not identified (NA).
-fit_vcov <- function(lay, tau, tau0, W, chi2, plan = model_plan(lay)) {
+fit_vcov <- function(lay, tau, tau0, W, chi2, plan = model_plan(lay), corr = NULL) {
   jj <- jacobian_lnav(lay, tau, tau0, plan)
   Js <- -wmul(W, jj$J)
-  V <- pinv(crossprod(Js)) * max(1, if (is.na(chi2)) 1 else chi2)
+  Ainv <- pinv(crossprod(Js))
+  V <- if (is.null(corr)) Ainv else Ainv %*% crossprod(Js, corr %*% Js) %*% Ainv
+  V <- V * max(1, if (is.na(chi2)) 1 else chi2)
   vc <- matrix(0, nrow(lay), nrow(lay), dimnames = list(lay$name, lay$name))
   fn <- lay$name[jj$free]
   vfree <- V
