@@ -117,6 +117,10 @@ mle_kalman_sums <- function(y, R, T, Q, P0, diffuse) {
     .Call(`_allanvar_mle_kalman_sums`, y, R, T, Q, P0, diffuse)
 }
 
+avfit_model_corr <- function(m, M, shape, coef, phi) {
+    .Call(`_allanvar_avfit_model_corr`, m, M, shape, coef, phi)
+}
+
 pdev_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_pdev_sums_cpp`, v, rate, m, threads, method)
 }

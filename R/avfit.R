@@ -73,6 +73,8 @@
 #' points were weighed as independent (the default) and the curve carries
 #' `n` and `freq`, it is the sandwich
 #' \eqn{(J^\top J)^{-1} J^\top R J (J^\top J)^{-1}} with \eqn{R} the
+#' correlation of the points under the fitted model (exact for sums of N,
+#' K, Q and Gauss-Markov terms with the overlapping estimator), else the
 #' white-noise correlation above: the estimates are those of the
 #' independent weighting, their spread that of correlated points (octave
 #' points share their data; without it the 95% intervals of N and K
@@ -265,7 +267,7 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
   dfres <- nrow(data) - nfree
   chi2 <- if (dfres > 0) objective / dfres else NA_real_
   vc <- fit_vcov(lay, data$tau, tau0, pr$W, chi2, pr$plan,
-                 corr = sandwich_corr(pr, curve))
+                 corr = sandwich_corr(pr, curve, lay))
   data$fitted <- fitted
   data$z <- z
   input <- curve
@@ -288,17 +290,21 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
     convergence = res$convergence, control = control, call = cl)
 }
 
-# The correlation of the fitted points that the weighting left out: the
-# white-noise correlation of the AV estimates (as `correlation = TRUE`
-# uses) when the fit treated them as independent and the curve says how
-# they were made (n and freq); NULL otherwise. Left out above
-# `sandwich_max_points` points (the J x J matrix; such dense grids come
-# from `taus = "all"` and are not what avfit() is fed in the package).
+# The correlation of the fitted points that the weighting left out, when
+# the fit treated them as independent and the curve says how they were
+# made (n and freq): under the fitted model itself where every stochastic
+# term has an exact structure function (N, K, Q, Gauss-Markov; overlapping
+# estimator), else the white-noise correlation `correlation = TRUE` uses;
+# NULL otherwise. Left out above `sandwich_max_points` points (the J x J
+# matrix; such dense grids come from `taus = "all"`).
 sandwich_max_points <- 2000L
-sandwich_corr <- function(pr, curve) {
+sandwich_corr <- function(pr, curve, lay) {
   if (!is.null(pr$corr) || is.null(curve$n) || is.null(curve$freq)) return(NULL)
   m <- pr$data$m
   if (is.null(m) || length(m) < 2L || length(m) > sandwich_max_points) return(NULL)
+  R <- model_corr(m, curve$n, curve$type, pr$data$tau, pr$tau0, lay,
+                  curve$L %||% (curve$n + 1))
+  if (!is.null(R)) return(R)
   if (!is.null(curve$corr) && nrow(curve$corr) == nrow(curve$data)) {
     keep <- match(pr$data$tau, curve$data$tau)
     if (!anyNA(keep)) return(curve$corr[keep, keep, drop = FALSE])

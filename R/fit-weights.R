@@ -73,14 +73,12 @@ edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
   plan <- model_plan(lay)
   comp <- model_components(tau, tau0, lay, plan)
   alpha <- model_alpha(tau, tau0, lay, plan)
-  exact <- vapply(plan, function(p) is.function(p$entry$exact_edf), NA)
-  power_law <- vapply(plan, function(p) is.finite(p$entry$psd_alpha), NA)
-  live <- colSums(comp) > 0
-  stoch <- live & colSums(!is.na(alpha)) > 0
-  use <- !is.null(tau0) && all(exact[stoch]) &&
-    (sum(stoch) > 1L || any(!power_law[stoch]))
-  if (!use) return(edf_model(m, n, type, comp, alpha, L))
-  parts <- exact_edf_parts(plan[exact], stats::setNames(lay$value, lay$name), tau0)
+  ex <- exact_model(plan, comp, alpha, lay, tau0)
+  if (is.null(ex) || !(ex$stochastic > 1L || !ex$power_law)) {
+    return(edf_model(m, n, type, comp, alpha, L))
+  }
+  exact <- ex$exact
+  parts <- ex$parts
   mm <- pmax(round(m), 1)
   nu_g <- avfit_exact_edf(as.double(mm),
                           as.double(allan_nterms(engine_type(type), mm, L)),
@@ -96,6 +94,19 @@ edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
   pmin(pmax(e, 1), n)
 }
 
+# The model as structure-function parts, when every live stochastic term
+# declares how it enters (the catalogue's `exact_edf`) and tau0 is known:
+# list(parts, exact (which plan entries), stochastic (how many live
+# stochastic terms), power_law (all of them power laws)); else NULL.
+exact_model <- function(plan, comp, alpha, lay, tau0) {
+  exact <- vapply(plan, function(p) is.function(p$entry$exact_edf), NA)
+  power_law <- vapply(plan, function(p) is.finite(p$entry$psd_alpha), NA)
+  stoch <- colSums(comp) > 0 & colSums(!is.na(alpha)) > 0
+  if (is.null(tau0) || !any(stoch) || !all(exact[stoch])) return(NULL)
+  list(parts = exact_edf_parts(plan[exact], stats::setNames(lay$value, lay$name), tau0),
+       exact = exact, stochastic = sum(stoch), power_law = all(power_law[stoch]))
+}
+
 # The structure-function parts the terms of `plan` declare (each entry's
 # exact_edf(amp, nl, tau0)), as the kernel's shape codes, coefficients and
 # AR(1) poles.
@@ -108,6 +119,22 @@ exact_edf_parts <- function(plan, values, tau0) {
   list(shape = match(vapply(parts, `[[`, "", "shape"), shapes) - 1L,
        coef = vapply(parts, function(q) as.double(q$coef), 0),
        phi = vapply(parts, function(q) as.double(q$phi %||% 0), 0))
+}
+
+# Correlation matrix of the overlapping AV estimates at cluster sizes m
+# under the fitted model (layout `lay`), when every stochastic term has an
+# exact structure function (exact_model()); NULL otherwise.
+model_corr <- function(m, n, type, tau, tau0, lay, L = n + 1) {
+  if (!identical(fit_stat(type)$name, "overlapping")) return(NULL)
+  plan <- model_plan(lay)
+  ex <- exact_model(plan, model_components(tau, tau0, lay, plan),
+                    model_alpha(tau, tau0, lay, plan), lay, tau0)
+  if (is.null(ex)) return(NULL)
+  mm <- pmax(round(m), 1)
+  R <- avfit_model_corr(as.double(mm), as.double(allan_nterms("overlapping", mm, L)),
+                        ex$parts$shape, ex$parts$coef, ex$parts$phi)
+  if (anyNA(R)) return(NULL)
+  R
 }
 
 # Correlation matrix of the AV estimates at cluster sizes m for white rate

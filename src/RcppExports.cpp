@@ -376,6 +376,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// avfit_model_corr
+Rcpp::NumericMatrix avfit_model_corr(const Rcpp::NumericVector& m, const Rcpp::NumericVector& M, const Rcpp::IntegerVector& shape, const Rcpp::NumericVector& coef, const Rcpp::NumericVector& phi);
+RcppExport SEXP _allanvar_avfit_model_corr(SEXP mSEXP, SEXP MSEXP, SEXP shapeSEXP, SEXP coefSEXP, SEXP phiSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type M(MSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type shape(shapeSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type coef(coefSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phi(phiSEXP);
+    rcpp_result_gen = Rcpp::wrap(avfit_model_corr(m, M, shape, coef, phi));
+    return rcpp_result_gen;
+END_RCPP
+}
 // pdev_sums_cpp
 Rcpp::NumericVector pdev_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_pdev_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -679,6 +693,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_mcap_index_cpp", (DL_FUNC) &_allanvar_mcap_index_cpp, 1},
     {"_allanvar_mcap_read_cpp", (DL_FUNC) &_allanvar_mcap_read_cpp, 6},
     {"_allanvar_mle_kalman_sums", (DL_FUNC) &_allanvar_mle_kalman_sums, 6},
+    {"_allanvar_avfit_model_corr", (DL_FUNC) &_allanvar_avfit_model_corr, 5},
     {"_allanvar_pdev_sums_cpp", (DL_FUNC) &_allanvar_pdev_sums_cpp, 5},
     {"_allanvar_csv_field_faults", (DL_FUNC) &_allanvar_csv_field_faults, 3},
     {"_allanvar_int64_rel_seconds", (DL_FUNC) &_allanvar_int64_rel_seconds, 3},

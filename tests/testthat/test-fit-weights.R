@@ -48,3 +48,38 @@ test_that("independent points keep W as its diagonal, and the fit is the same", 
   expect_equal(a$c, b$c, tolerance = 1e-10)
   expect_equal(a$objective, b$objective, tolerance = 1e-10)
 })
+
+test_that("the model's correlation of AV estimates: white noise exact, a random walk by Monte Carlo", {
+  n <- 4096
+  m <- c(1, 2, 4, 8, 16, 32, 64, 128)
+  M <- allan_nterms("overlapping", m, n + 1)
+  # white rate noise: the closed form of avar_white_cov()
+  expect_equal(avfit_model_corr(m, M, 0L, 1, 0), white_corr(m, n, "overlapping"),
+               tolerance = 1e-3)
+  # rate random walk (own generator, direct second differences of the phase)
+  skip_on_cran()
+  oav <- function(y, k) {
+    x <- c(0, cumsum(y))
+    L <- length(x)
+    d <- x[(2 * k + 1):L] - 2 * x[(k + 1):(L - k)] + x[1:(L - 2 * k)]
+    mean(d^2) / (2 * k^2)
+  }
+  set.seed(11)
+  sims <- replicate(1500, {
+    y <- cumsum(rnorm(n))
+    vapply(m, function(k) oav(y, k), 0)
+  })
+  R <- avfit_model_corr(m, M, 1L, 1, 0)
+  # the white-noise correlation is far off here (0.07 for m = 1 and 8)
+  expect_equal(cor(t(sims))[4, ], R[4, ], tolerance = 0.06)
+  expect_gt(R[1, 4], 0.25)
+  # a Gauss-Markov term beside white noise
+  phi <- exp(-1 / 20)
+  sims <- replicate(1500, {
+    w <- rnorm(n) * sqrt(1 - phi^2)
+    y <- as.numeric(stats::filter(w, phi, method = "recursive")) + 0.3 * rnorm(n)
+    vapply(m, function(k) oav(y, k), 0)
+  })
+  R <- avfit_model_corr(m, M, c(3L, 0L), c(1, 0.09), c(phi, 0))
+  expect_equal(cor(t(sims))[5, ], R[5, ], tolerance = 0.06)
+})
