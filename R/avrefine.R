@@ -119,7 +119,9 @@
 #'   `series_duplicates` (the rejected terms that would have described a
 #'   series effect of this run again, which was left in the data: step,
 #'   effect, params, `series_kind`, `ratio` = the AV that series effect
-#'   adds over the term's own AV, at `tau`; the readings of such a run
+#'   adds over the term's own AV, at `tau`, `how`: `"share"` when that
+#'   ratio is 1 or more, `"refit"` when the term no longer pays on the
+#'   curve with the effect's excess taken out; the readings of such a run
 #'   carry that series effect's bias, see [series_reading_bias()]),
 #'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range) and
 #'   `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,

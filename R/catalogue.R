@@ -98,6 +98,11 @@
 #                 list(shape, coef, phi) of its structure function, shape one
 #                 of "linear" (coef * l), "cubic" (-coef (l^3 - l) / 6),
 #                 "step" (2 coef for l > 0), "ar1" (coef = sigma^2, phi)
+#   noise_lookalike  TRUE for a "series" kind that a stationary noise
+#                 term's own excursions can produce (a Gauss-Markov
+#                 term's slow swings are transients to the series pass): a
+#                 term is then not judged on the curve with that kind's
+#                 excess taken out (series_pays_without())
 
 .catalogue <- new.env(parent = emptyenv())
 
@@ -175,7 +180,7 @@ new_effect <- function(name, title, params, component = "av",
                        remove = NULL, replaces = character(),
                        replaces_instance = NULL, admissible = NULL, proposed_only = FALSE,
                        statespace = NULL, diagnose = NULL, family = NULL,
-                       exact_edf = NULL) {
+                       exact_edf = NULL, noise_lookalike = FALSE) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -188,7 +193,8 @@ new_effect <- function(name, title, params, component = "av",
        replaces = replaces, replaces_instance = replaces_instance,
        admissible = admissible,
        proposed_only = proposed_only, statespace = statespace,
-       diagnose = diagnose, family = family, exact_edf = exact_edf)
+       diagnose = diagnose, family = family, exact_edf = exact_edf,
+       noise_lookalike = noise_lookalike)
 }
 
 validate_effect <- function(e) {
@@ -228,6 +234,9 @@ validate_effect <- function(e) {
   }
   if (!is.null(e$variants) && !is.function(e$variants)) {
     bad("`variants` must be a function(variant) or NULL.")
+  }
+  if (!isTRUE(e$noise_lookalike) && !isFALSE(e$noise_lookalike)) {
+    bad("`noise_lookalike` must be TRUE or FALSE.")
   }
   if (!is.function(e$sim)) bad("`sim` (the simulator) is required.")
   if (identical(e$component, "av")) {

@@ -98,6 +98,8 @@ effect_transient <- function() {
   new_effect(
     name = "transients", title = "transient (a pulse that returns)",
     component = "series",
+    # a Gauss-Markov term's own slow swings are transients to the detector
+    noise_lookalike = TRUE,
     params = rbind(
       effect_param("size", "amp", "u", "rate unit (offset while it lasts)"),
       effect_param("time", "nonlinear", "s", "second (start)"),

@@ -245,9 +245,71 @@ series_duplicate <- function(series, fit, label, share = 1) {
     at <- stats::approx(log(a$tau[ok]), ex[ok], log(tau[j]))$y
     r <- at / own
     if (is.finite(r) && r >= share && (is.null(out) || r > out$ratio)) {
-      out <- data.frame(series_kind = k, ratio = r, tau = tau[j],
+      out <- data.frame(series_kind = k, ratio = r, tau = tau[j], how = "share",
                         stringsAsFactors = FALSE)
     }
+  }
+  out
+}
+
+# A term that pays only for what a series effect left in adds to the curve
+# (a Gauss-Markov term taking a warm-up's excess together with part of the
+# axis's own long-tau level, which the share rule above does not reach):
+# where the kinds left in add at least `min_share` of the term's AV at the
+# tau it weighs most, the model with and without the term are refitted on
+# the curve with those kinds' excess (ADEV^2 with minus without each, from
+# the series pass) taken out; if the term no longer pays by the criterion
+# there, it describes the series effect. Kinds a noise term's own
+# excursions can produce (the entry's `noise_lookalike`: transients) are
+# not taken out: a measured accelerometer's 20 s GM is also six transients
+# to the series pass. Returns NULL or a one-row data
+# frame like series_duplicate()'s (`ratio` the kinds' share at that tau).
+series_pays_without <- function(st, new, label, min_share = 0.1) {
+  series <- st$series
+  if (is.null(series) || !NROW(series$table) || !NROW(series$adev_kinds)) return(NULL)
+  left <- unique(series$table$kind[!series$table$removed])
+  left <- left[!vapply(left, function(k) isTRUE(effect_entry(k)$noise_lookalike), NA)]
+  comp <- new$components
+  if (!length(left) || !label %in% colnames(comp)) return(NULL)
+  cv <- curve_of_fit(new)
+  tau <- cv$data$tau
+  ex <- kind_excess(series$adev_kinds, left, tau)
+  if (is.null(ex)) return(NULL)
+  sh <- comp[, label] / rowSums(comp)
+  j <- if (any(sh >= 0.5)) which.max(comp[, label] * (sh >= 0.5)) else which.max(sh)
+  own <- comp[j, label]
+  total <- rowSums(ex)
+  if (!(own > 0) || total[j] < min_share * own) return(NULL)
+  # taken out to at most 90% of a point: the excess is an estimate too
+  cv$data$avar <- pmax(cv$data$avar - total, 0.1 * cv$data$avar)
+  refit_on <- function(fit) {
+    args <- refit_args(fit, fit$terms, st$settings)
+    args$av <- cv
+    try_refit(args, "refit without the series effects")$fit
+  }
+  without <- refit_on(st$current)
+  with <- refit_on(new)
+  if (is.null(without) || is.null(with)) return(NULL)
+  if (refine_crit(st, with) < refine_crit(st, without) - st$args$min_gain) return(NULL)
+  k <- colnames(ex)[which.max(ex[j, ])]
+  data.frame(series_kind = k, ratio = total[j] / own, tau = tau[j], how = "refit",
+             stringsAsFactors = FALSE)
+}
+
+# The AV each kind left in adds at the taus `tau` (ADEV^2 with it minus
+# without it, interpolated on log tau; 0 outside the pass's taus and where
+# taking it out raised the curve): a matrix, one column per kind, or NULL.
+kind_excess <- function(adev_kinds, kinds, tau) {
+  out <- NULL
+  for (k in kinds) {
+    a <- adev_kinds[adev_kinds$kind == k, , drop = FALSE]
+    e <- a$before^2 - a$after^2
+    ok <- is.finite(e) & a$tau > 0
+    if (sum(ok) < 2L) next
+    v <- stats::approx(log(a$tau[ok]), pmax(e[ok], 0), log(tau))$y
+    v[is.na(v)] <- 0
+    out <- cbind(out, stats::setNames(list(v), k)[[1L]])
+    colnames(out)[ncol(out)] <- k
   }
   out
 }

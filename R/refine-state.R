@@ -102,12 +102,13 @@ new_rejected <- function() {
 }
 
 # Terms rejected because they describe a series effect of the same run
-# again (series_duplicate()): the series kind, the share of the term's AV
-# that effect adds and the tau it was read at.
+# again (series_duplicate(), series_pays_without()): the series kind, the
+# share of the term's AV that effect adds, the tau it was read at and how
+# the rule decided ("share", or "refit": no gain without the excess).
 new_duplicates <- function() {
   data.frame(step = integer(), effect = character(), params = character(),
              series_kind = character(), ratio = numeric(), tau = numeric(),
-             stringsAsFactors = FALSE)
+             how = character(), stringsAsFactors = FALSE)
 }
 
 add_rejected <- function(rejected, step, effect, par, reason) {
