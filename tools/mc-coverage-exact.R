@@ -13,7 +13,7 @@
 # averages the rows' limits rest on. A row is ok when cov68 is in
 # 0.60-0.76 and cov95 in 0.92-0.975.
 #
-#   [ALLANVAR_CI_EXACT=0] Rscript tools/mc-coverage-exact.R [replicates] [N] [types]
+#   [ALLANVAR_CI_EXACT=0] [MC_ROWS_ALONE=1] Rscript tools/mc-coverage-exact.R [replicates] [N] [types]
 source(file.path("tools", "mc-coverage.R"), local = TRUE)  # mc_generators()
 
 mc_exact <- function(type, gen, reps, m, alpha_true) {
@@ -27,7 +27,9 @@ mc_exact <- function(type, gen, reps, m, alpha_true) {
   lo <- ns$stat_entry(base)$alpha_range[1L]
   # the rows asked for with the octave grid below them, as allan()'s
   # default taus give a curve (the reading at many averages: exact_sets())
-  mall <- sort(unique(c(2^(0:floor(log2(min(m)))), m)))
+  # (MC_ROWS_ALONE=1: the rows alone, their own readings only)
+  mall <- if (nzchar(Sys.getenv("MC_ROWS_ALONE"))) m else
+    sort(unique(c(2^(0:floor(log2(min(m)))), m)))
   for (i in seq_len(reps)) {
     y <- gen()
     a <- allan(y, 1, taus = I(mall), type = type, conf = 0.683)
