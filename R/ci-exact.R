@@ -7,8 +7,9 @@
 # [adev / sqrt(q_{1-p}), adev / sqrt(q_p)].
 #
 # The noise type is read from the data at each tau, and at a few averages
-# that reading is weak; so the interval is the union of the intervals of
-# the types the reading leaves plausible (exact_alts(), exact_alpha()).
+# that reading is weak; so a row rests on the reading at many averages
+# where the curve has one, else on the union of the intervals of the types
+# its own reading leaves plausible (exact_sets()).
 #
 # Which rows: N/m <= getOption("allanvar.ci_exact", 16) (N rate samples);
 # Inf makes every row exact, 0 none. Types: the Allan and Hadamard families
@@ -41,10 +42,19 @@
 #' B)^{-(2 - \alpha)/2} e}), and the interval is
 #' \eqn{[\sigma / \sqrt{q_{1-p}}, \sigma / \sqrt{q_p}]} with its quantiles
 #' \eqn{q} (Imhof's integral). The noise type read at a few averages is
-#' weak, so the interval is the union over the types the reading leaves
-#' plausible: an FM type and its redder neighbour; below \eqn{N/m = 8},
-#' where flicker PM and white FM can no longer be told apart, the type read
-#' at the nearest shorter tau with \eqn{N/m \ge 8}. `options(allanvar.ci_exact = k)` moves the threshold
+#' weak (B1 from a handful of averages reads an FM type as its whiter
+#' neighbour in a third to all of the records), so a row rests on the
+#' type read at the nearest shorter tau with \eqn{N/m \ge 64} (the lag-1
+#' autocorrelation from 64 or more averages) where that is an FM type,
+#' joined with the row's own reading and its redder neighbour only where
+#' the own reading is redder (the type may turn redder at long tau).
+#' Without such a row, or where it reads PM, the interval is the union
+#' over the types the row's own reading leaves plausible: an FM type and
+#' its redder neighbour; below \eqn{N/m = 8}, where flicker PM and white
+#' FM can no longer be told apart, the type read at the nearest shorter tau
+#' with \eqn{N/m \ge 8}. So the limits of a row at few averages depend on
+#' the taus computed with it: a curve's default grid has the rows at many
+#' averages. `options(allanvar.ci_exact = k)` moves the threshold
 #' \eqn{N/m \le k} (`Inf`: every row, `0`: chi-square everywhere). The
 #' `edf` column keeps the two-moment EDF. Series with missing values
 #' (`gaps = "skip"`) keep the chi-square limits (their terms are not a
@@ -59,6 +69,7 @@ exact_nmax <- 300L
 exact_mcap <- 64L
 exact_nmax_pm <- 1000L
 exact_read_min <- 8
+exact_read_sure <- 64
 exact_cache <- new.env(parent = emptyenv())
 
 # Types with exact limits, by allan()'s names.
@@ -109,30 +120,29 @@ exact_factors_one <- function(code, m, n, alpha, conf) {
   out
 }
 
-# The noise exponents whose intervals are joined at a row. At N/m <= 16
-# the identification errs toward the whiter neighbour under FM noise
-# (Monte Carlo, N = 1024, overlapping: random-walk FM read as flicker or
-# white FM in 10-50% of records, flicker FM as white in 25-75%), while
-# white PM is read right in 95-100% of records at N/m >= 4 and flicker PM
-# in 90-100% (read as white FM, a wider interval, at N/m 6-8). So: an FM
-# reading joins its redder neighbour (alpha - 1); a PM reading stands alone.
+# The noise exponents whose intervals are joined at a row, from the row's
+# own reading (exact_alpha()). At N/m <= 16 B1 with Stable32's count errs
+# toward the whiter neighbour under FM noise (Monte Carlo, N = 1024,
+# overlapping, 2000 records: random-walk FM read as random walk in at most
+# 1 record, mostly as flicker FM; flicker FM read right in 26-33%, else as
+# white FM), while white PM is read right in 95-100% of records at N/m >= 4
+# and flicker PM in 90-100%. So: an FM reading joins its redder neighbour
+# (alpha - 1); a PM reading stands alone.
 exact_alts <- function(alpha, lo) {
   if (is.na(alpha)) return(lo:2L)
   if (alpha >= 1L) return(alpha)
   max(lo, alpha - 1L):alpha
 }
 
-# The noise exponent each row's interval rests on. Below N/m = 8 the
+# The noise exponent each row's own reading gives. Below N/m = 8 the
 # reading of flicker PM against white FM fails (overlapping, N = 1024:
 # flicker PM read right in 98% of records at N/m = 8, 34-37% at 4-6; at
 # N/m = 2-3 every noise reads as white FM or nothing), so such rows, and
 # rows without a reading, take the reading of the nearest shorter tau with
-# N/m >= exact_read_min (one octave back on an octave grid); NA where there
-# is none. Monte Carlo (tools/mc-coverage-exact.R, 1000 replicates, 190
-# rows): 184 rows in both bands, against 178 with each row's own reading
-# down to N/m = 4.
-exact_alpha <- function(m, L, alpha) {
-  own <- ifelse((L - 1) / m >= exact_read_min, alpha, NA_integer_)
+# N/m >= `min_avg` (one octave back on an octave grid); NA where there is
+# none.
+exact_alpha <- function(m, L, alpha, min_avg = exact_read_min) {
+  own <- ifelse((L - 1) / m >= min_avg, alpha, NA_integer_)
   o <- order(m)
   a <- own[o]
   last <- NA_integer_
@@ -142,6 +152,38 @@ exact_alpha <- function(m, L, alpha) {
   out <- integer(length(m))
   out[o] <- a
   out
+}
+
+# The noise exponents a row's interval rests on. Where the curve has a row
+# with N/m >= exact_read_sure at a shorter tau (the lag-1 ACF reading from
+# 64 or more averages: right in 97-100% of records under white FM and,
+# for the Allan types, random-walk FM (83% for the Hadamard types); in
+# about half under flicker FM, whose neighbours' intervals are close at
+# these N/m), a row at few
+# averages takes that reading, and joins the types its own weak reading
+# leaves plausible (exact_alts()) only when that reading is redder (the
+# type may turn redder at long tau: random-walk FM after white FM). Its own
+# reading alone, joined with the redder neighbour, covered white FM at
+# 0.74-0.76 (68%) and random-walk FM at 0.92 (95%, N/m = 3) on the
+# overlapping types (2000 records, N = 1024), since B1 from a few
+# averages cannot tell an FM type from its neighbour. Without such a row,
+# or where it reads PM: the union over the own reading's plausible types
+# (the ACF of cluster averages reads white PM as flicker PM in a quarter of
+# records at 64 averages, where R(n), in the own reading, tells them apart:
+# white PM's 68% coverage was 0.75-0.77 on the ACF's reading). Monte Carlo
+# (tools/mc-coverage-exact.R, curves with the octave taus below the rows,
+# 2000 records, N = 1024): 190 of 190 rows in both bands.
+exact_sets <- function(m, L, alpha, lo) {
+  own <- exact_alpha(m, L, alpha)
+  sure <- exact_alpha(m, L, alpha, exact_read_sure)
+  lapply(seq_along(m), function(i) {
+    weak <- exact_alts(own[i], lo)
+    if (is.na(sure[i]) || sure[i] >= 1L) return(weak)
+    if (!is.na(own[i]) && own[i] < sure[i]) {
+      return(sort(unique(c(weak, sure[i]))))
+    }
+    sure[i]
+  })
 }
 
 #' Exact limits of Allan-family rows (internal)
@@ -165,9 +207,9 @@ allan_limits_exact <- function(type, m, n, L, alpha, conf) {
   if (!length(rows)) return(list(lower = lower, upper = upper))
   code <- allan_type_code(type)
   lo <- e$alpha_range[1L]
-  alpha <- exact_alpha(m, L, rep_len(as.integer(alpha), k))
+  sets <- exact_sets(m, L, rep_len(as.integer(alpha), k), lo)
   for (i in rows) {
-    f <- vapply(exact_alts(alpha[i], lo), function(a) {
+    f <- vapply(sets[[i]], function(a) {
       f1 <- exact_factors_one(code, m[i], n[i], a, conf)
       if (anyNA(f1)) {
         # a type the exact route leaves to chi-square: its interval

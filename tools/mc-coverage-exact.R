@@ -6,28 +6,42 @@
 # is the ensemble mean of the variance over the replicates. `cov68`,
 # `cov95`: with the noise type allan() identifies (the union over its
 # neighbours); `true68`, `true95`: the exact interval of the generator's
-# own type alone (allan_limits_exact() with that type, no union). A row is
-# ok when cov68 is in 0.60-0.76 and cov95 in 0.92-0.975.
+# own type alone (allan_limits_exact() with that type, no union);
+# `set_true`: the share of records whose interval's set of noise types
+# (exact_sets()) holds the true one. Each record's curve has the octave
+# taus below the rows (as allan()'s default grid), whose readings at many
+# averages the rows' limits rest on. A row is ok when cov68 is in
+# 0.60-0.76 and cov95 in 0.92-0.975.
 #
-#   [ALLANVAR_CI_EXACT=0] Rscript tools/mc-coverage-exact.R [replicates] [N] [types]
+#   [ALLANVAR_CI_EXACT=0] [MC_ROWS_ALONE=1] Rscript tools/mc-coverage-exact.R [replicates] [N] [types]
 source(file.path("tools", "mc-coverage.R"), local = TRUE)  # mc_generators()
 
 mc_exact <- function(type, gen, reps, m, alpha_true) {
   ns <- asNamespace("allanvar")
   N <- length(gen())
   L <- N + 1
-  av <- lo68 <- hi68 <- lo95 <- hi95 <- matrix(NA_real_, length(m), reps)
+  av <- lo68 <- hi68 <- lo95 <- hi95 <- rd <- matrix(NA, length(m), reps)
   t68 <- t95 <- list()
   n <- NULL
   base <- if (type == "tdev") "modified" else type
+  lo <- ns$stat_entry(base)$alpha_range[1L]
+  # the rows asked for with the octave grid below them, as allan()'s
+  # default taus give a curve (the reading at many averages: exact_sets())
+  # (MC_ROWS_ALONE=1: the rows alone, their own readings only)
+  mall <- if (nzchar(Sys.getenv("MC_ROWS_ALONE"))) m else
+    sort(unique(c(2^(0:floor(log2(min(m)))), m)))
   for (i in seq_len(reps)) {
     y <- gen()
-    a <- allan(y, 1, taus = I(m), type = type, conf = 0.683)
-    b <- allan(y, 1, taus = I(m), type = type, conf = 0.95)
-    av[, i] <- a$avar
-    lo68[, i] <- a$lower; hi68[, i] <- a$upper
-    lo95[, i] <- b$lower; hi95[, i] <- b$upper
-    n <- a$n
+    a <- allan(y, 1, taus = I(mall), type = type, conf = 0.683)
+    b <- allan(y, 1, taus = I(mall), type = type, conf = 0.95)
+    r <- match(m, a$m)
+    av[, i] <- a$avar[r]
+    lo68[, i] <- a$lower[r]; hi68[, i] <- a$upper[r]
+    lo95[, i] <- b$lower[r]; hi95[, i] <- b$upper[r]
+    n <- a$n[r]
+    # does the set of types the limits rest on hold the true one?
+    sets <- ns$exact_sets(a$m, L, a$alpha, lo)[r]
+    rd[, i] <- vapply(sets, function(s) alpha_true %in% s, TRUE)
   }
   # the true type's exact factors (no union): every row of the type
   one <- function(conf) {
@@ -48,7 +62,8 @@ mc_exact <- function(type, gen, reps, m, alpha_true) {
   data.frame(m = m, N_over_m = round(N / m, 2), n = n,
              cov68 = cover(lo68, hi68), cov95 = cover(lo95, hi95),
              true68 = cover(dev * f68[, 1], dev * f68[, 2]),
-             true95 = cover(dev * f95[, 1], dev * f95[, 2]))
+             true95 = cover(dev * f95[, 1], dev * f95[, 2]),
+             set_true = rowMeans(rd))
 }
 
 if (sys.nframe() == 0L) {

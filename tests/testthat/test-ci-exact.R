@@ -99,17 +99,17 @@ test_that("allan() uses the exact limits at N/m <= 16 only", {
   expect_identical(a1$lower[!few], a0$lower[!few])
   many <- few & a1$n > 1
   expect_true(all(a1$upper[many] != a0$upper[many]))
-  # a row's factors: the union over its plausible types (white FM read at
-  # N/m >= 8: white and flicker FM)
+  # a row's factors: the union over the types exact_sets() keeps (the
+  # reading at N/m >= 64 where it is FM, else the own reading and its
+  # redder neighbour)
   i <- which(many)[1]
-  f <- sapply(c(-1L, 0L), function(a) {
+  set <- exact_sets(a1$m, 1025, a1$alpha, -2L)[[i]]
+  f <- sapply(set, function(a) {
     exact_factors_one(allan_type_code("overlapping"), a1$m[i], a1$n[i], a,
                       0.683)
   })
-  if (identical(a1$alpha[i], 0L)) {
-    expect_equal(a1$upper[i] / a1$adev[i], max(f[2, ]))
-    expect_equal(a1$lower[i] / a1$adev[i], min(f[1, ]))
-  }
+  expect_equal(a1$upper[i] / a1$adev[i], max(f[2, ]))
+  expect_equal(a1$lower[i] / a1$adev[i], min(f[1, ]))
   # one term: chi-square(1) whatever the type
   one <- which(a1$n == 1)
   expect_equal(a1$upper[one],
@@ -118,16 +118,40 @@ test_that("allan() uses the exact limits at N/m <= 16 only", {
   expect_error(allan(y, 1), class = "allanvar_error_argument")
 })
 
+test_that("exact_sets() rests few-average rows on the reading at many averages", {
+  L <- 1025
+  m <- c(1, 16, 64, 128, 256)  # N/m 1024, 64, 16, 8, 4
+  # an FM reading at N/m >= 64 alone where the own reading is not redder
+  expect_identical(exact_sets(m, L, c(0L, 0L, 0L, 0L, NA), -2L)[3:5],
+                   list(0L, 0L, 0L))
+  expect_identical(exact_sets(m, L, c(-1L, -1L, 0L, 1L, NA), -2L)[3:5],
+                   list(-1L, -1L, -1L))
+  # an own reading redder than it: both, with the own one's neighbour
+  expect_identical(exact_sets(m, L, c(0L, 0L, -1L, -1L, NA), -2L)[3:5],
+                   list(-2:0, -2:0, -2:0))
+  # a PM reading at many averages, or none: the own reading's set
+  expect_identical(exact_sets(m, L, c(2L, 2L, 2L, 0L, NA), -2L)[3:5],
+                   list(2L, -1:0, -1:0))
+  expect_identical(exact_sets(m[3:5], L, c(0L, -1L, NA), -2L),
+                   list(-1:0, -2:-1, -2:-1))
+  expect_identical(exact_sets(m[3:5], L, c(NA, NA, NA), -2L)[[1]], -2:2)
+})
+
 test_that("exact 95% intervals cover under random-walk FM (quick Monte Carlo)", {
   skip_on_cran()
   # own generator; truth (2 m^2 + 1) / (6 m) for unit innovations
   set.seed(29)
   m <- c(64, 128, 256)
+  # on the rows alone (their own readings) and on the octave curve (the
+  # reading at N/m >= 64 behind them)
   hits <- replicate(200, {
-    a <- allan(cumsum(rnorm(1024)), 1, taus = I(m), type = "overlapping",
-               conf = 0.95)
+    y <- cumsum(rnorm(1024))
+    a <- allan(y, 1, taus = I(m), type = "overlapping", conf = 0.95)
+    b <- allan(y, 1, type = "overlapping", conf = 0.95)
+    b <- b[match(m, b$m), ]
     truth <- sqrt((2 * m^2 + 1) / (6 * m))
-    a$lower <= truth & truth <= a$upper
+    c(a$lower <= truth & truth <= a$upper,
+      b$lower <= truth & truth <= b$upper)
   })
   cover <- rowMeans(hits)
   # 200 draws: binomial sd 0.015 at 0.95
