@@ -133,6 +133,7 @@ register_effect <- function(entry, replace = FALSE) {
   }
   entries[[entry$name]] <- entry
   .catalogue$entries <- entries
+  .catalogue$layouts <- NULL
   invisible(entry)
 }
 
@@ -146,6 +147,7 @@ unregister_effect <- function(name) {
           class = "catalogue")
   }
   .catalogue$entries <- entries[names(entries) != name]
+  .catalogue$layouts <- NULL
   invisible(NULL)
 }
 

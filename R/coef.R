@@ -79,6 +79,23 @@ coef_names <- function(e, label) {
 #' ("amp" or "nonlinear"), `unit`.
 #' @noRd
 coef_layout <- function(terms) {
+  # the loop's refits ask for the same few layouts thousands of times:
+  # each set of terms is built once per catalogue (register_effect() and
+  # unregister_effect() empty the store)
+  key <- if (is.character(terms) && !anyNA(terms)) paste(terms, collapse = "\r")
+  if (!is.null(key)) {
+    hit <- .catalogue$layouts[[key]]
+    if (!is.null(hit)) return(hit)
+  }
+  lay <- build_coef_layout(terms)
+  if (!is.null(key)) {
+    if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
+    assign(key, lay, envir = .catalogue$layouts)
+  }
+  lay
+}
+
+build_coef_layout <- function(terms) {
   terms <- check_terms(terms)
   labs <- term_labels(terms)
   sp <- split_term(terms)

@@ -105,10 +105,16 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     W <- max(1L, min(wbest, at - left, right - at))
     c(size = mean(xs[at:(at + W - 1L)]) - mean(xs[(at - W):(at - 1L)]), W = W)
   }
+  done <- -1L
   for (k in seq_len(max_steps + 20L)) {
     if (length(idx) >= max_steps) break
-    xs <- remove_steps(x, data.frame(index = idx, size = sizes))
-    r <- block_avg(xs, b)
+    # a candidate set aside leaves the steps as they were: the series and
+    # its block means are made again only when a step was added
+    if (done != length(idx)) {
+      xs <- remove_steps(x, data.frame(index = idx, size = sizes))
+      r <- block_avg(xs, b)
+      done <- length(idx)
+    }
     best <- list(z = 0)
     for (j in seq_along(ws)) {
       d <- allan_differences(r, ws[j])
@@ -264,13 +270,27 @@ step_return <- function(x, steps, k, gap, alpha, tau0) {
 # sample after it (the level before the first step is kept).
 remove_steps <- function(x, steps) {
   if (!nrow(steps)) return(x)
-  # one cumulative sum of the sizes placed at their indices: O(n)
-  jump <- numeric(length(x))
+  # the sizes summed at their indices, then their cumulative sum (cumsum()
+  # of the sparse jumps only: the zeros between them add nothing, so the
+  # levels are those of the cumsum() of the full jump series) held
+  # constant from each index on: O(n)
+  n <- length(x)
+  at <- sort(unique(steps$index))
+  if (any(at < 1 | at > n | at != floor(at))) {
+    # not sample indices: the full jump series, as before
+    jump <- numeric(n)
+    for (k in seq_len(nrow(steps))) {
+      i <- steps$index[k]
+      jump[i] <- jump[i] + steps$size[k]
+    }
+    return(x - cumsum(jump))
+  }
+  jump <- numeric(length(at))
   for (k in seq_len(nrow(steps))) {
-    i <- steps$index[k]
+    i <- match(steps$index[k], at)
     jump[i] <- jump[i] + steps$size[k]
   }
-  x - cumsum(jump)
+  x - rep.int(c(0, cumsum(jump)), diff(c(1L, at, n + 1L)))
 }
 
 #' Exponential warm-up (internal)
