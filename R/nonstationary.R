@@ -585,7 +585,9 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6,
     # its neighbours as an additive outlier of the series' own AR model
     # (a resonant or strongly filtered series gives the running median's
     # residual heavy tails that are not outliers)
-    ao <- spike_ao_z(x, i, med + pmax(pmin(r, 4 * s), -4 * s))
+    # (the winsorised series only where spike_ao_z() reads it: its start)
+    w <- seq_len(min(n, 200000L))
+    ao <- spike_ao_z(x, i, med[w] + pmax(pmin(r[w], 4 * s), -4 * s))
     i <- i[!(abs(ao) < ao_min)]
   }
   out <- data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
@@ -602,7 +604,7 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6,
 # the ends.
 spike_ao_z <- function(x, at, xw, p = 10L) {
   n <- length(x)
-  m <- min(n, 200000L)
+  m <- min(n, length(xw), 200000L)
   mu <- mean(xw[seq_len(m)])
   # Yule-Walker from the sample autocovariance (C, O(m p))
   g <- as.numeric(stats::acf(xw[seq_len(m)] - mu, lag.max = p, type = "covariance",
