@@ -138,6 +138,7 @@ register_effect <- function(entry, replace = FALSE) {
   }
   entries[[entry$name]] <- entry
   .catalogue$entries <- entries
+  .catalogue$layouts <- NULL
   invisible(entry)
 }
 
@@ -151,6 +152,7 @@ unregister_effect <- function(name) {
           class = "catalogue")
   }
   .catalogue$entries <- entries[names(entries) != name]
+  .catalogue$layouts <- NULL
   invisible(NULL)
 }
 

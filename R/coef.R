@@ -79,6 +79,23 @@ coef_names <- function(e, label) {
 #' ("amp" or "nonlinear"), `unit`.
 #' @noRd
 coef_layout <- function(terms) {
+  # the loop's refits ask for the same few layouts thousands of times:
+  # each set of terms is built once per catalogue (register_effect() and
+  # unregister_effect() empty the store)
+  key <- if (is.character(terms) && !anyNA(terms)) paste(terms, collapse = "\r")
+  if (!is.null(key)) {
+    hit <- .catalogue$layouts[[key]]
+    if (!is.null(hit)) return(hit)
+  }
+  lay <- build_coef_layout(terms)
+  if (!is.null(key)) {
+    if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
+    assign(key, lay, envir = .catalogue$layouts)
+  }
+  lay
+}
+
+build_coef_layout <- function(terms) {
   terms <- check_terms(terms)
   labs <- term_labels(terms)
   sp <- split_term(terms)
@@ -175,12 +192,24 @@ model_plan <- function(lay) {
 # Basis matrix: AV per squared amplitude, one column per amplitude
 # coefficient, rows are tau. `values` is a named vector holding (at least)
 # the nonlinear coefficients.
-plan_basis <- function(plan, tau, tau0, values) {
+# `memo`: an environment keeping each term's last columns and the values
+# they were made at, for a search that calls this for one `tau` many times
+# and moves one term at a time (the others' columns are reused as made).
+plan_basis <- function(plan, tau, tau0, values, memo = NULL) {
   amps <- unlist(lapply(plan, `[[`, "amp"))
   out <- matrix(0, length(tau), length(amps), dimnames = list(NULL, amps))
   for (p in plan) {
     nl <- if (length(p$nl)) stats::setNames(values[p$nl], p$nl_param) else NULL
-    out[, p$amp] <- p$entry$basis(tau, tau0, nl)
+    if (is.null(memo)) {
+      out[, p$amp] <- p$entry$basis(tau, tau0, nl)
+      next
+    }
+    hit <- memo[[p$label]]
+    if (is.null(hit) || !identical(hit$nl, nl)) {
+      hit <- list(nl = nl, b = p$entry$basis(tau, tau0, nl))
+      assign(p$label, hit, envir = memo)
+    }
+    out[, p$amp] <- hit$b
   }
   out
 }

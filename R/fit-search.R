@@ -139,7 +139,8 @@ fit_problem <- function(data, tau0, lay, bias_correct, corr, model_var = 0) {
   list(data = data, tau0 = tau0, lay = lay, plan = plan, y = y,
        s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct,
        amp = amp, plan_nl = plan[!const], basis0 = basis0,
-       values = stats::setNames(lay$value, lay$name))
+       values = stats::setNames(lay$value, lay$name),
+       memo = new.env(parent = emptyenv()))
 }
 
 # Solve for the squared amplitudes at nonlinear values `nlv` (named by
@@ -151,7 +152,7 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE) {
   values <- pr$values
   if (length(nlv)) values[names(nlv)] <- nlv
   amp <- pr$amp
-  Bm <- cbind(pr$basis0, plan_basis(pr$plan_nl, pr$data$tau, pr$tau0, values))
+  Bm <- cbind(pr$basis0, plan_basis(pr$plan_nl, pr$data$tau, pr$tau0, values, pr$memo))
   free <- amp$name[!amp$fixed & !amp$label %in% off]
   offset <- numeric(nrow(pr$data))
   for (i in which(amp$fixed)) offset <- offset + amp$value[i]^2 * Bm[, amp$name[i]]

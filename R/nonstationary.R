@@ -105,10 +105,16 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     W <- max(1L, min(wbest, at - left, right - at))
     c(size = mean(xs[at:(at + W - 1L)]) - mean(xs[(at - W):(at - 1L)]), W = W)
   }
+  done <- -1L
   for (k in seq_len(max_steps + 20L)) {
     if (length(idx) >= max_steps) break
-    xs <- remove_steps(x, data.frame(index = idx, size = sizes))
-    r <- block_avg(xs, b)
+    # a candidate set aside leaves the steps as they were: the series and
+    # its block means are made again only when a step was added
+    if (done != length(idx)) {
+      xs <- remove_steps(x, data.frame(index = idx, size = sizes))
+      r <- block_avg(xs, b)
+      done <- length(idx)
+    }
     best <- list(z = 0)
     for (j in seq_along(ws)) {
       d <- allan_differences(r, ws[j])
@@ -264,13 +270,27 @@ step_return <- function(x, steps, k, gap, alpha, tau0) {
 # sample after it (the level before the first step is kept).
 remove_steps <- function(x, steps) {
   if (!nrow(steps)) return(x)
-  # one cumulative sum of the sizes placed at their indices: O(n)
-  jump <- numeric(length(x))
+  # the sizes summed at their indices, then their cumulative sum (cumsum()
+  # of the sparse jumps only: the zeros between them add nothing, so the
+  # levels are those of the cumsum() of the full jump series) held
+  # constant from each index on: O(n)
+  n <- length(x)
+  at <- sort(unique(steps$index))
+  if (any(at < 1 | at > n | at != floor(at))) {
+    # not sample indices: the full jump series, as before
+    jump <- numeric(n)
+    for (k in seq_len(nrow(steps))) {
+      i <- steps$index[k]
+      jump[i] <- jump[i] + steps$size[k]
+    }
+    return(x - cumsum(jump))
+  }
+  jump <- numeric(length(at))
   for (k in seq_len(nrow(steps))) {
-    i <- steps$index[k]
+    i <- match(steps$index[k], at)
     jump[i] <- jump[i] + steps$size[k]
   }
-  x - cumsum(jump)
+  x - rep.int(c(0, cumsum(jump)), diff(c(1L, at, n + 1L)))
 }
 
 #' Exponential warm-up (internal)
@@ -565,7 +585,9 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6,
     # its neighbours as an additive outlier of the series' own AR model
     # (a resonant or strongly filtered series gives the running median's
     # residual heavy tails that are not outliers)
-    ao <- spike_ao_z(x, i, med + pmax(pmin(r, 4 * s), -4 * s))
+    # (the winsorised series only where spike_ao_z() reads it: its start)
+    w <- seq_len(min(n, 200000L))
+    ao <- spike_ao_z(x, i, med[w] + pmax(pmin(r[w], 4 * s), -4 * s))
     i <- i[!(abs(ao) < ao_min)]
   }
   out <- data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
@@ -582,7 +604,7 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6,
 # the ends.
 spike_ao_z <- function(x, at, xw, p = 10L) {
   n <- length(x)
-  m <- min(n, 200000L)
+  m <- min(n, length(xw), 200000L)
   mu <- mean(xw[seq_len(m)])
   # Yule-Walker from the sample autocovariance (C, O(m p))
   g <- as.numeric(stats::acf(xw[seq_len(m)] - mu, lag.max = p, type = "covariance",

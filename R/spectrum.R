@@ -650,7 +650,7 @@ remove_bands <- function(x, freq, bands) {
   P <- 2 * Mod(X)^2 / (n * freq)
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
-    M <- 2 * resonance_psd(fa, tau0, sqrt(b$power), b$f_center, b$tc)
+    M <- mirrored(fa, function(v) 2 * resonance_psd(v, tau0, sqrt(b$power), b$f_center, b$tc))
     w <- max(b$width, b$f_to - b$f_from)
     d <- abs(fa - b$f_center)
     near <- d > 3 * w & d < 6 * w
@@ -661,4 +661,23 @@ remove_bands <- function(x, freq, bands) {
     P <- P * g^2
   }
   Re(stats::fft(X, inverse = TRUE)) / n + m
+}
+
+# fun(v) of an elementwise `fun` over folded FFT frequencies v: computed
+# on the lower half and copied to each upper bin whose folded frequency
+# equals its mirror's bit for bit (the others computed), so the result is
+# fun(v) exactly at half the cost.
+mirrored <- function(v, fun) {
+  n <- length(v)
+  lo <- seq_len(n %/% 2L + 1L)
+  out <- numeric(n)
+  out[lo] <- fun(v[lo])
+  if (n > length(lo)) {
+    hi <- (length(lo) + 1L):n
+    mir <- n + 2L - hi
+    same <- v[hi] == v[mir]
+    out[hi[same]] <- out[mir[same]]
+    if (!all(same)) out[hi[!same]] <- fun(v[hi[!same]])
+  }
+  out
 }

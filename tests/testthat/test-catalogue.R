@@ -188,3 +188,18 @@ test_that("families (variants) and harmonic sets with a variable number of compo
       class = "allanvar_error_model")
   })
 })
+
+test_that("coef_layout()'s store of layouts follows the catalogue", {
+  expect_error(coef_layout(c("N", "telegraph")), class = "allanvar_error_argument")
+  with_effect(telegraph_entry(), {
+    lay <- coef_layout(c("N", "telegraph", "telegraph"))
+    expect_identical(lay$name, c("N", "telegraph1.amp", "telegraph1.rate",
+                                 "telegraph2.amp", "telegraph2.rate"))
+    expect_identical(coef_layout(c("N", "telegraph", "telegraph")),
+                     build_coef_layout(c("N", "telegraph", "telegraph")))
+  })
+  # unregistered: the stored layout goes with the entry
+  expect_error(coef_layout(c("N", "telegraph", "telegraph")),
+               class = "allanvar_error_argument")
+  expect_identical(coef_layout(c("N", "K")), build_coef_layout(c("N", "K")))
+})

@@ -187,3 +187,26 @@ test_that("a ramp is not a step, and a short pulse is a transient, not two steps
   expect_equal(pu$end, 830, tolerance = 0.01)
   expect_equal(pu$size, 0.05, tolerance = 0.2)
 })
+
+test_that("remove_steps() gives the values of the full jump series' cumsum", {
+  # the dense reference: the sizes placed at their indices, summed with
+  # cumsum() over every sample (the sparse form must agree bit for bit)
+  dense <- function(x, st) {
+    jump <- numeric(length(x))
+    for (k in seq_len(nrow(st))) jump[st$index[k]] <- jump[st$index[k]] + st$size[k]
+    x - cumsum(jump)
+  }
+  set.seed(11)
+  for (n in c(1L, 10L, 1000L, 100000L)) {
+    x <- stats::rnorm(n) * 1e3
+    k <- 7L
+    st <- data.frame(index = c(1L, n, sample.int(n, k - 2L, replace = TRUE)),
+                     size = stats::rnorm(k) * 10^stats::runif(k, -6, 6))
+    expect_identical(remove_steps(x, st), dense(x, st))
+    # and each size comes off every sample from its index on
+    y <- x
+    for (j in seq_len(k)) y[st$index[j]:n] <- y[st$index[j]:n] - st$size[j]
+    expect_equal(remove_steps(x, st), y, tolerance = 1e-12)
+  }
+  expect_identical(remove_steps(x, st[0, ]), x)
+})

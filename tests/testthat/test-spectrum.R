@@ -160,3 +160,13 @@ test_that("at the record's own resolution a line is a line and a band a band", {
   l <- lines_outside_bands(spectral_lines(bl, freq), bb)
   expect_false(is.na(match_line(12.21, l)))
 })
+
+test_that("mirrored() returns fun() of every folded frequency exactly", {
+  for (n in c(1L, 2L, 7L, 1000L, 1001L, 65537L)) {
+    freq <- 97.65625
+    f <- (seq_len(n) - 1) * freq / n
+    fa <- pmin(f, freq - f)
+    fun <- function(v) resonance_psd(v, 1 / freq, 0.3, 21.7, 0.05)
+    expect_identical(mirrored(fa, fun), fun(fa))
+  }
+})
