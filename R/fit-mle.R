@@ -74,15 +74,7 @@ avmle <- function(x, freq, terms = NULL, start = NULL) {
   terms <- check_terms(terms %||% statespace_kinds())
   lay <- coef_layout(terms)
   start <- check_named(start, "start", lay$name)
-  sp <- split_term(terms)
-  entries <- lapply(seq_along(terms), function(i) effect_entry(sp$kind[i], sp$variant[i]))
-  none <- !vapply(entries, function(e) is.function(e$statespace), NA)
-  if (any(none)) {
-    abort("`terms`: ", paste0("\"", unique(terms[none]), "\"", collapse = ", "),
-          " has no state-space form; avmle() fits terms that have one (",
-          paste0("\"", statespace_kinds(), "\"", collapse = ", "), ").",
-          class = "argument")
-  }
+  entries <- statespace_entries(terms, "terms", "avmle() fits terms that have one")
   tau0 <- 1 / freq
   # the curve fit only starts the likelihood: its own SEs are not reported
   fit0 <- quiet_fit_warnings(avfit(allan(x, freq), terms))
@@ -114,6 +106,21 @@ avmle <- function(x, freq, terms = NULL, start = NULL) {
   fit$avfit <- fit0
   fit$call <- cl
   validate_avfit(fit)
+}
+
+# The entries of `terms`, one per term, each with its state-space form; a
+# term without one is an error naming argument `arg` and what `needs` it.
+statespace_entries <- function(terms, arg, needs) {
+  sp <- split_term(terms)
+  entries <- lapply(seq_along(terms), function(i) effect_entry(sp$kind[i], sp$variant[i]))
+  none <- !vapply(entries, function(e) is.function(e$statespace), NA)
+  if (any(none)) {
+    abort("`", arg, "`: ", paste0("\"", unique(terms[none]), "\"", collapse = ", "),
+          " has no state-space form; ", needs, " (",
+          paste0("\"", statespace_kinds(), "\"", collapse = ", "), ").",
+          class = "argument")
+  }
+  entries
 }
 
 # The kinds that have a state-space form, in canonical order.
