@@ -315,13 +315,7 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
     check_representable(av, nonzero = res$sums[, j] > 0)
     lim <- stat_limits(e, av, m, nterms, L, res$alpha_int[, j], sub, conf,
                        ci, unbiased)
-    d <- list(tau = m / freq, m = as.integer(m), n = nterms, avar = av,
-              adev = lim$adev, lower = lim$lower, upper = lim$upper,
-              edf = lim$edf)
-    if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
-    d$alpha <- lim$alpha
-    out[[j]] <- structure(d, class = "data.frame",
-                          row.names = .set_row_names(length(m)))
+    out[[j]] <- allan_rows(m, nterms, av, lim, freq, ch, j)
   }
   out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)
   if (ch$nc > 1L) rownames(out) <- NULL
@@ -393,13 +387,7 @@ allan_gaps <- function(ch, freq, m, e, input, conf, ci = TRUE,
     lim <- stat_limits(e, av, mj, nj, L - missing[j], alpha,
                        if (ci || unbiased) seq_along(mj) else integer(0),
                        conf, ci, unbiased)
-    d <- list(tau = mj / freq, m = as.integer(mj), n = nj, avar = av,
-              adev = lim$adev, lower = lim$lower, upper = lim$upper,
-              edf = lim$edf)
-    if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(mj))
-    d$alpha <- lim$alpha
-    out[[j]] <- structure(d, class = "data.frame",
-                          row.names = .set_row_names(length(mj)))
+    out[[j]] <- allan_rows(mj, nj, av, lim, freq, ch, j)
   }
   if (length(dropped)) {
     warn("No complete term at cluster size(s) ",
@@ -413,6 +401,18 @@ allan_gaps <- function(ch, freq, m, e, input, conf, ci = TRUE,
   structure(out, class = c("allan", "data.frame"), freq = freq, type = type,
             input = input, N = N, conf = conf, missing = missing,
             ci = allan_ci_attr(ci), unbiased = allan_unbiased_attr(e, unbiased))
+}
+
+# Channel `j`'s rows of an allan() result at cluster sizes `m` with `n`
+# terms each, variances `av` and their limits `lim` (stat_limits()): a
+# data frame built without copies.
+allan_rows <- function(m, n, av, lim, freq, ch, j) {
+  d <- list(tau = m / freq, m = as.integer(m), n = n, avar = av,
+            adev = lim$adev, lower = lim$lower, upper = lim$upper,
+            edf = lim$edf)
+  if (ch$nc > 1L) d$channel <- rep(ch$names[j], length(m))
+  d$alpha <- lim$alpha
+  structure(d, class = "data.frame", row.names = .set_row_names(length(m)))
 }
 
 # ---- range: series near 1e300 or 1e-300, sampling rates near 1e300 ----

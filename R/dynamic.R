@@ -389,9 +389,7 @@ plot.allan_dynamic <- function(x, what = "surface", at = NULL, col = NULL,
                                contour = FALSE, main = NULL, xlab = NULL,
                                ylab = NULL, ...) {
   what <- check_choice(what, c("surface", "windows", "taus"), "what")
-  dev_name <- switch(x$type, standard = , overlapping = "Allan deviation",
-                     modified = "modified Allan deviation",
-                     "Hadamard deviation")
+  dev_name <- stat_entry(x$type)$ylab
   if (what == "surface") {
     dyn_plot_surface(x, col, contour, main, xlab, ylab, dev_name, ...)
   } else {

@@ -92,8 +92,9 @@ tool_params <- function(x, tool, axis = "max", freq = NULL,
 
 tool_names <- c("kalibr", "openvins", "imu_utils", "vins", "matlab")
 
-# Per axis: sensor, axis, N, B, K (SI) and each one's verdict and note
-# (`N_verdict`, `N_note`, ...; R/verdicts.R); dead axes left out.
+# Per axis: sensor, axis, and per reading of the catalogue (N, B, K) its
+# value (SI), verdict and note in columns named by its symbol (`N`,
+# `N_verdict`, `N_note`, ...; R/verdicts.R); dead axes left out.
 tool_readings <- function(x) {
   if (inherits(x, "avfit")) x <- fit_analysis(x)
   if (!inherits(x, "imu_analysis")) {
@@ -101,12 +102,13 @@ tool_readings <- function(x) {
           describe_type(x), ".", class = "argument")
   }
   check_analysis(x)
-  roles <- c(N = "white", B = "flicker", K = "random_walk")
+  re <- reading_entries()
   rows <- lapply(x$channels, function(ch) {
     if (!is.null(ch$dead) || is.na(ch$sensor)) return(NULL)
     out <- data.frame(sensor = ch$sensor, axis = ch$channel, stringsAsFactors = FALSE)
-    for (k in names(roles)) {
-      r <- reading_of(ch$readings, roles[[k]])
+    for (i in seq_len(nrow(re))) {
+      k <- re$symbol[i]
+      r <- reading_of(ch$readings, re$role[i])
       have <- nrow(r) > 0L
       out[[k]] <- if (have) r$value[1L] else NA_real_
       out[[paste0(k, "_verdict")]] <- if (have) r$verdict[1L] else "not_determined"
@@ -129,7 +131,7 @@ tool_readings <- function(x) {
 # when every axis is.
 combine_axes <- function(d, how, label = how) {
   out <- data.frame(sensor = d$sensor[1L], axis = label, stringsAsFactors = FALSE)
-  for (k in c("N", "B", "K")) {
+  for (k in reading_entries()$symbol) {
     v <- d[[k]]
     vk <- d[[paste0(k, "_verdict")]]
     nk <- d[[paste0(k, "_note")]]
@@ -155,7 +157,9 @@ combine_axes <- function(d, how, label = how) {
   out
 }
 
-# The tool's values of one sensor, one row per (axis, key).
+# The tool's values of one sensor, one row per (axis, key): the tool's
+# conventions, one row per key: its name, the reading it holds (by role),
+# the factor on it, its unit and its formula (`%s` the reading's symbol).
 tool_rows <- function(tool, sensor, d, freq, noise_type) {
   g <- sensor == "gyro"
   u <- if (g) "rad/s" else "m/s^2"
@@ -165,30 +169,31 @@ tool_rows <- function(tool, sensor, d, freq, noise_type) {
   long <- if (g) "gyroscope" else "accelerometer"
   spec <- switch(tool,
     kalibr = , openvins = list(
-      list(paste0(long, "_noise_density"), d$N, nd, "N", "N"),
-      list(paste0(long, "_random_walk"), d$K, kd, "K", "K")),
+      list(paste0(long, "_noise_density"), "white", 1, nd, "%s"),
+      list(paste0(long, "_random_walk"), "random_walk", 1, kd, "%s")),
     imu_utils = list(
-      list(paste0(pre, "_n"), d$N * sqrt(freq), u, "N * sqrt(freq)", "N"),
-      list(paste0(pre, "_w"), d$B * bias_floor, u,
-           "0.664 * B (min ADEV, the flat floor)", "B")),
+      list(paste0(pre, "_n"), "white", sqrt(freq), u, "%s * sqrt(freq)"),
+      list(paste0(pre, "_w"), "flicker", bias_floor, u,
+           "0.664 * %s (min ADEV, the flat floor)")),
     vins = list(
-      list(paste0(pre, "_n"), d$N * sqrt(freq), u, "N * sqrt(freq)", "N"),
-      list(paste0(pre, "_w"), d$K * sqrt(freq), u, "K * sqrt(freq)", "K")),
+      list(paste0(pre, "_n"), "white", sqrt(freq), u, "%s * sqrt(freq)"),
+      list(paste0(pre, "_w"), "random_walk", sqrt(freq), u, "%s * sqrt(freq)")),
     matlab = {
       s2 <- if (noise_type == "single-sided") sqrt(2) else 1
       f2 <- if (s2 == 1) "" else " * sqrt(2) (single-sided)"
-      list(list("NoiseDensity", d$N * s2, paste0("(", u, ")/sqrt(Hz)"),
-                paste0("N", f2), "N"),
-           list("BiasInstability", d$B, u, "B", "B"),
-           list("RandomWalk", d$K * s2, paste0("(", u, ")*sqrt(Hz)"),
-                paste0("K", f2), "K"))
+      list(list("NoiseDensity", "white", s2, paste0("(", u, ")/sqrt(Hz)"),
+                paste0("%s", f2)),
+           list("BiasInstability", "flicker", 1, u, "%s"),
+           list("RandomWalk", "random_walk", s2, paste0("(", u, ")*sqrt(Hz)"),
+                paste0("%s", f2)))
     })
   do.call(rbind, lapply(spec, function(s) {
+    k <- reading_symbol(s[[2L]])
+    verdict <- d[[paste0(k, "_verdict")]]
     data.frame(tool = tool, sensor = sensor, axis = d$axis, key = s[[1L]],
-               value = s[[2L]], unit = s[[3L]], formula = s[[4L]],
-               verdict = d[[paste0(s[[5L]], "_verdict")]],
-               note = d[[paste0(s[[5L]], "_note")]],
-               bound = d[[paste0(s[[5L]], "_verdict")]] == "upper_bound",
+               value = d[[k]] * s[[3L]], unit = s[[4L]],
+               formula = sprintf(s[[5L]], k), verdict = verdict,
+               note = d[[paste0(k, "_note")]], bound = verdict == "upper_bound",
                stringsAsFactors = FALSE)
   }))
 }

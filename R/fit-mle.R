@@ -46,7 +46,8 @@
 #' @param x The rate series (numeric vector, no missing values).
 #' @param freq Sampling frequency in Hz.
 #' @param terms Character vector of terms, each with a state-space form:
-#'   `"N"`, `"K"`, `"gm"` (repeatable). Default `c("N", "K", "gm")`.
+#'   `"N"`, `"K"`, `"gm"` (repeatable). `NULL` (the default): each term
+#'   that has one, once: `c("N", "K", "gm")`.
 #' @param start Optional named starting values (coefficient names as in
 #'   [avfit()], e.g. `c(gm1.tc = 2)`); by default avfit()'s estimate.
 #' @return An object of class `"avfit"` (see [avfit()]) whose coefficients,
@@ -64,24 +65,16 @@
 #' fit <- avmle(x, 100, c("N", "K"))
 #' coef(fit)
 #' fit$se
-avmle <- function(x, freq, terms = c("N", "K", "gm"), start = NULL) {
+avmle <- function(x, freq, terms = NULL, start = NULL) {
   cl <- match.call()
   check_present(missing(x), "x", "a rate series")
   x <- check_values(x, min_n = 16L, arg = "x")
   freq <- check_freq(freq)
-  terms <- check_terms(terms)
+  # the default model: every entry with a state-space form, once
+  terms <- check_terms(terms %||% statespace_kinds())
   lay <- coef_layout(terms)
   start <- check_named(start, "start", lay$name)
-  sp <- split_term(terms)
-  entries <- lapply(seq_along(terms), function(i) effect_entry(sp$kind[i], sp$variant[i]))
-  none <- !vapply(entries, function(e) is.function(e$statespace), NA)
-  if (any(none)) {
-    abort("`terms`: ", paste0("\"", unique(terms[none]), "\"", collapse = ", "),
-          " has no state-space form; avmle() fits terms that have one (",
-          paste0("\"", vapply(entries_with("statespace"), `[[`, "", "name"), "\"",
-                 collapse = ", "), ").",
-          class = "argument")
-  }
+  entries <- statespace_entries(terms, "terms", "avmle() fits terms that have one")
   tau0 <- 1 / freq
   # the curve fit only starts the likelihood: its own SEs are not reported
   fit0 <- quiet_fit_warnings(avfit(allan(x, freq), terms))
@@ -113,6 +106,26 @@ avmle <- function(x, freq, terms = c("N", "K", "gm"), start = NULL) {
   fit$avfit <- fit0
   fit$call <- cl
   validate_avfit(fit)
+}
+
+# The entries of `terms`, one per term, each with its state-space form; a
+# term without one is an error naming argument `arg` and what `needs` it.
+statespace_entries <- function(terms, arg, needs) {
+  sp <- split_term(terms)
+  entries <- lapply(seq_along(terms), function(i) effect_entry(sp$kind[i], sp$variant[i]))
+  none <- !vapply(entries, function(e) is.function(e$statespace), NA)
+  if (any(none)) {
+    abort("`", arg, "`: ", paste0("\"", unique(terms[none]), "\"", collapse = ", "),
+          " has no state-space form; ", needs, " (",
+          paste0("\"", statespace_kinds(), "\"", collapse = ", "), ").",
+          class = "argument")
+  }
+  entries
+}
+
+# The kinds that have a state-space form, in canonical order.
+statespace_kinds <- function() {
+  vapply(entries_with("statespace"), `[[`, "", "name", USE.NAMES = FALSE)
 }
 
 # Terms' state-space parts assembled: measurement variance R, diagonal T,

@@ -131,12 +131,11 @@ three_cornered_hat <- function(x, freq, pairs = NULL, taus = "octave",
           "\" is a time-error statistic.", class = "argument")
   }
   cmp <- hat_comparisons(x, pairs, n_allowed = 3L)
-  av <- allan(cmp$values, freq = freq, taus = taus, type = type,
-              input = input, conf = conf)
-  S <- hat_by_tau(av, "avar", cmp)
-  nu <- hat_by_tau(av, "edf", cmp)
-  d <- as.data.frame(av)
-  tau1 <- d[d$channel == colnames(cmp$values)[1L], ]
+  cv <- hat_curves(cmp, freq, taus, type, input, conf)
+  av <- cv$av
+  S <- cv$S
+  nu <- cv$nu
+  tau1 <- cv$tau1
   rows <- lapply(cmp$sources, function(src) {
     r <- hat_roles(cmp, src)
     est <- (S[, r$i] + S[, r$j] - S[, r$k]) / 2
@@ -177,12 +176,11 @@ groslambert <- function(x, freq, pairs = NULL, taus = "octave",
   if (missing(freq)) freq <- hat_ts_freq(x)
   type <- check_choice(type, dyn_types, "type")
   cmp <- hat_comparisons(x, pairs, n_allowed = 2:3)
-  av <- allan(cmp$values, freq = freq, taus = taus, type = type,
-              input = input, conf = conf)
-  S <- hat_by_tau(av, "avar", cmp)
-  nu <- hat_by_tau(av, "edf", cmp)
-  d <- as.data.frame(av)
-  tau1 <- d[d$channel == colnames(cmp$values)[1L], ]
+  cv <- hat_curves(cmp, freq, taus, type, input, conf)
+  av <- cv$av
+  S <- cv$S
+  nu <- cv$nu
+  tau1 <- cv$tau1
   m <- tau1$m
   nt <- tau1$n
   rate <- input == "rate"
@@ -330,6 +328,17 @@ hat_roles <- function(cmp, src) {
   sgn <- function(p) if (cmp$first[p] == src) 1 else -1
   list(i = i, j = j, k = if (length(k)) k else NA_integer_,
        other = c(other(i), other(j)), sign = sgn(i) * sgn(j))
+}
+
+# The comparisons' curves: the allan() result `av`, its variances `S` and
+# EDFs `nu` as tau x comparison matrices, and the first comparison's rows
+# `tau1` (the taus, m and n the estimates are reported at).
+hat_curves <- function(cmp, freq, taus, type, input, conf) {
+  av <- allan(cmp$values, freq = freq, taus = taus, type = type,
+              input = input, conf = conf)
+  d <- as.data.frame(av)
+  list(av = av, S = hat_by_tau(av, "avar", cmp), nu = hat_by_tau(av, "edf", cmp),
+       tau1 = d[d$channel == colnames(cmp$values)[1L], ])
 }
 
 # One column of the stacked allan() result as a tau x comparison matrix.

@@ -170,16 +170,8 @@ info_model <- function(model, freq) {
   }
   freq <- check_freq(freq)
   terms <- layout_terms(lay)
-  sp <- split_term(terms)
-  entries <- lapply(seq_along(terms), function(i) effect_entry(sp$kind[i], sp$variant[i]))
-  none <- !vapply(entries, function(e) is.function(e$statespace), NA)
-  if (any(none)) {
-    abort("`model`: ", paste0("\"", unique(terms[none]), "\"", collapse = ", "),
-          " has no state-space form; the exact information is defined for models ",
-          "of terms that have one (",
-          paste0("\"", vapply(entries_with("statespace"), `[[`, "", "name"), "\"",
-                 collapse = ", "), ").", class = "argument")
-  }
+  entries <- statespace_entries(terms, "model",
+    "the exact information is defined for models of terms that have one")
   v <- stats::setNames(lay$value, lay$name)
   if (any(!is.finite(v)) || any(v <= 0)) {
     bad <- lay$name[!is.finite(v) | v <= 0]

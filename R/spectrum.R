@@ -51,29 +51,64 @@ welch_psd <- function(x, freq, seg = NULL, detrend = TRUE) {
 
 # ---- backgrounds ----------------------------------------------------------------
 
+# Running median of `v` with an odd window `width[i]` centred on each bin
+# i, the background of a log periodogram (lines: octave_background();
+# bands: spectral_bands()).
+# * `exact = TRUE`: every bin's window median, by stats::runmed() over each
+#   run of bins sharing a window (the run and two windows either side, so
+#   its values are those of a runmed() of the whole vector), with Tukey's
+#   end rule (runmed()'s "median") at the vector's ends in O(k log k) by
+#   smooth_ends(): O(n log k) in all for windows constant over octaves.
+# * `exact = FALSE`: the median exactly at anchor bins a quarter window
+#   apart (each by partial sorting, O(window)), linear in between, the
+#   window held full against the ends: O(n) in all for a window that grows
+#   with every bin, where a run per window would cost O(n k).
+running_median <- function(v, width, exact = TRUE) {
+  nb <- length(v)
+  if (exact) {
+    # runmed() takes an odd window shorter than the vector
+    width <- pmin(width, 2L * ((nb - 1L) %/% 2L) - 1L)
+    out <- rep(NA_real_, nb)
+    r <- rle(width)
+    his <- cumsum(r$lengths)
+    los <- his - r$lengths + 1L
+    for (j in seq_along(los)) {
+      k <- r$values[j]
+      from <- max(1L, los[j] - 2L * k)
+      to <- min(nb, his[j] + 2L * k)
+      rm <- stats::runmed(v[from:to], k, endrule = "keep")
+      rm <- smooth_ends(rm, k, left = from == 1L, right = to == nb)
+      out[los[j]:his[j]] <- rm[(los[j]:his[j]) - from + 1L]
+    }
+    return(out)
+  }
+  anchors <- integer(0)
+  i <- 1L
+  while (i <= nb) {
+    anchors <- c(anchors, i)
+    i <- i + max(1L, width[i] %/% 4L)
+  }
+  if (anchors[length(anchors)] != nb) anchors <- c(anchors, nb)
+  med <- vapply(anchors, function(a) {
+    h <- width[a] %/% 2L
+    lo <- max(1L, a - h)
+    hi <- min(nb, a + h)
+    # keep the window full at the ends
+    if (hi - lo < 2L * h) {
+      if (lo == 1L) hi <- min(nb, lo + 2L * h) else lo <- max(1L, hi - 2L * h)
+    }
+    stats::median(v[lo:hi])
+  }, 0)
+  stats::approx(anchors, med, xout = seq_len(nb), rule = 2)$y
+}
+
 # Background of a log periodogram for line detection: a running median
-# with a window ~20% of the frequency (stats::runmed(lp, k, endrule =
-# "median") per octave band). Each band's median runs over the band and 2k
-# bins either side only, and the end rule is applied only at the ends of
-# the whole vector, in O(k) by smooth_ends(): the same values as a runmed()
-# of the whole vector per band, at O(nb) in all instead of O(nb) per band
-# plus smoothEnds()'s O(k^2).
+# with a window ~20% of the frequency, constant over each octave band of
+# bins (at least 11 bins).
 octave_background <- function(lp) {
   nb <- length(lp)
-  bg <- rep(NA_real_, nb)
-  bands <- unique(c(2^(0:floor(log2(nb))), nb + 1))
-  for (b in seq_len(length(bands) - 1L)) {
-    lo <- bands[b]
-    hi <- bands[b + 1L] - 1L
-    k <- max(11L, 2L * floor(0.1 * lo) + 1L)
-    k <- min(k, 2L * floor((nb - 1L) / 2L) - 1L)
-    from <- max(1L, lo - 2L * k)
-    to <- min(nb, hi + 2L * k)
-    rm <- stats::runmed(lp[from:to], k, endrule = "keep")
-    rm <- smooth_ends(rm, k, left = from == 1L, right = to == nb)
-    bg[lo:hi] <- rm[(lo:hi) - from + 1L]
-  }
-  bg
+  lo <- 2^(findInterval(seq_len(nb), 2^(0:floor(log2(nb)))) - 1L)
+  running_median(lp, as.integer(pmax(11, 2 * floor(0.1 * lo) + 1)))
 }
 
 # stats::smoothEnds(y, k) (Tukey's end-point rule, the runmed() end rule
@@ -132,32 +167,6 @@ growing_medians <- function(e) {
     out[(L - 1L) %/% 2L] <- e[o[m]]
   }
   out
-}
-
-# Running median of `v` with a window of `k(i)` bins centred on bin i, in
-# linear time: the median is taken exactly at anchor bins spaced a quarter
-# window apart (each costs O(window) by partial sorting) and interpolated
-# linearly between anchors. `width(i)` gives the (odd) window at bin i.
-sparse_running_median <- function(v, width) {
-  nb <- length(v)
-  anchors <- integer(0)
-  i <- 1L
-  while (i <= nb) {
-    anchors <- c(anchors, i)
-    i <- i + max(1L, width(i) %/% 4L)
-  }
-  if (anchors[length(anchors)] != nb) anchors <- c(anchors, nb)
-  med <- vapply(anchors, function(a) {
-    h <- width(a) %/% 2L
-    lo <- max(1L, a - h)
-    hi <- min(nb, a + h)
-    # keep the window full at the ends
-    if (hi - lo < 2L * h) {
-      if (lo == 1L) hi <- min(nb, lo + 2L * h) else lo <- max(1L, hi - 2L * h)
-    }
-    stats::median(v[lo:hi])
-  }, 0)
-  stats::approx(anchors, med, xout = seq_len(nb), rule = 2)$y
 }
 
 # ---- lines ------------------------------------------------------------------------
@@ -479,7 +488,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
   nb <- length(p)
   lp <- log(pmax(p, .Machine$double.xmin))
   corr <- log(stats::qchisq(0.5, w$nu) / w$nu)
-  octave <- function(i) 2L * as.integer(max(8, 0.35 * i)) + 1L
+  octave <- function(i) 2L * as.integer(pmax(8, 0.35 * i)) + 1L
   edge <- octave(1L) %/% 2L + 1L
   runs <- function(bg) {
     ratio <- p / bg
@@ -506,7 +515,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
     keep <- which(r$values & r$lengths >= min_bins)
     list(from = starts[keep], to = ends[keep], ratio = ratio)
   }
-  bg <- exp(sparse_running_median(lp, octave) - corr)
+  bg <- exp(running_median(lp, octave(seq_len(nb)), exact = FALSE) - corr)
   r1 <- runs(bg)
   if (length(r1$from)) {
     mask <- rep(FALSE, nb)
@@ -516,7 +525,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
     }
     keep <- which(!mask)
     if (length(keep) > 10L) {
-      bg2 <- exp(sparse_running_median(lp[keep], octave) - corr)
+      bg2 <- exp(running_median(lp[keep], octave(seq_along(keep)), exact = FALSE) - corr)
       bg <- exp(stats::approx(keep, log(bg2), xout = seq_len(nb), rule = 2)$y)
     }
   }

@@ -42,6 +42,7 @@ using allanvar::TOTAL;
 
 // a + b = s + e exactly (Knuth's TwoSum, src/dd.h).
 using allanvar::two_sum;
+using allanvar::fast_two_sum;
 
 // Sum of many squares: four interleaved chains, folded into a compensated
 // total block by block, keep the rounding far below 1e-15 relative.
@@ -586,9 +587,7 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
     double t, e;
     two_sum(h[2 * k], h[2 * k + 1], t, e);
     e += l[2 * k] + l[2 * k + 1];
-    const double hh = t + e;
-    l[k] = e - (hh - t);
-    h[k] = hh;
+    fast_two_sum(t, e, h[k], l[k]);
   }
   return n2;
 }

@@ -17,7 +17,8 @@ struct DD {
 };
 
 // a + b = s + e exactly (Knuth's TwoSum): the one TwoSum of the kernels
-// (allan.cpp, dynamic.cpp, local-phase.h and the double-double sums here).
+// (allan.cpp, dynamic.cpp, theo.cpp, local-phase.h and the double-double
+// sums here).
 inline void two_sum(double a, double b, double& s, double& e) {
   s = a + b;
   const double bb = s - a;

@@ -326,9 +326,9 @@ struct PhaseProducts {
     const double p = h[a] * h[b];
     const double e = ((h1[a] * h1[b] - p) + h1[a] * h2[b] + h2[a] * h1[b]) +
                      h2[a] * h2[b] + (h[a] * l[b] + l[a] * h[b]);
-    const double t = s + p;
-    const double z = t - s;
-    c += ((s - (t - z)) + (p - z)) + e;
+    double t, te;
+    allanvar::two_sum(s, p, t, te);
+    c += te + e;
     s = t;
   }
   DD prod(R_xlen_t a, R_xlen_t b) const {

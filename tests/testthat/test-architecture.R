@@ -51,11 +51,7 @@ test_that("no effect kind is named outside the catalogue files", {
     "hat.R" = "N",          # attribute: the number of samples
     "fit-input.R" = "N",    # attribute: the number of samples
     "report.R" = "N",       # attribute: the number of samples
-    "avfit.R" = "steps",    # the avfit object's `steps` field
-    # the datasheet's reading symbols as other tools' files name them
-    "export-tools.R" = c("N", "B", "K"),
-    # avmle()'s default model (its own file; to be asked of the catalogue)
-    "fit-mle.R" = c("N", "K", "gm"))
+    "avfit.R" = "steps")    # the avfit object's `steps` field
   files <- list.files(d, pattern = "[.]R$", full.names = TRUE)
   files <- files[!allowed(basename(files))]
   hits <- do.call(rbind, lapply(files, kind_literals, names = effect_names()))

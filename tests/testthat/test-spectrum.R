@@ -76,11 +76,25 @@ test_that("the sparse running median is exact at its anchors", {
   # anchors every width/4 bins (O(n) in all), linear in between
   set.seed(5)
   v <- rnorm(5000)
-  sm <- sparse_running_median(v, function(i) 41L)
+  sm <- running_median(v, rep(41L, length(v)), exact = FALSE)
   ex <- stats::runmed(v, 41, endrule = "keep")
   anchors <- seq(101, 4891, by = 10)
   expect_equal(sm[anchors], ex[anchors])
   expect_true(all(sm[anchors + 5] <= pmax(ex[anchors], ex[anchors + 10]) + 1e-12))
+})
+
+test_that("the exact running median is runmed()'s of the whole vector, window by window", {
+  set.seed(6)
+  v <- c(log(rchisq(3000, 3)), round(rnorm(1000), 1))
+  # windows constant over runs of bins, as the octave background's
+  w <- rep(c(11L, 13L, 25L, 51L, 201L), c(63L, 64L, 128L, 256L, 3489L))
+  sm <- running_median(v, w)
+  for (k in unique(w)) {
+    ex <- stats::runmed(v, k, endrule = "median")
+    expect_identical(sm[w == k], ex[w == k])
+  }
+  expect_identical(running_median(v, rep(7L, length(v))),
+                   as.vector(stats::runmed(v, 7L, endrule = "median")))
 })
 
 test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinusoid", {

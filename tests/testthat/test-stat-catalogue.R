@@ -11,10 +11,11 @@ test_that("no file of allan() and its helpers switches on statistic names", {
   expect_true(all(file.exists(files)))
   names <- stat_names()
   quoted <- paste0("\"(", paste(names, collapse = "|"), ")\"")
-  pats <- c("switch\\((type|base)\\b",
+  # `type`, `base` or a field of that name (`x$type`)
+  pats <- c("switch\\(([A-Za-z_.]+\\$)?(type|base)\\b",
             paste0("\\b(type|base)\\s*(==|!=)\\s*", quoted),
             "\\b(type|base)\\s*%in%\\s*c\\(",
-            paste0("identical\\((type|base),\\s*", quoted))
+            paste0("identical\\(([A-Za-z_.]+\\$)?(type|base),\\s*", quoted))
   catalogue <- grepl("/stat-[^/]*[.]R$", files)
   hits <- character()
   for (f in files[!catalogue]) {
@@ -27,6 +28,7 @@ test_that("no file of allan() and its helpers switches on statistic names", {
   expect_identical(hits, character())
   # the grep finds what it is meant to find
   expect_true(grepl(pats[1], "  switch(type, standard = 1)"))
+  expect_true(grepl(pats[1], "  switch(x$type, standard = 1)"))
   expect_true(grepl(pats[2], "if (type == \"theo1\") 1"))
   expect_true(grepl(pats[3], "type %in% c(\"mtie\", \"tierms\")"))
   expect_true(grepl(pats[4], "identical(type, \"overlapping\")"))
