@@ -101,8 +101,10 @@ edf_fit_model <- function(m, n, type, tau, tau0, lay, L = n + 1) {
 exact_model <- function(plan, comp, alpha, lay, tau0) {
   exact <- vapply(plan, function(p) is.function(p$entry$exact_edf), NA)
   power_law <- vapply(plan, function(p) is.finite(p$entry$psd_alpha), NA)
+  # AVs beyond double precision (a rate of 1e-300 Hz): no exact form
+  if (is.null(tau0) || !all(is.finite(comp))) return(NULL)
   stoch <- colSums(comp) > 0 & colSums(!is.na(alpha)) > 0
-  if (is.null(tau0) || !any(stoch) || !all(exact[stoch])) return(NULL)
+  if (!any(stoch) || !all(exact[stoch])) return(NULL)
   list(parts = exact_edf_parts(plan[exact], stats::setNames(lay$value, lay$name), tau0),
        exact = exact, stochastic = sum(stoch), power_law = all(power_law[stoch]))
 }
