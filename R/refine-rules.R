@@ -287,10 +287,10 @@ series_pays_without <- function(st, new, label, min_share = 0.1) {
     args$av <- cv
     try_refit(args, "refit without the series effects")$fit
   }
-  without <- refit_on(st$current)
-  with <- refit_on(new)
-  if (is.null(without) || is.null(with)) return(NULL)
-  if (refine_crit(st, with) < refine_crit(st, without) - st$args$min_gain) return(NULL)
+  f_out <- refit_on(st$current)
+  f_in <- refit_on(new)
+  if (is.null(f_out) || is.null(f_in)) return(NULL)
+  if (refine_crit(st, f_in) < refine_crit(st, f_out) - st$args$min_gain) return(NULL)
   k <- colnames(ex)[which.max(ex[j, ])]
   data.frame(series_kind = k, ratio = total[j] / own, tau = tau[j], how = "refit",
              stringsAsFactors = FALSE)
@@ -308,7 +308,7 @@ kind_excess <- function(adev_kinds, kinds, tau) {
     if (sum(ok) < 2L) next
     v <- stats::approx(log(a$tau[ok]), pmax(e[ok], 0), log(tau))$y
     v[is.na(v)] <- 0
-    out <- cbind(out, stats::setNames(list(v), k)[[1L]])
+    out <- cbind(out, v)
     colnames(out)[ncol(out)] <- k
   }
   out
