@@ -231,9 +231,7 @@ series_duplicate <- function(series, fit, label, share = 1) {
   tab <- series$table
   left <- unique(tab$kind[!tab$removed])
   tau <- fit$data$tau
-  sh <- comp[, label] / rowSums(comp)
-  # where the term dominates, the tau of its largest AV (a GM's peak)
-  j <- if (any(sh >= 0.5)) which.max(comp[, label] * (sh >= 0.5)) else which.max(sh)
+  j <- term_peak(comp, label)
   own <- comp[j, label]
   if (!(own > 0)) return(NULL)
   out <- NULL
@@ -271,15 +269,15 @@ series_pays_without <- function(st, new, label, min_share = 0.1) {
   left <- left[!vapply(left, function(k) isTRUE(effect_entry(k)$noise_lookalike), NA)]
   comp <- new$components
   if (!length(left) || !label %in% colnames(comp)) return(NULL)
-  cv <- curve_of_fit(new)
-  tau <- cv$data$tau
-  ex <- kind_excess(series$adev_kinds, left, tau)
-  if (is.null(ex)) return(NULL)
-  sh <- comp[, label] / rowSums(comp)
-  j <- if (any(sh >= 0.5)) which.max(comp[, label] * (sh >= 0.5)) else which.max(sh)
+  # the components are at the fitted taus (a tau_range may leave some of
+  # the curve out): the share is read there, the excess taken out of the
+  # whole curve
+  j <- term_peak(comp, label)
   own <- comp[j, label]
-  total <- rowSums(ex)
-  if (!(own > 0) || total[j] < min_share * own) return(NULL)
+  at <- kind_excess(series$adev_kinds, left, new$data$tau[j])
+  if (is.null(at) || !(own > 0) || sum(at) < min_share * own) return(NULL)
+  cv <- curve_of_fit(new)
+  total <- rowSums(kind_excess(series$adev_kinds, left, cv$data$tau))
   # taken out to at most 90% of a point: the excess is an estimate too
   cv$data$avar <- pmax(cv$data$avar - total, 0.1 * cv$data$avar)
   refit_on <- function(fit) {
@@ -291,9 +289,16 @@ series_pays_without <- function(st, new, label, min_share = 0.1) {
   f_in <- refit_on(new)
   if (is.null(f_out) || is.null(f_in)) return(NULL)
   if (refine_crit(st, f_in) < refine_crit(st, f_out) - st$args$min_gain) return(NULL)
-  k <- colnames(ex)[which.max(ex[j, ])]
-  data.frame(series_kind = k, ratio = total[j] / own, tau = tau[j], how = "refit",
-             stringsAsFactors = FALSE)
+  data.frame(series_kind = colnames(at)[which.max(at[1L, ])], ratio = sum(at) / own,
+             tau = new$data$tau[j], how = "refit", stringsAsFactors = FALSE)
+}
+
+# Where a term instance weighs most: of the taus where it holds at least
+# half the model AV, the one of its largest AV (a GM's peak); else where
+# its share is largest. A row index of the fit's components.
+term_peak <- function(comp, label) {
+  sh <- comp[, label] / rowSums(comp)
+  if (any(sh >= 0.5)) which.max(comp[, label] * (sh >= 0.5)) else which.max(sh)
 }
 
 # The AV each kind left in adds at the taus `tau` (ADEV^2 with it minus
