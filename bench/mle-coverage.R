@@ -13,7 +13,8 @@
 #
 #   R CMD INSTALL --preclean . && Rscript bench/mle-coverage.R [seeds_1e5] [seeds_1e6]
 # (defaults 40 8; the issue's "done when" asks for >= 400 / >= 200; simts
-# from $ALLANVAR_BENCH_LIB when set)
+# from $ALLANVAR_BENCH_LIB when set; MLE_CELLS="weak K" runs only the cells
+# named)
 library(allanvar)
 options(width = 200)
 source("bench/common.R")
@@ -28,6 +29,10 @@ pn <- c("N", "K", "sigma", "tc")
 cn <- c(N = "N", K = "K", sigma = "gm1.sigma", tc = "gm1.tc")
 cells <- list("strong K" = c(N = 0.01, K = 1e-3, sigma = 0.02, tc = 2),
               "weak K" = c(N = 0.01, K = 2e-4, sigma = 0.02, tc = 2))
+# MLE_CELLS="weak K": only the cells named (comma-separated)
+if (nzchar(Sys.getenv("MLE_CELLS"))) {
+  cells <- cells[trimws(strsplit(Sys.getenv("MLE_CELLS"), ",")[[1]])]
+}
 fit_gmwm <- function(x) {
   g <- simts::gmwm(simts::AR1() + simts::WN() + simts::RW(), data = x)
   est <- g$estimate[, 1]
