@@ -215,13 +215,18 @@ double edf_simple_oavar(double N, double m, int alpha) {
 }
 
 // The total variance (NIST SP 1065 section 5.2.11): Table 7,
-// b (N - 1)/m - c, for white, flicker and random-walk FM; for white and
-// flicker PM, as Stable32, the simple overlapping EDF of Table 5. Below
+// b (N - 1)/m - c, for white, flicker and random-walk FM; for white PM, as
+// Stable32, the simple overlapping EDF of Table 5; for flicker PM the
+// overlapping EDF (Greenhall's), not Table 5's simple formula, which
+// overstates it (3.3x at N = 556990, m = 100: the 68% intervals covered
+// 0.36-0.52 at m = 20-100, tools/stable32-rows-mc.R; 15-35% at N = 1024,
+// whose Monte Carlo EDF Greenhall's follows within 15%). Below
 // m = 8 the Total terms are (almost) the overlapping ones, and so is their
 // EDF: Table 7's 1.5 (N - 1)/m would claim 1500 at m = 1, N = 1001 where
 // the exact value for sampled white FM is 666 (the same terms as the
 // overlapping AV, whose Table 5 value is 666 too).
 double edf_total(double m, double L, int alpha, double oav_edf) {
+  if (alpha == 1 && std::isfinite(oav_edf) && oav_edf > 0) return oav_edf;
   if (alpha >= 1) return edf_simple_oavar(L, m, alpha);
   const double b = alpha == 0 ? 1.50 : alpha == -1 ? 1.17 : 0.93;
   const double c = alpha == 0 ? 0.0 : alpha == -1 ? 0.22 : 0.36;
