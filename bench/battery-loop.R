@@ -75,7 +75,8 @@ run_loop <- function(x) {
 }
 n_of <- function(r) {
   cf <- coef(r)
-  unname(if ("N" %in% names(cf)) cf[["N"]] else cf[["filter.Nf"]])
+  # N, or the white noise a filter term (any variant) carries
+  unname(cf[grepl("^N$|^filter[^.]*\\.Nf$", names(cf))][1L])
 }
 kinds <- function(r) sub(":.*", "", r$terms)
 named <- function(r, kind, value) {
