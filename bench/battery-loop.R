@@ -11,6 +11,7 @@
 # it did not add (`extra`), and the seconds of the run with the effect.
 #
 #   R_LIBS=/tmp/lib Rscript bench/battery-loop.R [data dir] [cases regex]
+# (BATTERY_OUT=file.rds saves the table)
 #
 # The recordings stay in the shared data directory (never shipped).
 suppressPackageStartupMessages(library(allanvar))
@@ -301,3 +302,5 @@ for (nm in grep(only, names(cases), value = TRUE)) {
 tab <- do.call(rbind, rows)
 cat("\n")
 print(tab, row.names = FALSE, right = FALSE)
+out <- Sys.getenv("BATTERY_OUT")
+if (nzchar(out)) saveRDS(tab, out)
