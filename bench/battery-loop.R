@@ -110,9 +110,12 @@ named_series <- function(r, kind, value) {
     got = tab$time[j])
 }
 # model terms and series effects (spikes excepted: they are counted apart)
+# (a resonance and a measured band are one class here, as in named(): the
+# loop may describe a band by either entry)
 kinds_all <- function(r) {
   sk <- if (!is.null(r$series)) r$series$table$kind else character()
-  c(kinds(r), sk[sk != "spikes"])
+  k <- c(kinds(r), sk[sk != "spikes"])
+  ifelse(k == "resonance", "band", k)
 }
 n_spikes <- function(r) if (is.null(r$series)) 0L else sum(r$series$table$kind == "spikes")
 extra_kinds <- function(r, base, expect) {
