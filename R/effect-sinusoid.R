@@ -4,6 +4,13 @@
 # Signature constants of the continuous form (checked in test-terms.R):
 sin_peak_ratio <- 0.3710      # sinusoid first ADEV peak at tau = 0.371 / f0
 sin_peak_adev <- 0.7246       # ... where ADEV = 0.7246 A
+# A fitted amplitude beyond this multiple of its periodogram line's (the
+# curve asking for more than 9x the line's power) is not backed by it. The
+# line's amplitude is read within +-3 Welch bins, and a measured line
+# whose frequency wanders spreads beyond them: the ADIS16405
+# accelerometers' own 1.6-1.7 Hz lines are fitted at 2.0-2.5x the amp read
+# there, the curve's misplaced sinusoids at 5-9x.
+sin_amp_factor <- 3
 
 # Raw-data evidence: a periodogram line near f0.
 evidence_sinusoid <- function(par, raw, x, freq) {
@@ -15,10 +22,18 @@ evidence_sinusoid <- function(par, raw, x, freq) {
     # not a fraction of f0
     j <- match_line(f0, l, tol = 1.5, pick = "strongest")
     if (!is.na(j)) {
-      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)",
+      # the line must carry the power the curve asks for: a weak line next
+      # to f0 does not back a sinusoid sized for a stronger one elsewhere
+      # (on a measured accelerometer a bump's sinusoid landed on a line of
+      # 1/7 its amplitude while the added line was 0.1 Hz away)
+      amp <- abs(par[["amp"]] %||% NA_real_)
+      big <- is.finite(amp) && l$amp[j] > 0 && amp > sin_amp_factor * l$amp[j]
+      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)%s",
                                  format_num(l$f0[j], 4), format_num(l$amp[j]),
-                                 l$p_value[j]),
-                  support = TRUE))
+                                 l$p_value[j],
+                                 if (big) sprintf(", %.1f x weaker than the fitted amp %s",
+                                                  amp / l$amp[j], format_num(amp)) else ""),
+                  support = !big))
     }
   }
   if (is.finite(f0) && f0 < 4 * res) {

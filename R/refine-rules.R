@@ -273,7 +273,11 @@ series_pays_without <- function(st, new, label, min_share = 0.1) {
   # the curve out): the share is read there, the excess taken out of the
   # whole curve
   j <- term_peak(comp, label)
-  own <- comp[j, label]
+  # the term's AV there, read no higher than the curve's own: a term the
+  # fit lets overshoot the few long-tau points (a rate ramp 14x above the
+  # curve at its last tau, standing in for a warm-up's tail) does not
+  # escape the check by its overshoot
+  own <- min(comp[j, label], new$data$avar[j])
   at <- kind_excess(series$adev_kinds, left, new$data$tau[j])
   if (is.null(at) || !(own > 0) || sum(at) < min_share * own) return(NULL)
   cv <- curve_of_fit(new)

@@ -11,6 +11,7 @@
 # it did not add (`extra`), and the seconds of the run with the effect.
 #
 #   R_LIBS=/tmp/lib Rscript bench/battery-loop.R [data dir] [cases regex]
+# (BATTERY_OUT=file.rds saves the table)
 #
 # The recordings stay in the shared data directory (never shipped).
 suppressPackageStartupMessages(library(allanvar))
@@ -47,6 +48,16 @@ g_flicker <- function(n, B) {               # flicker by summed AR(1)s, 1/f over
   for (tc in 10^seq(-1, 3, by = 0.5)) out <- out + g_gm(n, B * 0.6, tc)
   out
 }
+# an exponential warm-up of time constant tc, amplitude 50 x ADEV(tc) of
+# the series it is added to, random sign
+g_warmup <- function(b, tc) {
+  n <- length(b)
+  a <- 50 * allan(b, freq, taus = I(min(tc, n / freq / 4)))$adev * sample(c(-1, 1), 1)
+  a * exp(-(seq_len(n) - 1) / freq / tc)
+}
+# a bias step of 10 x ADEV(10 s) of the series, at time t0 (s)
+g_step_size <- function(b) 10 * allan(b, freq, taus = I(10))$adev * sample(c(-1, 1), 1)
+g_step <- function(n, t0, size) size * ((seq_len(n) - 1) / freq >= t0)
 # realised time constant of an injected GM alone: its AR(1) coefficient by
 # least squares (the maximum-likelihood estimate given the first sample)
 realised_tc <- function(g) {
@@ -65,10 +76,12 @@ run_loop <- function(x) {
 }
 n_of <- function(r) {
   cf <- coef(r)
-  unname(if ("N" %in% names(cf)) cf[["N"]] else cf[["filter.Nf"]])
+  # N, or the white noise a filter term (any variant) carries
+  unname(cf[grepl("^N$|^filter[^.]*\\.Nf$", names(cf))][1L])
 }
 kinds <- function(r) sub(":.*", "", r$terms)
 named <- function(r, kind, value) {
+  if (kind %in% c("warmup", "steps")) return(named_series(r, kind, value))
   cf <- coef(r)
   v <- switch(kind,
     sinusoid = cf[grepl("^sinusoid[0-9]*\\.f0$", names(cf))],
@@ -81,9 +94,33 @@ named <- function(r, kind, value) {
   j <- which.min(abs(log(v / value)))
   c(ok = unname(abs(v[j] / value - 1) <= tol), got = unname(v[j]))
 }
+# a series effect: warm-up tc within 25%; a step at `value` = c(time, size)
+# within 2 s and 25% in size
+named_series <- function(r, kind, value) {
+  tab <- r$series$table
+  tab <- tab[tab$kind == kind, , drop = FALSE]
+  if (!nrow(tab)) return(c(ok = FALSE, got = NA))
+  if (kind == "warmup") {
+    j <- which.min(abs(log(tab$tc / value[1])))
+    return(c(ok = unname(abs(tab$tc[j] / value[1] - 1) <= 0.25), got = tab$tc[j]))
+  }
+  j <- which.min(abs(tab$time - value[1]))
+  c(ok = unname(abs(tab$time[j] - value[1]) <= 2 &&
+                  abs(tab$size[j] / value[2] - 1) <= 0.25),
+    got = tab$time[j])
+}
+# model terms and series effects (spikes excepted: they are counted apart)
+# (a resonance and a measured band are one class here, as in named(): the
+# loop may describe a band by either entry)
+kinds_all <- function(r) {
+  sk <- if (!is.null(r$series)) r$series$table$kind else character()
+  k <- c(kinds(r), sk[sk != "spikes"])
+  ifelse(k == "resonance", "band", k)
+}
+n_spikes <- function(r) if (is.null(r$series)) 0L else sum(r$series$table$kind == "spikes")
 extra_kinds <- function(r, base, expect) {
-  ke <- table(kinds(r))
-  kb <- table(kinds(base))
+  ke <- table(kinds_all(r))
+  kb <- table(kinds_all(base))
   out <- character()
   for (k in names(ke)) {
     allowed <- (if (k %in% names(kb)) kb[[k]] else 0) + sum(expect == k)
@@ -125,6 +162,23 @@ cases <- list(
     list(x = b + g_band(n_sim, 0.006, 12, 0.3), base = b,
          expect = list(list("band", 12)))
   },
+  "sim: warm-up tc 1% of the record (50 s)" = function() {
+    b <- sim_base(); list(x = b + g_warmup(b, 50), base = b, expect = list(list("warmup", 50)))
+  },
+  "sim: warm-up tc 10% of the record (500 s)" = function() {
+    b <- sim_base(); list(x = b + g_warmup(b, 500), base = b, expect = list(list("warmup", 500)))
+  },
+  "sim: warm-up tc 30% of the record (1500 s)" = function() {
+    b <- sim_base(); list(x = b + g_warmup(b, 1500), base = b, expect = list(list("warmup", 1500)))
+  },
+  "sim: GM 3 s + warm-up 70 s (no GM for the warm-up)" = function() {
+    b <- sim_base() + g_gm(n_sim, 0.004, 3)
+    list(x = b + g_warmup(b, 70), base = b, expect = list(list("warmup", 70)))
+  },
+  "sim: step at 2100 s" = function() {
+    b <- sim_base(); sz <- g_step_size(b)
+    list(x = b + g_step(n_sim, 2100, sz), base = b, expect = list(list("steps", c(2100, sz))))
+  },
   "control: N + K" = function() list(x = sim_base(), base = NULL),
   "control: N + B + K" = function() list(x = sim_base() + g_flicker(n_sim, 3e-4), base = NULL),
   "control: N + K + R" = function() {
@@ -152,7 +206,13 @@ real <- list(
   list(u = 1, j = 6, what = "gm", tc = 20),
   list(u = 3, j = 4, what = "gm", tc = 20),
   list(u = 3, j = 1, what = "nyquist", f0 = 49.3),
-  list(u = 2, j = 6, what = "nyquist", f0 = 48.1)
+  list(u = 2, j = 6, what = "nyquist", f0 = 48.1),
+  list(u = 1, j = 5, what = "square", f0 = 0.8),
+  list(u = 2, j = 1, what = "warmup", tc = 300),
+  list(u = 3, j = 5, what = "warmup", tc = 100),
+  list(u = 1, j = 2, what = "warmup", tc = 70),
+  list(u = 2, j = 4, what = "step", t0 = 4100),
+  list(u = 3, j = 2, what = "step", t0 = 7300)
 )
 for (rc in real) local({
   rc <- rc
@@ -160,7 +220,10 @@ for (rc in real) local({
                 switch(rc$what, line = sprintf("line %s Hz", rc$f0),
                        band = sprintf("band %s Hz", rc$fr),
                        gm = sprintf("GM tc %s s", rc$tc),
-                       nyquist = sprintf("line %s Hz", rc$f0)))
+                       nyquist = sprintf("line %s Hz", rc$f0),
+                       square = sprintf("square wave %s Hz", rc$f0),
+                       warmup = sprintf("warm-up tc %s s", rc$tc),
+                       step = sprintf("step at %s s", rc$t0)))
   cases[[nm]] <<- function() {
     b <- real_axis(rc$u, rc$j)
     if (is.null(b)) return(NULL)
@@ -171,6 +234,15 @@ for (rc in real) local({
                   expect = list(list("sinusoid", rc$f0))),
       nyquist = list(x = b + g_line(n, s, rc$f0), base = b,
                      expect = list(list("sinusoid", rc$f0))),
+      square = list(x = b + g_square(n, 0.4 * s, rc$f0), base = b,
+                    expect = list(list("sinusoid", rc$f0), list("sinusoid", 3 * rc$f0),
+                                  list("sinusoid", 5 * rc$f0))),
+      warmup = list(x = b + g_warmup(b, rc$tc), base = b,
+                    expect = list(list("warmup", rc$tc))),
+      step = {
+        sz <- g_step_size(b)
+        list(x = b + g_step(n, rc$t0, sz), base = b, expect = list(list("steps", c(rc$t0, sz))))
+      },
       band = list(x = b + g_band(n, 0.5 * s, rc$fr, 0.3), base = b,
                   expect = list(list("band", rc$fr))),
       gm = {
@@ -183,7 +255,6 @@ for (rc in real) local({
         list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
       })
   }
-  for (u in 1:3) for (j in c(1, 3, 4, 6)) NULL
 })
 for (u in 1:3) for (j in 1:6) local({
   u <- u; j <- j
@@ -194,30 +265,38 @@ for (u in 1:3) for (j in 1:6) local({
 })
 
 base_cache <- new.env()
+key_of <- function(x) paste(length(x), sum(x[1:1000]), sum(x[length(x) - 0:999]), sep = ":")
+cached_run <- function(x) {
+  key <- key_of(x)
+  if (is.null(base_cache[[key]])) base_cache[[key]] <- run_loop(x)
+  base_cache[[key]]
+}
 rows <- list()
 for (nm in grep(only, names(cases), value = TRUE)) {
   set.seed(2700 + match(nm, names(cases)))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
-  r <- run_loop(cs$x)
   if (is.null(cs$base)) {
+    r <- cached_run(cs$x)
     rows[[length(rows) + 1L]] <- data.frame(
-      case = nm, named = NA, got = "", N_change = NA, extra = paste(kinds(r)[!kinds(r) %in% c("N", "B", "K")], collapse = "+"),
+      case = nm, named = NA, got = "", N_change = NA,
+      extra = paste(setdiff(kinds_all(r), c("N", "B", "K")), collapse = "+"),
+      spikes = sprintf("%d", n_spikes(r)),
       contradicted = contradicted(r), chi2 = round(r$chi2, 2), seconds = round(r$seconds, 1))
   } else {
-    key <- digest_key <- paste(length(cs$base), sum(cs$base[1:1000]), sep = ":")
-    base <- base_cache[[key]]
-    if (is.null(base)) base <- base_cache[[key]] <- run_loop(cs$base)
+    r <- run_loop(cs$x)
+    base <- cached_run(cs$base)
     nmd <- vapply(cs$expect, function(e) named(r, e[[1]], e[[2]])[["ok"]], 0)
     got <- vapply(cs$expect, function(e) {
       sprintf("%s %s/%s", e[[1]], format(signif(named(r, e[[1]], e[[2]])[["got"]], 3)),
-              format(signif(e[[2]], 3)))
+              format(signif(e[[2]][1], 3)))
     }, "")
     rows[[length(rows) + 1L]] <- data.frame(
       case = nm, named = sprintf("%d/%d", sum(nmd == 1), length(nmd)),
       got = paste(got, collapse = "; "),
       N_change = round(100 * (n_of(r) / n_of(base) - 1), 1),
       extra = extra_kinds(r, base, vapply(cs$expect, `[[`, "", 1)),
+      spikes = sprintf("%d/%d", n_spikes(r), n_spikes(base)),
       contradicted = contradicted(r), chi2 = round(r$chi2, 2),
       seconds = round(r$seconds, 1))
   }
@@ -226,3 +305,5 @@ for (nm in grep(only, names(cases), value = TRUE)) {
 tab <- do.call(rbind, rows)
 cat("\n")
 print(tab, row.names = FALSE, right = FALSE)
+out <- Sys.getenv("BATTERY_OUT")
+if (nzchar(out)) saveRDS(tab, out)

@@ -47,3 +47,19 @@ test_that("a 0.8 Hz square wave: its lines 0.8, 2.4 and 4.0 Hz are named, no ban
   expect_false(any(grepl("^(band|resonance)", r$terms)))
   expect_false(any(r$steps$confirmed %in% FALSE))
 })
+
+test_that("a sinusoid sized for a strong line is not backed by a weak line beside it", {
+  # own generator: white noise, a line at 1.7 Hz of amplitude 0.3 and one
+  # at 1.59 Hz five times weaker (on a measured accelerometer the loop
+  # once fitted the strong line's power at the weak line's frequency)
+  set.seed(27)
+  freq <- 100
+  t <- seq_len(2e5) / freq
+  x <- rnorm(length(t)) + 0.3 * sin(2 * pi * 1.7 * t + 1) + 0.06 * sin(2 * pi * 1.59 * t + 2)
+  raw <- avdiagnose(x, freq)
+  ev <- allanvar:::evidence_sinusoid
+  expect_false(ev(list(amp = 0.3, f0 = 1.59), raw, x, freq)$support)
+  expect_match(ev(list(amp = 0.3, f0 = 1.59), raw, x, freq)$text, "weaker than the fitted amp")
+  expect_true(ev(list(amp = 0.3, f0 = 1.7), raw, x, freq)$support)
+  expect_true(ev(list(amp = 0.06, f0 = 1.59), raw, x, freq)$support)
+})

@@ -95,3 +95,22 @@ test_that("series_duplicate() reads the series effect's AV against the term's", 
   expect_null(series_duplicate(pass, fit, "gm1"))
   expect_null(series_duplicate(NULL, fit, "gm1"))
 })
+
+test_that("a long warm-up left in the data is not described again by a rate ramp", {
+  skip_on_cran()
+  # a warm-up of tc 10% of a 5000 s record: its tail reads as a linear
+  # trend, and the fit lets R overshoot the last, sparse taus many times,
+  # which hid its duplicate share before (R was added in every seed)
+  for (s in 1:2) {
+    set.seed(s)
+    n <- 5e5
+    t <- (seq_len(n) - 1) / 100
+    x <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-5)) - 0.07 * exp(-t / 500)
+    ref <- suppressMessages(avrefine(avfit(allan(x, 100), terms = c("N", "B", "K")), data = x))
+    wu <- ref$series$table[ref$series$table$kind == "warmup", , drop = FALSE]
+    expect_equal(nrow(wu), 1L)
+    expect_lt(abs(wu$tc / 500 - 1), 0.25)
+    expect_false("R" %in% ref$terms)
+    expect_true("R" %in% ref$refine$series_duplicates$effect)
+  }
+})
