@@ -218,9 +218,11 @@ double edf_simple_oavar(double N, double m, int alpha) {
 // b (N - 1)/m - c, for white, flicker and random-walk FM; for white PM, as
 // Stable32, the simple overlapping EDF of Table 5; for flicker PM the
 // overlapping EDF (Greenhall's), not Table 5's simple formula, which
-// overstates it (3.3x at N = 556990, m = 100: the 68% intervals covered
-// 0.36-0.52 at m = 20-100, tools/stable32-rows-mc.R; 15-35% at N = 1024,
-// whose Monte Carlo EDF Greenhall's follows within 15%). Below
+// overstates it at long records: at N = 556989, m = 20 and 100, the Monte
+// Carlo EDF of the total variance of flicker PM is 1.28e5 and 4.5e4,
+// Greenhall's 9.6e4 and 3.5e4, Table 5's 1.96e5 and 1.16e5. Greenhall's
+// is the conservative side (at N = 1024 it is 10-25% below the Monte
+// Carlo EDF, Table 5's 0-20% above). Below
 // m = 8 the Total terms are (almost) the overlapping ones, and so is their
 // EDF: Table 7's 1.5 (N - 1)/m would claim 1500 at m = 1, N = 1001 where
 // the exact value for sampled white FM is 666 (the same terms as the
