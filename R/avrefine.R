@@ -146,6 +146,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   args <- check_refine_args(fit, data, candidates, max_steps, criterion,
                             min_gain, level, remove, series)
   st <- new_refine_state(fit, args, refit_settings(fit, list(...)))
+  # the refits share the basis columns they build (R/coef.R)
+  basis_store_open()
+  on.exit(basis_store_close(), add = TRUE)
   # the stages in order (R/refine-stages.R), each taking and returning the state
   for (stage in refine_stages()) st <- validate_refine_state(stage(st))
   st$result

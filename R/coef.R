@@ -201,17 +201,67 @@ plan_basis <- function(plan, tau, tau0, values, memo = NULL) {
   for (p in plan) {
     nl <- if (length(p$nl)) stats::setNames(values[p$nl], p$nl_param) else NULL
     if (is.null(memo)) {
-      out[, p$amp] <- p$entry$basis(tau, tau0, nl)
+      out[, p$amp] <- stored_basis(p$entry, tau, tau0, nl)
       next
     }
     hit <- memo[[p$label]]
     if (is.null(hit) || !identical(hit$nl, nl)) {
-      hit <- list(nl = nl, b = p$entry$basis(tau, tau0, nl))
+      hit <- list(nl = nl, b = stored_basis(p$entry, tau, tau0, nl))
       assign(p$label, hit, envir = memo)
     }
     out[, p$amp] <- hit$b
   }
   out
+}
+
+# The basis columns of one term, through the store avrefine() opens for
+# its call: the loop's many refits rebuild the same terms at the same
+# values (each candidate's grid, the model's terms at their current
+# values), so each (term, values, tau grid) is built once per call. The
+# columns are a pure function of those, so the store changes no result.
+# Outside a loop, and on long tau grids, the columns are built directly.
+basis_store <- new.env(parent = emptyenv())
+basis_store$depth <- 0L
+basis_store$slots <- list()
+
+basis_store_open <- function() {
+  basis_store$depth <- basis_store$depth + 1L
+  invisible(NULL)
+}
+
+basis_store_close <- function() {
+  basis_store$depth <- max(basis_store$depth - 1L, 0L)
+  if (basis_store$depth == 0L) basis_store$slots <- list()
+  invisible(NULL)
+}
+
+stored_basis <- function(entry, tau, tau0, nl) {
+  if (basis_store$depth == 0L || length(tau) > 2048L) {
+    return(entry$basis(tau, tau0, nl))
+  }
+  slots <- basis_store$slots
+  env <- NULL
+  for (s in slots) {
+    if (identical(s$tau, tau) && identical(s$tau0, tau0)) {
+      env <- s$env
+      break
+    }
+  }
+  if (is.null(env)) {
+    env <- new.env(hash = TRUE, parent = emptyenv())
+    # a few tau grids per call (the curve, a trimmed range); oldest out
+    if (length(slots) >= 8L) slots <- slots[-1L]
+    basis_store$slots <- c(slots, list(list(tau = tau, tau0 = tau0, env = env)))
+  }
+  # [[ ]]: `$variant` would partially match `variants` on a bare entry
+  key <- paste0(entry[["name"]], ":", entry[["variant"]], "|",
+                paste(sprintf("%a", nl), collapse = ","))
+  b <- env[[key]]
+  if (is.null(b)) {
+    b <- entry$basis(tau, tau0, nl)
+    assign(key, b, envir = env)
+  }
+  b
 }
 
 # Per-instance AV contributions (matrix, columns = term labels).

@@ -136,11 +136,40 @@ fit_problem <- function(data, tau0, lay, bias_correct, corr, model_var = 0) {
   held <- stats::setNames(lay$fixed, lay$name)
   const <- vapply(plan, function(p) !length(p$nl) || all(held[p$nl]), NA)
   basis0 <- plan_basis(plan[const], data$tau, tau0, stats::setNames(lay$value, lay$name))
+  plan_nl <- plan[!const]
+  # the full basis with the constant columns in place (the searched terms'
+  # columns after them), and each amplitude's column in it, so that a
+  # solve only fills the searched terms' columns
+  cols <- c(colnames(basis0), unlist(lapply(plan_nl, `[[`, "amp")))
+  B0 <- matrix(0, nrow(data), length(cols), dimnames = list(NULL, cols))
+  B0[, seq_len(ncol(basis0))] <- basis0
+  amp$col <- match(amp$name, cols)
   list(data = data, tau0 = tau0, lay = lay, plan = plan, y = y,
        s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct,
-       amp = amp, plan_nl = plan[!const], basis0 = basis0,
+       amp = amp, plan_nl = plan_nl, basis0 = basis0, B0 = B0,
+       nl_cols = lapply(plan_nl, function(p) match(p$amp, cols)),
        values = stats::setNames(lay$value, lay$name),
        memo = new.env(parent = emptyenv()))
+}
+
+# The basis of a solve: the problem's constant columns and the searched
+# terms' columns at `values`, each term's kept in the problem's memo while
+# its values do not move (what plan_basis() does with a memo, without
+# rebuilding the constant part per solve).
+solve_basis <- function(pr, values) {
+  Bm <- pr$B0
+  memo <- pr$memo
+  for (k in seq_along(pr$plan_nl)) {
+    p <- pr$plan_nl[[k]]
+    nl <- if (length(p$nl)) stats::setNames(values[p$nl], p$nl_param) else NULL
+    hit <- memo[[p$label]]
+    if (is.null(hit) || !identical(hit$nl, nl)) {
+      hit <- list(nl = nl, b = stored_basis(p$entry, pr$data$tau, pr$tau0, nl))
+      assign(p$label, hit, envir = memo)
+    }
+    Bm[, pr$nl_cols[[k]]] <- hit$b
+  }
+  Bm
 }
 
 # Solve for the squared amplitudes at nonlinear values `nlv` (named by
@@ -152,10 +181,11 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE) {
   values <- pr$values
   if (length(nlv)) values[names(nlv)] <- nlv
   amp <- pr$amp
-  Bm <- cbind(pr$basis0, plan_basis(pr$plan_nl, pr$data$tau, pr$tau0, values, pr$memo))
-  free <- amp$name[!amp$fixed & !amp$label %in% off]
+  Bm <- solve_basis(pr, values)
+  on <- !amp$fixed & !amp$label %in% off
+  free <- amp$name[on]
   offset <- numeric(nrow(pr$data))
-  for (i in which(amp$fixed)) offset <- offset + amp$value[i]^2 * Bm[, amp$name[i]]
+  for (i in which(amp$fixed)) offset <- offset + amp$value[i]^2 * Bm[, amp$col[i]]
   cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
   lay <- NULL
   if (layout) {
@@ -167,7 +197,7 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE) {
     return(list(c = cc, objective = obj, iterations = 0L, converged = TRUE,
                 layout = lay))
   }
-  r <- avfit_log_nnls(Bm[, free, drop = FALSE], offset, pr$y, pr$W,
+  r <- avfit_log_nnls(Bm[, amp$col[on], drop = FALSE], offset, pr$y, pr$W,
                       numeric(length(free)), control$inner_maxit,
                       control$inner_tol)
   cc[free] <- r$c
