@@ -474,6 +474,10 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
   }
 }
 
+// Highest difference order whose squares the octave pass sums for the ACF
+// (dmax + 1: Hadamard types difference up to three times).
+const int kMaxOrder = 4;
+
 // Non-overlapping AV at m = 2^j straight from the rate samples: cluster sums
 // are built pairwise in double-double, level by level, inside cache-sized
 // blocks, so the data are read once. `lev` carries, per level, the last
@@ -501,6 +505,21 @@ struct Level {
   // are stored in that loop, so they need `line` too
   bool line = false;
   double s0 = 0, sp = 0, i0 = 0, cc = 0;
+  // Hadamard at m = 2^j (had): squared second differences of the cluster
+  // sums, each difference of dd values through TwoSum (as exact as the
+  // first differences above), in hacc.
+  bool had = false;
+  Acc hacc;
+  // The lag-1 ACF from moments read in this pass (acf_from_moments()):
+  // K > 0 sums q[k] of squared k-th differences, k = 0, 2 .. K (plain
+  // double; k = 1 is acc), over the values z = h + l.
+  int K = 0;
+  double q[kMaxOrder + 1] = {0, 0, 0, 0, 0};
+  double dp[kMaxOrder] = {0, 0, 0, 0};  // the last difference of each order
+  // the first and last kMaxOrder values (dd), nv of them seen
+  double fh2[kMaxOrder] = {0, 0, 0, 0}, fl2[kMaxOrder] = {0, 0, 0, 0};
+  double lh2[kMaxOrder] = {0, 0, 0, 0}, ll2[kMaxOrder] = {0, 0, 0, 0};
+  R_xlen_t nv = 0;
 };
 
 // Consume n dd values at level j: accumulate squared differences, keep the
@@ -520,9 +539,145 @@ inline double level_diff(const double* h, const double* l, R_xlen_t a,
 
 // Exact = false (noise id alone): plain double sums in h, l unused; their
 // rounding (1e-16 of a sum) is far below what a noise type can feel.
+// Second difference c - 2 b + a of dd values: each first difference by
+// TwoSum, so drift that the difference cancels leaves no rounding behind.
+template <bool Exact>
+inline double second_diff(double ah, double al, double bh, double bl,
+                          double ch, double cl) {
+  if (!Exact) return (ch - bh) - (bh - ah);
+  double t1, e1, t0, e0;
+  two_sum(ch, -bh, t1, e1);
+  two_sum(bh, -ah, t0, e0);
+  return ((t1 - t0) + (e1 - e0)) + ((cl - bl) - (bl - al));
+}
+
+// The Hadamard sum and the moments of the values [0, n) of a level, with
+// the values of earlier calls carried in L (first/last values, the last
+// difference of each order); called before the values are paired.
+template <bool Exact>
+inline void level_extra(const double* h, const double* l, R_xlen_t n,
+                        Level& L) {
+  if (n <= 0) return;
+  const R_xlen_t nv = L.nv;
+  if (L.had) {
+    double s0 = 0, s1 = 0;
+    // the terms ending at 0 and 1 reach back into earlier calls
+    if (nv >= 2) {
+      const double d = second_diff<Exact>(L.lh2[kMaxOrder - 2],
+                                          L.ll2[kMaxOrder - 2],
+                                          L.lh2[kMaxOrder - 1],
+                                          L.ll2[kMaxOrder - 1], h[0],
+                                          Exact ? l[0] : 0.0);
+      s0 += d * d;
+    }
+    if (nv >= 1 && n >= 2) {
+      const double d = second_diff<Exact>(L.lh2[kMaxOrder - 1],
+                                          L.ll2[kMaxOrder - 1], h[0],
+                                          Exact ? l[0] : 0.0, h[1],
+                                          Exact ? l[1] : 0.0);
+      s0 += d * d;
+    }
+    R_xlen_t i = 2;
+    for (; i + 2 <= n; i += 2) {
+      const double d0 = Exact ? second_diff<true>(h[i - 2], l[i - 2], h[i - 1],
+                                                  l[i - 1], h[i], l[i])
+                              : (h[i] - h[i - 1]) - (h[i - 1] - h[i - 2]);
+      const double d1 = Exact ? second_diff<true>(h[i - 1], l[i - 1], h[i],
+                                                  l[i], h[i + 1], l[i + 1])
+                              : (h[i + 1] - h[i]) - (h[i] - h[i - 1]);
+      s0 += d0 * d0;
+      s1 += d1 * d1;
+    }
+    if (i < n) {
+      const double d = Exact ? second_diff<true>(h[i - 2], l[i - 2], h[i - 1],
+                                                 l[i - 1], h[i], l[i])
+                             : (h[i] - h[i - 1]) - (h[i - 1] - h[i - 2]);
+      s0 += d * d;
+    }
+    L.hacc.add(s0 + s1);
+  }
+  if (L.K > 0) {
+    // differences of orders 1..K of z (k = 1 only as a step to the others)
+    double q0 = 0, q2 = 0, q3 = 0, q4 = 0;
+    double p0 = L.nv > 0 ? L.lh2[kMaxOrder - 1] + L.ll2[kMaxOrder - 1] : 0;
+    double p1 = L.dp[1], p2 = L.dp[2], p3 = L.dp[3];
+    R_xlen_t i = 0;
+    // the first values of the level: orders not yet defined
+    for (; i < n && nv + i < kMaxOrder; ++i) {
+      const double z = level_at<Exact>(h, l, i);
+      q0 += z * z;
+      const R_xlen_t c = nv + i;
+      double d1 = 0, d2 = 0, d3 = 0;
+      if (c >= 1) d1 = z - p0;
+      if (c >= 2) {
+        d2 = d1 - p1;
+        q2 += d2 * d2;
+      }
+      if (c >= 3) {
+        d3 = d2 - p2;
+        q3 += d3 * d3;
+      }
+      p0 = z;
+      p1 = d1;
+      p2 = d2;
+      p3 = d3;
+    }
+    if (L.K >= 4) {
+      for (; i < n; ++i) {
+        const double z = level_at<Exact>(h, l, i);
+        const double d1 = z - p0, d2 = d1 - p1, d3 = d2 - p2, d4 = d3 - p3;
+        q0 += z * z;
+        q2 += d2 * d2;
+        q3 += d3 * d3;
+        q4 += d4 * d4;
+        p0 = z;
+        p1 = d1;
+        p2 = d2;
+        p3 = d3;
+      }
+    } else {
+      for (; i < n; ++i) {
+        const double z = level_at<Exact>(h, l, i);
+        const double d1 = z - p0, d2 = d1 - p1, d3 = d2 - p2;
+        q0 += z * z;
+        q2 += d2 * d2;
+        q3 += d3 * d3;
+        p0 = z;
+        p1 = d1;
+        p2 = d2;
+        p3 = d3;
+      }
+    }
+    L.q[0] += q0;
+    L.q[2] += q2;
+    L.q[3] += q3;
+    L.q[4] += q4;
+    L.dp[1] = p1;
+    L.dp[2] = p2;
+    L.dp[3] = p3;
+  }
+  // the first and last kMaxOrder values
+  for (R_xlen_t i = 0; i < n && nv + i < kMaxOrder; ++i) {
+    L.fh2[nv + i] = h[i];
+    L.fl2[nv + i] = Exact ? l[i] : 0.0;
+  }
+  const R_xlen_t keep_old = n >= kMaxOrder ? 0 : kMaxOrder - n;
+  for (R_xlen_t k = 0; k < keep_old; ++k) {
+    L.lh2[k] = L.lh2[k + n];
+    L.ll2[k] = L.ll2[k + n];
+  }
+  for (R_xlen_t k = keep_old; k < kMaxOrder; ++k) {
+    const R_xlen_t i = n - (kMaxOrder - k);
+    L.lh2[k] = h[i];
+    L.ll2[k] = Exact ? l[i] : 0.0;
+  }
+  L.nv += n;
+}
+
 template <bool Exact>
 inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
                            bool pair) {
+  level_extra<Exact>(h, l, n, L);
   double s = 0, s1 = 0;  // two chains: the add latency bounds one
   if (n > 0) {
     if (!L.has) {
@@ -635,15 +790,82 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
   }
 }
 
+// The k-th difference of w at s (k <= kMaxOrder).
+inline double diff_k(const double* w, int s, int k) {
+  double t[kMaxOrder + 1];
+  for (int i = 0; i <= k; ++i) t[i] = w[s + i];
+  for (int o = 1; o <= k; ++o)
+    for (int i = 0; i + o <= k; ++i) t[i] = t[i + 1] - t[i];
+  return t[0];
+}
+
+// Joins level_extra()'s sums of the right part R into those of the left
+// part L: the terms that straddle the cut, from L's last and R's first
+// values.
+void join_extra(Level& L, const Level& R, bool exact) {
+  if (R.nv == 0) return;
+  const int nl = static_cast<int>(std::min<R_xlen_t>(L.nv, kMaxOrder));
+  const int nr = static_cast<int>(std::min<R_xlen_t>(R.nv, kMaxOrder));
+  double wh[2 * kMaxOrder], wl[2 * kMaxOrder], wz[2 * kMaxOrder];
+  for (int i = 0; i < nl; ++i) {
+    wh[i] = L.lh2[kMaxOrder - nl + i];
+    wl[i] = L.ll2[kMaxOrder - nl + i];
+  }
+  for (int i = 0; i < nr; ++i) {
+    wh[nl + i] = R.fh2[i];
+    wl[nl + i] = R.fl2[i];
+  }
+  const int nw = nl + nr;
+  for (int i = 0; i < nw; ++i) wz[i] = wh[i] + wl[i];
+  if (L.had) {
+    double s = 0;
+    for (int a = std::max(0, nl - 2); a < nl && a + 2 < nw; ++a) {
+      const double d =
+          exact ? second_diff<true>(wh[a], wl[a], wh[a + 1], wl[a + 1],
+                                    wh[a + 2], wl[a + 2])
+                : second_diff<false>(wh[a], 0, wh[a + 1], 0, wh[a + 2], 0);
+      s += d * d;
+    }
+    L.hacc.add(s);
+    L.hacc.add(R.hacc.value());
+  }
+  if (L.K > 0) {
+    L.q[0] += R.q[0];
+    for (int k = 2; k <= L.K; ++k) {
+      double s = 0;
+      for (int a = std::max(0, nl - k); a < nl && a + k < nw; ++a) {
+        const double d = diff_k(wz, a, k);
+        s += d * d;
+      }
+      L.q[k] += s + R.q[k];
+    }
+  }
+  // first values: L's, completed by R's; last values: R's, preceded by L's
+  for (int i = nl; i < kMaxOrder && i < nw; ++i) {
+    L.fh2[i] = wh[i];
+    L.fl2[i] = wl[i];
+  }
+  for (int k = 0; k < kMaxOrder; ++k) {
+    const int i = nw - kMaxOrder + k;
+    if (i < 0) continue;
+    L.lh2[k] = wh[i];
+    L.ll2[k] = wl[i];
+  }
+  L.nv += R.nv;
+}
+
 // Non-overlapping AV at m = 2^j, j = 0..J: the record is cut in two halves
 // at a block boundary (one per thread), whose per-level sums are then
 // joined with the one difference that straddles the cut.
 // exact = false: noise id alone (no sums reported; plain double cluster
 // sums, about a third of the work).
+// had: the Hadamard sums too (hacc); K: the ACF's moments at the `line`
+// levels (level_extra()).
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
                      const std::vector<bool>& keep,
                      const std::vector<bool>& line, std::vector<Level>& lev,
-                     double* range, bool exact, int threads, bool main) {
+                     double* range, bool exact, bool had, int K, int threads,
+                     bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -662,6 +884,10 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
     L.cc = (static_cast<double>(N >> j) - 1) / 2;
   };
   for (int j = 0; j <= jin; ++j) {
+    for (int p = 0; p < P; ++p) {
+      part[p][j].had = had;
+      part[p][j].K = line[j] ? K : 0;
+    }
     if (line[j] || keep[j]) {  // level_step() stores in the line's loop
       for (int p = 0; p < P; ++p) set_line(part[p][j], j, cut[p]);
     }
@@ -696,6 +922,7 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
     L = std::move(part[0][j]);  // z stays valid: the store moves with it
     if (P == 2) {
       const Level& R = part[1][j];
+      join_extra(L, R, exact);
       L.acc.add(R.acc.value());
       if (L.has && R.has) {
         const double d = (R.fh - L.ph) + (R.fl - L.pl);
@@ -724,6 +951,8 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
         lev[j].z = lev[j].store.data();
       }
       if (line[j] || lev[j].keep) set_line(lev[j], j, 0);
+      lev[j].had = had;
+      lev[j].K = line[j] ? K : 0;
       cur = exact ? level_step<true>(h.data(), l.data(), cur, lev[j], j < J)
                   : level_step<false>(h.data(), l.data(), cur, lev[j], j < J);
     }
@@ -765,17 +994,38 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const double* z = lj == 0 ? v : lev[lj].z;
     allanvar::NoiseId id;
     if (n >= rules.acf_min) {
-      // the line read in the octave pass: level 0's sums are of v - c
+      // from the moments read in the octave pass (sums of v - c)
       const Level& L = lev[lj];
-      const allanvar::AcfLine ln =
-          allanvar::acf_line_from(L.s0, L.sp, lj == 0 ? c : 0.0, n, false);
-      if (lj == 1) {  // not kept: pairs of the samples
-        id = allanvar::acf_noise_id_line(
-            [v, c](R_xlen_t i) { return (v[2 * i] - c) + (v[2 * i + 1] - c); },
-            n, false, dmax, ln);
-      } else {
-        id = allanvar::acf_noise_id_line([z](R_xlen_t i) { return z[i]; }, n,
-                                         false, dmax, ln);
+      allanvar::AcfMoments mo;
+      mo.s0 = L.s0;
+      mo.sp = L.sp;
+      mo.q[0] = L.q[0];
+      mo.q[1] = L.acc.value();
+      for (int k = 2; k <= kMaxOrder; ++k) mo.q[k] = L.q[k];
+      for (int k = 0; k < kMaxOrder; ++k) {
+        mo.first[k] = L.fh2[k] + L.fl2[k];
+        mo.last[k] = L.lh2[k] + L.ll2[k];
+      }
+      bool ok = false;
+      if (L.K > dmax) id = allanvar::acf_noise_id_moments(mo, n, dmax, ok);
+      if (!ok) {
+        // a strong mean or line: the values read again (the line in the
+        // pass: level 0's sums are of v - c)
+        const allanvar::AcfLine ln =
+            allanvar::acf_line_from(L.s0, L.sp, lj == 0 ? c : 0.0, n, false);
+        if (lj == 0) {
+          id = allanvar::acf_noise_id_line([v](R_xlen_t i) { return v[i]; },
+                                           n, false, dmax, ln);
+        } else {
+          id = allanvar::acf_noise_id_line(
+              [v, c, m](R_xlen_t i) {
+                double a = 0;
+                const double* p = v + i * m;
+                for (R_xlen_t u = 0; u < m; ++u) a += p[u] - c;
+                return a;
+              },
+              n, false, dmax, ln);
+        }
       }
     } else {
       id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], modified, rules,
@@ -823,7 +1073,9 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   for (R_xlen_t m : mid) {
     if (m < 1 || m > N || (m & (m - 1)) != 0) octave_id = false;
   }
-  const bool std_octave = type == STANDARD && rate && octave;
+  // the standard and Hadamard sums at m = 2^j from the octave pass
+  const bool std_octave = (type == STANDARD || type == HADAMARD) && rate &&
+                          octave;
   double range[2] = {v[0], v[0]};
   bool have_range = false;
   if (std_octave || octave_id) {
@@ -845,13 +1097,15 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       if (lj > J) continue;
       const bool acf = (N >> lj) >= rules.acf_min;
       line[lj] = acf;
-      keep[lj] = lj > 1 || (lj == 1 && !acf);
+      keep[lj] = lj >= 1 && !acf;  // B1 reads the few values
     }
     std::vector<Level> lev;
     // the range only where the sums' kernel below needs it
     have_range = !std_octave && opts.sums;
     standard_octave(v, N, v[0], J, keep, line, lev,
-                    have_range ? range : nullptr, std_octave, threads, main);
+                    have_range ? range : nullptr, std_octave,
+                    std_octave && type == HADAMARD && opts.sums, dmax + 1,
+                    threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
@@ -860,7 +1114,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       for (size_t j = 0; j < nt; ++j) {
         int lj = 0;
         while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
-        out.sums[j] = lev[lj].acc.value();
+        out.sums[j] = type == HADAMARD ? lev[lj].hacc.value()
+                                       : lev[lj].acc.value();
       }
     }
     octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, type == MODIFIED,
