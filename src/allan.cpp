@@ -515,7 +515,6 @@ struct Level {
   // double; k = 1 is acc), over the values z = h + l.
   int K = 0;
   double q[kMaxOrder + 1] = {0, 0, 0, 0, 0};
-  double dp[kMaxOrder] = {0, 0, 0, 0};  // the last difference of each order
   // the first and last kMaxOrder values (dd), nv of them seen
   double fh2[kMaxOrder] = {0, 0, 0, 0}, fl2[kMaxOrder] = {0, 0, 0, 0};
   double lh2[kMaxOrder] = {0, 0, 0, 0}, ll2[kMaxOrder] = {0, 0, 0, 0};
@@ -541,120 +540,140 @@ inline double level_diff(const double* h, const double* l, R_xlen_t a,
 // rounding (1e-16 of a sum) is far below what a noise type can feel.
 // Second difference c - 2 b + a of dd values: each first difference by
 // TwoSum, so drift that the difference cancels leaves no rounding behind.
-template <bool Exact>
-inline double second_diff(double ah, double al, double bh, double bl,
-                          double ch, double cl) {
+// T: double or (GCC/Clang) a vector of two.
+template <bool Exact, class T>
+inline T second_diff(T ah, T al, T bh, T bl, T ch, T cl) {
   if (!Exact) return (ch - bh) - (bh - ah);
-  double t1, e1, t0, e0;
-  two_sum(ch, -bh, t1, e1);
-  two_sum(bh, -ah, t0, e0);
+  const T t1 = ch - bh, c1 = t1 - ch, e1 = (ch - (t1 - c1)) - (bh + c1);
+  const T t0 = bh - ah, c0 = t0 - bh, e0 = (bh - (t0 - c0)) - (ah + c0);
   return ((t1 - t0) + (e1 - e0)) + ((cl - bl) - (bl - al));
 }
 
+// The k-th difference (k < kMaxOrder) at the end of the last values of L.
+inline double last_diff(const Level& L, int k) {
+  double t[kMaxOrder];
+  for (int i = 0; i <= k; ++i) {
+    t[i] = L.lh2[kMaxOrder - 1 - k + i] + L.ll2[kMaxOrder - 1 - k + i];
+  }
+  for (int o = 1; o <= k; ++o)
+    for (int i = 0; i + o <= k; ++i) t[i] = t[i + 1] - t[i];
+  return t[0];
+}
+
 // The Hadamard sum and the moments of the values [0, n) of a level, with
-// the values of earlier calls carried in L (first/last values, the last
-// difference of each order); called before the values are paired.
+// the last values of earlier calls carried in L; called before the values
+// are paired. The terms reaching back into earlier calls are summed one by
+// one, the others from this call's values, two per vector.
 template <bool Exact>
 inline void level_extra(const double* h, const double* l, R_xlen_t n,
                         Level& L) {
   if (n <= 0) return;
   const R_xlen_t nv = L.nv;
+  auto H = [h](R_xlen_t i) { return h[i]; };
+  auto Lo = [l](R_xlen_t i) { return Exact ? l[i] : 0.0; };
   if (L.had) {
     double s0 = 0, s1 = 0;
-    // the terms ending at 0 and 1 reach back into earlier calls
+    const double* lh = L.lh2 + kMaxOrder - 2;
+    const double* ll = L.ll2 + kMaxOrder - 2;
     if (nv >= 2) {
-      const double d = second_diff<Exact>(L.lh2[kMaxOrder - 2],
-                                          L.ll2[kMaxOrder - 2],
-                                          L.lh2[kMaxOrder - 1],
-                                          L.ll2[kMaxOrder - 1], h[0],
-                                          Exact ? l[0] : 0.0);
+      const double d = second_diff<Exact>(lh[0], ll[0], lh[1], ll[1], H(0), Lo(0));
       s0 += d * d;
     }
     if (nv >= 1 && n >= 2) {
-      const double d = second_diff<Exact>(L.lh2[kMaxOrder - 1],
-                                          L.ll2[kMaxOrder - 1], h[0],
-                                          Exact ? l[0] : 0.0, h[1],
-                                          Exact ? l[1] : 0.0);
+      const double d = second_diff<Exact>(lh[1], ll[1], H(0), Lo(0), H(1), Lo(1));
       s0 += d * d;
     }
     R_xlen_t i = 2;
-    for (; i + 2 <= n; i += 2) {
-      const double d0 = Exact ? second_diff<true>(h[i - 2], l[i - 2], h[i - 1],
-                                                  l[i - 1], h[i], l[i])
-                              : (h[i] - h[i - 1]) - (h[i - 1] - h[i - 2]);
-      const double d1 = Exact ? second_diff<true>(h[i - 1], l[i - 1], h[i],
-                                                  l[i], h[i + 1], l[i + 1])
-                              : (h[i + 1] - h[i]) - (h[i] - h[i - 1]);
-      s0 += d0 * d0;
-      s1 += d1 * d1;
+#if defined(__GNUC__)
+    v2d a0 = {0, 0}, a1 = {0, 0};
+    const v2d zero = {0, 0};
+    auto Lv = [l, zero](R_xlen_t k) { return Exact ? ld2(l + k) : zero; };
+    for (; i + 4 <= n; i += 4) {
+      const v2d d0 = second_diff<Exact>(ld2(h + i - 2), Lv(i - 2), ld2(h + i - 1),
+                                        Lv(i - 1), ld2(h + i), Lv(i));
+      const v2d d1 = second_diff<Exact>(ld2(h + i), Lv(i), ld2(h + i + 1),
+                                        Lv(i + 1), ld2(h + i + 2), Lv(i + 2));
+      a0 += d0 * d0;
+      a1 += d1 * d1;
     }
-    if (i < n) {
-      const double d = Exact ? second_diff<true>(h[i - 2], l[i - 2], h[i - 1],
-                                                 l[i - 1], h[i], l[i])
-                             : (h[i] - h[i - 1]) - (h[i - 1] - h[i - 2]);
+    s1 = (a0[0] + a1[0]) + (a0[1] + a1[1]);
+#endif
+    for (; i < n; ++i) {
+      const double d = second_diff<Exact>(H(i - 2), Lo(i - 2), H(i - 1),
+                                          Lo(i - 1), H(i), Lo(i));
       s0 += d * d;
     }
     L.hacc.add(s0 + s1);
   }
   if (L.K > 0) {
-    // differences of orders 1..K of z (k = 1 only as a step to the others)
     double q0 = 0, q2 = 0, q3 = 0, q4 = 0;
-    double p0 = L.nv > 0 ? L.lh2[kMaxOrder - 1] + L.ll2[kMaxOrder - 1] : 0;
-    double p1 = L.dp[1], p2 = L.dp[2], p3 = L.dp[3];
+    // the first values of this call: differences reaching back
+    double p0 = 0, p1 = 0, p2 = 0, p3 = 0;
+    if (nv >= 1) p0 = last_diff(L, 0);
+    if (nv >= 2) p1 = last_diff(L, 1);
+    if (nv >= 3) p2 = last_diff(L, 2);
+    if (nv >= 4) p3 = last_diff(L, 3);
+    const bool k4 = L.K >= 4;
     R_xlen_t i = 0;
-    // the first values of the level: orders not yet defined
-    for (; i < n && nv + i < kMaxOrder; ++i) {
-      const double z = level_at<Exact>(h, l, i);
+    for (; i < n && i < kMaxOrder; ++i) {
+      const double z = H(i) + Lo(i);
       q0 += z * z;
       const R_xlen_t c = nv + i;
-      double d1 = 0, d2 = 0, d3 = 0;
-      if (c >= 1) d1 = z - p0;
-      if (c >= 2) {
-        d2 = d1 - p1;
-        q2 += d2 * d2;
-      }
-      if (c >= 3) {
-        d3 = d2 - p2;
-        q3 += d3 * d3;
-      }
+      const double d1 = c >= 1 ? z - p0 : 0;
+      const double d2 = c >= 2 ? d1 - p1 : 0;
+      const double d3 = c >= 3 ? d2 - p2 : 0;
+      const double d4 = c >= 4 ? d3 - p3 : 0;
+      q2 += d2 * d2;
+      q3 += d3 * d3;
+      if (k4) q4 += d4 * d4;
       p0 = z;
       p1 = d1;
       p2 = d2;
       p3 = d3;
     }
-    if (L.K >= 4) {
-      for (; i < n; ++i) {
-        const double z = level_at<Exact>(h, l, i);
-        const double d1 = z - p0, d2 = d1 - p1, d3 = d2 - p2, d4 = d3 - p3;
-        q0 += z * z;
-        q2 += d2 * d2;
-        q3 += d3 * d3;
-        q4 += d4 * d4;
-        p0 = z;
-        p1 = d1;
-        p2 = d2;
-        p3 = d3;
+    // the rest from this call's values alone
+    auto Z = [&](R_xlen_t k) { return H(k) + Lo(k); };
+#if defined(__GNUC__)
+    {
+      const v2d zero = {0, 0};
+      auto Zv = [h, l, zero](R_xlen_t k) {
+        return Exact ? ld2(h + k) + ld2(l + k) : ld2(h + k) + zero;
+      };
+      v2d a0 = zero, a2 = zero, a3 = zero, a4 = zero;
+      for (; i + 2 <= n; i += 2) {
+        const v2d z0 = Zv(i), z1 = Zv(i - 1), z2 = Zv(i - 2), z3 = Zv(i - 3);
+        const v2d d2 = (z0 + z2) - 2.0 * z1;
+        const v2d d3 = (z0 - z3) + 3.0 * (z2 - z1);
+        a0 += z0 * z0;
+        a2 += d2 * d2;
+        a3 += d3 * d3;
+        if (k4) {
+          const v2d d4 = ((z0 + Zv(i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
+          a4 += d4 * d4;
+        }
       }
-    } else {
-      for (; i < n; ++i) {
-        const double z = level_at<Exact>(h, l, i);
-        const double d1 = z - p0, d2 = d1 - p1, d3 = d2 - p2;
-        q0 += z * z;
-        q2 += d2 * d2;
-        q3 += d3 * d3;
-        p0 = z;
-        p1 = d1;
-        p2 = d2;
-        p3 = d3;
+      q0 += a0[0] + a0[1];
+      q2 += a2[0] + a2[1];
+      q3 += a3[0] + a3[1];
+      q4 += a4[0] + a4[1];
+    }
+#endif
+    for (; i < n; ++i) {
+      const double z0 = Z(i), z1 = Z(i - 1), z2 = Z(i - 2), z3 = Z(i - 3);
+      const double d2 = (z0 + z2) - 2.0 * z1;
+      const double d3 = (z0 - z3) + 3.0 * (z2 - z1);
+      q0 += z0 * z0;
+      q2 += d2 * d2;
+      q3 += d3 * d3;
+      if (k4) {
+        const double d4 = ((z0 + Z(i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
+        q4 += d4 * d4;
       }
     }
     L.q[0] += q0;
     L.q[2] += q2;
     L.q[3] += q3;
     L.q[4] += q4;
-    L.dp[1] = p1;
-    L.dp[2] = p2;
-    L.dp[3] = p3;
   }
   // the first and last kMaxOrder values
   for (R_xlen_t i = 0; i < n && nv + i < kMaxOrder; ++i) {
@@ -823,7 +842,7 @@ void join_extra(Level& L, const Level& R, bool exact) {
       const double d =
           exact ? second_diff<true>(wh[a], wl[a], wh[a + 1], wl[a + 1],
                                     wh[a + 2], wl[a + 2])
-                : second_diff<false>(wh[a], 0, wh[a + 1], 0, wh[a + 2], 0);
+                : second_diff<false>(wh[a], 0.0, wh[a + 1], 0.0, wh[a + 2], 0.0);
       s += d * d;
     }
     L.hacc.add(s);
@@ -846,7 +865,12 @@ void join_extra(Level& L, const Level& R, bool exact) {
     L.fl2[i] = wl[i];
   }
   for (int k = 0; k < kMaxOrder; ++k) {
-    const int i = nw - kMaxOrder + k;
+    if (R.nv >= kMaxOrder) {
+      L.lh2[k] = R.lh2[k];
+      L.ll2[k] = R.ll2[k];
+      continue;
+    }
+    const int i = nw - kMaxOrder + k;  // R's few values are its first ones
     if (i < 0) continue;
     L.lh2[k] = wh[i];
     L.ll2[k] = wl[i];
