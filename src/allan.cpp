@@ -606,7 +606,10 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
     L.hacc.add(s0 + s1);
   }
   if (L.K > 0) {
-    double q0 = 0, q2 = 0, q3 = 0, q4 = 0;
+    // h alone: l is below an ulp of h, far below what a noise type feels;
+    // the line's sums s0, sp (acf_line_from()) are read here too
+    double q0 = 0, q2 = 0, q3 = 0, q4 = 0, a = 0, p = 0;
+    const double t0 = L.i0 - L.cc;
     // the first values of this call: differences reaching back
     double p0 = 0, p1 = 0, p2 = 0, p3 = 0;
     if (nv >= 1) p0 = last_diff(L, 0);
@@ -616,7 +619,9 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
     const bool k4 = L.K >= 4;
     R_xlen_t i = 0;
     for (; i < n && i < kMaxOrder; ++i) {
-      const double z = H(i) + Lo(i);
+      const double z = h[i];
+      a += z;
+      p += (t0 + static_cast<double>(i)) * z;
       q0 += z * z;
       const R_xlen_t c = nv + i;
       const double d1 = c >= 1 ? z - p0 : 0;
@@ -632,44 +637,51 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
       p3 = d3;
     }
     // the rest from this call's values alone
-    auto Z = [&](R_xlen_t k) { return H(k) + Lo(k); };
 #if defined(__GNUC__)
     {
       const v2d zero = {0, 0};
-      auto Zv = [h, l, zero](R_xlen_t k) {
-        return Exact ? ld2(h + k) + ld2(l + k) : ld2(h + k) + zero;
-      };
-      v2d a0 = zero, a2 = zero, a3 = zero, a4 = zero;
+      v2d a0 = zero, pp = zero, s2 = zero, a2 = zero, a3 = zero, a4 = zero;
+      v2d t = {t0 + static_cast<double>(i), t0 + static_cast<double>(i + 1)};
       for (; i + 2 <= n; i += 2) {
-        const v2d z0 = Zv(i), z1 = Zv(i - 1), z2 = Zv(i - 2), z3 = Zv(i - 3);
+        const v2d z0 = ld2(h + i), z1 = ld2(h + i - 1), z2 = ld2(h + i - 2),
+                  z3 = ld2(h + i - 3);
         const v2d d2 = (z0 + z2) - 2.0 * z1;
         const v2d d3 = (z0 - z3) + 3.0 * (z2 - z1);
-        a0 += z0 * z0;
+        a0 += z0;
+        pp += t * z0;
+        t += 2.0;
+        s2 += z0 * z0;
         a2 += d2 * d2;
         a3 += d3 * d3;
         if (k4) {
-          const v2d d4 = ((z0 + Zv(i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
+          const v2d d4 = ((z0 + ld2(h + i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
           a4 += d4 * d4;
         }
       }
-      q0 += a0[0] + a0[1];
+      q0 += s2[0] + s2[1];
+      a += a0[0] + a0[1];
+      p += pp[0] + pp[1];
       q2 += a2[0] + a2[1];
       q3 += a3[0] + a3[1];
       q4 += a4[0] + a4[1];
     }
 #endif
     for (; i < n; ++i) {
-      const double z0 = Z(i), z1 = Z(i - 1), z2 = Z(i - 2), z3 = Z(i - 3);
+      const double z0 = h[i], z1 = h[i - 1], z2 = h[i - 2], z3 = h[i - 3];
       const double d2 = (z0 + z2) - 2.0 * z1;
       const double d3 = (z0 - z3) + 3.0 * (z2 - z1);
+      a += z0;
+      p += (t0 + static_cast<double>(i)) * z0;
       q0 += z0 * z0;
       q2 += d2 * d2;
       q3 += d3 * d3;
       if (k4) {
-        const double d4 = ((z0 + Z(i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
+        const double d4 = ((z0 + h[i - 4]) + 6.0 * z2) - 4.0 * (z1 + z3);
         q4 += d4 * d4;
       }
     }
+    L.s0 += a;
+    L.sp += p;
     L.q[0] += q0;
     L.q[2] += q2;
     L.q[3] += q3;
@@ -722,7 +734,9 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
     L.pl = Exact ? l[n - 1] : 0.0;
   }
   L.acc.add(s + s1);
-  if (L.line) {
+  if (L.line && L.K > 0 && !L.keep) {
+    L.i0 += static_cast<double>(n);  // s0 and sp read by level_extra()
+  } else if (L.line) {
     double* z = L.z + L.zn;
     const double t = L.i0 - L.cc;
     double a0 = 0, a1 = 0, q0 = 0, q1 = 0;
