@@ -788,7 +788,7 @@ template <bool Exact>
 void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
                  int jin, int b, std::vector<Level>& lev,
                  std::vector<double>& th, std::vector<double>& tl,
-                 double* range) {
+                 double* range, std::vector<double>* tr) {
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   std::vector<double> h(B), l(B);
   double lo = y[s0], hi = y[s0];
@@ -813,10 +813,24 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
     } else {
       for (R_xlen_t i = 0; i < n; ++i) h[i] = y[k0 + i] - c;
     }
+    // R(n)'s block sums (RnCache::build_from_blocks()): sum (B-1-i) z_i
+    double ramp = 0;
+    if (tr && n == B) {
+      double r[4] = {0, 0, 0, 0};
+      for (R_xlen_t i = 0; i < n; i += 4) {
+        const double w = static_cast<double>(B - 1 - i);
+        r[0] += w * level_at<Exact>(h.data(), l.data(), i);
+        r[1] += (w - 1) * level_at<Exact>(h.data(), l.data(), i + 1);
+        r[2] += (w - 2) * level_at<Exact>(h.data(), l.data(), i + 2);
+        r[3] += (w - 3) * level_at<Exact>(h.data(), l.data(), i + 3);
+      }
+      ramp = (r[0] + r[1]) + (r[2] + r[3]);
+    }
     R_xlen_t cur = n;
     for (int j = 0; j <= jin; ++j)
       cur = level_step<Exact>(h.data(), l.data(), cur, lev[j], j < J);
     if (J >= b && cur == 1) {
+      if (tr) tr->push_back(ramp);
       th.push_back(h[0]);
       tl.push_back(Exact ? l[0] : 0.0);
     }
@@ -892,18 +906,24 @@ void join_extra(Level& L, const Level& R, bool exact) {
   L.nv += R.nv;
 }
 
+// Per block of B samples: its sum of v - c and sum (B-1-i)(v_i - c).
+struct RnBlocks {
+  R_xlen_t B = 0;
+  std::vector<double> sum, ramp;
+};
+
 // Non-overlapping AV at m = 2^j, j = 0..J: the record is cut in two halves
 // at a block boundary (one per thread), whose per-level sums are then
 // joined with the one difference that straddles the cut.
 // exact = false: noise id alone (no sums reported; plain double cluster
 // sums, about a third of the work).
 // had: the Hadamard sums too (hacc); K: the ACF's moments at the `line`
-// levels (level_extra()).
+// levels (level_extra()); rnb: R(n)'s sums per block of 2^b samples (J >= b).
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
                      const std::vector<bool>& keep,
                      const std::vector<bool>& line, std::vector<Level>& lev,
-                     double* range, bool exact, bool had, int K, int threads,
-                     bool main) {
+                     double* range, bool exact, bool had, int K,
+                     RnBlocks* rnb, int threads, bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -936,16 +956,16 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
       part[p][j].z = part[0][j].store.data() + (cut[p] >> j);
     }
   }
-  std::vector<std::vector<double> > th(P), tl(P);
+  std::vector<std::vector<double> > th(P), tl(P), tr(P);
   double pr[2][2] = {{y[0], y[0]}, {y[0], y[0]}};
   run_items(P, threads, main, [&](R_xlen_t p) {
     double* rp = range ? pr[p] : nullptr;
     if (exact) {
       octave_part<true>(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p],
-                        tl[p], rp);
+                        tl[p], rp, rnb ? &tr[p] : nullptr);
     } else {
       octave_part<false>(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p],
-                         tl[p], rp);
+                         tl[p], rp, rnb ? &tr[p] : nullptr);
     }
   });
   if (range) {
@@ -981,6 +1001,13 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
     if (P == 2) {
       h.insert(h.end(), th[1].begin(), th[1].end());
       l.insert(l.end(), tl[1].begin(), tl[1].end());
+    }
+    if (rnb) {
+      rnb->B = B;
+      rnb->ramp = tr[0];
+      if (P == 2) rnb->ramp.insert(rnb->ramp.end(), tr[1].begin(), tr[1].end());
+      rnb->sum.resize(h.size());
+      for (size_t k = 0; k < h.size(); ++k) rnb->sum[k] = h[k] + l[k];
     }
     R_xlen_t cur = static_cast<R_xlen_t>(h.size());
     for (int j = b; j <= J; ++j) {
@@ -1019,8 +1046,13 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<R_xlen_t>& mid,
                      const std::vector<double>& mid_n, int dmax,
                      bool modified, const allanvar::NoiseIdRules& rules,
-                     int threads, bool main, Channel& out) {
-  auto build = [=](allanvar::RnCache& r) { r.build_from_rate(v, N, c); };
+                     const RnBlocks& rnb, int threads, bool main,
+                     Channel& out) {
+  auto build = [&rnb, v, N, c](allanvar::RnCache& r) {
+    if (!r.build_from_blocks(rnb.sum.data(), rnb.ramp.data(),
+                             static_cast<R_xlen_t>(rnb.sum.size()), rnb.B, N))
+      r.build_from_rate(v, N, c);
+  };
   allanvar::LazyRn<decltype(build)> rn(build);
   // taus are independent: shared between the threads
   run_items(static_cast<R_xlen_t>(mid.size()), threads, main, [&](R_xlen_t j) {
@@ -1138,12 +1170,19 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       keep[lj] = lj >= 1 && !acf;  // B1 reads the few values
     }
     std::vector<Level> lev;
+    // R(n)'s block sums where B1 may ask for it on a long record
+    // (RnCache::build_from_blocks())
+    bool b1 = false;
+    for (R_xlen_t m : mid) b1 = b1 || (m > 1 && N / m < rules.acf_min);
+    RnBlocks rnb;
+    const bool want_rnb =
+        b1 && J >= 11 && allanvar::RnCache::blocks_usable(2048, N);
     // the range only where the sums' kernel below needs it
     have_range = !std_octave && opts.sums;
     standard_octave(v, N, v[0], J, keep, line, lev,
                     have_range ? range : nullptr, std_octave,
                     std_octave && type == HADAMARD && opts.sums, dmax + 1,
-                    threads, main);
+                    want_rnb ? &rnb : nullptr, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
@@ -1157,7 +1196,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       }
     }
     octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, type == MODIFIED,
-                    rules, threads, main, out);
+                    rules, rnb, threads, main, out);
     if (std_octave || !opts.sums) return;
   }
 

@@ -362,6 +362,19 @@ class RnCache {
   }
   // The same from rate samples v[0..N) about c (phase L = N + 1 points).
   void build_from_rate(const double* v, R_xlen_t N, double c);
+  // The same from sums over nb blocks of B samples of v - c, sum[i] and
+  // ramp[i] = sum (B-1-u)(v_{iB+u} - c): no pass over the samples. The grid
+  // step is then a multiple of B no coarser than build_from_rate()'s
+  // (exact at m = 2^j >= B), which needs L/4096 >= B and no partial last
+  // block; false (nothing built) otherwise.
+  static bool blocks_usable(R_xlen_t B, R_xlen_t N) {
+    const R_xlen_t L = N + 1;
+    if (B < 1 || L / 4096 < B) return false;
+    const R_xlen_t s = (L / 4096 / B) * B;
+    return L % s != 0;
+  }
+  bool build_from_blocks(const double* sum, const double* ramp, R_xlen_t nb,
+                         R_xlen_t B, R_xlen_t N);
   // MVAR/AVAR at (about) m; NaN when the record holds less than 4 m phase
   // points (the MVAR terms would all overlap: one effective sample).
   double ratio(R_xlen_t m) const;
