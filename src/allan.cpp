@@ -242,38 +242,106 @@ inline double diff_at(const double* h, const double* l, R_xlen_t m, R_xlen_t k) 
          ((l[k + 3 * m] - l[k]) + 3.0 * (l[k + m] - l[k + 2 * m]));
 }
 
+// Sum of squared differences for k in [k0, k1): eight terms per step in
+// eight lanes (k mod 8 within the step), folded as
+// ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)) (the vector extensions
+// SSE2 uses four vectors of two, AVX2 two of four: the same lanes, the same
+// additions and no fused multiply-add, so both give the same bits), then the
+// last k1 - k0 mod 8 terms one by one.
+#if defined(__GNUC__)
+template <int D, class V>
+inline V diff_vec(const double* h, const double* l, R_xlen_t m, R_xlen_t k) {
+  auto ld = [](const double* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  if (D == 2) {
+    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
+           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
+  }
+  return ((ld(h + 3 * m + k) - ld(h + k)) +
+          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
+         ((ld(l + 3 * m + k) - ld(l + k)) +
+          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+}
+
+template <int D>
+inline double sumsq8_sse2(const double* h, const double* l, R_xlen_t m,
+                          R_xlen_t& k, R_xlen_t k1) {
+  v2d a0 = {0, 0}, a1 = {0, 0}, a2 = {0, 0}, a3 = {0, 0};
+  for (; k + 8 <= k1; k += 8) {
+    const v2d d0 = diff_vec<D, v2d>(h, l, m, k);
+    const v2d d1 = diff_vec<D, v2d>(h, l, m, k + 2);
+    const v2d d2 = diff_vec<D, v2d>(h, l, m, k + 4);
+    const v2d d3 = diff_vec<D, v2d>(h, l, m, k + 6);
+    a0 += d0 * d0;
+    a1 += d1 * d1;
+    a2 += d2 * d2;
+    a3 += d3 * d3;
+  }
+  return ((a0[0] + a2[0]) + (a1[0] + a3[0])) +
+         ((a0[1] + a2[1]) + (a1[1] + a3[1]));
+}
+
+#if defined(__x86_64__)
+#define ALLANVAR_AVX2 1
+typedef double v4d __attribute__((vector_size(32)));
+
+__attribute__((target("avx2"))) inline v4d ld4(const double* p) {
+  v4d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+template <int D>
+__attribute__((target("avx2"))) inline v4d diff4(const double* h,
+                                                 const double* l, R_xlen_t m,
+                                                 R_xlen_t k) {
+  auto ld = ld4;
+  if (D == 2) {
+    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
+           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
+  }
+  return ((ld(h + 3 * m + k) - ld(h + k)) +
+          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
+         ((ld(l + 3 * m + k) - ld(l + k)) +
+          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+}
+
+template <int D>
+__attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
+                                                   const double* l, R_xlen_t m,
+                                                   R_xlen_t& k, R_xlen_t k1) {
+  v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
+  for (; k + 8 <= k1; k += 8) {
+    const v4d d0 = diff4<D>(h, l, m, k);
+    const v4d d1 = diff4<D>(h, l, m, k + 4);
+    a0 += d0 * d0;
+    a1 += d1 * d1;
+  }
+  // lanes: a0 = (l0 l1 l2 l3), a1 = (l4 l5 l6 l7)
+  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
+         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
+}
+
+inline bool have_avx2() {
+  static const bool ok = __builtin_cpu_supports("avx2");
+  return ok;
+}
+#endif
+#endif
+
 template <int D>
 inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
                      R_xlen_t k1) {
   double tail = 0;
   R_xlen_t k = k0;
-#if defined(__GNUC__)
-  v2d a0 = {0, 0}, a1 = {0, 0};
-  const double* h1 = h + m;
-  const double* h2 = h + 2 * m;
-  const double* h3 = h + 3 * m;
-  const double* l1 = l + m;
-  const double* l2 = l + 2 * m;
-  const double* l3 = l + 3 * m;
-  for (; k + 4 <= k1; k += 4) {
-    v2d d0, d1;
-    if (D == 2) {
-      d0 = ((ld2(h2 + k) + ld2(h + k)) - 2.0 * ld2(h1 + k)) +
-           ((ld2(l2 + k) + ld2(l + k)) - 2.0 * ld2(l1 + k));
-      d1 = ((ld2(h2 + k + 2) + ld2(h + k + 2)) - 2.0 * ld2(h1 + k + 2)) +
-           ((ld2(l2 + k + 2) + ld2(l + k + 2)) - 2.0 * ld2(l1 + k + 2));
-    } else {
-      d0 = ((ld2(h3 + k) - ld2(h + k)) + 3.0 * (ld2(h1 + k) - ld2(h2 + k))) +
-           ((ld2(l3 + k) - ld2(l + k)) + 3.0 * (ld2(l1 + k) - ld2(l2 + k)));
-      d1 = ((ld2(h3 + k + 2) - ld2(h + k + 2)) +
-            3.0 * (ld2(h1 + k + 2) - ld2(h2 + k + 2))) +
-           ((ld2(l3 + k + 2) - ld2(l + k + 2)) +
-            3.0 * (ld2(l1 + k + 2) - ld2(l2 + k + 2)));
-    }
-    a0 += d0 * d0;
-    a1 += d1 * d1;
-  }
-  tail = (a0[0] + a1[0]) + (a0[1] + a1[1]);
+#if defined(ALLANVAR_AVX2)
+  tail = have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
+                     : sumsq8_sse2<D>(h, l, m, k, k1);
+#elif defined(__GNUC__)
+  tail = sumsq8_sse2<D>(h, l, m, k, k1);
 #endif
   for (; k < k1; ++k) {
     const double d = diff_at<D>(h, l, m, k);
