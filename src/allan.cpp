@@ -617,6 +617,32 @@ inline T second_diff(T ah, T al, T bh, T bl, T ch, T cl) {
   return ((t1 - t0) + (e1 - e0)) + ((cl - bl) - (bl - al));
 }
 
+#if defined(ALLANVAR_AVX2)
+// level_extra()'s Hadamard terms at [i, i + 4 k) in AVX2: the lanes and
+// additions of its SSE2 loop (two vectors of two there), the same bits.
+template <bool Exact>
+__attribute__((target("avx2"))) double had_avx2(const double* h,
+                                                const double* l, R_xlen_t& i,
+                                                R_xlen_t n) {
+  v4d a = {0, 0, 0, 0};
+  const v4d zero = {0, 0, 0, 0};
+  for (; i + 4 <= n; i += 4) {
+    const v4d ah = ld4(h + i - 2), bh = ld4(h + i - 1), ch = ld4(h + i);
+    v4d d;
+    if (Exact) {
+      const v4d al = ld4(l + i - 2), bl = ld4(l + i - 1), cl = ld4(l + i);
+      const v4d t1 = ch - bh, c1 = t1 - ch, e1 = (ch - (t1 - c1)) - (bh + c1);
+      const v4d t0 = bh - ah, c0 = t0 - bh, e0 = (bh - (t0 - c0)) - (ah + c0);
+      d = ((t1 - t0) + (e1 - e0)) + ((cl - bl) - (bl - al));
+    } else {
+      d = ((ch - bh) - (bh - ah)) + zero;
+    }
+    a += d * d;
+  }
+  return (a[0] + a[2]) + (a[1] + a[3]);
+}
+#endif
+
 // The k-th difference (k < kMaxOrder) at the end of the last values of L.
 inline double last_diff(const Level& L, int k) {
   double t[kMaxOrder];
@@ -652,7 +678,13 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
       s0 += d * d;
     }
     R_xlen_t i = 2;
+#if defined(ALLANVAR_AVX2)
+    if (have_avx2()) {
+      s1 = had_avx2<Exact>(h, l, i, n);
+    } else
+#endif
 #if defined(__GNUC__)
+    {
     v2d a0 = {0, 0}, a1 = {0, 0};
     const v2d zero = {0, 0};
     auto Lv = [l, zero](R_xlen_t k) { return Exact ? ld2(l + k) : zero; };
@@ -665,6 +697,7 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
       a1 += d1 * d1;
     }
     s1 = (a0[0] + a1[0]) + (a0[1] + a1[1]);
+    }
 #endif
     for (; i < n; ++i) {
       const double d = second_diff<Exact>(H(i - 2), Lo(i - 2), H(i - 1),
