@@ -134,8 +134,10 @@
 #' The phase is accumulated once per channel as a pair of double arrays
 #' (hi on a fixed grid, lo the remainder), \eqn{16 N} bytes, besides at most
 #' one copy of the input (integer or data-frame input is converted). The
-#' standard type at octave cluster sizes needs no prefix arrays at all: it
-#' builds the cluster sums pairwise in one pass over the data. Stride-1
+#' standard and Hadamard types at octave cluster sizes need no prefix arrays
+#' at all: they build the cluster sums pairwise in one pass over the data,
+#' which also gathers what the noise identification of the limits needs
+#' (for every type at octave taus of rate data). Stride-1
 #' types cost \eqn{O(N)} per tau (so `taus = "all"` is \eqn{O(N^2)} for
 #' them), stride-\eqn{m} types \eqn{O(N/m)}. Channels are shared between
 #' `getOption("allanvar.threads", 2)` threads; a single channel splits its
@@ -169,8 +171,8 @@
 #'   `missing`); or `"error"`: refuse them. `Inf` is always an error.
 #' @param ci `TRUE` (default): confidence limits, which need the noise type
 #'   identified at every tau and its EDF. `FALSE`: the values alone, without
-#'   noise identification (faster: for the standard type at octave taus the
-#'   one pass over the data is all): the columns stay, `lower`, `upper`,
+#'   noise identification (faster: for the standard and Hadamard types at
+#'   octave taus the one pass over the data is all): the columns stay, `lower`, `upper`,
 #'   `edf` and `alpha` are `NA` (the bias-corrected `"mtotdev"`,
 #'   `"ttotdev"`, `"htotdev"` and `"theo1"` still identify the type their
 #'   correction needs, and report it in `alpha`). `print()` says there are

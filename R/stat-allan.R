@@ -43,7 +43,7 @@ stats_allan_family <- function() {
               max_m = function(L) floor((L - 1) / 3),
               nterms = function(m, L) floor((L - 1) / m) - 2,
               divisor = function(m) 6 * m^2, alpha_range = c(-4L, 2L),
-              min_points = 4L),
+              min_points = 4L, octave_pass = TRUE),
     allan_dev("ohadamard", "ohadamard variance", "Hadamard deviation",
               max_m = function(L) floor((L - 1) / 3),
               nterms = function(m, L) L - 3 * m,

@@ -242,38 +242,106 @@ inline double diff_at(const double* h, const double* l, R_xlen_t m, R_xlen_t k) 
          ((l[k + 3 * m] - l[k]) + 3.0 * (l[k + m] - l[k + 2 * m]));
 }
 
+// Sum of squared differences for k in [k0, k1): eight terms per step in
+// eight lanes (k mod 8 within the step), folded as
+// ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)) (the vector extensions
+// SSE2 uses four vectors of two, AVX2 two of four: the same lanes, the same
+// additions and no fused multiply-add, so both give the same bits), then the
+// last k1 - k0 mod 8 terms one by one.
+#if defined(__GNUC__)
+template <int D, class V>
+inline V diff_vec(const double* h, const double* l, R_xlen_t m, R_xlen_t k) {
+  auto ld = [](const double* p) {
+    V v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  if (D == 2) {
+    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
+           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
+  }
+  return ((ld(h + 3 * m + k) - ld(h + k)) +
+          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
+         ((ld(l + 3 * m + k) - ld(l + k)) +
+          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+}
+
+template <int D>
+inline double sumsq8_sse2(const double* h, const double* l, R_xlen_t m,
+                          R_xlen_t& k, R_xlen_t k1) {
+  v2d a0 = {0, 0}, a1 = {0, 0}, a2 = {0, 0}, a3 = {0, 0};
+  for (; k + 8 <= k1; k += 8) {
+    const v2d d0 = diff_vec<D, v2d>(h, l, m, k);
+    const v2d d1 = diff_vec<D, v2d>(h, l, m, k + 2);
+    const v2d d2 = diff_vec<D, v2d>(h, l, m, k + 4);
+    const v2d d3 = diff_vec<D, v2d>(h, l, m, k + 6);
+    a0 += d0 * d0;
+    a1 += d1 * d1;
+    a2 += d2 * d2;
+    a3 += d3 * d3;
+  }
+  return ((a0[0] + a2[0]) + (a1[0] + a3[0])) +
+         ((a0[1] + a2[1]) + (a1[1] + a3[1]));
+}
+
+#if defined(__x86_64__)
+#define ALLANVAR_AVX2 1
+typedef double v4d __attribute__((vector_size(32)));
+
+__attribute__((target("avx2"))) inline v4d ld4(const double* p) {
+  v4d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+template <int D>
+__attribute__((target("avx2"))) inline v4d diff4(const double* h,
+                                                 const double* l, R_xlen_t m,
+                                                 R_xlen_t k) {
+  auto ld = ld4;
+  if (D == 2) {
+    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
+           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
+  }
+  return ((ld(h + 3 * m + k) - ld(h + k)) +
+          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
+         ((ld(l + 3 * m + k) - ld(l + k)) +
+          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+}
+
+template <int D>
+__attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
+                                                   const double* l, R_xlen_t m,
+                                                   R_xlen_t& k, R_xlen_t k1) {
+  v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
+  for (; k + 8 <= k1; k += 8) {
+    const v4d d0 = diff4<D>(h, l, m, k);
+    const v4d d1 = diff4<D>(h, l, m, k + 4);
+    a0 += d0 * d0;
+    a1 += d1 * d1;
+  }
+  // lanes: a0 = (l0 l1 l2 l3), a1 = (l4 l5 l6 l7)
+  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
+         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
+}
+
+inline bool have_avx2() {
+  static const bool ok = __builtin_cpu_supports("avx2");
+  return ok;
+}
+#endif
+#endif
+
 template <int D>
 inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
                      R_xlen_t k1) {
   double tail = 0;
   R_xlen_t k = k0;
-#if defined(__GNUC__)
-  v2d a0 = {0, 0}, a1 = {0, 0};
-  const double* h1 = h + m;
-  const double* h2 = h + 2 * m;
-  const double* h3 = h + 3 * m;
-  const double* l1 = l + m;
-  const double* l2 = l + 2 * m;
-  const double* l3 = l + 3 * m;
-  for (; k + 4 <= k1; k += 4) {
-    v2d d0, d1;
-    if (D == 2) {
-      d0 = ((ld2(h2 + k) + ld2(h + k)) - 2.0 * ld2(h1 + k)) +
-           ((ld2(l2 + k) + ld2(l + k)) - 2.0 * ld2(l1 + k));
-      d1 = ((ld2(h2 + k + 2) + ld2(h + k + 2)) - 2.0 * ld2(h1 + k + 2)) +
-           ((ld2(l2 + k + 2) + ld2(l + k + 2)) - 2.0 * ld2(l1 + k + 2));
-    } else {
-      d0 = ((ld2(h3 + k) - ld2(h + k)) + 3.0 * (ld2(h1 + k) - ld2(h2 + k))) +
-           ((ld2(l3 + k) - ld2(l + k)) + 3.0 * (ld2(l1 + k) - ld2(l2 + k)));
-      d1 = ((ld2(h3 + k + 2) - ld2(h + k + 2)) +
-            3.0 * (ld2(h1 + k + 2) - ld2(h2 + k + 2))) +
-           ((ld2(l3 + k + 2) - ld2(l + k + 2)) +
-            3.0 * (ld2(l1 + k + 2) - ld2(l2 + k + 2)));
-    }
-    a0 += d0 * d0;
-    a1 += d1 * d1;
-  }
-  tail = (a0[0] + a1[0]) + (a0[1] + a1[1]);
+#if defined(ALLANVAR_AVX2)
+  tail = have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
+                     : sumsq8_sse2<D>(h, l, m, k, k1);
+#elif defined(__GNUC__)
+  tail = sumsq8_sse2<D>(h, l, m, k, k1);
 #endif
   for (; k < k1; ++k) {
     const double d = diff_at<D>(h, l, m, k);
@@ -474,6 +542,10 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
   }
 }
 
+// Highest difference order whose squares the octave pass sums for the ACF
+// (dmax + 1: Hadamard types difference up to three times).
+const int kMaxOrder = 4;
+
 // Non-overlapping AV at m = 2^j straight from the rate samples: cluster sums
 // are built pairwise in double-double, level by level, inside cache-sized
 // blocks, so the data are read once. `lev` carries, per level, the last
@@ -501,6 +573,20 @@ struct Level {
   // are stored in that loop, so they need `line` too
   bool line = false;
   double s0 = 0, sp = 0, i0 = 0, cc = 0;
+  // Hadamard at m = 2^j (had): squared second differences of the cluster
+  // sums, each difference of dd values through TwoSum (as exact as the
+  // first differences above), in hacc.
+  bool had = false;
+  Acc hacc;
+  // The lag-1 ACF from moments read in this pass (acf_from_moments()):
+  // K > 0 sums q[k] of squared k-th differences, k = 0, 2 .. K (plain
+  // double; k = 1 is acc), over the values z = h + l.
+  int K = 0;
+  double q[kMaxOrder + 1] = {0, 0, 0, 0, 0};
+  // the first and last kMaxOrder values (dd), nv of them seen
+  double fh2[kMaxOrder] = {0, 0, 0, 0}, fl2[kMaxOrder] = {0, 0, 0, 0};
+  double lh2[kMaxOrder] = {0, 0, 0, 0}, ll2[kMaxOrder] = {0, 0, 0, 0};
+  R_xlen_t nv = 0;
 };
 
 // Consume n dd values at level j: accumulate squared differences, keep the
@@ -520,9 +606,210 @@ inline double level_diff(const double* h, const double* l, R_xlen_t a,
 
 // Exact = false (noise id alone): plain double sums in h, l unused; their
 // rounding (1e-16 of a sum) is far below what a noise type can feel.
+// Second difference c - 2 b + a of dd values: each first difference by
+// TwoSum, so drift that the difference cancels leaves no rounding behind.
+// T: double or (GCC/Clang) a vector of two.
+template <bool Exact, class T>
+inline T second_diff(T ah, T al, T bh, T bl, T ch, T cl) {
+  if (!Exact) return (ch - bh) - (bh - ah);
+  const T t1 = ch - bh, c1 = t1 - ch, e1 = (ch - (t1 - c1)) - (bh + c1);
+  const T t0 = bh - ah, c0 = t0 - bh, e0 = (bh - (t0 - c0)) - (ah + c0);
+  return ((t1 - t0) + (e1 - e0)) + ((cl - bl) - (bl - al));
+}
+
+#if defined(ALLANVAR_AVX2)
+// level_extra()'s Hadamard terms at [i, i + 4 k) in AVX2: the lanes and
+// additions of its SSE2 loop (two vectors of two there), the same bits.
+template <bool Exact>
+__attribute__((target("avx2"))) double had_avx2(const double* h,
+                                                const double* l, R_xlen_t& i,
+                                                R_xlen_t n) {
+  v4d a = {0, 0, 0, 0};
+  const v4d zero = {0, 0, 0, 0};
+  for (; i + 4 <= n; i += 4) {
+    const v4d ah = ld4(h + i - 2), bh = ld4(h + i - 1), ch = ld4(h + i);
+    v4d d;
+    if (Exact) {
+      const v4d al = ld4(l + i - 2), bl = ld4(l + i - 1), cl = ld4(l + i);
+      const v4d t1 = ch - bh, c1 = t1 - ch, e1 = (ch - (t1 - c1)) - (bh + c1);
+      const v4d t0 = bh - ah, c0 = t0 - bh, e0 = (bh - (t0 - c0)) - (ah + c0);
+      d = ((t1 - t0) + (e1 - e0)) + ((cl - bl) - (bl - al));
+    } else {
+      d = ((ch - bh) - (bh - ah)) + zero;
+    }
+    a += d * d;
+  }
+  return (a[0] + a[2]) + (a[1] + a[3]);
+}
+#endif
+
+// The k-th difference (k < kMaxOrder) at the end of the last values of L.
+inline double last_diff(const Level& L, int k) {
+  double t[kMaxOrder];
+  for (int i = 0; i <= k; ++i) {
+    t[i] = L.lh2[kMaxOrder - 1 - k + i] + L.ll2[kMaxOrder - 1 - k + i];
+  }
+  for (int o = 1; o <= k; ++o)
+    for (int i = 0; i + o <= k; ++i) t[i] = t[i + 1] - t[i];
+  return t[0];
+}
+
+// The Hadamard sum and the moments of the values [0, n) of a level, with
+// the last values of earlier calls carried in L; called before the values
+// are paired. The terms reaching back into earlier calls are summed one by
+// one, the others from this call's values, two per vector.
+template <bool Exact>
+inline void level_extra(const double* h, const double* l, R_xlen_t n,
+                        Level& L) {
+  if (n <= 0) return;
+  const R_xlen_t nv = L.nv;
+  auto H = [h](R_xlen_t i) { return h[i]; };
+  auto Lo = [l](R_xlen_t i) { return Exact ? l[i] : 0.0; };
+  if (L.had) {
+    double s0 = 0, s1 = 0;
+    const double* lh = L.lh2 + kMaxOrder - 2;
+    const double* ll = L.ll2 + kMaxOrder - 2;
+    if (nv >= 2) {
+      const double d = second_diff<Exact>(lh[0], ll[0], lh[1], ll[1], H(0), Lo(0));
+      s0 += d * d;
+    }
+    if (nv >= 1 && n >= 2) {
+      const double d = second_diff<Exact>(lh[1], ll[1], H(0), Lo(0), H(1), Lo(1));
+      s0 += d * d;
+    }
+    R_xlen_t i = 2;
+#if defined(ALLANVAR_AVX2)
+    if (have_avx2()) {
+      s1 = had_avx2<Exact>(h, l, i, n);
+    } else
+#endif
+#if defined(__GNUC__)
+    {
+    v2d a0 = {0, 0}, a1 = {0, 0};
+    const v2d zero = {0, 0};
+    auto Lv = [l, zero](R_xlen_t k) { return Exact ? ld2(l + k) : zero; };
+    for (; i + 4 <= n; i += 4) {
+      const v2d d0 = second_diff<Exact>(ld2(h + i - 2), Lv(i - 2), ld2(h + i - 1),
+                                        Lv(i - 1), ld2(h + i), Lv(i));
+      const v2d d1 = second_diff<Exact>(ld2(h + i), Lv(i), ld2(h + i + 1),
+                                        Lv(i + 1), ld2(h + i + 2), Lv(i + 2));
+      a0 += d0 * d0;
+      a1 += d1 * d1;
+    }
+    s1 = (a0[0] + a1[0]) + (a0[1] + a1[1]);
+    }
+#endif
+    for (; i < n; ++i) {
+      const double d = second_diff<Exact>(H(i - 2), Lo(i - 2), H(i - 1),
+                                          Lo(i - 1), H(i), Lo(i));
+      s0 += d * d;
+    }
+    L.hacc.add(s0 + s1);
+  }
+  if (L.K > 0) {
+    // h alone: l is below an ulp of h, far below what a noise type feels;
+    // the line's sums s0, sp (acf_line_from()) are read here too
+    double q0 = 0, q2 = 0, q3 = 0, q4 = 0, a = 0, p = 0;
+    const double t0 = L.i0 - L.cc;
+    // the first values of this call: differences reaching back
+    double p0 = 0, p1 = 0, p2 = 0, p3 = 0;
+    if (nv >= 1) p0 = last_diff(L, 0);
+    if (nv >= 2) p1 = last_diff(L, 1);
+    if (nv >= 3) p2 = last_diff(L, 2);
+    if (nv >= 4) p3 = last_diff(L, 3);
+    const bool k4 = L.K >= 4;
+    R_xlen_t i = 0;
+    for (; i < n && i < kMaxOrder; ++i) {
+      const double z = h[i];
+      a += z;
+      p += (t0 + static_cast<double>(i)) * z;
+      q0 += z * z;
+      const R_xlen_t c = nv + i;
+      const double d1 = c >= 1 ? z - p0 : 0;
+      const double d2 = c >= 2 ? d1 - p1 : 0;
+      const double d3 = c >= 3 ? d2 - p2 : 0;
+      const double d4 = c >= 4 ? d3 - p3 : 0;
+      q2 += d2 * d2;
+      q3 += d3 * d3;
+      if (k4) q4 += d4 * d4;
+      p0 = z;
+      p1 = d1;
+      p2 = d2;
+      p3 = d3;
+    }
+    // the rest from this call's values alone
+#if defined(__GNUC__)
+    {
+      const v2d zero = {0, 0};
+      v2d a0 = zero, pp = zero, s2 = zero, a2 = zero, a3 = zero, a4 = zero;
+      v2d t = {t0 + static_cast<double>(i), t0 + static_cast<double>(i + 1)};
+      for (; i + 2 <= n; i += 2) {
+        const v2d z0 = ld2(h + i), z1 = ld2(h + i - 1), z2 = ld2(h + i - 2),
+                  z3 = ld2(h + i - 3);
+        const v2d d2 = (z0 + z2) - 2.0 * z1;
+        const v2d d3 = (z0 - z3) + 3.0 * (z2 - z1);
+        a0 += z0;
+        pp += t * z0;
+        t += 2.0;
+        s2 += z0 * z0;
+        a2 += d2 * d2;
+        a3 += d3 * d3;
+        if (k4) {
+          const v2d d4 = ((z0 + ld2(h + i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
+          a4 += d4 * d4;
+        }
+      }
+      q0 += s2[0] + s2[1];
+      a += a0[0] + a0[1];
+      p += pp[0] + pp[1];
+      q2 += a2[0] + a2[1];
+      q3 += a3[0] + a3[1];
+      q4 += a4[0] + a4[1];
+    }
+#endif
+    for (; i < n; ++i) {
+      const double z0 = h[i], z1 = h[i - 1], z2 = h[i - 2], z3 = h[i - 3];
+      const double d2 = (z0 + z2) - 2.0 * z1;
+      const double d3 = (z0 - z3) + 3.0 * (z2 - z1);
+      a += z0;
+      p += (t0 + static_cast<double>(i)) * z0;
+      q0 += z0 * z0;
+      q2 += d2 * d2;
+      q3 += d3 * d3;
+      if (k4) {
+        const double d4 = ((z0 + h[i - 4]) + 6.0 * z2) - 4.0 * (z1 + z3);
+        q4 += d4 * d4;
+      }
+    }
+    L.s0 += a;
+    L.sp += p;
+    L.q[0] += q0;
+    L.q[2] += q2;
+    L.q[3] += q3;
+    L.q[4] += q4;
+  }
+  // the first and last kMaxOrder values
+  for (R_xlen_t i = 0; i < n && nv + i < kMaxOrder; ++i) {
+    L.fh2[nv + i] = h[i];
+    L.fl2[nv + i] = Exact ? l[i] : 0.0;
+  }
+  const R_xlen_t keep_old = n >= kMaxOrder ? 0 : kMaxOrder - n;
+  for (R_xlen_t k = 0; k < keep_old; ++k) {
+    L.lh2[k] = L.lh2[k + n];
+    L.ll2[k] = L.ll2[k + n];
+  }
+  for (R_xlen_t k = keep_old; k < kMaxOrder; ++k) {
+    const R_xlen_t i = n - (kMaxOrder - k);
+    L.lh2[k] = h[i];
+    L.ll2[k] = Exact ? l[i] : 0.0;
+  }
+  L.nv += n;
+}
+
 template <bool Exact>
 inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
                            bool pair) {
+  level_extra<Exact>(h, l, n, L);
   double s = 0, s1 = 0;  // two chains: the add latency bounds one
   if (n > 0) {
     if (!L.has) {
@@ -548,7 +835,9 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
     L.pl = Exact ? l[n - 1] : 0.0;
   }
   L.acc.add(s + s1);
-  if (L.line) {
+  if (L.line && L.K > 0 && !L.keep) {
+    L.i0 += static_cast<double>(n);  // s0 and sp read by level_extra()
+  } else if (L.line) {
     double* z = L.z + L.zn;
     const double t = L.i0 - L.cc;
     double a0 = 0, a1 = 0, q0 = 0, q1 = 0;
@@ -600,7 +889,7 @@ template <bool Exact>
 void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
                  int jin, int b, std::vector<Level>& lev,
                  std::vector<double>& th, std::vector<double>& tl,
-                 double* range) {
+                 double* range, std::vector<double>* tr) {
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   std::vector<double> h(B), l(B);
   double lo = y[s0], hi = y[s0];
@@ -625,25 +914,117 @@ void octave_part(const double* y, R_xlen_t s0, R_xlen_t s1, double c, int J,
     } else {
       for (R_xlen_t i = 0; i < n; ++i) h[i] = y[k0 + i] - c;
     }
+    // R(n)'s block sums (RnCache::build_from_blocks()): sum (B-1-i) z_i
+    double ramp = 0;
+    if (tr && n == B) {
+      double r[4] = {0, 0, 0, 0};
+      for (R_xlen_t i = 0; i < n; i += 4) {
+        const double w = static_cast<double>(B - 1 - i);
+        r[0] += w * level_at<Exact>(h.data(), l.data(), i);
+        r[1] += (w - 1) * level_at<Exact>(h.data(), l.data(), i + 1);
+        r[2] += (w - 2) * level_at<Exact>(h.data(), l.data(), i + 2);
+        r[3] += (w - 3) * level_at<Exact>(h.data(), l.data(), i + 3);
+      }
+      ramp = (r[0] + r[1]) + (r[2] + r[3]);
+    }
     R_xlen_t cur = n;
     for (int j = 0; j <= jin; ++j)
       cur = level_step<Exact>(h.data(), l.data(), cur, lev[j], j < J);
     if (J >= b && cur == 1) {
+      if (tr) tr->push_back(ramp);
       th.push_back(h[0]);
       tl.push_back(Exact ? l[0] : 0.0);
     }
   }
 }
 
+// The k-th difference of w at s (k <= kMaxOrder).
+inline double diff_k(const double* w, int s, int k) {
+  double t[kMaxOrder + 1];
+  for (int i = 0; i <= k; ++i) t[i] = w[s + i];
+  for (int o = 1; o <= k; ++o)
+    for (int i = 0; i + o <= k; ++i) t[i] = t[i + 1] - t[i];
+  return t[0];
+}
+
+// Joins level_extra()'s sums of the right part R into those of the left
+// part L: the terms that straddle the cut, from L's last and R's first
+// values.
+void join_extra(Level& L, const Level& R, bool exact) {
+  if (R.nv == 0) return;
+  const int nl = static_cast<int>(std::min<R_xlen_t>(L.nv, kMaxOrder));
+  const int nr = static_cast<int>(std::min<R_xlen_t>(R.nv, kMaxOrder));
+  double wh[2 * kMaxOrder], wl[2 * kMaxOrder], wz[2 * kMaxOrder];
+  for (int i = 0; i < nl; ++i) {
+    wh[i] = L.lh2[kMaxOrder - nl + i];
+    wl[i] = L.ll2[kMaxOrder - nl + i];
+  }
+  for (int i = 0; i < nr; ++i) {
+    wh[nl + i] = R.fh2[i];
+    wl[nl + i] = R.fl2[i];
+  }
+  const int nw = nl + nr;
+  for (int i = 0; i < nw; ++i) wz[i] = wh[i] + wl[i];
+  if (L.had) {
+    double s = 0;
+    for (int a = std::max(0, nl - 2); a < nl && a + 2 < nw; ++a) {
+      const double d =
+          exact ? second_diff<true>(wh[a], wl[a], wh[a + 1], wl[a + 1],
+                                    wh[a + 2], wl[a + 2])
+                : second_diff<false>(wh[a], 0.0, wh[a + 1], 0.0, wh[a + 2], 0.0);
+      s += d * d;
+    }
+    L.hacc.add(s);
+    L.hacc.add(R.hacc.value());
+  }
+  if (L.K > 0) {
+    L.q[0] += R.q[0];
+    for (int k = 2; k <= L.K; ++k) {
+      double s = 0;
+      for (int a = std::max(0, nl - k); a < nl && a + k < nw; ++a) {
+        const double d = diff_k(wz, a, k);
+        s += d * d;
+      }
+      L.q[k] += s + R.q[k];
+    }
+  }
+  // first values: L's, completed by R's; last values: R's, preceded by L's
+  for (int i = nl; i < kMaxOrder && i < nw; ++i) {
+    L.fh2[i] = wh[i];
+    L.fl2[i] = wl[i];
+  }
+  for (int k = 0; k < kMaxOrder; ++k) {
+    if (R.nv >= kMaxOrder) {
+      L.lh2[k] = R.lh2[k];
+      L.ll2[k] = R.ll2[k];
+      continue;
+    }
+    const int i = nw - kMaxOrder + k;  // R's few values are its first ones
+    if (i < 0) continue;
+    L.lh2[k] = wh[i];
+    L.ll2[k] = wl[i];
+  }
+  L.nv += R.nv;
+}
+
+// Per block of B samples: its sum of v - c and sum (B-1-i)(v_i - c).
+struct RnBlocks {
+  R_xlen_t B = 0;
+  std::vector<double> sum, ramp;
+};
+
 // Non-overlapping AV at m = 2^j, j = 0..J: the record is cut in two halves
 // at a block boundary (one per thread), whose per-level sums are then
 // joined with the one difference that straddles the cut.
 // exact = false: noise id alone (no sums reported; plain double cluster
 // sums, about a third of the work).
+// had: the Hadamard sums too (hacc); K: the ACF's moments at the `line`
+// levels (level_extra()); rnb: R(n)'s sums per block of 2^b samples (J >= b).
 void standard_octave(const double* y, R_xlen_t N, double c, int J,
                      const std::vector<bool>& keep,
                      const std::vector<bool>& line, std::vector<Level>& lev,
-                     double* range, bool exact, int threads, bool main) {
+                     double* range, bool exact, bool had, int K,
+                     RnBlocks* rnb, int threads, bool main) {
   const int b = 11;
   const R_xlen_t B = static_cast<R_xlen_t>(1) << b;
   const int jin = std::min(J, b - 1);  // levels handled inside blocks
@@ -662,6 +1043,10 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
     L.cc = (static_cast<double>(N >> j) - 1) / 2;
   };
   for (int j = 0; j <= jin; ++j) {
+    for (int p = 0; p < P; ++p) {
+      part[p][j].had = had;
+      part[p][j].K = line[j] ? K : 0;
+    }
     if (line[j] || keep[j]) {  // level_step() stores in the line's loop
       for (int p = 0; p < P; ++p) set_line(part[p][j], j, cut[p]);
     }
@@ -672,16 +1057,16 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
       part[p][j].z = part[0][j].store.data() + (cut[p] >> j);
     }
   }
-  std::vector<std::vector<double> > th(P), tl(P);
+  std::vector<std::vector<double> > th(P), tl(P), tr(P);
   double pr[2][2] = {{y[0], y[0]}, {y[0], y[0]}};
   run_items(P, threads, main, [&](R_xlen_t p) {
     double* rp = range ? pr[p] : nullptr;
     if (exact) {
       octave_part<true>(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p],
-                        tl[p], rp);
+                        tl[p], rp, rnb ? &tr[p] : nullptr);
     } else {
       octave_part<false>(y, cut[p], cut[p + 1], c, J, jin, b, part[p], th[p],
-                         tl[p], rp);
+                         tl[p], rp, rnb ? &tr[p] : nullptr);
     }
   });
   if (range) {
@@ -696,6 +1081,7 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
     L = std::move(part[0][j]);  // z stays valid: the store moves with it
     if (P == 2) {
       const Level& R = part[1][j];
+      join_extra(L, R, exact);
       L.acc.add(R.acc.value());
       if (L.has && R.has) {
         const double d = (R.fh - L.ph) + (R.fl - L.pl);
@@ -717,6 +1103,13 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
       h.insert(h.end(), th[1].begin(), th[1].end());
       l.insert(l.end(), tl[1].begin(), tl[1].end());
     }
+    if (rnb) {
+      rnb->B = B;
+      rnb->ramp = tr[0];
+      if (P == 2) rnb->ramp.insert(rnb->ramp.end(), tr[1].begin(), tr[1].end());
+      rnb->sum.resize(h.size());
+      for (size_t k = 0; k < h.size(); ++k) rnb->sum[k] = h[k] + l[k];
+    }
     R_xlen_t cur = static_cast<R_xlen_t>(h.size());
     for (int j = b; j <= J; ++j) {
       if (lev[j].keep) {
@@ -724,6 +1117,8 @@ void standard_octave(const double* y, R_xlen_t N, double c, int J,
         lev[j].z = lev[j].store.data();
       }
       if (line[j] || lev[j].keep) set_line(lev[j], j, 0);
+      lev[j].had = had;
+      lev[j].K = line[j] ? K : 0;
       cur = exact ? level_step<true>(h.data(), l.data(), cur, lev[j], j < J)
                   : level_step<false>(h.data(), l.data(), cur, lev[j], j < J);
     }
@@ -752,8 +1147,13 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
                      const std::vector<R_xlen_t>& mid,
                      const std::vector<double>& mid_n, int dmax,
                      bool modified, const allanvar::NoiseIdRules& rules,
-                     int threads, bool main, Channel& out) {
-  auto build = [=](allanvar::RnCache& r) { r.build_from_rate(v, N, c); };
+                     const RnBlocks& rnb, int threads, bool main,
+                     Channel& out) {
+  auto build = [&rnb, v, N, c](allanvar::RnCache& r) {
+    if (!r.build_from_blocks(rnb.sum.data(), rnb.ramp.data(),
+                             static_cast<R_xlen_t>(rnb.sum.size()), rnb.B, N))
+      r.build_from_rate(v, N, c);
+  };
   allanvar::LazyRn<decltype(build)> rn(build);
   // taus are independent: shared between the threads
   run_items(static_cast<R_xlen_t>(mid.size()), threads, main, [&](R_xlen_t j) {
@@ -765,17 +1165,38 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
     const double* z = lj == 0 ? v : lev[lj].z;
     allanvar::NoiseId id;
     if (n >= rules.acf_min) {
-      // the line read in the octave pass: level 0's sums are of v - c
+      // from the moments read in the octave pass (sums of v - c)
       const Level& L = lev[lj];
-      const allanvar::AcfLine ln =
-          allanvar::acf_line_from(L.s0, L.sp, lj == 0 ? c : 0.0, n, false);
-      if (lj == 1) {  // not kept: pairs of the samples
-        id = allanvar::acf_noise_id_line(
-            [v, c](R_xlen_t i) { return (v[2 * i] - c) + (v[2 * i + 1] - c); },
-            n, false, dmax, ln);
-      } else {
-        id = allanvar::acf_noise_id_line([z](R_xlen_t i) { return z[i]; }, n,
-                                         false, dmax, ln);
+      allanvar::AcfMoments mo;
+      mo.s0 = L.s0;
+      mo.sp = L.sp;
+      mo.q[0] = L.q[0];
+      mo.q[1] = L.acc.value();
+      for (int k = 2; k <= kMaxOrder; ++k) mo.q[k] = L.q[k];
+      for (int k = 0; k < kMaxOrder; ++k) {
+        mo.first[k] = L.fh2[k] + L.fl2[k];
+        mo.last[k] = L.lh2[k] + L.ll2[k];
+      }
+      bool ok = false;
+      if (L.K > dmax) id = allanvar::acf_noise_id_moments(mo, n, dmax, ok);
+      if (!ok) {
+        // a strong mean or line: the values read again (the line in the
+        // pass: level 0's sums are of v - c)
+        const allanvar::AcfLine ln =
+            allanvar::acf_line_from(L.s0, L.sp, lj == 0 ? c : 0.0, n, false);
+        if (lj == 0) {
+          id = allanvar::acf_noise_id_line([v](R_xlen_t i) { return v[i]; },
+                                           n, false, dmax, ln);
+        } else {
+          id = allanvar::acf_noise_id_line(
+              [v, c, m](R_xlen_t i) {
+                double a = 0;
+                const double* p = v + i * m;
+                for (R_xlen_t u = 0; u < m; ++u) a += p[u] - c;
+                return a;
+              },
+              n, false, dmax, ln);
+        }
       }
     } else {
       id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], modified, rules,
@@ -823,7 +1244,9 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   for (R_xlen_t m : mid) {
     if (m < 1 || m > N || (m & (m - 1)) != 0) octave_id = false;
   }
-  const bool std_octave = type == STANDARD && rate && octave;
+  // the standard and Hadamard sums at m = 2^j from the octave pass
+  const bool std_octave = (type == STANDARD || type == HADAMARD) && rate &&
+                          octave;
   double range[2] = {v[0], v[0]};
   bool have_range = false;
   if (std_octave || octave_id) {
@@ -845,13 +1268,22 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       if (lj > J) continue;
       const bool acf = (N >> lj) >= rules.acf_min;
       line[lj] = acf;
-      keep[lj] = lj > 1 || (lj == 1 && !acf);
+      keep[lj] = lj >= 1 && !acf;  // B1 reads the few values
     }
     std::vector<Level> lev;
+    // R(n)'s block sums where B1 may ask for it on a long record
+    // (RnCache::build_from_blocks())
+    bool b1 = false;
+    for (R_xlen_t m : mid) b1 = b1 || (m > 1 && N / m < rules.acf_min);
+    RnBlocks rnb;
+    const bool want_rnb =
+        b1 && J >= 11 && allanvar::RnCache::blocks_usable(2048, N);
     // the range only where the sums' kernel below needs it
     have_range = !std_octave && opts.sums;
     standard_octave(v, N, v[0], J, keep, line, lev,
-                    have_range ? range : nullptr, std_octave, threads, main);
+                    have_range ? range : nullptr, std_octave,
+                    std_octave && type == HADAMARD && opts.sums, dmax + 1,
+                    want_rnb ? &rnb : nullptr, threads, main);
     if (!std::isfinite(lev[0].acc.value())) {
       out.bad = allanvar::first_nonfinite(v, N);
       if (out.bad > 0) return;
@@ -860,11 +1292,12 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
       for (size_t j = 0; j < nt; ++j) {
         int lj = 0;
         while ((static_cast<R_xlen_t>(1) << lj) < ms[j]) ++lj;
-        out.sums[j] = lev[lj].acc.value();
+        out.sums[j] = type == HADAMARD ? lev[lj].hacc.value()
+                                       : lev[lj].acc.value();
       }
     }
     octave_noise_id(v, N, v[0], lev, mid, mid_n, dmax, type == MODIFIED,
-                    rules, threads, main, out);
+                    rules, rnb, threads, main, out);
     if (std_octave || !opts.sums) return;
   }
 

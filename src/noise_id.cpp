@@ -130,6 +130,37 @@ void RnCache::build_from_rate(const double* v, R_xlen_t N, double c) {
   k_ = L_;
 }
 
+bool RnCache::build_from_blocks(const double* sum, const double* ramp,
+                                R_xlen_t nb, R_xlen_t B, R_xlen_t N) {
+  if (!blocks_usable(B, N)) return false;
+  const R_xlen_t L = N + 1, k = L / 4096 / B, s = k * B;
+  if (nb < (L / s) * k) return false;
+  L_ = L;
+  s_ = s;
+  X_.clear();
+  P_.clear();
+  X_.reserve(L / s + 1);
+  P_.reserve(L / s + 1);
+  // grid block g: phase points [g s, (g + 1) s), i.e. samples of the
+  // blocks gk .. gk + k - 1 (the last sample's weight is 0)
+  double X = 0, P = 0;
+  const double Bd = static_cast<double>(B), sd = static_cast<double>(s);
+  for (R_xlen_t g = 0; g < L / s; ++g) {
+    X_.push_back(X);
+    P_.push_back(P);
+    double S = 0, R = 0;
+    for (R_xlen_t i = 0; i < k; ++i) {
+      const double si = sum[g * k + i];
+      R += static_cast<double>(k - 1 - i) * Bd * si + ramp[g * k + i];
+      S += si;
+    }
+    P += sd * X + R;
+    X += S;
+  }
+  k_ = L_;
+  return true;
+}
+
 double RnCache::ratio(R_xlen_t m) const {
   if (L_ - 1 < 4 * m) return NAN;
   const R_xlen_t ms = std::max<R_xlen_t>(1, (m + s_ / 2) / s_);

@@ -211,6 +211,85 @@ NoiseId acf_noise_id_line(const Z& z, R_xlen_t n, bool phase, int dmax,
   }
 }
 
+// The same method (averaged frequencies, the line removed) from moments of
+// z(0..n) read in one pass elsewhere: s0 = sum z, sp = sum (i - c) z,
+// q[k] the sum of squared k-th differences (k = 0 .. dmax + 1), first and
+// last the first and last four values. Each sum of squares about a mean
+// comes from a raw one minus the mean's share, and the lag-1 sum from the
+// next order's squared differences: sum (u_i - u_{i-1})^2 = 2 sum u^2 -
+// u_0^2 - u_{n-1}^2 - 2 sum u_{i-1} u_i. ok = false where the mean or line
+// takes more than all but 1e-6 of a raw sum (six digits lost): the caller
+// then reads z as acf_noise_id_line() does.
+struct AcfMoments {
+  double s0 = 0, sp = 0;
+  double q[5] = {0, 0, 0, 0, 0};
+  double first[4] = {0, 0, 0, 0}, last[4] = {0, 0, 0, 0};
+};
+
+inline NoiseId acf_noise_id_moments(const AcfMoments& mo, R_xlen_t n,
+                                    int dmax, bool& ok) {
+  using namespace noise_id_detail;
+  NoiseId out;
+  out.points = n;
+  ok = true;
+  if (n < 4) return out;
+  if (dmax > 3) {
+    ok = false;
+    return out;
+  }
+  const double nn = static_cast<double>(n), c = (nn - 1) / 2;
+  const double T = nn * (nn * nn - 1) / 12;
+  const double mu = mo.s0 / nn, b = mo.sp / T;
+  const double S = mo.q[0] - nn * mu * mu - b * b * T;
+  const double e0 = mo.first[0] - mu + b * c;
+  const double en = mo.last[3] - mu - b * (nn - 1 - c);
+  const double De = mo.q[1] - 2 * b * (mo.last[3] - mo.first[0]) +
+                    (nn - 1) * b * b;
+  if (!(S > 1e-6 * mo.q[0]) || !(De > 1e-6 * mo.q[1])) {
+    ok = false;
+    return out;
+  }
+  double rho = delta_of((2 * S - e0 * e0 - en * en - De) / 2, S, n);
+  // k-th difference at the start and at the end of the record
+  auto head = [&mo](int k) {
+    double t[4];
+    for (int i = 0; i <= k; ++i) t[i] = mo.first[i];
+    for (int o = 1; o <= k; ++o)
+      for (int i = 0; i + o <= k; ++i) t[i] = t[i + 1] - t[i];
+    return t[0];
+  };
+  auto tail = [&mo](int k) {
+    double t[4];
+    for (int i = 0; i <= k; ++i) t[i] = mo.last[3 - k + i];
+    for (int o = 1; o <= k; ++o)
+      for (int i = 0; i + o <= k; ++i) t[i] = t[i + 1] - t[i];
+    return t[0];
+  };
+  int d = 0;
+  R_xlen_t len = n;
+  for (;;) {
+    if (!std::isfinite(rho)) return out;  // sums beyond the double range
+    if (rho < 0.25 || d >= dmax || len < 4) {
+      out.alpha = -2.0 * (rho + d);
+      out.alpha_int = static_cast<int>(-std::nearbyint(2 * rho) - 2.0 * d);
+      out.method = NOISE_ID_ACF;
+      return out;
+    }
+    ++d;
+    --len;
+    // w = the d-th differences: their sum telescopes
+    const double ln = static_cast<double>(len);
+    const double wbar = (tail(d - 1) - head(d - 1)) / ln;
+    const double Sw = mo.q[d] - ln * wbar * wbar;
+    if (!(Sw > 1e-6 * mo.q[d])) {
+      ok = false;
+      return out;
+    }
+    const double wf = head(d) - wbar, wl = tail(d) - wbar;
+    rho = delta_of((2 * Sw - wf * wf - wl * wl - mo.q[d + 1]) / 2, Sw, len);
+  }
+}
+
 // The lag-1 ACF method on z(0..n): two passes (line, then the sums about it).
 template <class Z>
 NoiseId acf_noise_id_at(const Z& z, R_xlen_t n, bool phase, int dmax) {
@@ -283,6 +362,19 @@ class RnCache {
   }
   // The same from rate samples v[0..N) about c (phase L = N + 1 points).
   void build_from_rate(const double* v, R_xlen_t N, double c);
+  // The same from sums over nb blocks of B samples of v - c, sum[i] and
+  // ramp[i] = sum (B-1-u)(v_{iB+u} - c): no pass over the samples. The grid
+  // step is then a multiple of B no coarser than build_from_rate()'s
+  // (exact at m = 2^j >= B), which needs L/4096 >= B and no partial last
+  // block; false (nothing built) otherwise.
+  static bool blocks_usable(R_xlen_t B, R_xlen_t N) {
+    const R_xlen_t L = N + 1;
+    if (B < 1 || L / 4096 < B) return false;
+    const R_xlen_t s = (L / 4096 / B) * B;
+    return L % s != 0;
+  }
+  bool build_from_blocks(const double* sum, const double* ramp, R_xlen_t nb,
+                         R_xlen_t B, R_xlen_t N);
   // MVAR/AVAR at (about) m; NaN when the record holds less than 4 m phase
   // points (the MVAR terms would all overlap: one effective sample).
   double ratio(R_xlen_t m) const;

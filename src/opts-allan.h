@@ -13,7 +13,7 @@ namespace allanvar {
 struct AllanOptions {
   int type;      // an Estimator
   bool rate;     // rate samples (else integrated: phase, angle, velocity)
-  bool octave;   // standard type at m = 2^j: the pairwise one-pass kernel
+  bool octave;   // standard or Hadamard at m = 2^j: the one-pass kernel
   int threads;   // threads the kernel may use (>= 1)
   // noise identification (src/noise_id.h, R/taus.R noise_id_rules()):
   R_xlen_t acf_min = 64;     // fewest points the lag-1 ACF is read from
@@ -57,8 +57,10 @@ inline AllanOptions allan_options(const Rcpp::List& o) {
     if (opts.acf_min < 4) Rcpp::stop("internal: allan option `acf_min` < 4");
   }
   if (o.containsElementNamed("sums")) opts.sums = opt_flag(o, "sums");
-  if (opts.octave && (opts.type != STANDARD || !opts.rate))
-    Rcpp::stop("internal: the octave kernel is for standard rate input only");
+  if (opts.octave && ((opts.type != STANDARD && opts.type != HADAMARD) ||
+                      !opts.rate))
+    Rcpp::stop("internal: the octave kernel is for standard or Hadamard rate "
+               "input only");
   return opts;
 }
 

@@ -536,3 +536,47 @@ test_that("limits agree with Stable32's on >= 95% of its reference rows", {
   expect_gt(of, 700)
   expect_gte(ok / of, 0.95)
 })
+
+test_that("the lag-1 ACF read from the octave pass's moments is the direct one", {
+  # Riley & Greenhall's method written out on the averaged frequencies
+  # (mean and line removed, differenced while delta >= 0.25), against the
+  # noise type allan() reads at octave m of rate data from raw sums of the
+  # one pass (src/noise_id.h acf_noise_id_moments())
+  acf_alpha <- function(y, m, dmax) {
+    n <- length(y) %/% m
+    z <- colSums(matrix(y[seq_len(n * m)], m))
+    t <- seq_len(n) - (n + 1) / 2
+    e <- z - mean(z) - sum(t * z) / sum(t^2) * t
+    d <- 0
+    repeat {
+      r1 <- sum(e[-1] * e[-length(e)]) / sum(e^2)
+      delta <- r1 / (1 + r1)
+      if (delta < 0.25 || d >= dmax) return(-2 * (delta + d))
+      e <- diff(e)
+      e <- e - mean(e)
+      d <- d + 1
+    }
+  }
+  set.seed(29)
+  N <- 2^15 + 77
+  gens <- list(white = rnorm(N), rw = cumsum(rnorm(N)),
+               drift = 5 + 1e-3 * seq_len(N) + rnorm(N),
+               wpm = diff(rnorm(N + 1)))
+  for (type in c("standard", "overlapping", "hadamard")) {
+    dmax <- if (type == "hadamard") 3 else 2
+    for (g in names(gens)) {
+      for (threads in 1:2) {
+        old <- options(allanvar.threads = threads)
+        # the kernel's continuous alpha (allan() reports the integer one)
+        m <- 2^(0:8)
+        k <- allanvar:::allan_sums_cpp(gens[[g]], N, m, N %/% m - 1, m,
+                                       allanvar:::allan_opts(type, TRUE,
+                                                             type != "overlapping"))
+        options(old)
+        ref <- vapply(m, function(mm) acf_alpha(gens[[g]], mm, dmax), 0)
+        expect_equal(k$alpha[, 1], ref, tolerance = 1e-9,
+                     info = paste(type, g, threads))
+      }
+    }
+  }
+})
