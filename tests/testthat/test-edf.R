@@ -580,3 +580,35 @@ test_that("the lag-1 ACF read from the octave pass's moments is the direct one",
     }
   }
 })
+
+test_that("the total type's EDF under flicker PM follows a Monte Carlo of its own generator", {
+  skip_on_cran()
+  # flicker phase by Kasdin & Walter's fractional integration (written
+  # here, not avsim()); y its first differences
+  N <- 16384
+  n <- N + 1
+  h <- numeric(n)
+  h[1] <- 1
+  for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
+  H <- stats::fft(c(h, rep(0, n)))
+  flicker <- function() {
+    Re(stats::fft(H * stats::fft(c(stats::rnorm(n), rep(0, n))),
+                  inverse = TRUE))[1:n] / (2 * n)
+  }
+  m <- c(16, 64, 256)
+  set.seed(3)
+  av <- replicate(300, {
+    allan(diff(flicker()), 1, taus = m, type = "total", ci = FALSE)$avar
+  })
+  edf_mc <- 2 * rowMeans(av)^2 / apply(av, 1, stats::var)
+  L <- N + 1
+  edf <- vapply(m, function(mm) {
+    allan_edf_direct("total", mm, L - 2 * mm, L, 1L)
+  }, 0)
+  # within the Monte Carlo's own spread (about 10% with 300 records), on
+  # the conservative side
+  expect_true(all(edf / edf_mc > 0.7 & edf / edf_mc < 1.1))
+  # NIST SP 1065 Table 5's simple formula, used before, claims 1.5-2x
+  simple <- exp(sqrt(log((L - 1) / (2 * m)) * log((2 * m + 1) * (L - 1) / 4)))
+  expect_true(all(simple / edf_mc > 1.3))
+})
