@@ -17,12 +17,16 @@
 #   [ALLANVAR_NOISE_ID=rule] Rscript tools/mc-coverage.R [replicates] [N] [types]
 #   e.g. Rscript tools/mc-coverage.R 300 1024 overlapping,modified,tdev
 mc_generators <- function(N) {
+  filters <- list()  # the filter's transform, built once per length
   flicker <- function(n) {
-    h <- numeric(n)
-    h[1] <- 1
-    for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
-    Re(stats::fft(stats::fft(c(h, rep(0, n))) *
-                    stats::fft(c(stats::rnorm(n), rep(0, n))),
+    key <- as.character(n)
+    if (is.null(filters[[key]])) {
+      h <- numeric(n)
+      h[1] <- 1
+      for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
+      filters[[key]] <<- stats::fft(c(h, rep(0, n)))
+    }
+    Re(stats::fft(filters[[key]] * stats::fft(c(stats::rnorm(n), rep(0, n))),
                   inverse = TRUE))[1:n] / (2 * n)
   }
   list(wfm = function() stats::rnorm(N), ffm = function() flicker(N),

@@ -3,9 +3,9 @@
 # (tools/check-stable32.R). For each such row the record is simulated with
 # the file's length and input (phase or frequency), once for every noise
 # type in question (Stable32's printed alpha and the one allan() reads),
-# with this file's own generators (white, flicker by Kasdin & Walter's
-# filter, random-walk FM; white and flicker PM as their differences),
-# never avsim(). Each replicate runs allan() on the file's whole tau grid,
+# with tools/mc-coverage.R's generators (white, flicker by Kasdin &
+# Walter's filter, random-walk FM; white and flicker PM as their
+# differences), never avsim(). Each replicate runs allan() on the file's whole tau grid,
 # as check-stable32.R does; the row's truth is the ensemble mean of the
 # variance. `ours`: coverage of allan()'s interval; `s32`: coverage of
 # Stable32's interval, a chi-square one with the EDF its printed limits
@@ -17,28 +17,18 @@
 # writes it.
 source(file.path("tools", "check-stable32.R"), local = TRUE)
 
-# Frequency noise y of exponent alpha (S_y ~ f^alpha), n samples.
+# Frequency noise y of exponent alpha (S_y ~ f^alpha), n samples, from
+# tools/mc-coverage.R's generators (one set per length, so each flicker
+# filter is built once).
+source(file.path("tools", "mc-coverage.R"), local = TRUE)  # mc_generators()
 mc_noise <- local({
-  cache <- new.env()
-  flicker <- function(n) {
-    key <- as.character(n)
-    if (is.null(cache[[key]])) {
-      h <- numeric(n)
-      h[1] <- 1
-      for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
-      cache[[key]] <- stats::fft(c(h, rep(0, n)))
-    }
-    Re(stats::fft(cache[[key]] * stats::fft(c(stats::rnorm(n), rep(0, n))),
-                  inverse = TRUE))[1:n] / (2 * n)
-  }
+  sets <- list()
+  names_of <- c("2" = "wpm", "1" = "fpm", "0" = "wfm", "-1" = "ffm", "-2" = "rwfm")
   function(alpha, n) {
-    switch(as.character(alpha),
-           "2" = diff(stats::rnorm(n + 1)),
-           "1" = diff(flicker(n + 1)),
-           "0" = stats::rnorm(n),
-           "-1" = flicker(n),
-           "-2" = cumsum(stats::rnorm(n)),
-           stop("no generator for alpha ", alpha))
+    key <- as.character(n)
+    if (is.null(sets[[key]])) sets[[key]] <<- mc_generators(n)
+    g <- names_of[[as.character(alpha)]]
+    sets[[key]][[g]]()
   }
 })
 

@@ -4,11 +4,16 @@
 # fractional integration for flicker (applied by FFT), cumsum for random
 # walk, first differences of white or flicker phase for PM.
 mc_gens <- function(N) {
+  filters <- list()  # the filter's transform, built once per length
   flicker <- function(n) {
-    h <- numeric(n)
-    h[1] <- 1
-    for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
-    Re(stats::fft(stats::fft(c(h, rep(0, n))) * stats::fft(c(rnorm(n), rep(0, n))),
+    key <- as.character(n)
+    if (is.null(filters[[key]])) {
+      h <- numeric(n)
+      h[1] <- 1
+      for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
+      filters[[key]] <<- stats::fft(c(h, rep(0, n)))
+    }
+    Re(stats::fft(filters[[key]] * stats::fft(c(rnorm(n), rep(0, n))),
                   inverse = TRUE))[1:n] / (2 * n)
   }
   list(wfm = function() rnorm(N), ffm = function() flicker(N),
@@ -583,22 +588,13 @@ test_that("the lag-1 ACF read from the octave pass's moments is the direct one",
 
 test_that("the total type's EDF under flicker PM follows a Monte Carlo of its own generator", {
   skip_on_cran()
-  # flicker phase by Kasdin & Walter's fractional integration (written
-  # here, not avsim()); y its first differences
+  # flicker PM from this file's own generator (not avsim())
   N <- 16384
-  n <- N + 1
-  h <- numeric(n)
-  h[1] <- 1
-  for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
-  H <- stats::fft(c(h, rep(0, n)))
-  flicker <- function() {
-    Re(stats::fft(H * stats::fft(c(stats::rnorm(n), rep(0, n))),
-                  inverse = TRUE))[1:n] / (2 * n)
-  }
+  fpm <- mc_gens(N)$fpm
   m <- c(16, 64, 256)
   set.seed(3)
   av <- replicate(300, {
-    allan(diff(flicker()), 1, taus = m, type = "total", ci = FALSE)$avar
+    allan(fpm(), 1, taus = m, type = "total", ci = FALSE)$avar
   })
   edf_mc <- 2 * rowMeans(av)^2 / apply(av, 1, stats::var)
   L <- N + 1
