@@ -43,7 +43,7 @@ edf_of_limits <- function(lo, hi, conf = 0.683) {
   exp(stats::uniroot(f, c(log(0.05), log(1e9)), tol = 1e-10)$root)
 }
 
-stable32_rows_mc <- function(res, root, reps) {
+stable32_rows_mc <- function(res, reps) {
   ci <- res$status == "ok" & res$has_ci
   bad <- res[ci & !res$limits_ok, ]
   out <- list()
@@ -107,7 +107,7 @@ if (sys.nframe() == 0L) {
   allan_ci <- utils::getFromNamespace("allan_ci", "allanvar")
   set.seed(20261128)
   res <- check_stable32(root)
-  tab <- stable32_rows_mc(res, root, reps)
+  tab <- stable32_rows_mc(res, reps)
   tab$ours_ok <- tab$ours >= 0.60 & tab$ours <= 0.76
   tab$s32_ok <- tab$s32 >= 0.60 & tab$s32 <= 0.76
   old <- options(width = 220)
