@@ -14,7 +14,7 @@
 #   R CMD INSTALL --preclean . && Rscript bench/mle-coverage.R [seeds_1e5] [seeds_1e6]
 # (defaults 40 8; the issue's "done when" asks for >= 400 / >= 200; simts
 # from $ALLANVAR_BENCH_LIB when set; MLE_CELLS="weak K" runs only the cells
-# named)
+# named; MLE_SAVE=dir keeps each cell's fits so far in dir)
 library(allanvar)
 options(width = 200)
 source("bench/common.R")
@@ -75,6 +75,11 @@ for (cell in names(cells)) for (j in 1:2) {
       Hi[s, , r[[1]]] <- r[[2]]$hi; conv[s, r[[1]]] <- r[[2]]$conv
     }
     if (has_gmwm) E[s, , "gmwm"] <- tryCatch(fit_gmwm(x), error = function(e) NA_real_)
+    # MLE_SAVE=dir: the fits so far, per cell, so a long run can be read before its end
+    if (nzchar(Sys.getenv("MLE_SAVE"))) {
+      saveRDS(list(cell = cell, n = n, seeds = s, E = E, Lo = Lo, Hi = Hi, conv = conv, truth = truth),
+              file.path(Sys.getenv("MLE_SAVE"), sprintf("%s-%g.rds", gsub(" ", "", cell), n)))
+    }
   }
   for (k in meth) for (p in pn) {
     rel <- E[, p, k] / truth[[p]] - 1
