@@ -14,7 +14,8 @@
 #   R CMD INSTALL --preclean . && Rscript bench/mle-coverage.R [seeds_1e5] [seeds_1e6]
 # (defaults 40 8; the issue's "done when" asks for >= 400 / >= 200; simts
 # from $ALLANVAR_BENCH_LIB when set; MLE_CELLS="weak K" runs only the cells
-# named; MLE_SAVE=dir keeps each cell's fits so far in dir)
+# named; MLE_SAVE=dir keeps each cell's fits so far in dir, and a run
+# started again with the same dir and seeds resumes where it stopped)
 library(allanvar)
 options(width = 200)
 source("bench/common.R")
@@ -66,7 +67,17 @@ for (cell in names(cells)) for (j in 1:2) {
   E <- array(NA_real_, c(ns, 4, length(meth)), list(NULL, pn, meth))
   Lo <- Hi <- E
   conv <- matrix(NA, ns, length(meth), dimnames = list(NULL, meth))
-  for (s in seq_len(ns)) {
+  save_to <- if (nzchar(Sys.getenv("MLE_SAVE")))
+    file.path(Sys.getenv("MLE_SAVE"), sprintf("%s-%g.rds", gsub(" ", "", cell), n))
+  done <- 0L
+  # a run stopped before its end resumes from its saved fits (same seeds)
+  if (!is.null(save_to) && file.exists(save_to)) {
+    old <- readRDS(save_to)
+    if (identical(dim(old$E), dim(E)) && identical(dimnames(old$E), dimnames(E))) {
+      E <- old$E; Lo <- old$Lo; Hi <- old$Hi; conv <- old$conv; done <- old$seeds
+    }
+  }
+  for (s in seq_len(ns)[seq_len(ns) > done]) {
     x <- composite_series(n, 1000 * j + s, truth, tau0)
     m <- tryCatch(one_fit(avmle(x, freq)), error = function(e) NULL)
     a <- tryCatch(one_fit(avfit(allan(x, freq), c("N", "K", "gm"))), error = function(e) NULL)
@@ -76,9 +87,9 @@ for (cell in names(cells)) for (j in 1:2) {
     }
     if (has_gmwm) E[s, , "gmwm"] <- tryCatch(fit_gmwm(x), error = function(e) NA_real_)
     # MLE_SAVE=dir: the fits so far, per cell, so a long run can be read before its end
-    if (nzchar(Sys.getenv("MLE_SAVE"))) {
+    if (!is.null(save_to)) {
       saveRDS(list(cell = cell, n = n, seeds = s, E = E, Lo = Lo, Hi = Hi, conv = conv, truth = truth),
-              file.path(Sys.getenv("MLE_SAVE"), sprintf("%s-%g.rds", gsub(" ", "", cell), n)))
+              save_to)
     }
   }
   for (k in meth) for (p in pn) {
