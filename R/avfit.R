@@ -414,9 +414,7 @@ check_dots_empty <- function(...) {
 #' [avfit()]; `type = "log"` gives \eqn{\ln\widehat{AV}_j - \ln AV_j} minus
 #' the chi-square log bias, `type = "relative"` gives
 #' \eqn{\sqrt{\widehat{AV}_j/AV_j} - 1}, the relative ADEV error).
-#' `confint()` gives Wald intervals on the log scale; for an amplitude of
-#' an [avmle()] fit near 0 (log-scale SE above 1/8), at level 0.95, the
-#' profile-likelihood interval; for an amplitude at
+#' `confint()` gives Wald intervals on the log scale; for an amplitude at
 #' 0 a one-sided interval `[0, upper]` (from the profile likelihood for
 #' [avmle()] fits, at level 0.95; for curve fits from the quadratic
 #' approximation of the objective in the variance coefficient c = amp^2,
@@ -523,17 +521,6 @@ confint.avfit <- function(object, parm, level = 0.95, ...) {
   lo[zero] <- 0
   hi[zero] <- ifelse(is.finite(bu[zero]), if (abs(level - 0.95) < 1e-12) bu[zero] else NA_real_,
                      sqrt(stats::qnorm(level)) * s[zero])
-  # an amplitude near 0 of an avmle() fit (log-scale SE above 1/8): its
-  # 95% profile-likelihood interval, computed with the fit
-  pr <- object[["profile_ci"]]
-  near <- role == "amp" & est > 0 & parm %in% rownames(pr)
-  if (!is.null(pr) && abs(level - 0.95) < 1e-12) for (j in which(near)) {
-    ci <- pr[parm[j], ]
-    if (all(is.finite(ci))) {
-      lo[j] <- ci[[1]]
-      hi[j] <- ci[[2]]
-    }
-  }
   lab <- lay$label[match(parm, lay$name)]
   dead <- role == "nonlinear" & lab %in% lay$label[lay$role == "amp" & cf[lay$name] == 0] &
     !is.finite(s)

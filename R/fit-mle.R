@@ -32,13 +32,6 @@
 #'   [av_information()] at the estimate). `confint()` gives Wald intervals
 #'   on the log scale; `se` is the delta-method SE on the linear scale and
 #'   `vcov` the covariance on that scale.
-#' * an amplitude near 0 (its log-scale SE above 1/8: its variance within
-#'   4 SEs of 0, where the likelihood is far from quadratic in the log
-#'   amplitude): `profile_ci` holds its 95% profile-likelihood interval
-#'   (the values where the likelihood, maximised over the other
-#'   parameters, has dropped by `qchisq(0.95, 1) / 2`; lower end 0 when
-#'   the profile at 0 has not dropped that far), which `confint()` gives;
-#'   its Wald SE is still in `se`.
 #' * an amplitude at its boundary (the likelihood is highest at 0; an
 #'   estimate whose removal costs less than 0.01 in log-likelihood is set to
 #'   0): no Wald SE (`NA`); `bound_upper` holds its one-sided 95% upper
@@ -63,8 +56,8 @@
 #'   overlapping curve of `x`. Extra elements: `method = "mle"`, `loglik`
 #'   (the exact log-likelihood of `x[-1]` given `x[1]`: the sensor's bias is
 #'   unknown, a diffuse level, or the random walk's start when there is a
-#'   `K` term), `avfit` (the curve fit it started from), `bound_upper`,
-#'   `profile_ci` and `interval` (see Uncertainty).
+#'   `K` term), `avfit` (the curve fit it started from), `bound_upper` and
+#'   `interval` (see Uncertainty).
 #' @seealso [avfit()], [avsim()]
 #' @export
 #' @examples
@@ -103,7 +96,6 @@ avmle <- function(x, freq, terms = NULL, start = NULL) {
   # (a zero amplitude's SE is NA by design: it has its bound_upper)
   fit$vcov <- unc$vcov
   fit$bound_upper <- unc$bound_upper
-  fit$profile_ci <- unc$profile
   fit$interval <- unc$interval
   fit$layout$fixed <- FALSE
   fit$npar <- nrow(lay)
@@ -288,63 +280,7 @@ mle_uncertainty <- function(x, est, lay, model, p0, freq) {
     bound[i] <- mle_profile_upper(x, par, i, ok, lay, model, p0, est$loglik)
     interval[i] <- "one-sided, profile likelihood"
   }
-  # an amplitude near 0 (its variance a^2 within 4 Wald SEs of 0, i.e. a
-  # log-scale SE above 1/8, or no SE at all): the likelihood is far from
-  # quadratic in log a and the Wald interval misplaces both ends
-  prof <- matrix(NA_real_, k, 2L, dimnames = list(lay$name, c("lower", "upper")))
-  se_log <- se / par
-  for (i in which(lay$role == "amp" & par > 0 & !(se_log <= 1 / 8))) {
-    prof[i, ] <- mle_profile_interval(x, par, i, ok, lay, model, est$loglik)
-    if (all(is.finite(prof[i, ]))) interval[i] <- "profile likelihood"
-  }
-  list(se = se, vcov = vc, bound_upper = bound, profile = prof, interval = interval)
-}
-
-# The 95% profile-likelihood interval of the amplitude `i` (> 0): the
-# values where the log-likelihood, maximised over the other identified
-# parameters, has dropped by qchisq(0.95, 1) / 2; the lower end is 0 when
-# the profile at 0 has not dropped that far.
-mle_profile_interval <- function(x, par, i, ok, lay, model, llmax) {
-  drop <- stats::qchisq(0.95, 1) / 2
-  free <- ok & seq_along(par) != i
-  lp_start <- log(par[free])
-  box <- c(-1, 1) * log(1e3)
-  lp_warm <- lp_start
-  prof <- function(a) {
-    f <- function(lp) {
-      v <- -mle_loglik(x, model(replace(replace(par, free, exp(lp)), i, a)))
-      if (is.finite(v)) v else .Machine$double.xmax
-    }
-    o <- tryCatch(stats::optim(lp_warm, f, method = "L-BFGS-B",
-                               lower = lp_start + box[1], upper = lp_start + box[2],
-                               control = list(maxit = 300, factr = 1e5)),
-                  error = function(e) NULL)
-    if (is.null(o)) return(NA_real_)
-    lp_warm <<- o$par
-    -o$value
-  }
-  g <- function(la) llmax - prof(exp(la)) - drop
-  root_from <- function(step) {
-    lp_warm <<- lp_start
-    a <- log(par[i]); ga <- -drop
-    for (k in 1:12) {
-      b <- a + step
-      gb <- g(b)
-      if (!is.finite(gb)) return(NA_real_)
-      if (gb > 0) {
-        r <- stats::uniroot(g, sort(c(a, b)), f.lower = if (step > 0) ga else gb,
-                            f.upper = if (step > 0) gb else ga, tol = 0.02)$root
-        return(exp(r))
-      }
-      a <- b; ga <- gb
-    }
-    if (step < 0) 0 else NA_real_
-  }
-  upper <- root_from(log(2))
-  lp_warm <- lp_start
-  at0 <- prof(0)
-  lower <- if (!is.finite(at0)) NA_real_ else if (llmax - at0 <= drop) 0 else root_from(-log(2))
-  c(lower, upper)
+  list(se = se, vcov = vc, bound_upper = bound, interval = interval)
 }
 
 mle_inverse <- function(H) {
