@@ -231,6 +231,21 @@ kernel_theo <- function(own_type) {
                 class = "argument")
         }
         t1 <- t1 * as.numeric(kf)
+        if (ctx$ci || ctx$unbiased) {
+          # TheoBR's slope is Theo1's (kappa is one factor): the row's type
+          # as Theo1's (R/theo1-type.R), the interval the union over the
+          # candidate types (R/theobr-edf.R)
+          ta <- theo1_alpha(ctx$v, ctx$rate, L, mt,
+                            t1 / as.numeric(kf) / ctx$sc_rate,
+                            alpha[theo_row], ctx$threads)
+          alpha[theo_row] <- as.integer(ta)
+          if (ctx$ci) {
+            u <- theobr_union(ctx$entry$name, t1, mt, L, attr(ta, "alts"),
+                              ctx$n[theo_row],
+                              ctx$conf, attr(kf, "kappa"))
+            limits <- list(rows = theo_row, lower = u$lower, upper = u$upper)
+          }
+        }
       }
       av[theo_row] <- t1
       # TheoBR: the factor's uncertainty joins Theo1's (R/theobr-edf.R)

@@ -20,38 +20,51 @@
 # above (PM noise: nu_kappa grows like N^0.3 to N^1.2; FM noise on the N/6
 # ladder it is flat, as the ladder's long end, with few averages whatever
 # N, dominates). rho is a function of u = m / (L - 1) alone (the runs at
-# N = 256, 1024, 4096 agree within their sampling error, ~0.03): near 0
-# below u = 1/16, up to 0.6-0.9 where Theo1(m) shares the ladder's long
-# end.
+# N = 256, 1024, 4096 agree within their sampling error, ~0.03): small
+# below u = 1/32 (|rho| <= 0.16; white PM on the N/30 ladder -0.3, where
+# nu_kappa is in the thousands), up to 0.6-0.9 where Theo1(m) shares the
+# ladder's long end.
+#
+# The row's noise type (for nu_T) is Theo1's (theo1_alpha(), R/theo1-
+# type.R: TheoBR's slope is Theo1's), the interval the union over its
+# candidate types (theobr_union() below); the factor's type (for nu_kappa
+# and rho) the one read along the ladder (theobr_ladder_alpha(),
+# R/theo-fast.R), NA: the smallest nu_kappa and largest rho over the types.
 
-# The tables: log2 L - 1 (N = L - 1 = 64 ... 16384) by noise exponent (rows
-# alpha = 2, 1, 0, -1, -2); rho at u = 2^-10 ... 2^0.
+# The tables (`MC_INSTALLED=1 Rscript tools/theobr-ratio-edf.R 1000
+# 64,256,1024,4096 29`, 2026-11-28; N = 16384 from 300 records, seed 4):
+# nu_kappa at N = L - 1 = 64 ... 16384 (columns) by noise exponent (rows
+# alpha = 2, 1, 0, -1, -2); rho at u = 2^-10 ... 2^0, the mean over N =
+# 256, 1024, 4096.
 theobr_kappa_table <- function() {
   list(
     N = c(64, 256, 1024, 4096, 16384),
     nu = list(
-      "N/6" = rbind(c(NA, 784, 4080, 18700, NA),
-                    c(NA, 73.7, 117, 158, NA),
-                    c(NA, 20.8, 23.6, 21.4, NA),
-                    c(NA, 20.1, 24.7, 24.7, NA),
-                    c(NA, 23.6, 26.3, 27.8, NA)),
-      "N/30" = rbind(c(NA, 977, 13200, 96700, NA),
-                     c(NA, 201, 486, 810, NA),
-                     c(NA, 99.7, 157, 165, NA),
-                     c(NA, 129, 227, 249, NA),
-                     c(NA, 186, 289, 356, NA))),
+      "N/6" = rbind(c(113, 841, 4170, 16100, 55300),
+                    c(35.4, 70.2, 114, 148, 172),
+                    c(14.4, 23.0, 22.0, 22.9, 24.6),
+                    c(13.4, 22.0, 23.6, 23.9, 23.3),
+                    c(13.6, 24.3, 27.9, 27.1, 29.1)),
+      # no N/30 ladder below 90 phase points
+      "N/30" = rbind(c(NA, 931, 11800, 97100, 610000),
+                     c(NA, 202, 436, 722, 921),
+                     c(NA, 108, 160, 189, 200),
+                     c(NA, 128, 223, 255, 267),
+                     c(NA, 217, 282, 356, 365))),
     lu = -10:0,
     rho = list(
-      "N/6" = rbind(c(0, 0, 0, 0, 0, 0, 0, 0.1, 0.1, 0, 0),
-                    c(0, 0, 0, 0, 0, 0, 0, 0.1, 0.3, 0.55, 0.1),
-                    c(0, 0, 0, 0, 0, 0, 0, 0, 0.2, 0.65, 0.55),
-                    c(0, 0, 0, 0, 0, 0, 0, 0, 0.2, 0.7, 0.7),
-                    c(0, 0, 0, 0, 0, 0.05, 0.1, 0.15, 0.35, 0.75, 0.8)),
-      "N/30" = rbind(c(0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0),
-                     c(0, 0, 0, 0, 0, 0, 0, 0.3, 0.6, 0.5, 0),
-                     c(0, 0, 0, 0, 0, 0, 0, 0.35, 0.85, 0.75, 0.45),
-                     c(0, 0, 0, 0, 0, 0, 0, 0.25, 0.8, 0.85, 0.45),
-                     c(0, 0, 0, 0, 0, 0.1, 0.2, 0.45, 0.8, 0.9, 0.65)))
+      "N/6" = rbind(
+        c(-0.06, -0.11, -0.09, -0.12, -0.09, -0.08, -0.06, -0.01, 0.08, 0.03, 0.05),
+        c(-0.03, -0.04, -0.07, -0.10, -0.09, -0.07, -0.01, 0.09, 0.28, 0.55, 0.10),
+        c(0.04, 0.04, 0.03, -0.01, -0.04, -0.06, -0.07, 0.00, 0.23, 0.67, 0.51),
+        c(0.02, 0.02, 0.01, -0.01, -0.05, -0.07, -0.08, -0.03, 0.16, 0.68, 0.69),
+        c(-0.05, -0.05, -0.04, -0.01, 0.00, 0.01, 0.04, 0.12, 0.32, 0.72, 0.77)),
+      "N/30" = rbind(
+        c(-0.27, -0.31, -0.24, -0.25, -0.20, -0.16, -0.09, -0.08, -0.05, -0.05, -0.04),
+        c(-0.10, -0.11, -0.14, -0.15, -0.14, -0.04, 0.21, 0.54, 0.56, 0.52, 0.05),
+        c(-0.05, -0.04, -0.08, -0.10, -0.14, -0.09, 0.27, 0.82, 0.74, 0.44, 0.11),
+        c(-0.03, -0.07, -0.07, -0.10, -0.16, -0.10, 0.24, 0.80, 0.83, 0.47, 0.17),
+        c(0.00, 0.01, 0.01, 0.02, 0.06, 0.18, 0.44, 0.80, 0.90, 0.68, 0.41)))
   )
 }
 
@@ -110,4 +123,18 @@ edf_rule_theobr <- function(e, m, n, L, alpha, kappa = NULL) {
   rho <- theobr_rho(ak, m, L, kappa$ladder)
   v <- 1 / nt + 1 / nk + 2 * rho / sqrt(nt * nk)
   pmax(1, 1 / v)
+}
+
+# TheoBR limits where the row's noise type is ambiguous (theo1_alpha()'s
+# candidates `alts`): the union of the candidate types' chi-square
+# intervals, each with its EDF by the rule above (as theo1_union() does for
+# Theo1, without a bias correction: TheoBR is bias-removed by its factor).
+# `type`: the statistic's name, for its EDF rule.
+theobr_union <- function(type, av, m, L, alts, n, conf, kappa) {
+  row <- rep(seq_along(m), lengths(alts))
+  al <- unlist(alts, use.names = FALSE)
+  e <- extra_edf(type, m[row], L, al, n[row], kappa = kappa)
+  ci <- allan_ci(av[row], e, conf)
+  list(lower = vapply(split(ci$lower, row), min, 0),
+       upper = vapply(split(ci$upper, row), max, 0))
 }
