@@ -175,7 +175,7 @@ theobr_kernel_factor <- function(ctx) {
   if (!fast) {
     kf <- theobr_factor(ctx$v, ctx$freq, ctx$rate, L, ctx$threads, o$ladder)
     alpha <- if (isTRUE(ctx$ci) || isTRUE(ctx$unbiased)) {
-      theobr_ladder_alpha(ctx$v, ctx$freq, ctx$input, L, o$ladder)
+      theobr_kappa_alpha(ctx$v, ctx$rate, L, o$ladder, ctx$threads)
     } else NA_integer_
     return(structure(kf, kappa = list(ladder = o$ladder, L = L,
                                       alpha = alpha)))
@@ -188,7 +188,11 @@ theobr_kernel_factor <- function(ctx) {
   }
   alpha <- theobr_ladder_alpha(ctx$v, ctx$freq, ctx$input, L, o$ladder)
   kf <- theobr_factor_fast(ctx$v, ctx$rate, L, r, alpha, ctx$threads, o$ladder)
-  structure(kf, kappa = list(ladder = o$ladder, L = L %/% r, alpha = alpha))
+  ak <- if (isTRUE(ctx$ci) || isTRUE(ctx$unbiased)) {
+    xb <- theo_avg_phase(ctx$v, ctx$rate, r)
+    theobr_kappa_alpha(xb, FALSE, length(xb), o$ladder, ctx$threads)
+  } else NA_integer_
+  structure(kf, kappa = list(ladder = o$ladder, L = L %/% r, alpha = ak))
 }
 
 # The noise type of the ladder, for the fast factor's correction: the most

@@ -138,3 +138,30 @@ theobr_union <- function(type, av, m, L, alts, n, conf, kappa) {
   list(lower = vapply(split(ci$lower, row), min, 0),
        upper = vapply(split(ci$upper, row), max, 0))
 }
+
+# The factor's noise type (for nu_kappa and rho): the most frequent of the
+# types Theo1's slope reads (theo1_alpha()) at five even m spaced
+# geometrically over the ladder's Theo1 span, 16 .. 12 + 4n (ties: the
+# longer tau); NA when none is read. The Allan variance's identification
+# alone, as the fast factor's correction takes it (theobr_ladder_alpha()),
+# reads random-walk FM as flicker or white FM at m = 25-510 in 55-95% of
+# records (N = 1024), and so the factor's EDF as 22 where it is 28.
+# v: the phase (or rate) the factor was computed on (the averaged phase on
+# the fast path), L its phase points.
+theobr_kappa_alpha <- function(v, rate, L, ladder, threads) {
+  n <- theobr_ladder_n(L, ladder)
+  if (n < 1) return(NA_integer_)
+  top <- min(12 + 4 * n, L - 1)
+  m <- unique(2 * round(exp(seq(log(16), log(top), length.out = 5)) / 2))
+  m <- m[m >= 2 & m <= L - 1]
+  if (!length(m)) return(NA_integer_)
+  t1 <- theo1_sums_cpp(v, rate, m, threads) / (0.75 * (L - m) * m^2)
+  input <- if (rate) "rate" else "integrated"
+  a0 <- extra_alpha(v, 1, round(0.75 * m), "overlapping", input, L)
+  a <- as.integer(theo1_alpha(v, rate, L, m, t1, a0, threads))
+  a <- rev(a[!is.na(a)])
+  if (!length(a)) return(NA_integer_)
+  tab <- table(a)
+  top <- names(tab)[tab == max(tab)]
+  a[match(TRUE, as.character(a) %in% top)]
+}
