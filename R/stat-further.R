@@ -235,9 +235,18 @@ kernel_theo <- function(own_type) {
           # TheoBR's slope is Theo1's (kappa is one factor): the row's type
           # as Theo1's (R/theo1-type.R), the interval the union over the
           # candidate types (R/theobr-edf.R)
+          # beyond the Allan variance's reach (three cluster averages;
+          # extra_alpha() repeats its type there) the type read along the
+          # ladder is the record's evidence (white PM read as white FM at
+          # N/m <= 4 in half the records, N = 1024)
+          a0 <- alpha[theo_row]
+          top <- min(allan_max_m(ctx$entry$id_base, L),
+                     max(1, floor((L - 1) / 3)))
+          ka <- attr(kf, "kappa")$alpha
+          if (!is.na(ka)) a0[round(0.75 * mt) > top] <- ka
           ta <- theo1_alpha(ctx$v, ctx$rate, L, mt,
-                            t1 / as.numeric(kf) / ctx$sc_rate,
-                            alpha[theo_row], ctx$threads)
+                            t1 / as.numeric(kf) / ctx$sc_rate, a0,
+                            ctx$threads)
           alpha[theo_row] <- as.integer(ta)
           if (ctx$ci) {
             u <- theobr_union(ctx$entry$name, t1, mt, L, attr(ta, "alts"),
