@@ -26,10 +26,12 @@
 # ladder's long end.
 #
 # The row's noise type (for nu_T) is Theo1's (theo1_alpha(), R/theo1-
-# type.R: TheoBR's slope is Theo1's), the interval the union over its
+# type.R: TheoBR's slope is Theo1's; beyond the Allan variance's reach
+# starting from the factor's type), the interval the union over its
 # candidate types (theobr_union() below); the factor's type (for nu_kappa
-# and rho) the one read along the ladder (theobr_ladder_alpha(),
-# R/theo-fast.R), NA: the smallest nu_kappa and largest rho over the types.
+# and rho) the one Theo1's slope reads along the ladder
+# (theobr_kappa_alpha() below), NA: the smallest nu_kappa and largest rho
+# over the types.
 
 # The tables (`MC_INSTALLED=1 Rscript tools/theobr-ratio-edf.R 1000
 # 64,256,1024,4096 29`, 2026-11-28; N = 16384 from 300 records, seed 4):
