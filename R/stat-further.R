@@ -234,11 +234,10 @@ kernel_theo <- function(own_type) {
         if (ctx$ci || ctx$unbiased) {
           # TheoBR's slope is Theo1's (kappa is one factor): the row's type
           # as Theo1's (R/theo1-type.R), the interval the union over the
-          # candidate types (R/theobr-edf.R)
-          # beyond the Allan variance's reach (three cluster averages;
-          # extra_alpha() repeats its type there) the type read along the
-          # ladder is the record's evidence (white PM read as white FM at
-          # N/m <= 4 in half the records, N = 1024)
+          # candidate types (R/theobr-edf.R). Beyond the Allan variance's
+          # reach (three cluster averages; extra_alpha() repeats its type
+          # there) the type read along the ladder starts it (white PM was
+          # read as white FM at N/m <= 4 in half the records, N = 1024).
           a0 <- alpha[theo_row]
           top <- min(allan_max_m(ctx$entry$id_base, L),
                      max(1, floor((L - 1) / 3)))
