@@ -89,11 +89,28 @@
 #' \eqn{(N/m)(0.713 + 0.5725 \ln m)^2/(1 + 1.344 m/N)} (within 11% of
 #' Monte Carlo up to \eqn{m = N/4}; beyond, where the terms fall to a few,
 #' times a factor in their number); at \eqn{m = 1}, where HTOT is the
-#' overlapping Hadamard variance, its EDF. Theo1 and TheoBR use Howe and
+#' overlapping Hadamard variance, its EDF. Theo1 uses Howe and
 #' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV the modified Allan
-#' EDF. The noise type of a TheoBR row is the overlapping Allan variance's at
-#' \eqn{0.75 m}, or at \eqn{(L - 1)/3} beyond it (no fewer than three
-#' cluster averages). A Theo1 row's type, which picks its bias correction
+#' EDF. TheoBR (and TheoH's TheoBR rows) is Theo1 times a factor
+#' \eqn{\kappa} estimated from the same record, one random factor on every
+#' row: its EDF is \eqn{1/\nu = 1/\nu_T + 1/\nu_\kappa +
+#' 2\rho/\sqrt{\nu_T \nu_\kappa}}, \eqn{\nu_T} Theo1's EDF,
+#' \eqn{\nu_\kappa = 2/\mathrm{Var}\log\kappa} (13-30 for FM noise on the
+#' N/6 ladder whatever \eqn{L}, 100-370 on the N/30 one, more for PM noise)
+#' and \eqn{\rho} the correlation of \eqn{\log\kappa} with
+#' \eqn{\log}Theo1(\eqn{m}) (up to 0.9 near the ladder's long end), both
+#' from an offline Monte Carlo by noise type, ladder and its record length
+#' (the averaged phase's on the fast path), at the type read along the
+#' ladder (as Theo1's slope reads it at five points of the ladder). Theo1's
+#' EDF alone ignored \eqn{\kappa}: 68% coverage 0.10-0.35 under FM noise,
+#' 7 of 50 Monte Carlo rows (N = 1024, five noise types) inside both bands
+#' (68% in 0.60-0.76, 95% in 0.92-0.975); now 41 of 46, the misses at
+#' \eqn{N/m \le 4}, all over-covering. The noise type of a Theo1 or
+#' TheoBR row starts from the
+#' overlapping Allan variance's at \eqn{0.75 m}, or at \eqn{(L - 1)/3}
+#' beyond it (no fewer than three cluster averages; TheoBR there: the
+#' ladder's type). Its type, which for
+#' Theo1 picks its bias correction
 #' (up to 2.7-fold apart between adjacent types), also uses Theo1's own
 #' slope from \eqn{m' = 2\,\mathrm{round}(m/4)} (\eqn{m = 2}: 4) to
 #' \eqn{m}, against each type's expected slope with its correction: among

@@ -69,19 +69,21 @@ allan_edf_direct <- function(type, m, n, L, alpha) {
 
 # EDF of the rows of a statistic with a kernel of its own, by its entry's
 # rule; an unknown noise type (alpha NA) gets the smallest EDF over the
-# admissible ones (the widest interval), as allan_edf() does.
-extra_edf <- function(type, m, L, alpha, n) {
+# admissible ones (the widest interval), as allan_edf() does. `...`: what
+# a rule takes beyond its five arguments (TheoBR's: its factor's ladder).
+extra_edf <- function(type, m, L, alpha, n, ...) {
   s <- stat_entry(type)
   rule <- stat_edf_rules()[[s$edf]]
   a <- as.integer(alpha)
   unknown <- is.na(a)
   e <- rep(NA_real_, length(m))
   if (any(!unknown)) {
-    e[!unknown] <- rule(s, m[!unknown], n[!unknown], L, a[!unknown])
+    e[!unknown] <- rule(s, m[!unknown], n[!unknown], L, a[!unknown], ...)
   }
   lo <- s$alpha_range[1L]
   for (i in which(unknown)) {
-    e[i] <- min(vapply(lo:2L, function(al) rule(s, m[i], n[i], L, al), 0))
+    e[i] <- min(vapply(lo:2L, function(al) rule(s, m[i], n[i], L, al, ...),
+                       0))
   }
   e
 }
@@ -94,7 +96,8 @@ extra_edf <- function(type, m, L, alpha, n) {
 # element here.
 stat_edf_rules <- function() {
   list(engine = edf_rule_engine, engine_modified = edf_rule_modified,
-       mtot = edf_rule_mtot, htot = edf_rule_htot, theo1 = edf_rule_theo1)
+       mtot = edf_rule_mtot, htot = edf_rule_htot, theo1 = edf_rule_theo1,
+       theobr = edf_rule_theobr)
 }
 
 # The one engine (src/edf.cpp) for the statistic itself.

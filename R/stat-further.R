@@ -46,14 +46,14 @@ stats_further <- function() {
     further("theobr", "bias-removed Theo1 deviation (TheoBR)",
             max_m = function(L) L - 1, nterms = theo_n,
             taus = stat_taus_theo, kernel = kernel_theo(own_type = FALSE),
-            edf = "theo1", id_base = "overlapping", theo = theo_defaults()),
+            edf = "theobr", id_base = "overlapping", theo = theo_defaults()),
     further("theoh", "TheoH deviation (Allan, then TheoBR)",
             max_m = function(L) L - 1,
             nterms = function(m, L, theo_row) {
               ifelse(theo_row, (L - m) * m / 2, L - 2 * m)
             },
             taus = stat_taus_theoh, kernel = kernel_theo(own_type = FALSE),
-            edf = "theo1", id_base = "overlapping", theo = theo_defaults()),
+            edf = "theobr", id_base = "overlapping", theo = theo_defaults()),
     further("mtie", "maximum time interval error MTIE", time = TRUE,
             max_m = function(L) L - 1,
             nterms = function(m, L, theo_row = NULL) L - m,
@@ -230,11 +230,39 @@ kernel_theo <- function(own_type) {
           abort("TheoBR needs at least 19 phase points (", L, " given).",
                 class = "argument")
         }
-        t1 <- t1 * kf
+        t1 <- t1 * as.numeric(kf)
+        if (ctx$ci || ctx$unbiased) {
+          # TheoBR's slope is Theo1's (kappa is one factor): the row's type
+          # as Theo1's (R/theo1-type.R), the interval the union over the
+          # candidate types (R/theobr-edf.R). Beyond the Allan variance's
+          # reach (three cluster averages; extra_alpha() repeats its type
+          # there) the type read along the ladder starts it (white PM was
+          # read as white FM at N/m <= 4 in half the records, N = 1024).
+          a0 <- alpha[theo_row]
+          top <- min(allan_max_m(ctx$entry$id_base, L),
+                     max(1, floor((L - 1) / 3)))
+          ka <- attr(kf, "kappa")$alpha
+          if (!is.na(ka)) a0[round(0.75 * mt) > top] <- ka
+          ta <- theo1_alpha(ctx$v, ctx$rate, L, mt,
+                            t1 / as.numeric(kf) / ctx$sc_rate, a0,
+                            ctx$threads)
+          alpha[theo_row] <- as.integer(ta)
+          if (ctx$ci) {
+            u <- theobr_union(ctx$entry$name, t1, mt, L, attr(ta, "alts"),
+                              ctx$n[theo_row],
+                              ctx$conf, attr(kf, "kappa"))
+            limits <- list(rows = theo_row, lower = u$lower, upper = u$upper)
+          }
+        }
       }
       av[theo_row] <- t1
-      edf[theo_row] <- extra_edf("theo1", mt, L, alpha[theo_row],
-                                 ctx$n[theo_row])
+      # TheoBR: the factor's uncertainty joins Theo1's (R/theobr-edf.R)
+      edf[theo_row] <- if (own_type) {
+        extra_edf(ctx$entry$name, mt, L, alpha[theo_row], ctx$n[theo_row])
+      } else {
+        extra_edf(ctx$entry$name, mt, L, alpha[theo_row], ctx$n[theo_row],
+                  kappa = attr(kf, "kappa"))
+      }
     }
     if (any(!theo_row)) {
       a <- allan(ctx$v, ctx$freq, taus = I(m[!theo_row] / ctx$freq),

@@ -162,7 +162,10 @@ theo_fast_correction <- function(alpha, L, r, ladder = "N/6") {
 # The factor of kernel_theo() (ctx: its context, ctx$theo the options):
 # the fast path when asked, or with method "auto" above `fast_above` phase
 # points (with a message); the exact factor otherwise, and wherever the
-# averaging would keep every point (r = 1).
+# averaging would keep every point (r = 1). Its attribute `kappa` is what
+# the factor's EDF needs (edf_rule_theobr(), R/theobr-edf.R): the ladder,
+# its record length (the averaged phase's on the fast path) and the noise
+# type read along it (NA where no limits are asked).
 theobr_kernel_factor <- function(ctx) {
   o <- ctx$theo
   L <- ctx$L
@@ -170,7 +173,12 @@ theobr_kernel_factor <- function(ctx) {
   fast <- r >= 2 && (identical(o$method, "fast") ||
                        (identical(o$method, "auto") && L > o$fast_above))
   if (!fast) {
-    return(theobr_factor(ctx$v, ctx$freq, ctx$rate, L, ctx$threads, o$ladder))
+    kf <- theobr_factor(ctx$v, ctx$freq, ctx$rate, L, ctx$threads, o$ladder)
+    alpha <- if (isTRUE(ctx$ci) || isTRUE(ctx$unbiased)) {
+      theobr_kappa_alpha(ctx$v, ctx$rate, L, o$ladder, ctx$threads)
+    } else NA_integer_
+    return(structure(kf, kappa = list(ladder = o$ladder, L = L,
+                                      alpha = alpha)))
   }
   if (identical(o$method, "auto")) {
     inform("TheoBR's bias factor from the phase averaged over ", r,
@@ -179,7 +187,12 @@ theobr_kernel_factor <- function(ctx) {
            "for the exact factor.", class = "theo_fast")
   }
   alpha <- theobr_ladder_alpha(ctx$v, ctx$freq, ctx$input, L, o$ladder)
-  theobr_factor_fast(ctx$v, ctx$rate, L, r, alpha, ctx$threads, o$ladder)
+  kf <- theobr_factor_fast(ctx$v, ctx$rate, L, r, alpha, ctx$threads, o$ladder)
+  ak <- if (isTRUE(ctx$ci) || isTRUE(ctx$unbiased)) {
+    xb <- theo_avg_phase(ctx$v, ctx$rate, r)
+    theobr_kappa_alpha(xb, FALSE, length(xb), o$ladder, ctx$threads)
+  } else NA_integer_
+  structure(kf, kappa = list(ladder = o$ladder, L = L %/% r, alpha = ak))
 }
 
 # The noise type of the ladder, for the fast factor's correction: the most

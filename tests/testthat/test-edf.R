@@ -535,7 +535,10 @@ test_that("limits agree with Stable32's on >= 95% of its reference rows", {
   r1 <- e1$check_stable32(at[1])
   ci <- r1$status == "ok" & r1$has_ci
   d <- e2$check_stable32_types(roots, verbose = FALSE)
-  st <- !d$loose
+  # TheoH's TheoBR rows: Stable32 prints Theo1's chi-square limits, which
+  # ignore the bias factor's uncertainty (68% coverage 0.10-0.35 under FM
+  # noise, bench/README.md); allan() does not use that convention
+  st <- !d$loose & d$type != "theoh/theobr"
   ok <- sum(r1$limits_ok[ci], na.rm = TRUE) + sum(d$lim_ok[st], na.rm = TRUE)
   of <- sum(ci) + sum(!is.na(d$lim_ok[st]))
   expect_gt(of, 700)

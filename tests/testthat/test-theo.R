@@ -240,3 +240,37 @@ test_that("bad `theo` gives classed errors", {
   expect_error(allan(y, 1, type = "theo1", theo = list(method = "fast")),
                class = "allanvar_error_argument")
 })
+
+test_that("TheoBR's intervals carry its bias factor's uncertainty", {
+  # TheoBR = kappa * Theo1, kappa estimated from the same record: one random
+  # factor on every row (its EDF ~20-30 under FM noise, N/6 ladder), where
+  # Theo1's EDF alone claims hundreds at small m (68% coverage 0.1-0.35).
+  # Own generators (white FM: rnorm; random-walk FM: cumsum), the truth the
+  # ensemble mean; both ladders.
+  skip_on_cran()
+  N <- 256L
+  reps <- 200L
+  gens <- list(wfm = function() rnorm(N), rwfm = function() cumsum(rnorm(N)))
+  set.seed(2929)
+  for (g in names(gens)) {
+    runs <- lapply(seq_len(reps), function(i) {
+      y <- gens[[g]]()
+      list(allan(y, 1, type = "theobr", taus = I(c(3, 6, 12))),
+           allan(y, 1, type = "theobr", taus = I(c(3, 6, 12)),
+                 theo = list(ladder = "N/30")))
+    })
+    for (j in 1:2) {
+      get <- function(col) sapply(runs, function(r) r[[j]][[col]])
+      truth <- sqrt(rowMeans(get("avar")))
+      cover <- rowMeans(get("lower") <= truth & truth <= get("upper"))
+      lab <- paste(g, c("N/6", "N/30")[j])
+      expect_true(all(cover > 0.57 & cover < 0.79),
+                  label = paste(lab, paste(cover, collapse = " ")))
+      # the EDF against the Monte Carlo one of log TheoBR
+      edf_mc <- 2 / apply(log(get("avar")), 1, stats::var)
+      ratio <- apply(get("edf"), 1, stats::median) / edf_mc
+      expect_true(all(ratio > 0.7 & ratio < 1.45),
+                  label = paste(lab, paste(signif(ratio, 3), collapse = " ")))
+    }
+  }
+})
