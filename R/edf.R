@@ -116,9 +116,9 @@ edf_rule_modified <- function(e, m, n, L, alpha) {
 
 # PDEV: the exact two-moment EDF of its terms, a stationary sequence of
 # parabolic phase filters, under discrete power-law noise (src/edf.cpp
-# terms_edf_cpp()). The modified Allan EDF it borrowed before is 20-35%
-# below it (N = 1024: 0.65-0.84 of it at m = 2 .. 64), and the limits
-# over-covered (0.74-0.79 at 68%, bench/README.md).
+# terms_edf_cpp()). The modified Allan EDF it borrowed before is 16-35%
+# below it (N = 1024: 0.65-0.84 of it at m = 2 .. 64, 0.50-0.74 at 128
+# and 256), and the limits over-covered (0.74-0.79 at 68%, bench/README.md).
 edf_rule_terms <- function(e, m, n, L, alpha) {
   a <- pmin(2L, pmax(-2L, as.integer(alpha)))
   edf_floor_terms(terms_edf_cpp(e$code, as.double(m), as.double(n), a), n)
