@@ -90,10 +90,8 @@
 #' Monte Carlo up to \eqn{m = N/4}; beyond, where the terms fall to a few,
 #' times a factor in their number); at \eqn{m = 1}, where HTOT is the
 #' overlapping Hadamard variance, its EDF. Theo1 and TheoBR use Howe and
-#' Peppler's formulas in \eqn{0.75 m} (at least 1). PDEV's EDF is exact
-#' for its terms under discrete power-law noise (\eqn{2 E[V]^2/Var[V]}
-#' from the terms' autocovariance), and its rows at few averages take the
-#' exact intervals below, as the Allan types do. The noise type of a TheoBR row is the overlapping Allan variance's at
+#' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV its terms' exact
+#' EDF. The noise type of a TheoBR row is the overlapping Allan variance's at
 #' \eqn{0.75 m}, or at \eqn{(L - 1)/3} beyond it (no fewer than three
 #' cluster averages). A Theo1 row's type, which picks its bias correction
 #' (up to 2.7-fold apart between adjacent types), also uses Theo1's own

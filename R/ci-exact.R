@@ -35,8 +35,8 @@
 #' Where a row has few averages, \eqn{N/m \le 16} (\eqn{N} rate samples),
 #' the limits of the Allan and Hadamard types (`"standard"`,
 #' `"overlapping"`, `"modified"`, `"hadamard"`, `"ohadamard"`, and so
-#' `"tdev"`) and of `"pdev"` are not the chi-square ones: the estimate over its expectation
-#' is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
+#' `"tdev"`) and of `"pdev"` are not the chi-square ones: the estimate
+#' over its expectation is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
 #' \eqn{\lambda_i} the eigenvalues of the covariance of its terms under
 #' discrete power-law noise of the row's noise type (\eqn{x = (1 -
 #' B)^{-(2 - \alpha)/2} e}), and the interval is

@@ -359,7 +359,7 @@ Rcpp::List ci_long_cpp(const Rcpp::NumericVector& avar,
 }
 
 // Two-moment EDF of an estimator whose terms are a stationary sequence of
-// phase filters (PDEV; src/term_acov.h): for the mean V of M terms with
+// phase filters (PDEV; any type of src/term_acov.h): for the mean V of M terms with
 // autocovariance c(k) under the power law, Isserlis gives
 //   edf = 2 E[V]^2 / Var[V] = M^2 c(0)^2 / sum_{|k|<M} (M - |k|) c(k)^2,
 // the (sum lambda)^2 / sum lambda^2 of the exact law's eigenvalues
@@ -401,12 +401,14 @@ Rcpp::NumericVector terms_edf_cpp(int type, const Rcpp::NumericVector& m,
       continue;
     long mp = static_cast<long>(m[i]);
     if (m[i] > kTermsMcap) {
-      const double want = std::min<double>(
+      // terms at stride m keep their number; overlapping ones their N/m
+      const double want = !info.overlapping ? 0 : std::min<double>(
           kTermsMmax, std::ceil(kTermsMin * m[i] / n[i]));
       mp = static_cast<long>(
           std::min(m[i], std::max<double>(kTermsMcap, want)));
     }
-    const double M = n[i] * static_cast<double>(mp) / m[i];
+    const double M = info.overlapping ? n[i] * static_cast<double>(mp) / m[i]
+                                      : n[i];
     if (M < 1) {
       out[i] = 1;
       continue;

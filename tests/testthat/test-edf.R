@@ -647,6 +647,15 @@ test_that("PDEV's EDF is the exact one of its terms (dense covariance)", {
                                  alpha)
     expect_equal(sum(lam)^2 / sum(lam^2), ours, tolerance = 1e-9)
   }
+  # the same route for the Allan and Hadamard types gives the engine's
+  # exact discrete EDF (Isserlis on the rate innovations, coded apart)
+  for (ty in c("standard", "modified", "ohadamard")) for (alpha in c(0L, -2L)) {
+    n <- ns$allan_nterms(ty, c(3, 8), 501)
+    expect_equal(ns$terms_edf_cpp(ns$stat_entry(ty)$code, c(3, 8), n,
+                                  rep(alpha, 2)),
+                 ns$allan_edf_direct(ty, c(3, 8), n, 501, alpha),
+                 tolerance = 1e-9)
+  }
   # m = 1: PVAR is the Allan variance of the L - 2 second differences
   expect_equal(ns$extra_edf("pdev", 1, 201, 0L, 199),
                ns$allan_edf_direct("overlapping", 1, 199, 201, 0L),
