@@ -61,6 +61,10 @@ ci_long_cpp <- function(avar, edf, lg0, h, flo, fhi, p) {
     .Call(`_allanvar_ci_long_cpp`, avar, edf, lg0, h, flo, fhi, p)
 }
 
+terms_edf_cpp <- function(type, m, n, alpha) {
+    .Call(`_allanvar_terms_edf_cpp`, type, m, n, alpha)
+}
+
 acf_sums <- function(x, max_lag) {
     .Call(`_allanvar_acf_sums`, x, max_lag)
 }

@@ -90,7 +90,7 @@
 #' Monte Carlo up to \eqn{m = N/4}; beyond, where the terms fall to a few,
 #' times a factor in their number); at \eqn{m = 1}, where HTOT is the
 #' overlapping Hadamard variance, its EDF. Theo1 uses Howe and
-#' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV the modified Allan
+#' Peppler's formulas in \eqn{0.75 m} (at least 1), PDEV its terms' exact
 #' EDF. TheoBR (and TheoH's TheoBR rows) is Theo1 times a factor
 #' \eqn{\kappa} estimated from the same record, one random factor on every
 #' row: its EDF is \eqn{1/\nu = 1/\nu_T + 1/\nu_\kappa +
@@ -330,6 +330,13 @@ extra_channel <- function(v, freq, m, theo_row, e, rate, L, conf, debias,
   lim <- stat_interval(av, edf, conf, limits, unbiased)
   lower <- lim$lower
   upper <- lim$upper
+  if (limits && isTRUE(e$exact_ci)) {
+    # rows at few averages: the exact limits (R/ci-exact.R)
+    ex <- allan_limits_exact(e$name, m, n, L, alpha, conf)
+    ok <- !is.na(ex$lower)
+    lower[ok] <- sqrt(av[ok]) * ex$lower[ok]
+    upper[ok] <- sqrt(av[ok]) * ex$upper[ok]
+  }
   if (limits && !is.null(r$limits)) {
     lower[r$limits$rows] <- r$limits$lower
     upper[r$limits$rows] <- r$limits$upper

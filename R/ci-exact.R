@@ -14,7 +14,7 @@
 # Which rows: N/m <= getOption("allanvar.ci_exact", 16) (N rate samples);
 # Inf makes every row exact, 0 none. Types: the Allan and Hadamard families
 # (standard, overlapping, modified, hadamard, ohadamard; tdev through
-# modified, TheoH's Allan rows through overlapping).
+# modified, TheoH's Allan rows through overlapping) and PDEV.
 #
 # Cost: an eigenproblem of the terms (at most `exact_nmax` of them) and two
 # Imhof quantiles per (type, m, n, alpha, conf), cached for the session.
@@ -35,8 +35,8 @@
 #' Where a row has few averages, \eqn{N/m \le 16} (\eqn{N} rate samples),
 #' the limits of the Allan and Hadamard types (`"standard"`,
 #' `"overlapping"`, `"modified"`, `"hadamard"`, `"ohadamard"`, and so
-#' `"tdev"`) are not the chi-square ones: the estimate over its expectation
-#' is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
+#' `"tdev"`) and of `"pdev"` are not the chi-square ones: the estimate
+#' over its expectation is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
 #' \eqn{\lambda_i} the eigenvalues of the covariance of its terms under
 #' discrete power-law noise of the row's noise type (\eqn{x = (1 -
 #' B)^{-(2 - \alpha)/2} e}), and the interval is
@@ -89,8 +89,7 @@ exact_rows <- function(m, L) {
 # one problem: type code, cluster size m, n terms, noise exponent alpha
 # (integer), level conf. NA where it does not apply (see above).
 exact_factors_one <- function(code, m, n, alpha, conf) {
-  info <- allan_type_table()
-  ov <- info$overlapping[match(code, info$code)]
+  ov <- Find(function(s) s$code == code, stat_catalogue())$overlapping
   if (ov && alpha >= 1L) {
     # PM: no scaling (the EDF grows with m at fixed N/m); the problem as it
     # is up to exact_nmax_pm terms
@@ -213,8 +212,9 @@ allan_limits_exact <- function(type, m, n, L, alpha, conf) {
       f1 <- exact_factors_one(code, m[i], n[i], a, conf)
       if (anyNA(f1)) {
         # a type the exact route leaves to chi-square: its interval
-        e <- allan_edf_direct(type, m[i], n[i], L, a)
-        f1 <- sqrt(e / stats::qchisq(c(1 - (1 - conf) / 2, (1 - conf) / 2), e))
+        ed <- stat_edf_rules()[[e$edf]](e, m[i], n[i], L, a)
+        f1 <- sqrt(ed / stats::qchisq(c(1 - (1 - conf) / 2, (1 - conf) / 2),
+                                      ed))
       }
       f1
     }, numeric(2))

@@ -67,7 +67,7 @@ stats_further <- function() {
             nterms = function(m, L, theo_row = NULL) {
               ifelse(m == 1, L - 2, L - 2 * m)
             },
-            kernel = kernel_pdev, edf = "engine_modified",
+            kernel = kernel_pdev, edf = "terms", exact_ci = TRUE,
             id_base = "modified")
   )
 }

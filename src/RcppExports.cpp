@@ -209,6 +209,19 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// terms_edf_cpp
+Rcpp::NumericVector terms_edf_cpp(int type, const Rcpp::NumericVector& m, const Rcpp::NumericVector& n, const Rcpp::IntegerVector& alpha);
+RcppExport SEXP _allanvar_terms_edf_cpp(SEXP typeSEXP, SEXP mSEXP, SEXP nSEXP, SEXP alphaSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< int >::type type(typeSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type n(nSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type alpha(alphaSEXP);
+    rcpp_result_gen = Rcpp::wrap(terms_edf_cpp(type, m, n, alpha));
+    return rcpp_result_gen;
+END_RCPP
+}
 // acf_sums
 Rcpp::NumericVector acf_sums(const Rcpp::NumericVector& x, int max_lag);
 RcppExport SEXP _allanvar_acf_sums(SEXP xSEXP, SEXP max_lagSEXP) {
@@ -679,6 +692,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
     {"_allanvar_edf_interpolate_cpp", (DL_FUNC) &_allanvar_edf_interpolate_cpp, 4},
     {"_allanvar_ci_long_cpp", (DL_FUNC) &_allanvar_ci_long_cpp, 7},
+    {"_allanvar_terms_edf_cpp", (DL_FUNC) &_allanvar_terms_edf_cpp, 4},
     {"_allanvar_acf_sums", (DL_FUNC) &_allanvar_acf_sums, 2},
     {"_allanvar_detrend_line", (DL_FUNC) &_allanvar_detrend_line, 1},
     {"_allanvar_welch_segments", (DL_FUNC) &_allanvar_welch_segments, 3},

@@ -4,9 +4,13 @@
 //    Tables 1-3;
 //  * exact Gaussian moments (Isserlis) for discrete white or random-walk
 //    rate noise, where the continuous-time model of Greenhall overstates the
-//    EDF at small m.
+//    EDF at small m;
+//  * for PDEV, the same moments under every discrete power-law noise, from
+//    its terms' autocovariance (src/term_acov.h): terms_edf_cpp().
 #include <Rcpp.h>
+#include "term_acov.h"
 #include "types.h"
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -352,4 +356,80 @@ Rcpp::List ci_long_cpp(const Rcpp::NumericVector& avar,
   return Rcpp::List::create(Rcpp::Named("lower") = lower,
                             Rcpp::Named("upper") = upper,
                             Rcpp::Named("adev") = adev);
+}
+
+// Two-moment EDF of an estimator whose terms are a stationary sequence of
+// phase filters (PDEV; any type of src/term_acov.h): for the mean V of M terms with
+// autocovariance c(k) under the power law, Isserlis gives
+//   edf = 2 E[V]^2 / Var[V] = M^2 c(0)^2 / sum_{|k|<M} (M - |k|) c(k)^2,
+// the (sum lambda)^2 / sum lambda^2 of the exact law's eigenvalues
+// (src/gchisq.cpp) without the eigenproblem. Lags: c(k) vanishes beyond the
+// filter's span under white PM, white FM and random-walk FM; flicker's tails
+// (c(k) ~ k^-2 FM, k^-4 PM) are cut at 16 spans (EDF within 5e-6).
+// Beyond m = kTermsMcap the terms' correlation is that of continuous time
+// (at fixed M/m the EDF moves by under 2e-4 from m = 128 to 256, flicker PM
+// the slowest), so the EDF is taken at a smaller m' with M' = M m'/m (real:
+// the sum is linear in M between integers): m' = kTermsMcap, or more where
+// that leaves fewer than kTermsMin terms (up to kTermsMmax; the EDF of a
+// single term, or of a few nearly equal ones, is 1). Consecutive rows with
+// the same (m', alpha) compute c once: O(V^2 + lags V), V ~ 2 m'.
+namespace {
+const long kTermsMcap = 128;
+const long kTermsMmax = 2048;
+const double kTermsMin = 64;
+const long kFlickerSpans = 16;
+}  // namespace
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector terms_edf_cpp(int type, const Rcpp::NumericVector& m,
+                                  const Rcpp::NumericVector& n,
+                                  const Rcpp::IntegerVector& alpha) {
+  if (type < 0 || type >= allanvar::N_TYPES)
+    Rcpp::stop("internal: no estimator code %d", type);
+  const allanvar::EstimatorInfo& info = allanvar::estimator_info(type);
+  const R_xlen_t k = m.size();
+  if (n.size() != k || alpha.size() != k)
+    Rcpp::stop("internal: terms_edf_cpp needs n and alpha per m");
+  Rcpp::NumericVector out(k);
+  long cm = -1;
+  int ca = 0;
+  std::vector<double> c;  // c(k) of the last (m', alpha)
+  for (R_xlen_t i = 0; i < k; ++i) {
+    out[i] = NA_REAL;
+    if (!(m[i] >= 1 && m[i] < 1e15) || !(n[i] >= 1) ||
+        alpha[i] == NA_INTEGER || alpha[i] + 2 * info.d <= 1 || alpha[i] > 2)
+      continue;
+    long mp = static_cast<long>(m[i]);
+    if (m[i] > kTermsMcap) {
+      // terms at stride m keep their number; overlapping ones their N/m
+      const double want = !info.overlapping ? 0 : std::min<double>(
+          kTermsMmax, std::ceil(kTermsMin * m[i] / n[i]));
+      mp = static_cast<long>(
+          std::min(m[i], std::max<double>(kTermsMcap, want)));
+    }
+    const double M = info.overlapping ? n[i] * static_cast<double>(mp) / m[i]
+                                      : n[i];
+    if (M < 1) {
+      out[i] = 1;
+      continue;
+    }
+    const std::vector<double> w = allanvar::phase_weights(type, mp);
+    const long s = info.overlapping ? 1 : mp;
+    const long span = static_cast<long>(w.size()) + 2;
+    const long reach = alpha[i] % 2 == 0 ? span : kFlickerSpans * span;
+    // the lags the sum reads: those below M, at most the noise's reach
+    const long lags = static_cast<long>(
+        std::min<double>(reach / s + 1, std::ceil(M)));
+    if (mp != cm || alpha[i] != ca || static_cast<long>(c.size()) < lags) {
+      c = allanvar::term_acov(w, info.d, alpha[i], s, lags);
+      cm = mp;
+      ca = alpha[i];
+    }
+    const double c0 = c[0] * c[0];
+    double den = M * c0;
+    for (std::size_t j = 1; j < c.size() && static_cast<double>(j) < M; ++j)
+      den += 2 * (M - static_cast<double>(j)) * c[j] * c[j];
+    out[i] = M * M * c0 / den;
+  }
+  return out;
 }

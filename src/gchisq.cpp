@@ -12,60 +12,13 @@
 #include <Rcpp.h>
 #include <RcppEigen.h>
 #include <R_ext/Applic.h>
+#include "term_acov.h"
 #include "types.h"
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
 namespace {
-
-// Weights of one term on the phase (first point at 0): second (d = 2) or
-// third (d = 3) differences at spacing m, or for the modified type the sum
-// of m shifted second differences.
-std::vector<double> phase_weights(const allanvar::EstimatorInfo& info, long m) {
-  std::vector<double> w;
-  if (info.d == 3) {
-    w.assign(3 * m + 1, 0.0);
-    w[0] = -1;
-    w[m] = 3;
-    w[2 * m] = -3;
-    w[3 * m] = 1;
-  } else if (info.modified) {
-    w.assign(3 * m, 0.0);
-    for (long j = 0; j < m; ++j) {
-      w[j] += 1;
-      w[j + m] -= 2;
-      w[j + 2 * m] += 1;
-    }
-  } else {
-    w.assign(2 * m + 1, 0.0);
-    w[0] = 1;
-    w[m] = -2;
-    w[2 * m] = 1;
-  }
-  return w;
-}
-
-// v with w(B) = (1 - B)^d v(B): d running sums (exact in integers; the
-// last d entries vanish because w annihilates polynomials of degree < d).
-std::vector<double> undifference(std::vector<double> w, int d) {
-  for (int k = 0; k < d; ++k) {
-    for (std::size_t i = 1; i < w.size(); ++i) w[i] += w[i - 1];
-    w.pop_back();
-  }
-  return w;
-}
-
-// Autocovariance of (1 - B)^(-f) e, f <= 0, at lags 0..H (unit innovation
-// variance): gamma(0) = Gamma(1 - 2f)/Gamma(1 - f)^2 and
-// gamma(h + 1) = gamma(h) (h + f)/(h + 1 - f); at integer f the finite
-// moving average's (the ratio reaches zero at h = -f).
-std::vector<double> farima_acf(double f, long H) {
-  std::vector<double> g(H + 1);
-  g[0] = std::exp(std::lgamma(1 - 2 * f) - 2 * std::lgamma(1 - f));
-  for (long h = 0; h < H; ++h) g[h + 1] = g[h] * (h + f) / (h + 1 - f);
-  return g;
-}
 
 // The weights of Q, the largest kKeep as they are and the rest as one term
 // c chi2_k with c and k matching their mean and variance (Imhof's formula
@@ -198,36 +151,17 @@ double cdf_minus_p(double lq, void* info) {
 }  // namespace
 
 // Eigenvalues, over their sum, of the covariance of the terms of estimator
-// `type` (src/types.h; Allan and Hadamard families) with cluster size m and
-// n terms, under power-law noise of rate PSD exponent alpha; decreasing,
+// `type` (src/types.h; Allan and Hadamard families, PDEV) with cluster size
+// m and n terms, under power-law noise of rate PSD exponent alpha; decreasing,
 // those below 1e-13 of the largest dropped. Clean input: alpha + 2 d > 1,
 // n >= 1, m >= 1.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector gchisq_weights_cpp(int type, double m, double n, int alpha) {
   const allanvar::EstimatorInfo& info = allanvar::estimator_info(type);
   const long mm = static_cast<long>(m), nn = static_cast<long>(n);
-  const int d = info.d;
-  const std::vector<double> v = undifference(phase_weights(info, mm), d);
-  const long V = static_cast<long>(v.size());
-  const long s = info.overlapping ? 1 : mm;
-  // autocorrelation of v
-  std::vector<double> a(V);
-  for (long l = 0; l < V; ++l) {
-    double acc = 0;
-    for (long i = 0; i + l < V; ++i) acc += v[i] * v[i + l];
-    a[l] = acc;
-  }
-  const double f = (2.0 - alpha) / 2.0 - d;
-  const std::vector<double> g = farima_acf(f, (nn - 1) * s + V);
-  // c(k) = sum_l a(|l|) gamma(|k s + l|)
-  std::vector<double> c(nn);
-  for (long k = 0; k < nn; ++k) {
-    double acc = a[0] * g[k * s];
-    for (long l = 1; l < V; ++l) {
-      acc += a[l] * (g[k * s + l] + g[std::labs(k * s - l)]);
-    }
-    c[k] = acc;
-  }
+  const std::vector<double> c = allanvar::term_acov(
+      allanvar::phase_weights(type, mm), info.d, alpha,
+      info.overlapping ? 1 : mm, nn);
   Eigen::MatrixXd C(nn, nn);
   for (long i = 0; i < nn; ++i)
     for (long j = 0; j < nn; ++j) C(i, j) = c[std::labs(i - j)];

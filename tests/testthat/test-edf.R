@@ -611,3 +611,104 @@ test_that("the total type's EDF under flicker PM follows a Monte Carlo of its ow
   simple <- exp(sqrt(log((L - 1) / (2 * m)) * log((2 * m + 1) * (L - 1) / 4)))
   expect_true(all(simple / edf_mc > 1.3))
 })
+
+# PDEV's terms S_i = sum_{k<m} ((m - 1)/2 - k) (x(i + k) - x(i + m + k))
+# (Vernotte et al. 2016, as src/pdev.cpp computes them) written out as rows
+# of a matrix on the L phase points.
+pdev_term_matrix <- function(m, L) {
+  k <- 0:(m - 1)
+  w <- c((m - 1) / 2 - k, -((m - 1) / 2 - k))
+  M <- L - 2 * m
+  W <- matrix(0, M, L)
+  for (i in seq_len(M)) W[i, i - 1 + seq_along(w)] <- w
+  W
+}
+
+test_that("PDEV's EDF is the exact one of its terms (dense covariance)", {
+  ns <- asNamespace("allanvar")
+  # phase x = H e, H lower-triangular Toeplitz of Kasdin's coefficients of
+  # (1 - B)^(-delta), after 1500 points of burn-in (flicker then all but
+  # stationary); the mean V of the squared terms has
+  # 2 E[V]^2 / Var[V] = tr(S)^2 / sum(S^2), S the terms' covariance
+  dense <- function(m, L, alpha, burn = 1500) {
+    delta <- (2 - alpha) / 2
+    K <- L + burn
+    h <- cumprod(c(1, (seq_len(K - 1) - 1 + delta) / seq_len(K - 1)))
+    H <- stats::toeplitz(h)
+    H[upper.tri(H)] <- 0
+    WH <- pdev_term_matrix(m, L) %*% H[burn + seq_len(L), ]
+    S <- tcrossprod(WH)
+    sum(diag(S))^2 / sum(S^2)
+  }
+  for (alpha in 2:-2) for (m in c(2L, 5L, 8L)) {
+    L <- 2 * m + 40
+    ours <- ns$extra_edf("pdev", m, L, alpha, L - 2 * m)
+    expect_equal(ours, dense(m, L, alpha), tolerance = 1e-4,
+                 label = paste("PDEV EDF, alpha", alpha, "m", m))
+    # the eigenvalues of the exact limits' law give the same two moments
+    lam <- ns$gchisq_weights_cpp(ns$stat_entry("pdev")$code, m, L - 2 * m,
+                                 alpha)
+    expect_equal(sum(lam)^2 / sum(lam^2), ours, tolerance = 1e-9)
+  }
+  # the same route for the Allan and Hadamard types gives the engine's
+  # exact discrete EDF (Isserlis on the rate innovations, coded apart)
+  for (ty in c("standard", "modified", "ohadamard")) for (alpha in c(0L, -2L)) {
+    n <- ns$allan_nterms(ty, c(3, 8), 501)
+    expect_equal(ns$terms_edf_cpp(ns$stat_entry(ty)$code, c(3, 8), n,
+                                  rep(alpha, 2)),
+                 ns$allan_edf_direct(ty, c(3, 8), n, 501, alpha),
+                 tolerance = 1e-9)
+  }
+  # m = 1: PVAR is the Allan variance of the L - 2 second differences
+  expect_equal(ns$extra_edf("pdev", 1, 201, 0L, 199),
+               ns$allan_edf_direct("overlapping", 1, 199, 201, 0L),
+               tolerance = 1e-9)
+})
+
+test_that("PDEV's EDF matches a Monte Carlo of its own generator", {
+  skip_on_cran()
+  ns <- asNamespace("allanvar")
+  N <- 256
+  L <- N + 1
+  gens <- mc_gens(N)
+  set.seed(2016)
+  y1 <- gens$wfm()
+  x1 <- c(0, cumsum(y1))
+  W8 <- pdev_term_matrix(8, L)
+  # the dense terms give allan()'s PVAR (72 / (M m^6) sum S_i^2, tau0 = 1)
+  expect_equal(72 * sum((W8 %*% x1)^2) / (nrow(W8) * 8^6),
+               allan(y1, 1, taus = I(8), type = "pdev", ci = FALSE)$avar,
+               tolerance = 1e-10)
+  reps <- 3000
+  for (g in c("wfm", "ffm", "wpm")) {
+    X <- vapply(seq_len(reps), function(i) c(0, cumsum(gens[[g]]())),
+                numeric(L))
+    alpha <- c(wfm = 0L, ffm = -1L, wpm = 2L)[[g]]
+    for (m in c(4L, 8L, 16L)) {
+      v <- colMeans((pdev_term_matrix(m, L) %*% X)^2)
+      mc <- 2 * mean(v)^2 / stats::var(v)
+      # 3000 records: the Monte Carlo EDF within about 3% (1 sd); the
+      # modified Allan EDF PDEV took before is 17-30% below it here
+      expect_equal(ns$extra_edf("pdev", m, L, alpha, L - 2 * m), mc,
+                   tolerance = 0.1, label = paste("PDEV EDF,", g, "m", m))
+    }
+  }
+})
+
+test_that("PDEV's rows at few averages take the exact limits", {
+  ns <- asNamespace("allanvar")
+  set.seed(29)
+  y <- rnorm(1024)
+  a <- allan(y, 1, type = "pdev")
+  b <- withr_options(list(allanvar.ci_exact = 0), allan(y, 1, type = "pdev"))
+  few <- (1024 / a$m) <= 16 & a$n > 1
+  expect_true(any(few))
+  expect_equal(a$lower[!few], b$lower[!few])
+  expect_equal(a$edf, b$edf)
+  # the generalized chi-square quantiles of PDEV's own terms, not the
+  # chi-square ones
+  ex <- ns$allan_limits_exact("pdev", a$m, a$n, 1025, a$alpha, 0.683)
+  expect_equal(a$lower[few], a$adev[few] * ex$lower[few])
+  expect_equal(a$upper[few], a$adev[few] * ex$upper[few])
+  expect_true(all(abs(a$upper[few] / b$upper[few] - 1) > 1e-3))
+})
