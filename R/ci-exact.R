@@ -186,35 +186,54 @@ exact_sets <- function(m, L, alpha, lo) {
   })
 }
 
-#' Exact limits of Allan-family rows (internal)
+#' Exact limits of the rows at few averages (internal)
 #'
 #' The hook of allan()'s limits: lower and upper factors (multiply the
 #' deviation) of the generalized chi-square interval, the union over the
 #' plausible noise types, for the rows where they apply (`exact_rows()`),
-#' `NA` elsewhere.
+#' `NA` elsewhere. The law comes from the stationary terms (Allan and
+#' Hadamard families) or, for an entry with an `exact_form`, from its dense
+#' quadratic form (R/ci-exact-forms.R).
 #' @param type allan()'s type name.
 #' @param m,n,L cluster sizes, numbers of terms, phase points.
 #' @param alpha identified integer noise exponents (`NA`: unknown).
 #' @param conf confidence level.
+#' @param sets the noise exponents to join at each row (a list), or `NULL`:
+#'   `exact_sets()`.
+#' @param debias whether the deviation carries the bias correction of the
+#'   type read (`alpha`): a candidate type's interval then takes its own.
 #' @return A list of numeric vectors `lower` and `upper`, one per row.
 #' @noRd
-allan_limits_exact <- function(type, m, n, L, alpha, conf) {
+allan_limits_exact <- function(type, m, n, L, alpha, conf, sets = NULL,
+                               debias = FALSE) {
   k <- length(m)
   lower <- upper <- rep(NA_real_, k)
   e <- stat_entry(type)
   if (!isTRUE(e$exact_ci)) return(list(lower = lower, upper = upper))
   rows <- which(exact_rows(m, L) & n >= 1)
   if (!length(rows)) return(list(lower = lower, upper = upper))
+  dense <- !is.null(e$exact_form)
   code <- allan_type_code(type)
   lo <- e$alpha_range[1L]
-  sets <- exact_sets(m, L, rep_len(as.integer(alpha), k), lo)
+  alpha <- rep_len(as.integer(alpha), k)
+  if (is.null(sets)) sets <- exact_sets(m, L, alpha, lo)
+  rule <- stat_edf_rules()[[e$edf]]
   for (i in rows) {
     f <- vapply(sets[[i]], function(a) {
-      f1 <- exact_factors_one(code, m[i], n[i], a, conf)
+      f1 <- if (dense) {
+        exact_dense_factors(e$exact_form, m[i], L, a, conf)
+      } else {
+        exact_factors_one(code, m[i], n[i], a, conf)
+      }
       if (anyNA(f1)) {
         # a type the exact route leaves to chi-square: its interval
-        e <- allan_edf_direct(type, m[i], n[i], L, a)
-        f1 <- sqrt(e / stats::qchisq(c(1 - (1 - conf) / 2, (1 - conf) / 2), e))
+        ed <- rule(e, m[i], n[i], L, a)
+        f1 <- sqrt(ed / stats::qchisq(c(1 - (1 - conf) / 2, (1 - conf) / 2),
+                                      ed))
+      }
+      if (debias) {
+        f1 <- f1 * sqrt(debias_factor(type, a, m[i]) /
+                          debias_factor(type, alpha[i], m[i]))
       }
       f1
     }, numeric(2))

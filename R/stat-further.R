@@ -27,22 +27,26 @@ stats_further <- function() {
     further("mtotdev", "modified total deviation",
             max_m = mod_max, nterms = mod_n,
             kernel = kernel_total_modified(time = FALSE), edf = "mtot",
-            id_base = "modified", debias = debias_mtot),
+            id_base = "modified", debias = debias_mtot, exact_ci = TRUE,
+            exact_form = "exact_form_mtot"),
     further("ttotdev", "time total deviation TTOT", time = TRUE,
             max_m = mod_max, nterms = mod_n,
             kernel = kernel_total_modified(time = TRUE), edf = "mtot",
-            id_base = "modified", debias = debias_mtot),
+            id_base = "modified", debias = debias_mtot, exact_ci = TRUE,
+            exact_form = "exact_form_mtot"),
     further("htotdev", "Hadamard total deviation",
             max_m = function(L) floor((L - 1) / 3),
             nterms = function(m, L, theo_row = NULL) {
               ifelse(m == 1, L - 3, L - 3 * m)
             },
             kernel = kernel_htot, edf = "htot", alpha_range = c(-4L, 2L),
-            id_base = "ohadamard", debias = debias_htot),
+            id_base = "ohadamard", debias = debias_htot, exact_ci = TRUE,
+            exact_form = "exact_form_htot"),
     further("theo1", "Theo1 deviation",
             max_m = function(L) L - 1, nterms = theo_n,
             taus = stat_taus_theo, kernel = kernel_theo(own_type = TRUE),
-            edf = "theo1", id_base = "overlapping", debias = debias_theo1),
+            edf = "theo1", id_base = "overlapping", debias = debias_theo1,
+            exact_ci = TRUE, exact_form = "exact_form_theo1"),
     further("theobr", "bias-removed Theo1 deviation (TheoBR)",
             max_m = function(L) L - 1, nterms = theo_n,
             taus = stat_taus_theo, kernel = kernel_theo(own_type = FALSE),
@@ -201,6 +205,7 @@ kernel_theo <- function(own_type) {
     alpha <- rep(NA_integer_, length(m))
     edf <- rep(NA_real_, length(m))
     limits <- NULL
+    sets <- NULL
     mt <- m[theo_row]
     if (length(mt)) {
       # many m: the recurrence over k (O(L log^2 L + kmax^2)) beats
@@ -220,6 +225,9 @@ kernel_theo <- function(own_type) {
           u <- theo1_union(t1, mt, L, attr(ta, "alts"), ctx$n[theo_row],
                            ctx$conf, ctx$debias)
           limits <- list(rows = theo_row, lower = u$lower, upper = u$upper)
+          # the candidate types, for the exact limits at few averages
+          sets <- as.list(alpha)
+          sets[theo_row] <- attr(ta, "alts")
         }
         if (ctx$debias) {
           t1 <- t1 * debias_factor(ctx$entry$name, alpha[theo_row], mt)
@@ -244,6 +252,7 @@ kernel_theo <- function(own_type) {
       alpha[!theo_row] <- a$alpha
       edf[!theo_row] <- a$edf
     }
-    list(av = av, alpha = alpha, edf = edf, limits = limits)
+    list(av = av, alpha = alpha, edf = edf, limits = limits,
+         exact_sets = sets)
   }
 }
