@@ -14,7 +14,9 @@
 # Which rows: N/m <= getOption("allanvar.ci_exact", 16) (N rate samples);
 # Inf makes every row exact, 0 none. Types: the Allan and Hadamard families
 # (standard, overlapping, modified, hadamard, ohadamard; tdev through
-# modified, TheoH's Allan rows through overlapping).
+# modified, TheoH's Allan rows through overlapping); the total family and
+# Theo1 by their dense quadratic forms (R/ci-exact-forms.R), the catalogue
+# entries' `exact_form`.
 #
 # Cost: an eigenproblem of the terms (at most `exact_nmax` of them) and two
 # Imhof quantiles per (type, m, n, alpha, conf), cached for the session.
@@ -35,11 +37,16 @@
 #' Where a row has few averages, \eqn{N/m \le 16} (\eqn{N} rate samples),
 #' the limits of the Allan and Hadamard types (`"standard"`,
 #' `"overlapping"`, `"modified"`, `"hadamard"`, `"ohadamard"`, and so
-#' `"tdev"`) are not the chi-square ones: the estimate over its expectation
+#' `"tdev"`; the total family `"total"`, `"mtotdev"`, `"ttotdev"`,
+#' `"htotdev"`; and `"theo1"`) are not the chi-square ones: the estimate
+#' over its expectation
 #' is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
 #' \eqn{\lambda_i} the eigenvalues of the covariance of its terms under
 #' discrete power-law noise of the row's noise type (\eqn{x = (1 -
-#' B)^{-(2 - \alpha)/2} e}), and the interval is
+#' B)^{-(2 - \alpha)/2} e}; for the total family and Theo1, whose terms
+#' come from a reflected or detrended record, the eigenvalues of their
+#' quadratic form in the phase under that noise started at rest), and the
+#' interval is
 #' \eqn{[\sigma / \sqrt{q_{1-p}}, \sigma / \sqrt{q_p}]} with its quantiles
 #' \eqn{q} (Imhof's integral). The noise type read at a few averages is
 #' weak (B1 from a handful of averages reads an FM type as its whiter
@@ -62,7 +69,11 @@
 #' type of noise, level) is computed once per session; large problems are
 #' scaled to at most 300 terms at \eqn{m \le 64} with the same
 #' \eqn{N/m} (FM noise), or, under PM noise on the overlapping types
-#' beyond 1000 terms, keep the chi-square interval.
+#' beyond 1000 terms, keep the chi-square interval. The total family and
+#' Theo1 take their law at the same \eqn{N/m} on at most 513 phase points
+#' under FM noise and, under PM noise, as it is up to 1100 points (beyond,
+#' the chi-square interval); such a problem costs about a second the first
+#' time (Theo1's union over plausible types several).
 NULL
 
 exact_nmax <- 300L

@@ -39,6 +39,9 @@
 #                 name of a function(m, L) giving the statistic's quadratic
 #                 form in the phase, whose law is computed densely
 #                 (R/ci-exact-forms.R: the total family, Theo1)
+#   exact_id    "sums" kernels: the Allan-family statistic whose noise
+#                 identification the exact rows rest on, or NA: the
+#                 statistic's own
 #   id_base     for kernel functions: the Allan-family statistic whose
 #                 noise identification gives the type at each tau (NA:
 #                 none, or the kernel's own)
@@ -106,7 +109,8 @@ new_stat <- function(name, title, ylab, max_m, nterms, kernel = "sums",
                      aliases = character(),
                      edf_fallback = function(m, n, L) n,
                      octave_pass = FALSE, min_points = 3L,
-                     exact_ci = FALSE, exact_form = NULL, variance = TRUE,
+                     exact_ci = FALSE, exact_form = NULL,
+                     exact_id = NA_character_, variance = TRUE,
                      theo = NULL) {
   list(name = name, title = title, ylab = ylab, max_m = max_m,
        nterms = nterms, kernel = kernel, divisor = divisor, taus = taus,
@@ -114,8 +118,8 @@ new_stat <- function(name, title, ylab, max_m, nterms, kernel = "sums",
        noise_id = noise_id, debias = debias, unbiased = unbiased, gaps = gaps,
        aliases = aliases, edf_fallback = edf_fallback,
        octave_pass = octave_pass, min_points = min_points,
-       exact_ci = exact_ci, exact_form = exact_form, variance = variance,
-       theo = theo)
+       exact_ci = exact_ci, exact_form = exact_form, exact_id = exact_id,
+       variance = variance, theo = theo)
 }
 
 validate_stat <- function(e) {
