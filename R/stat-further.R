@@ -205,7 +205,6 @@ kernel_theo <- function(own_type) {
     alpha <- rep(NA_integer_, length(m))
     edf <- rep(NA_real_, length(m))
     limits <- NULL
-    sets <- NULL
     mt <- m[theo_row]
     if (length(mt)) {
       # many m: the recurrence over k (O(L log^2 L + kmax^2)) beats
@@ -225,9 +224,6 @@ kernel_theo <- function(own_type) {
           u <- theo1_union(t1, mt, L, attr(ta, "alts"), ctx$n[theo_row],
                            ctx$conf, ctx$debias)
           limits <- list(rows = theo_row, lower = u$lower, upper = u$upper)
-          # the candidate types, for the exact limits at few averages
-          sets <- as.list(alpha)
-          sets[theo_row] <- attr(ta, "alts")
         }
         if (ctx$debias) {
           t1 <- t1 * debias_factor(ctx$entry$name, alpha[theo_row], mt)
@@ -252,7 +248,6 @@ kernel_theo <- function(own_type) {
       alpha[!theo_row] <- a$alpha
       edf[!theo_row] <- a$edf
     }
-    list(av = av, alpha = alpha, edf = edf, limits = limits,
-         exact_sets = sets)
+    list(av = av, alpha = alpha, edf = edf, limits = limits)
   }
 }
