@@ -59,7 +59,9 @@
 #' over the types the row's own reading leaves plausible: an FM type and
 #' its redder neighbour; below \eqn{N/m = 8}, where flicker PM and white
 #' FM can no longer be told apart, the type read at the nearest shorter tau
-#' with \eqn{N/m \ge 8}. So the limits of a row at few averages depend on
+#' with \eqn{N/m \ge 8}. The total type's rows take the noise type as
+#' `"overlapping"` reads it (its own reading leans to white FM at long
+#' tau). So the limits of a row at few averages depend on
 #' the taus computed with it: a curve's default grid has the rows at many
 #' averages. `options(allanvar.ci_exact = k)` moves the threshold
 #' \eqn{N/m \le k} (`Inf`: every row, `0`: chi-square everywhere). The
