@@ -10,7 +10,7 @@
 # sum. A is dense in L phase points: under PM noise the problem is solved
 # as it is up to exact_dense_max points, beyond the chi-square interval is
 # kept (the law moves with m at fixed N/m: white PM's total EDF at N/m = 8
-# is 45 at N = 256, 84 at N = 1024); under FM noise it is solved at the
+# is 59 at N = 256, 84 at N = 1024); under FM noise it is solved at the
 # same N/m on at most exact_dense_fm points (the law at fixed N/m tends to
 # that of continuous time as m grows). The catalogue entry's `exact_form`
 # names the form (R/stat-allan.R, R/stat-further.R). Cost (2026-11-28,

@@ -54,10 +54,9 @@ test_that("the dense law's EDF matches a Monte Carlo of own generators", {
 test_that("the total type's limits cover under white PM at few averages", {
   skip_on_cran()
   # white PM, N = 256, N/m = 8: the law at the true type covers; the
-  # chi-square interval with Table 5's EDF (several hundred against the
-  # law's 45) under-covers (0.55), as allan()'s limits did;
-  # allan() joins the types its reading leaves plausible (white FM is read
-  # in a third of the records at this N/m), so it may over-cover
+  # chi-square interval with Table 5's EDF (111 against the law's 59)
+  # under-covers (0.55), as allan()'s limits did; allan() joins the types
+  # its reading leaves plausible, so it may over-cover a little
   set.seed(13)
   N <- 256
   recs <- replicate(600, diff(stats::rnorm(N + 1)), simplify = FALSE)
