@@ -342,6 +342,14 @@ extra_channel <- function(v, freq, m, theo_row, e, rate, L, conf, debias,
     upper[r$limits$rows] <- r$limits$upper
   }
   adev <- if (is.null(r$adev)) lim$adev else r$adev
+  if (limits && isTRUE(e$exact_ci)) {
+    # rows at few averages: the exact law (R/ci-exact.R)
+    ex <- allan_limits_exact(e$name, m, n, L, alpha, conf, r$exact_sets,
+                             debias && !is.null(e$debias))
+    ok <- which(!is.na(ex$lower))
+    lower[ok] <- sqrt(av[ok]) * ex$lower[ok]
+    upper[ok] <- sqrt(av[ok]) * ex$upper[ok]
+  }
   if (!stat_has_limits(e) || !(limits || unbiased)) edf <- na
   list(tau = ifelse(theo_row, 0.75, 1) * m / freq, m = as.integer(m), n = n,
        avar = av, adev = adev, lower = lower, upper = upper, edf = edf,

@@ -315,8 +315,17 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
       av <- times_pow2(av * a * a, 2 * sc[j] + 2 * b)
     }
     check_representable(av, nonzero = res$sums[, j] > 0)
+    # the rows at few averages may rest on another statistic's reading
+    # (the entry's exact_id; R/ci-exact.R)
+    ex_alpha <- NULL
+    if (ci && !is.na(e$exact_id) && any(exact_rows(m, L))) {
+      xj <- ch$values
+      if (ch$nc > 1L) xj <- xj[(j - 1) * N + seq_len(N)]
+      ex_alpha <- extra_alpha(as.double(xj), freq, m, e$exact_id,
+                              if (rate) "rate" else "integrated", L)
+    }
     lim <- stat_limits(e, av, m, nterms, L, res$alpha_int[, j], sub, conf,
-                       ci, unbiased)
+                       ci, unbiased, ex_alpha)
     out[[j]] <- allan_rows(m, nterms, av, lim, freq, ch, j)
   }
   out <- if (ch$nc == 1L) out[[1L]] else do.call(rbind, out)

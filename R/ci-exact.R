@@ -14,7 +14,9 @@
 # Which rows: N/m <= getOption("allanvar.ci_exact", 16) (N rate samples);
 # Inf makes every row exact, 0 none. Types: the Allan and Hadamard families
 # (standard, overlapping, modified, hadamard, ohadamard; tdev through
-# modified, TheoH's Allan rows through overlapping) and PDEV.
+# modified, TheoH's Allan rows through overlapping) and PDEV; the total family and
+# Theo1 by their dense quadratic forms (R/ci-exact-forms.R), the catalogue
+# entries' `exact_form`.
 #
 # Cost: an eigenproblem of the terms (at most `exact_nmax` of them) and two
 # Imhof quantiles per (type, m, n, alpha, conf), cached for the session.
@@ -35,11 +37,16 @@
 #' Where a row has few averages, \eqn{N/m \le 16} (\eqn{N} rate samples),
 #' the limits of the Allan and Hadamard types (`"standard"`,
 #' `"overlapping"`, `"modified"`, `"hadamard"`, `"ohadamard"`, and so
-#' `"tdev"`) and of `"pdev"` are not the chi-square ones: the estimate
-#' over its expectation is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
+#' `"tdev"`; `"pdev"`; the total family `"total"`, `"mtotdev"`, `"ttotdev"`,
+#' `"htotdev"`; and `"theo1"`) are not the chi-square ones: the estimate
+#' over its expectation
+#' is a generalized chi-square, \eqn{\sum_i \lambda_i \chi^2_1} with
 #' \eqn{\lambda_i} the eigenvalues of the covariance of its terms under
 #' discrete power-law noise of the row's noise type (\eqn{x = (1 -
-#' B)^{-(2 - \alpha)/2} e}), and the interval is
+#' B)^{-(2 - \alpha)/2} e}; for the total family and Theo1, whose terms
+#' come from a reflected or detrended record, the eigenvalues of their
+#' quadratic form in the phase under that noise started at rest), and the
+#' interval is
 #' \eqn{[\sigma / \sqrt{q_{1-p}}, \sigma / \sqrt{q_p}]} with its quantiles
 #' \eqn{q} (Imhof's integral). The noise type read at a few averages is
 #' weak (B1 from a handful of averages reads an FM type as its whiter
@@ -52,7 +59,9 @@
 #' over the types the row's own reading leaves plausible: an FM type and
 #' its redder neighbour; below \eqn{N/m = 8}, where flicker PM and white
 #' FM can no longer be told apart, the type read at the nearest shorter tau
-#' with \eqn{N/m \ge 8}. So the limits of a row at few averages depend on
+#' with \eqn{N/m \ge 8}. The total type's rows take the noise type as
+#' `"overlapping"` reads it (its own reading leans to white FM at long
+#' tau). So the limits of a row at few averages depend on
 #' the taus computed with it: a curve's default grid has the rows at many
 #' averages. `options(allanvar.ci_exact = k)` moves the threshold
 #' \eqn{N/m \le k} (`Inf`: every row, `0`: chi-square everywhere). The
@@ -62,7 +71,11 @@
 #' type of noise, level) is computed once per session; large problems are
 #' scaled to at most 300 terms at \eqn{m \le 64} with the same
 #' \eqn{N/m} (FM noise), or, under PM noise on the overlapping types
-#' beyond 1000 terms, keep the chi-square interval.
+#' beyond 1000 terms, keep the chi-square interval. The total family and
+#' Theo1 take their law at the same \eqn{N/m} on at most 513 phase points
+#' under FM noise and, under PM noise, as it is up to 1100 points (beyond,
+#' the chi-square interval); such a problem costs about a second the first
+#' time (Theo1's union over plausible types several).
 NULL
 
 exact_nmax <- 300L
@@ -185,36 +198,54 @@ exact_sets <- function(m, L, alpha, lo) {
   })
 }
 
-#' Exact limits of Allan-family rows (internal)
+#' Exact limits of the rows at few averages (internal)
 #'
 #' The hook of allan()'s limits: lower and upper factors (multiply the
 #' deviation) of the generalized chi-square interval, the union over the
 #' plausible noise types, for the rows where they apply (`exact_rows()`),
-#' `NA` elsewhere.
+#' `NA` elsewhere. The law comes from the stationary terms (Allan and
+#' Hadamard families) or, for an entry with an `exact_form`, from its dense
+#' quadratic form (R/ci-exact-forms.R).
 #' @param type allan()'s type name.
 #' @param m,n,L cluster sizes, numbers of terms, phase points.
 #' @param alpha identified integer noise exponents (`NA`: unknown).
 #' @param conf confidence level.
+#' @param sets the noise exponents to join at each row (a list), or `NULL`:
+#'   `exact_sets()`.
+#' @param debias whether the deviation carries the bias correction of the
+#'   type read (`alpha`): a candidate type's interval then takes its own.
 #' @return A list of numeric vectors `lower` and `upper`, one per row.
 #' @noRd
-allan_limits_exact <- function(type, m, n, L, alpha, conf) {
+allan_limits_exact <- function(type, m, n, L, alpha, conf, sets = NULL,
+                               debias = FALSE) {
   k <- length(m)
   lower <- upper <- rep(NA_real_, k)
   e <- stat_entry(type)
   if (!isTRUE(e$exact_ci)) return(list(lower = lower, upper = upper))
   rows <- which(exact_rows(m, L) & n >= 1)
   if (!length(rows)) return(list(lower = lower, upper = upper))
+  dense <- !is.null(e$exact_form)
   code <- allan_type_code(type)
   lo <- e$alpha_range[1L]
-  sets <- exact_sets(m, L, rep_len(as.integer(alpha), k), lo)
+  alpha <- rep_len(as.integer(alpha), k)
+  if (is.null(sets)) sets <- exact_sets(m, L, alpha, lo)
+  rule <- stat_edf_rules()[[e$edf]]
   for (i in rows) {
     f <- vapply(sets[[i]], function(a) {
-      f1 <- exact_factors_one(code, m[i], n[i], a, conf)
+      f1 <- if (dense) {
+        exact_dense_factors(e$exact_form, m[i], L, a, conf)
+      } else {
+        exact_factors_one(code, m[i], n[i], a, conf)
+      }
       if (anyNA(f1)) {
         # a type the exact route leaves to chi-square: its interval
-        ed <- stat_edf_rules()[[e$edf]](e, m[i], n[i], L, a)
+        ed <- rule(e, m[i], n[i], L, a)
         f1 <- sqrt(ed / stats::qchisq(c(1 - (1 - conf) / 2, (1 - conf) / 2),
                                       ed))
+      }
+      if (debias) {
+        f1 <- f1 * sqrt(debias_factor(type, a, m[i]) /
+                          debias_factor(type, alpha[i], m[i]))
       }
       f1
     }, numeric(2))

@@ -236,10 +236,11 @@ edf_rule_theo1 <- function(e, m, n, L, alpha) {
 
 # The EDF, deviation and limits of a curve of a "sums" statistic (its
 # entry `e`): the EDF by the entry's rule at the rows `sub` where the noise
-# type was identified (alpha: those rows' exponents); with neither `ci` nor
+# type was identified (alpha: those rows' exponents; exact_alpha: the
+# exponents the exact rows rest on, when not those); with neither `ci` nor
 # `unbiased` nothing is identified and edf, lower, upper and alpha are NA.
 stat_limits <- function(e, av, m, n, L, alpha, sub, conf, ci = TRUE,
-                        unbiased = FALSE) {
+                        unbiased = FALSE, exact_alpha = NULL) {
   if (ci || unbiased) {
     ed <- allan_edf(e, m, n, L, alpha, sub)
   } else {
@@ -249,8 +250,11 @@ stat_limits <- function(e, av, m, n, L, alpha, sub, conf, ci = TRUE,
   out <- stat_interval(av, ed$edf, conf, ci, FALSE)
   # rows at few averages: the exact generalized chi-square limits
   # (R/ci-exact.R) where the entry has them
-  if (ci) out <- exact_limits_merge(out, allan_limits_exact(e$name, m, n, L,
-                                                            ed$alpha, conf))
+  if (ci) {
+    ea <- if (is.null(exact_alpha)) ed$alpha else exact_alpha
+    out <- exact_limits_merge(out, allan_limits_exact(e$name, m, n, L, ea,
+                                                      conf))
+  }
   if (unbiased && e$unbiased) out$adev <- out$adev / stat_c4(ed$edf)
   out$edf <- ed$edf
   out$alpha <- ed$alpha

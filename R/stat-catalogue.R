@@ -34,6 +34,14 @@
 #   alpha_range the noise exponents the EDF rule admits (c(lo, hi))
 #   exact_ci    whether rows at few averages take the exact generalized
 #                 chi-square limits (R/ci-exact.R; from alpha_range's lo)
+#   exact_form  NULL: the exact law from the stationary terms' covariance
+#                 (src/gchisq.cpp, the Allan and Hadamard families); or the
+#                 name of a function(m, L) giving the statistic's quadratic
+#                 form in the phase, whose law is computed densely
+#                 (R/ci-exact-forms.R: the total family, Theo1)
+#   exact_id    "sums" kernels: the Allan-family statistic whose noise
+#                 identification the exact rows rest on, or NA: the
+#                 statistic's own
 #   id_base     for kernel functions: the Allan-family statistic whose
 #                 noise identification gives the type at each tau (NA:
 #                 none, or the kernel's own)
@@ -101,14 +109,17 @@ new_stat <- function(name, title, ylab, max_m, nterms, kernel = "sums",
                      aliases = character(),
                      edf_fallback = function(m, n, L) n,
                      octave_pass = FALSE, min_points = 3L,
-                     exact_ci = FALSE, variance = TRUE, theo = NULL) {
+                     exact_ci = FALSE, exact_form = NULL,
+                     exact_id = NA_character_, variance = TRUE,
+                     theo = NULL) {
   list(name = name, title = title, ylab = ylab, max_m = max_m,
        nterms = nterms, kernel = kernel, divisor = divisor, taus = taus,
        edf = edf, alpha_range = as.integer(alpha_range), id_base = id_base,
        noise_id = noise_id, debias = debias, unbiased = unbiased, gaps = gaps,
        aliases = aliases, edf_fallback = edf_fallback,
        octave_pass = octave_pass, min_points = min_points,
-       exact_ci = exact_ci, variance = variance, theo = theo)
+       exact_ci = exact_ci, exact_form = exact_form, exact_id = exact_id,
+       variance = variance, theo = theo)
 }
 
 validate_stat <- function(e) {
@@ -122,6 +133,10 @@ validate_stat <- function(e) {
   }
   if (!isTRUE(e$variance) && !isFALSE(e$variance)) {
     bad("`variance` must be TRUE or FALSE.")
+  }
+  if (!is.null(e$exact_form) && !(is.character(e$exact_form) &&
+                                   length(e$exact_form) == 1L)) {
+    bad("`exact_form` must be NULL or a function's name.")
   }
   if (!is.null(e$debias) && !is.function(e$debias)) {
     bad("`debias` must be a function or NULL.")

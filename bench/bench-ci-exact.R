@@ -2,7 +2,7 @@
 # with chi-square limits only (options(allanvar.ci_exact = 0)), with the
 # exact ones in a fresh session (every problem computed), and again (the
 # session's cache). Each in its own callr process; medians of `reps`.
-#   Rscript bench/bench-ci-exact.R [reps]
+#   [BENCH_TYPES=total,mtotdev] Rscript bench/bench-ci-exact.R [reps]
 args <- commandArgs(TRUE)
 reps <- if (length(args)) as.integer(args[1]) else 3L
 lib <- Sys.getenv("ALLANVAR_LIB", .libPaths()[1])
@@ -17,9 +17,13 @@ one <- function(N, type, taus, exact) {
     c(first = t1, again = t2)
   }, list(N, type, taus, exact, lib))
 }
+types <- if (nzchar(Sys.getenv("BENCH_TYPES"))) {
+  strsplit(Sys.getenv("BENCH_TYPES"), ",")[[1]]
+} else {
+  c("standard", "overlapping", "modified", "hadamard", "ohadamard")
+}
 rows <- list()
-for (N in c(1e4, 1e6)) for (type in c("standard", "overlapping", "modified",
-                                       "hadamard", "ohadamard")) {
+for (N in c(1e4, 1e6)) for (type in types) {
   for (taus in c("octave", "decade")) {
     t0 <- replicate(reps, one(N, type, taus, 0))
     t1 <- replicate(reps, one(N, type, taus, 16))
