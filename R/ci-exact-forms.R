@@ -192,14 +192,7 @@ exact_dense_factors <- function(form_name, m, L, alpha, conf) {
   hit <- exact_dense_cache[[key]]
   if (!is.null(hit)) return(hit)
   lam <- exact_dense_weights(form_name, pr[1L], pr[2L], alpha)
-  p <- (1 - conf) / 2
-  if (length(lam) == 1L || max(lam) - min(lam) < 1e-12 * max(lam)) {
-    nu <- length(lam)
-    q <- stats::qchisq(c(p, 1 - p), nu) / nu
-  } else {
-    q <- gchisq_quantile_cpp(lam, c(p, 1 - p))
-  }
-  out <- c(sqrt(1 / q[2L]), sqrt(1 / q[1L]))
+  out <- gchisq_factors(lam, conf)
   assign(key, out, envir = exact_dense_cache)
   out
 }

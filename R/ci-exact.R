@@ -120,6 +120,14 @@ exact_factors_one <- function(code, m, n, alpha, conf) {
   hit <- exact_cache[[key]]
   if (!is.null(hit)) return(hit)
   lam <- gchisq_weights_cpp(as.integer(code), mp, np, as.integer(alpha))
+  out <- gchisq_factors(lam, conf)
+  assign(key, out, envir = exact_cache)
+  out
+}
+
+# The interval's factors c(lower, upper) on the deviation from the law's
+# weights `lam` (sum lam_i chi2_1 over its mean) at confidence `conf`.
+gchisq_factors <- function(lam, conf) {
   p <- (1 - conf) / 2
   if (length(lam) == 1L || max(lam) - min(lam) < 1e-12 * max(lam)) {
     nu <- length(lam)  # equal weights: the chi-square itself
@@ -127,9 +135,7 @@ exact_factors_one <- function(code, m, n, alpha, conf) {
   } else {
     q <- gchisq_quantile_cpp(lam, c(p, 1 - p))
   }
-  out <- c(sqrt(1 / q[2L]), sqrt(1 / q[1L]))
-  assign(key, out, envir = exact_cache)
-  out
+  c(sqrt(1 / q[2L]), sqrt(1 / q[1L]))
 }
 
 # The noise exponents whose intervals are joined at a row, from the row's
