@@ -48,8 +48,16 @@ KalmanSums kalman_sums(const double* y, R_xlen_t n, const KalmanModel& m) {
     }
     t0 = 1;
   }
-  for (R_xlen_t t = t0; t < n; ++t) {
+  // The Riccati recursion does not see the data: once an update leaves P
+  // bit for bit unchanged, every later step has the same F and gain, so the
+  // rest of the record runs with them fixed (no covariance update, one log)
+  // and the sums are those of the full filter up to their order.
+  std::vector<double> P_prev(d * d);
+  R_xlen_t t = t0;
+  bool steady = false;
+  for (; t < n && !steady; ++t) {
     if ((t & 0xFFFF) == 0) Rcpp::checkUserInterrupt();
+    P_prev = P;
     double pred = 0.0, F = m.R;
     for (std::size_t i = 0; i < d; ++i) {
       pred += a[i];
@@ -69,6 +77,29 @@ KalmanSums kalman_sums(const double* y, R_xlen_t n, const KalmanModel& m) {
         P[i * d + l] = m.T[i] * m.T[l] * (P[i * d + l] - k[i] * k[l] * iF);
       }
       P[i * d + i] += m.Q[i];
+    }
+    steady = P == P_prev;
+  }
+  if (t < n) {
+    double F = m.R;
+    std::vector<double> g(d);
+    for (std::size_t i = 0; i < d; ++i) {
+      double s = 0.0;
+      for (std::size_t l = 0; l < d; ++l) s += P[i * d + l];
+      g[i] = s;
+      F += s;
+    }
+    const double iF = 1.0 / F;
+    for (std::size_t i = 0; i < d; ++i) g[i] *= iF;
+    out.logF += static_cast<double>(n - t) * std::log(F);
+    out.count += static_cast<double>(n - t);
+    for (; t < n; ++t) {
+      if ((t & 0xFFFF) == 0) Rcpp::checkUserInterrupt();
+      double pred = 0.0;
+      for (std::size_t i = 0; i < d; ++i) pred += a[i];
+      const double v = y[t] - pred;
+      out.v2F += v * v * iF;
+      for (std::size_t i = 0; i < d; ++i) a[i] = m.T[i] * (a[i] + g[i] * v);
     }
   }
   return out;
