@@ -249,42 +249,52 @@ mle_identified <- function(par, lay) {
 
 # L-BFGS-B on numerical gradients of a sum over 1e6 samples often ends in
 # a failed line search at the maximum (the log-likelihood's last digits are
-# rounding). Such a stop is checked by one Fisher-scoring step from there
-# (the exact expected information, central-difference gradient): the step
-# is taken when it gains, and the fit counts as converged when the gain a
-# scoring step predicts, g'I^-1 g / 2, is below 1e-3 log-likelihood units.
+# rounding). Such a stop is checked by Fisher-scoring steps from there
+# (the exact expected information at the stop, central-difference
+# gradient; at most five, each halved until it gains), and the fit counts as
+# converged when the gain a further step predicts, g'I^-1 g / 2, is below
+# 1e-3 log-likelihood units.
 mle_scoring_check <- function(x, est, lay, model, freq, tol = 1e-3) {
   if (isTRUE(est$convergence$converged)) return(est)
   par <- est$par
   ok <- mle_identified(par, lay)
-  V <- mle_inverse(tryCatch(av_information(par[ok], n = length(x), freq = freq)$information,
-                            allanvar_error = function(e) NULL))
-  if (is.null(V)) return(est)
   f <- function(lp) mle_loglik(x, model(replace(par, ok, exp(lp))))
-  grad <- function(lp) {
+  # the scoring direction and the gain it predicts at lp
+  direction <- function(lp) {
+    V <- mle_inverse(tryCatch(av_information(replace(par, ok, exp(lp))[ok], n = length(x),
+                                             freq = freq)$information,
+                              allanvar_error = function(e) NULL))
+    if (is.null(V)) return(NULL)
     h <- 1e-3
-    vapply(seq_along(lp), function(j) {
+    g <- vapply(seq_along(lp), function(j) {
       e <- replace(numeric(length(lp)), j, h)
       (f(lp + e) - f(lp - e)) / (2 * h)
     }, 0)
+    d <- as.numeric(V %*% g)
+    list(d = d, gain = sum(g * d) / 2)
   }
   lp <- log(par[ok])
-  g <- grad(lp)
-  gain <- sum(g * (V %*% g)) / 2
-  lp1 <- lp + as.numeric(V %*% g)
-  ll1 <- f(lp1)
-  if (is.finite(ll1) && ll1 > est$loglik) {
-    par[ok] <- exp(lp1)
-    est$par <- par
+  dir <- direction(lp)
+  # a few steps at most, each halved until it gains
+  for (step in 1:5) {
+    if (is.null(dir) || !is.finite(dir$gain) || dir$gain < tol) break
+    moved <- FALSE
+    for (half in 0:5) {
+      lp1 <- lp + dir$d / 2^half
+      ll1 <- f(lp1)
+      if (is.finite(ll1) && ll1 > est$loglik) { moved <- TRUE; break }
+    }
+    if (!moved) break
+    lp <- lp1
+    est$par <- replace(par, ok, exp(lp))
     est$loglik <- ll1
-    g <- grad(lp1)
-    gain <- sum(g * (V %*% g)) / 2
+    dir <- direction(lp)
   }
-  if (is.finite(gain) && gain < tol) {
+  if (!is.null(dir) && is.finite(dir$gain) && dir$gain < tol) {
     est$convergence$converged <- TRUE
     est$convergence$message <- sprintf(
-      "%s; a Fisher-scoring step from the stop gains %.1e in log-likelihood: at the maximum",
-      est$convergence$message, gain)
+      "%s; Fisher scoring from the stop: a further step would gain %.1e in log-likelihood, at the maximum",
+      est$convergence$message, dir$gain)
   }
   est
 }

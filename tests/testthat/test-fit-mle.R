@@ -83,6 +83,29 @@ test_that("avmle() recovers N, K, sigma and tc within 3 Cramer-Rao SDs", {
   expect_true(all(fit$se / truth > crb / 2 & fit$se / truth < crb * 2))
 })
 
+test_that("a stop short of the maximum is finished by Fisher scoring, and only then converged", {
+  y <- gen_series(2e4, 0.01, 0.01, 1e-3, 0.02, 1, seed = 8)
+  fit <- avmle(y, 100)
+  expect_true(fit$convergence$converged)
+  lay <- allanvar:::coef_layout(c("N", "K", "gm"))
+  entries <- lapply(c("N", "K", "gm"), allanvar:::effect_entry)
+  model <- function(p) allanvar:::mle_model(p, lay, entries, 0.01)
+  # a line search that stopped half an SE away from the maximum
+  p1 <- coef(fit) * exp(0.5 * fit$se / coef(fit) * c(1, -1, 1, -1))
+  est <- list(par = p1, loglik = allanvar:::mle_loglik(y, model(p1)),
+              convergence = list(converged = FALSE, message = "ABNORMAL_TERMINATION_IN_LNSRCH"))
+  out <- allanvar:::mle_scoring_check(y, est, lay, model, 100)
+  expect_gt(out$loglik, est$loglik)
+  expect_lt(fit$loglik - out$loglik, 1e-3)
+  expect_true(out$convergence$converged)
+  expect_match(out$convergence$message, "Fisher scoring")
+  # far from the maximum one step is not enough: not converged
+  p2 <- coef(fit) * exp(8 * fit$se / coef(fit) * c(1, -1, 1, -1))
+  est2 <- list(par = p2, loglik = allanvar:::mle_loglik(y, model(p2)),
+               convergence = list(converged = FALSE, message = "ABNORMAL_TERMINATION_IN_LNSRCH"))
+  expect_false(allanvar:::mle_scoring_check(y, est2, lay, model, 100)$convergence$converged)
+})
+
 test_that("avmle() returns an avfit object the methods accept", {
   y <- gen_series(2e4, 0.01, 0.01, 1e-3, 0, 1, seed = 3)
   fit <- avmle(y, 100, c("N", "K"))
