@@ -414,7 +414,13 @@ check_dots_empty <- function(...) {
 #' [avfit()]; `type = "log"` gives \eqn{\ln\widehat{AV}_j - \ln AV_j} minus
 #' the chi-square log bias, `type = "relative"` gives
 #' \eqn{\sqrt{\widehat{AV}_j/AV_j} - 1}, the relative ADEV error).
-#' `confint()` gives Wald intervals on the log scale; for an amplitude at
+#' `confint()` gives Wald intervals on the log scale, except for a weakly
+#' determined amplitude of a curve fit (its variance coefficient c = amp^2
+#' has nu = 2 c^2 / SE(c)^2 below 100): there a value c0 is in the interval
+#' when the estimate lies between the (1 -+ level)/2 quantiles of its law
+#' under c0, a shifted scaled chi-square with mean c0 and the SD the fit's
+#' covariance gives under c0 (a Neyman construction; Wald intervals at the
+#' estimate were too short for estimates that came out high). For an amplitude at
 #' 0 a one-sided interval `[0, upper]` (from the profile likelihood for
 #' [avmle()] fits, at level 0.95; for curve fits from the quadratic
 #' approximation of the objective in the variance coefficient c = amp^2,
@@ -526,6 +532,15 @@ confint.avfit <- function(object, parm, level = 0.95, ...) {
     !is.finite(s)
   lo[dead] <- 0
   hi[dead] <- Inf
+  # a weakly determined amplitude of a curve fit: the Neyman construction
+  # of R/fit-amp-interval.R instead of Wald
+  for (k in which(amp_interval_weak(object, parm))) {
+    ab <- amp_interval(object, parm[k], level)
+    if (all(!is.na(ab))) {
+      lo[k] <- ab[1]
+      hi[k] <- ab[2]
+    }
+  }
   pct <- paste(format(100 * c((1 - level) / 2, (1 + level) / 2), trim = TRUE,
                       digits = 3), "%")
   out <- cbind(lo, hi)

@@ -517,6 +517,39 @@ test_that("confint(): log-scale Wald, one-sided at a zero amplitude, (0, Inf) fo
   expect_equal(unname(confint(g)["gm1.tc", ]), c(0, Inf))
 })
 
+test_that("a weakly determined amplitude's interval is the Neyman one of its shifted chi-square law", {
+  # own generator: white noise, a weak rate random walk beside a
+  # Gauss-Markov term (K's AV shows only in the last octaves)
+  set.seed(23)
+  n <- 2^15
+  phi <- exp(-1 / (100 * 2))
+  w <- rnorm(n, sd = 0.02 * sqrt(1 - phi^2))
+  x <- rnorm(n, sd = 0.1) + cumsum(rnorm(n, sd = 1e-4)) +
+    as.numeric(stats::filter(w, phi, method = "recursive"))
+  fit <- avfit(allan(x, 100), c("N", "K", "gm"))
+  expect_gt(coef(fit)[["K"]], 0)
+  weak <- allanvar:::amp_interval_weak(fit, c("N", "K", "gm1.sigma"))
+  expect_identical(unname(weak), c(FALSE, TRUE, FALSE))
+  ci <- confint(fit)
+  k <- coef(fit)[["K"]]
+  expect_lt(ci["K", 1], k)
+  expect_gt(ci["K", 2], k)
+  # N keeps its log-scale Wald interval
+  expect_equal(unname(ci["N", ]), coef(fit)[["N"]] *
+                 exp(c(-1, 1) * qnorm(0.975) * fit$se[["N"]] / coef(fit)[["N"]]))
+  # at each end the law under that value puts the estimate at its 97.5% /
+  # 2.5% quantile: c + s ~ (c0 + s) chi2_m / m with the fit's SE under c0
+  se0 <- allanvar:::amp_se_c(fit, "K", 1e-4 * k^2)
+  quant <- function(c0, p) {
+    se <- allanvar:::amp_se_c(fit, "K", c0)
+    s <- c0 * se0 / (se - se0)
+    m <- 2 * (c0 + s)^2 / se^2
+    (c0 + s) * qchisq(p, m) / m - s
+  }
+  if (ci["K", 1] > 0) expect_equal(quant(ci["K", 1]^2, 0.975), k^2, tolerance = 1e-3)
+  expect_equal(quant(ci["K", 2]^2, 0.025), k^2, tolerance = 1e-3)
+})
+
 test_that("independent-points fits: 95% intervals cover (sandwich with the points' correlation)", {
   skip_on_cran()
   # own generator: white rate noise N and a rate random walk K at 100 Hz;
