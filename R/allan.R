@@ -50,7 +50,12 @@
 #'   at 30 points; between 30 and 63 the lag-1 autocorrelation misreads
 #'   flicker PM often enough that TOTDEV's 68% intervals cover 0.55 of it
 #'   at N/m = 32 (Monte Carlo, N = 1024), so B1 and R(n) are used there
-#'   (no limit compared with Stable32's changes);
+#'   (no limit compared with Stable32's changes). Where it reads phase
+#'   noise at \eqn{m \ge 4} within two standard errors of the white/flicker
+#'   PM boundary, R(n) over the whole record chooses between the two (it
+#'   read flicker PM as white PM in 25-47% of records at N = 1024, m =
+#'   4-16; the 68% intervals of the total family covered 0.58-0.63 there,
+#'   now 0.67-0.73);
 #' * below that, Barnes' B1 ratio (standard over Allan variance of the
 #'   cluster averages) against its expected values for N = the statistic's
 #'   number of terms and Howe et al.'s (2000) boundaries, as Stable32.

@@ -1198,6 +1198,7 @@ void octave_noise_id(const double* v, R_xlen_t N, double c,
               n, false, dmax, ln);
         }
       }
+      allanvar::rn_refine_pm(id, m, rules, [&]() { return rn.ratio(m); });
     } else {
       id = allanvar::b1_noise_id(z, n, false, m, mid_n[j], modified, rules,
                                  [&]() { return rn.ratio(m); });

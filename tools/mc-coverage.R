@@ -14,7 +14,7 @@
 # type, `edf_mc` the Monte Carlo EDF 2 E^2 / Var of the uncorrected
 # estimate, `edf_alpha` the formula's at the true type.
 #
-#   [ALLANVAR_NOISE_ID=rule] Rscript tools/mc-coverage.R [replicates] [N] [types]
+#   [ALLANVAR_NOISE_ID=rule] [MC_NOISES=fpm,wpm] Rscript tools/mc-coverage.R [replicates] [N] [types]
 #   e.g. Rscript tools/mc-coverage.R 300 1024 overlapping,modified,tdev
 mc_generators <- function(N) {
   filters <- list()  # the filter's transform, built once per length
@@ -132,6 +132,10 @@ if (sys.nframe() == 0L) {
   }
   set.seed(8)
   gens <- mc_generators(N)
+  # MC_NOISES=fpm,wpm runs only those generators
+  if (nzchar(Sys.getenv("MC_NOISES"))) {
+    gens <- gens[strsplit(Sys.getenv("MC_NOISES"), ",")[[1]]]
+  }
   alphas <- c(wfm = 0L, ffm = -1L, rwfm = -2L, wpm = 2L, fpm = 1L)
   out <- list()
   for (type in types) for (g in names(gens)) {

@@ -14,7 +14,8 @@
 #   ALLANVAR_PEER_DATA=/path/to/allantools Rscript tools/stable32-rows-mc.R [replicates]
 #
 # Prints one line per row and noise type; ALLANVAR_STABLE32_MC_OUT=file.csv
-# writes it.
+# writes it; ALLANVAR_STABLE32_MC_FILES=regex keeps the reference files whose
+# path matches (to rerun only the rows a change touched).
 source(file.path("tools", "check-stable32.R"), local = TRUE)
 
 # Frequency noise y of exponent alpha (S_y ~ f^alpha), n samples, from
@@ -107,6 +108,8 @@ if (sys.nframe() == 0L) {
   allan_ci <- utils::getFromNamespace("allan_ci", "allanvar")
   set.seed(20261128)
   res <- check_stable32(root)
+  keep <- Sys.getenv("ALLANVAR_STABLE32_MC_FILES")
+  if (nzchar(keep)) res <- res[grepl(keep, res$file), ]
   tab <- stable32_rows_mc(res, reps)
   tab$ours_ok <- tab$ours >= 0.60 & tab$ours <= 0.76
   tab$s32_ok <- tab$s32 >= 0.60 & tab$s32 <= 0.76

@@ -356,6 +356,41 @@ test_that("68% coverage of white and flicker PM where B1 reads a few averaged fr
   }
 })
 
+test_that("R(n) tells white from flicker PM where the lag-1 ACF reads PM (m >= 4)", {
+  skip_on_cran()
+  # The lag-1 ACF of the decimated phase read generated flicker PM as white
+  # PM in 25-47% of records at N = 1024, m = 4-16; R(n) = MVAR/AVAR over the
+  # whole record separates them there by many of its standard deviations
+  # (src/noise_id.h rn_refine_pm()). Own generators; both identification
+  # paths (rate input: the octave pass; phase input: identify_noise()).
+  old <- options(allanvar.threads = 1, allanvar.noise_id = NULL)
+  on.exit(options(old))
+  set.seed(29)
+  N <- 1024
+  gens <- mc_gens(N)
+  m <- c(4, 8, 16)
+  read_as <- function(g, input) {
+    t(replicate(60, {
+      y <- gens[[g]]()
+      x <- if (input == "rate") y else c(0, cumsum(y))
+      a <- allan(x, 1, taus = m, type = "overlapping", input = input)
+      a$alpha
+    }))
+  }
+  for (input in c("rate", "integrated")) {
+    f <- read_as("fpm", input)
+    w <- read_as("wpm", input)
+    expect_true(all(colMeans(f == 1) >= 0.9),
+                info = paste(input, toString(colMeans(f == 1))))
+    expect_true(all(colMeans(w == 2) >= 0.9),
+                info = paste(input, toString(colMeans(w == 2))))
+  }
+  # Stable32's rules keep the ACF's reading: flicker PM read as white PM in
+  # some records there
+  options(allanvar.noise_id = "stable32")
+  expect_gt(mean(read_as("fpm", "rate") == 2), 0.05)
+})
+
 test_that("MTOT/TTOT at m = 1, 2 and HTOT at m = 1: the EDF of the estimator they are", {
   skip_on_cran()
   # SP 1065 Table 11's b N/m - c claims 1950 (white PM) and 1230 (flicker
