@@ -313,7 +313,10 @@ remove_steps <- function(x, steps) {
 #' the data allow). Present when z exceeds `z_level`. A second exponential
 #' (an added warm-up on an axis that has one of its own) is looked for with
 #' the first in the regression, and kept when its own z also passes and
-#' the time constants are at least a factor 2 apart.
+#' the time constants are at least a factor 2 apart. An exponential is kept
+#' only when it explains the block means better than a straight line (a
+#' rate ramp) in its place, and when its time constant lies inside the grid
+#' (a profile still rising at 40% of the record is a random walk's wander).
 #' @return list `present`, `amplitude` (rate unit, the offset at t = 0),
 #'   `tc` (s), `z`, `level` (the settled level c; `NA` from the GLS
 #'   fit), and `all`: a data.frame (`amplitude`, `tc`, `z`) of every
@@ -384,6 +387,28 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1000L,
       break
     }
     fixed <- list(X = matrix(expo(tc), nb), A = prof$A)
+  }
+  # A rate ramp (the catalogue's R) is a straight line in the rate, and a
+  # slow exponential over a record fits much of a line (or of a random
+  # walk's drift): an exponential is a warm-up only when it explains the
+  # block means better than a straight line in its place (the GLS z of
+  # each alone, beside the other exponential found). Both have one free
+  # amplitude; a long warm-up's curvature makes its own fit the better one.
+  if (nrow(found)) {
+    ramp <- matrix(seq(-1, 1, length.out = nb), nb)
+    better <- vapply(seq_len(nrow(found)), function(i) {
+      others <- if (nrow(found) > 1L)
+        vapply(found$tc[-i], expo, numeric(nb)) else NULL
+      z_exp <- warmup_profile(y, matrix(expo(found$tc[i]), nb), found$tc[i],
+                              model, others)$z
+      z_line <- warmup_profile(y, ramp, 1, model, others)$z
+      is.finite(z_exp) && abs(z_exp) > abs(z_line)
+    }, TRUE)
+    # A profile still rising at the longest time constant the grid allows
+    # (40% of the record) resolves no decay: a random walk's wander over
+    # the record, not a warm-up (a warm-up of up to 30% peaks inside).
+    inside <- found$tc < grid[length(grid)] * (1 - 1e-9)
+    found <- found[better & inside, , drop = FALSE]
   }
   if (!nrow(found)) {
     none$z <- if (exists("prof")) abs(prof$z) else 0
