@@ -241,7 +241,7 @@ mle_collapse <- function(x, est, lay, model) {
 }
 
 # The parameters the likelihood identifies: amplitudes above 0 and the
-# nonlinear parameters of terms with one.
+# nonlinear parameters of terms whose amplitude is above 0.
 mle_identified <- function(par, lay) {
   zero_lab <- lay$label[lay$role == "amp" & par == 0]
   !(lay$label %in% zero_lab & lay$role == "nonlinear") & !(lay$role == "amp" & par == 0)
@@ -317,7 +317,8 @@ mle_uncertainty <- function(x, est, lay, model, p0, freq) {
   }
   # the exact expected information first: the numerical Hessian of a sum
   # over 1e6 samples is noisy (95% intervals for a weak K covered 84% at
-  # 1e6 samples, 98.5% at 1e5; with the expected information 97% and 95%)
+  # 1e6 samples, 98.5% at 1e5; with the expected information 94.1% and
+  # 97.1%, bench/README.md)
   I <- tryCatch(av_information(par[ok], n = length(x), freq = freq)$information,
                 allanvar_error = function(e) NULL)
   V <- mle_inverse(I)
