@@ -6,17 +6,8 @@
 args <- commandArgs(TRUE)
 reps <- if (length(args)) as.integer(args[1]) else 3L
 lib <- Sys.getenv("ALLANVAR_LIB", .libPaths()[1])
-one <- function(N, type, taus, exact) {
-  callr::r(function(N, type, taus, exact, lib) {
-    library(allanvar, lib.loc = lib)
-    options(allanvar.threads = 1, allanvar.ci_exact = exact)
-    set.seed(1)
-    y <- cumsum(rnorm(N)) * 1e-3 + rnorm(N)
-    t1 <- system.time(allan(y, 1, type = type, taus = taus))[["elapsed"]]
-    t2 <- system.time(allan(y, 1, type = type, taus = taus))[["elapsed"]]
-    c(first = t1, again = t2)
-  }, list(N, type, taus, exact, lib))
-}
+source("bench/common.R")
+one <- function(N, type, taus, exact) allan_fresh_times(N, type, taus, exact, lib)
 types <- if (nzchar(Sys.getenv("BENCH_TYPES"))) {
   strsplit(Sys.getenv("BENCH_TYPES"), ",")[[1]]
 } else {

@@ -9,19 +9,8 @@
 args <- commandArgs(TRUE)
 reps <- if (length(args)) as.integer(args[1]) else 3L
 lib <- Sys.getenv("ALLANVAR_LIB", .libPaths()[1])
-one <- function(N, taus, ci, exact) {
-  callr::r(function(N, taus, ci, exact, lib) {
-    library(allanvar, lib.loc = lib)
-    options(allanvar.threads = 1, allanvar.ci_exact = exact)
-    set.seed(1)
-    y <- cumsum(rnorm(N)) * 1e-3 + rnorm(N)
-    t1 <- system.time(allan(y, 1, type = "pdev", taus = taus,
-                            ci = ci))[["elapsed"]]
-    t2 <- system.time(allan(y, 1, type = "pdev", taus = taus,
-                            ci = ci))[["elapsed"]]
-    c(first = t1, again = t2)
-  }, list(N, taus, ci, exact, lib))
-}
+source("bench/common.R")
+one <- function(N, taus, ci, exact) allan_fresh_times(N, "pdev", taus, exact, lib, ci = ci)
 rows <- list()
 for (N in c(1e4, 1e5, 1e6)) for (taus in c("octave", "decade")) {
   t0 <- replicate(reps, one(N, taus, FALSE, 0))

@@ -1,6 +1,7 @@
 # What every bench script shares: the package installed into a temporary
 # library (optimised and byte-compiled, as users have it; pkgload would
-# compile without optimisation) and a median timer. Sourced from the
+# compile without optimisation), a median timer and timings in fresh
+# processes. Sourced from the
 # repository root: source("bench/common.R").
 stopifnot(file.exists("DESCRIPTION"))
 
@@ -49,4 +50,20 @@ composite_series <- function(n, seed, truth, tau0) {
   rnorm(n, sd = truth[["N"]] / sqrt(tau0)) +
     cumsum(rnorm(n, sd = truth[["K"]] * sqrt(tau0))) +
     as.numeric(stats::filter(w, phi, method = "recursive"))
+}
+
+# allan() on a fixed series of N samples (a random walk plus white noise),
+# timed in a fresh callr process with the library `lib`: the first call
+# (nothing cached) and a second one in the same process.
+# options(allanvar.ci_exact = exact); returns c(first, again) in seconds.
+allan_fresh_times <- function(N, type, taus, exact, lib, ci = TRUE) {
+  callr::r(function(N, type, taus, exact, lib, ci) {
+    library(allanvar, lib.loc = lib)
+    options(allanvar.threads = 1, allanvar.ci_exact = exact)
+    set.seed(1)
+    y <- cumsum(rnorm(N)) * 1e-3 + rnorm(N)
+    t1 <- system.time(allan(y, 1, type = type, taus = taus, ci = ci))[["elapsed"]]
+    t2 <- system.time(allan(y, 1, type = type, taus = taus, ci = ci))[["elapsed"]]
+    c(first = t1, again = t2)
+  }, list(N, type, taus, exact, lib, ci))
 }
