@@ -72,10 +72,17 @@ amp_interval <- function(object, name, level) {
   alpha <- (1 - level) / 2
   se0 <- amp_se_c(object, name, 1e-4 * c_hat)
   if (!is.finite(se0)) return(c(NA_real_, NA_real_))
+  # SE_c at c0 = exp(lc), once per value (both ends start at the estimate)
+  memo <- new.env(parent = emptyenv())
+  se_at <- function(lc) {
+    key <- sprintf("%.17g", lc)
+    if (is.null(memo[[key]])) memo[[key]] <- amp_se_c(object, name, exp(lc))
+    memo[[key]]
+  }
   # the law's p-quantile under c0 = exp(lc), minus the estimate, relative
   limit <- function(lc, p) {
     c0 <- exp(lc)
-    se <- amp_se_c(object, name, c0)
+    se <- se_at(lc)
     if (!is.finite(se) || se <= 0) return(NA_real_)
     if (se <= se0 * (1 + 1e-9)) {
       q <- c0 + stats::qnorm(p) * se
@@ -98,7 +105,9 @@ amp_interval <- function(object, name, level) {
       fb <- limit(b, p)
       if (!is.finite(fa) || !is.finite(fb)) return(NA_real_)
       if (sign(fb) != sign(fa)) {
-        r <- stats::uniroot(function(l) limit(l, p), sort(c(a, b)), tol = 1e-4)$root
+        ends <- if (a < b) c(fa, fb) else c(fb, fa)
+        r <- stats::uniroot(function(l) limit(l, p), sort(c(a, b)), f.lower = ends[1],
+                            f.upper = ends[2], tol = 1e-4)$root
         return(exp(r))
       }
       a <- b
