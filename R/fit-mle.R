@@ -311,10 +311,6 @@ mle_uncertainty <- function(x, est, lay, model, p0, freq) {
   par <- est$par
   k <- nrow(lay)
   ok <- mle_identified(par, lay)
-  nll <- function(lp) {
-    v <- -mle_loglik(x, model(replace(par, ok, exp(lp))))
-    if (is.finite(v)) v else .Machine$double.xmax
-  }
   # the exact expected information first: the numerical Hessian of a sum
   # over 1e6 samples is noisy (95% intervals for a weak K covered 84% at
   # 1e6 samples, 98.5% at 1e5; with the expected information 94.1% and
@@ -324,6 +320,10 @@ mle_uncertainty <- function(x, est, lay, model, p0, freq) {
   V <- mle_inverse(I)
   source <- "expected"
   if (is.null(V)) {
+    nll <- function(lp) {
+      v <- -mle_loglik(x, model(replace(par, ok, exp(lp))))
+      if (is.finite(v)) v else .Machine$double.xmax
+    }
     lp <- log(par[ok])
     H <- tryCatch(stats::optimHess(lp, nll, control = list(ndeps = rep(1e-3, length(lp)))),
                   error = function(e) NULL)
