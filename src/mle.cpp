@@ -52,20 +52,26 @@ KalmanSums kalman_sums(const double* y, R_xlen_t n, const KalmanModel& m) {
   // bit for bit unchanged, every later step has the same F and gain, so the
   // rest of the record runs with them fixed (no covariance update, one log)
   // and the sums are those of the full filter up to their order.
+  // k = P Z' and the innovation variance F = Z P Z' + R
+  auto gain = [&]() {
+    double F = m.R;
+    for (std::size_t i = 0; i < d; ++i) {
+      double s = 0.0;
+      for (std::size_t l = 0; l < d; ++l) s += P[i * d + l];
+      k[i] = s;
+      F += s;
+    }
+    return F;
+  };
   std::vector<double> P_prev(d * d);
   R_xlen_t t = t0;
   bool steady = false;
   for (; t < n && !steady; ++t) {
     if ((t & 0xFFFF) == 0) Rcpp::checkUserInterrupt();
     P_prev = P;
-    double pred = 0.0, F = m.R;
-    for (std::size_t i = 0; i < d; ++i) {
-      pred += a[i];
-      double s = 0.0;
-      for (std::size_t l = 0; l < d; ++l) s += P[i * d + l];
-      k[i] = s;  // P Z'
-      F += s;
-    }
+    double pred = 0.0;
+    for (std::size_t i = 0; i < d; ++i) pred += a[i];
+    const double F = gain();
     const double v = y[t] - pred, iF = 1.0 / F;
     out.logF += std::log(F);
     out.v2F += v * v * iF;
@@ -81,16 +87,9 @@ KalmanSums kalman_sums(const double* y, R_xlen_t n, const KalmanModel& m) {
     steady = P == P_prev;
   }
   if (t < n) {
-    double F = m.R;
+    const double F = gain(), iF = 1.0 / F;
     std::vector<double> g(d);
-    for (std::size_t i = 0; i < d; ++i) {
-      double s = 0.0;
-      for (std::size_t l = 0; l < d; ++l) s += P[i * d + l];
-      g[i] = s;
-      F += s;
-    }
-    const double iF = 1.0 / F;
-    for (std::size_t i = 0; i < d; ++i) g[i] *= iF;
+    for (std::size_t i = 0; i < d; ++i) g[i] = k[i] * iF;
     out.logF += static_cast<double>(n - t) * std::log(F);
     out.count += static_cast<double>(n - t);
     for (; t < n; ++t) {
