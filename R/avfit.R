@@ -266,8 +266,7 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
   nfree <- sum(!lay$fixed)
   dfres <- nrow(data) - nfree
   chi2 <- if (dfres > 0) objective / dfres else NA_real_
-  vc <- fit_vcov(lay, data$tau, tau0, pr$W, chi2, pr$plan,
-                 corr = sandwich_corr(pr, curve, lay))
+  vc <- fit_covariance(pr, curve, lay, chi2)
   data$fitted <- fitted
   data$z <- z
   input <- curve
@@ -288,6 +287,15 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
     bias_correct = pr$bias_correct, correlation = !is.null(pr$corr),
     corr = pr$corr, steps = new_steps(), input = input,
     convergence = res$convergence, control = control, call = cl)
+}
+
+# The covariance a fit of layout `lay` on problem `pr` reports (the
+# sandwich with the points' correlation where the weighting left it out),
+# scaled by its chi2 per dof; also R/fit-amp-interval.R's under a tested
+# value.
+fit_covariance <- function(pr, curve, lay, chi2) {
+  fit_vcov(lay, pr$data$tau, pr$tau0, pr$W, chi2, pr$plan,
+           corr = sandwich_corr(pr, curve, lay))
 }
 
 # The correlation of the fitted points that the weighting left out, when

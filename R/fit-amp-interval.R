@@ -59,9 +59,7 @@ amp_se_c <- function(object, name, c0) {
   me <- object$model_error
   pr <- fit_problem(d, tau0, lay, isTRUE(object$bias_correct), object$corr,
                     model_var = if (is.null(me)) 0 else me^2)
-  vc <- fit_vcov(lay, d$tau, tau0, pr$W, object$chi2, pr$plan,
-                 corr = sandwich_corr(pr, curve, lay))
-  v <- vc[i, i]
+  v <- fit_covariance(pr, curve, lay, object$chi2)[i, i]
   if (!is.finite(v) || v < 0) return(NA_real_)
   2 * sqrt(c0) * sqrt(v)
 }
