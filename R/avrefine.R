@@ -86,7 +86,9 @@
 #'   fit's sampling frequency, used to confirm effects from the data itself.
 #' @param candidates Effects that may be added: terms of the catalogue
 #'   ([av_terms()]); default all of them.
-#' @param max_steps Maximum number of effects to add.
+#' @param max_steps Maximum number of effects to add. A further line of a
+#'   harmonic set already in the model is not counted (at most 10 of
+#'   those): it adds no new source.
 #' @param criterion `"BIC"` (default) or `"AIC"`.
 #' @param min_gain Minimum decrease of the criterion for an effect to be
 #'   kept (10 is "very strong" evidence on the BIC scale; adjacent taus of

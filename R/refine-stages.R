@@ -44,8 +44,26 @@ stage_prepare <- function(st) {
   st
 }
 
+# A step that adds a further line of a harmonic set the model already holds
+# (the trial's prerequisites, `after`, are that set's stronger lines) adds
+# no new source: it does not spend the `max_steps` budget (at most
+# `max_set_steps` such steps in a call). Once the budget is spent, steps go
+# on with those trials alone, so an axis's own effects cannot starve a set
+# of its harmonics.
+max_set_steps <- 10L
+
 stage_steps <- function(st) {
-  for (step in seq_len(st$args$max_steps)) {
+  budget <- st$args$max_steps
+  if (budget < 1L) return(st)
+  step <- 0L
+  free <- 0L
+  st$only_sets <- FALSE
+  repeat {
+    if (step - free >= budget) {
+      if (free >= max_set_steps) break
+      st$only_sets <- TRUE
+    }
+    step <- step + 1L
     st$step <- step
     st$flow <- "go"
     for (s in step_stages()) {
@@ -53,8 +71,18 @@ stage_steps <- function(st) {
       if (st$flow != "go") break
     }
     if (st$flow == "stop") break
+    if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
+      free <- free + 1L
+    } else if (st$only_sets) {
+      break
+    }
   }
+  st$only_sets <- FALSE
   st
+}
+
+continues_set <- function(trial) {
+  !is.null(trial) && !is.null(trial$after) && length(unlist(trial$after)) > 0L
 }
 
 # The loop may have ended on a step that chose a family again.
@@ -154,6 +182,10 @@ step_trace <- function(st) {
                              raw = st$raw)
   st$trials <- ready_trials(candidate_trials(traced, cur$terms, st$args$candidates,
                                              st$sig), st$settings$fixed)
+  if (isTRUE(st$only_sets) && nrow(st$trials)) {
+    keep <- vapply(seq_len(nrow(st$trials)), function(i) continues_set(st$trials[i, ]), NA)
+    st$trials <- st$trials[keep, , drop = FALSE]
+  }
   if (!nrow(st$trials)) st$flow <- "stop"
   st
 }

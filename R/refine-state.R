@@ -27,6 +27,7 @@ new_refine_state <- function(fit, args, settings) {
     hold = numeric(0),         # nonlinear values held while it was screened
     c0 = NA_real_,             # the criterion before the step
     flow = "go",               # "go", "next" (on to the next step), "stop"
+    only_sets = FALSE,         # budget spent: only further lines of held harmonic sets
     remaining = NULL,          # signatures left when the loop stopped
     unexplained = NULL,
     tau_range = NULL,

@@ -63,3 +63,27 @@ test_that("a sinusoid sized for a strong line is not backed by a weak line besid
   expect_true(ev(list(amp = 0.3, f0 = 1.7), raw, x, freq)$support)
   expect_true(ev(list(amp = 0.06, f0 = 1.59), raw, x, freq)$support)
 })
+
+test_that("a harmonic set's further lines do not spend the step budget", {
+  # the square wave above with room for one effect only: its fundamental
+  # spends the budget, 2.4 and 4.0 Hz follow as lines of the same source
+  set.seed(2712)
+  freq <- 100
+  n <- 5e5
+  t <- seq_len(n) / freq
+  sq <- 0.004 * sign(sin(2 * pi * 0.8 * t + 0.3))
+  b <- gen_base(n, freq)
+  f0s <- function(x) {
+    fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
+    r <- suppressMessages(avrefine(fit, data = x, max_steps = 1))
+    coef(r)[grepl("^sinusoid[0-9]+\\.f0$", names(coef(r)))]
+  }
+  f0 <- f0s(b + sq)
+  expect_length(f0, 3L)
+  for (h in c(1, 3, 5)) expect_lte(min(abs(f0 / (0.8 * h) - 1)), 0.03)
+  # an unrelated line (1.3 Hz, no harmonic of 0.8) is a new source: with
+  # the budget spent it is not added, and only lines of the set are
+  f0 <- f0s(b + sq + 0.002 * sin(2 * pi * 1.3 * t + 1))
+  expect_false(any(abs(f0 / 1.3 - 1) < 0.03))
+  expect_true(all(abs(f0 / 0.8 - round(f0 / 0.8)) < 0.01))
+})
