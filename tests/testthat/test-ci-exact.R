@@ -114,6 +114,13 @@ test_that("allan() uses the exact limits at N/m <= 16 only", {
   one <- which(a1$n == 1)
   expect_equal(a1$upper[one],
                a1$adev[one] / sqrt(qchisq((1 - 0.683) / 2, 1)))
+  # the default threshold is N/m <= 32
+  options(allanvar.ci_exact = NULL)
+  a2 <- allan(y, 1, type = "overlapping")
+  few32 <- 1024 / a0$m <= 32 & a0$n > 1
+  expect_true(any(few32 & !few))
+  expect_true(all(a2$upper[few32] != a0$upper[few32]))
+  expect_identical(a2$lower[!few32], a0$lower[!few32])
   options(allanvar.ci_exact = "a")
   expect_error(allan(y, 1), class = "allanvar_error_argument")
 })

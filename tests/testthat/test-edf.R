@@ -194,10 +194,10 @@ test_that("68.3% intervals cover the true ADEV 65-72% of the time", {
       expect_gte(length(cw$cov), 7)
       for (g in c("white", "walk")) {
         r <- if (g == "white") cw else cr
-        # N/m <= 16: the exact limits (R/ci-exact.R), whose union over the
+        # N/m <= 32: the exact limits (R/ci-exact.R), whose union over the
         # plausible noise types is held to the accepted band 0.60-0.76
         long <- (rule == "default" & g == "walk" & N %/% r$m < 64) |
-          N / r$m <= 16
+          N / r$m <= 32
         expect_gte(sum(!long), 5)
         expect_true(all(r$cov[!long] >= 0.65 & r$cov[!long] <= 0.72),
                     info = paste(rule, type, g, toString(r$cov)))
@@ -736,7 +736,7 @@ test_that("PDEV's rows at few averages take the exact limits", {
   y <- rnorm(1024)
   a <- allan(y, 1, type = "pdev")
   b <- withr_options(list(allanvar.ci_exact = 0), allan(y, 1, type = "pdev"))
-  few <- (1024 / a$m) <= 16 & a$n > 1
+  few <- (1024 / a$m) <= 32 & a$n > 1
   expect_true(any(few))
   expect_equal(a$lower[!few], b$lower[!few])
   expect_equal(a$edf, b$edf)
