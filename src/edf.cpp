@@ -294,7 +294,9 @@ double edf_total_wpm(long m, long L) {
 }
 
 double edf_total(double m, double L, int alpha, double oav_edf) {
-  if (alpha == 2 && m < 1e9 && L < 1e15) {
+  // the sparse part grows as 50 m map entries: exact up to m = 4096
+  // (~2e5 entries); beyond it Table 5's simple EDF as before (too high)
+  if (alpha == 2 && m <= 4096 && L < 1e15) {
     const double e = edf_total_wpm(static_cast<long>(m), static_cast<long>(L));
     if (std::isfinite(e) && e > 0) return e;
   }
