@@ -747,3 +747,30 @@ test_that("PDEV's rows at few averages take the exact limits", {
   expect_equal(a$upper[few], a$adev[few] * ex$upper[few])
   expect_true(all(abs(a$upper[few] / b$upper[few] - 1) > 1e-3))
 })
+
+test_that("the total variance's EDF under white PM is the exact two-moment one", {
+  # dense reference: E[V]^2 / |C|_F^2, C = W W' the terms' covariance of
+  # the reflected record's quadratic form (R/ci-exact-forms.R)
+  code <- stat_entry("total")$code
+  for (L in c(64, 129)) for (m in c(1, 3, 8, 16)) {
+    C <- tcrossprod(exact_form_total(m, L))
+    dense <- sum(diag(C))^2 / sum(C^2)
+    fast <- allan_edf_cpp(code, m, L - 2 * m, L, 2L, FALSE)
+    expect_equal(fast, dense, tolerance = 1e-10)
+  }
+  # own Monte Carlo (iid normal phase), N = 512, m = 32 (N/m = 16):
+  # Table 5's simple EDF would claim 248
+  set.seed(2903)
+  L <- 512
+  m <- 32
+  v <- replicate(1500, {
+    x <- stats::rnorm(L)
+    xs <- c(2 * x[1] - x[(m + 1):2], x, 2 * x[L] - x[(L - 1):(L - m)])
+    i <- (m + 2):(m + L - 1)
+    sum((xs[i - m] - 2 * xs[i] + xs[i + m])^2)
+  })
+  mc <- 2 * mean(v)^2 / stats::var(v)
+  e <- allan_edf_cpp(code, m, L - 2 * m, L, 2L, FALSE)
+  expect_lt(e, 0.7 * 248)
+  expect_equal(e, mc, tolerance = 0.15)
+})
