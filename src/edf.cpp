@@ -220,19 +220,6 @@ double edf_simple_oavar(double N, double m, int alpha) {
   }
 }
 
-// The total variance (NIST SP 1065 section 5.2.11): Table 7,
-// b (N - 1)/m - c, for white, flicker and random-walk FM; for white PM, as
-// Stable32, the simple overlapping EDF of Table 5; for flicker PM the
-// overlapping EDF (Greenhall's), not Table 5's simple formula, which
-// overstates it at long records: at N = 556989, m = 20 and 100, the Monte
-// Carlo EDF of the total variance of flicker PM is 1.28e5 and 4.5e4,
-// Greenhall's 9.6e4 and 3.5e4, Table 5's 1.96e5 and 1.16e5. Greenhall's
-// is the conservative side (at N = 1024 it is 10-25% below the Monte
-// Carlo EDF, Table 5's 0-20% above). Below
-// m = 8 the Total terms are (almost) the overlapping ones, and so is their
-// EDF: Table 7's 1.5 (N - 1)/m would claim 1500 at m = 1, N = 1001 where
-// the exact value for sampled white FM is 666 (the same terms as the
-// overlapping AV, whose Table 5 value is 666 too).
 // Exact two-moment EDF of the total variance under discrete white PM
 // (unit variance): V = |W x|^2 over its L - 2 terms (centres 1 .. L-2 of
 // the reflected record), E[V] = tr(A), Var[V] = 2 |A|_F^2 with
@@ -293,6 +280,20 @@ double edf_total_wpm(long m, long L) {
   return tr * tr / fro;
 }
 
+// The total variance (NIST SP 1065 section 5.2.11): Table 7,
+// b (N - 1)/m - c, for white, flicker and random-walk FM; for white PM the
+// exact two-moment EDF above (Stable32 takes Table 5's simple overlapping
+// EDF, 1.3-2.3x too high at N/m = 16-32); for flicker PM the
+// overlapping EDF (Greenhall's), not Table 5's simple formula, which
+// overstates it at long records: at N = 556989, m = 20 and 100, the Monte
+// Carlo EDF of the total variance of flicker PM is 1.28e5 and 4.5e4,
+// Greenhall's 9.6e4 and 3.5e4, Table 5's 1.96e5 and 1.16e5. Greenhall's
+// is the conservative side (at N = 1024 it is 10-25% below the Monte
+// Carlo EDF, Table 5's 0-20% above). Below
+// m = 8 the Total terms are (almost) the overlapping ones, and so is their
+// EDF: Table 7's 1.5 (N - 1)/m would claim 1500 at m = 1, N = 1001 where
+// the exact value for sampled white FM is 666 (the same terms as the
+// overlapping AV, whose Table 5 value is 666 too).
 double edf_total(double m, double L, int alpha, double oav_edf) {
   // the sparse part grows as 50 m map entries: exact up to m = 4096
   // (~2e5 entries); beyond it Table 5's simple EDF as before (too high)
