@@ -154,9 +154,11 @@ noise_right <- function(M, alpha) {
 exact_dense_problem <- function(m, L, alpha) {
   if (alpha >= 1L) return(if (L <= exact_dense_max) c(m, L))
   if (L <= exact_dense_fm) return(c(m, L))
-  mp <- max(1, round(m * (exact_dense_fm - 1) / (L - 1)))
+  # rounded down, so that the window (3m points for MTOT, N/m >= 3) still
+  # fits in the scaled record: rounding up broke m = 500, L = 1501
+  mp <- max(1, floor(m * (exact_dense_fm - 1) / (L - 1)))
   # an even m stays even (Theo1 is defined at even m only)
-  if (m %% 2 == 0) mp <- max(2, 2 * round(mp / 2))
+  if (m %% 2 == 0) mp <- max(2, 2 * floor(mp / 2))
   c(mp, min(exact_dense_fm, round((L - 1) * mp / m) + 1))
 }
 

@@ -164,3 +164,26 @@ test_that("exact 95% intervals cover under random-walk FM (quick Monte Carlo)", 
   # 200 draws: binomial sd 0.015 at 0.95
   expect_true(all(cover >= 0.90 & cover <= 0.995))
 })
+
+test_that("a dense grid's exact factors come from knots, interpolated", {
+  # taus = "all": each row its own problem; computed at knots spaced by
+  # 5% in m and in the number of terms, interpolated in log m between
+  L <- 301
+  m <- 10:148
+  n <- L - 2 * m
+  code <- allan_type_code("overlapping")
+  one <- function(i, a) exact_factors_one(code, m[i], n[i], a, 0.683)
+  rows <- seq_along(m)
+  sets <- rep(list(c(0L, 2L)), length(m))
+  a <- exact_factor_table(rows, sets, m, n, one, smooth = TRUE)
+  b <- exact_factor_table(rows, sets, m, n, one, smooth = FALSE)
+  k <- exact_knots(m, n)
+  expect_lt(length(k), 0.8 * length(m))
+  expect_true(all(c(1L, length(m)) %in% k))
+  for (al in c("0", "2")) {
+    expect_identical(a[[al]][, k], b[[al]][, k])
+    expect_lt(max(abs(a[[al]] / b[[al]] - 1)), 1e-2)
+  }
+  # with few terms every row is a knot (the law moves with each one)
+  expect_true(all(which(n <= 20) %in% k))
+})
