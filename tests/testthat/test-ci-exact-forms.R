@@ -79,3 +79,12 @@ test_that("the total type's limits cover under white PM at few averages", {
   expect_gt(cover, 0.6)
   expect_lt(cover, 0.85)
 })
+
+test_that("the scaled problem keeps the window inside its record (m = N/3)", {
+  # rounding the scaled m up gave a 3m window longer than the record
+  pr <- exact_dense_problem(500, 1501, 0L)
+  expect_gte(pr[2] - 1, 3 * pr[1])
+  set.seed(11)
+  a <- allan(rnorm(1500), 1, type = "mtotdev", taus = c(499, 500))
+  expect_true(all(is.finite(c(a$lower, a$upper))))
+})
