@@ -37,7 +37,7 @@ try_refit <- function(args, stage) {
     log$conditions[[length(log$conditions) + 1L]] <- list(condition = cnd, stage = stage)
   }
   res <- withCallingHandlers(
-    tryCatch(do.call(avfit, args), error = function(e) {
+    tryCatch(refit_curve(args), error = function(e) {
       keep(e)
       NULL
     }),
@@ -50,6 +50,20 @@ try_refit <- function(args, stage) {
     res <- NULL
   }
   list(fit = res, conditions = log$conditions)
+}
+
+# avfit() with `args` (as do.call(avfit, args) calls it), without the
+# covariance's costly part: the loop reads its refits' criterion, chi2 and
+# shares, never their SEs; the fit it returns gets its full covariance at
+# the end (complete_covariance(), stage_assemble()).
+refit_curve <- function(args) {
+  cl <- match.call(avfit, as.call(c(list(avfit), args)))
+  a <- c(formals(avfit)[setdiff(names(formals(avfit)), c("av", "..."))], list(av = NULL))
+  a$control <- avfit_control()
+  a[names(args)] <- args
+  fit_curve(a$av, a$terms, a$n, a$freq, a$type, a$channel, a$start, a$fixed,
+            a$tau_range, a$bias_correct, a$correlation, a$control, cl,
+            covariance = FALSE)
 }
 
 # Refit the curve with one more term. avfit() profiles the nonlinear
