@@ -96,7 +96,7 @@ effect_filter <- function() {
         # series, read once
         filter_raw_support(sp, par[["Nf"]],
                            diag_part(raw, "filter") %||% filter_evidence(x, freq),
-                           stats::var(x), freq)
+                           diag_var(raw, x), freq)
       }
     ))
   }

@@ -107,6 +107,15 @@ diag_cache <- function(dg) {
   if (inherits(dg, "refine_diagnostics")) dg$cache else NULL
 }
 
+# The variance of `x`, kept in the call's store when `x` is the series the
+# checks see (every candidate's evidence reads it).
+diag_var <- function(dg, x) {
+  cache <- diag_cache(dg)
+  if (is.null(cache) || !identical(x, diag_series(dg))) return(stats::var(x))
+  if (is.null(cache$var)) cache$var <- stats::var(x)
+  cache$var
+}
+
 # The series the raw-data checks see.
 diag_series <- function(dg) {
   if (inherits(dg, "refine_diagnostics")) dg$series else NULL
