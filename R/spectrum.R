@@ -49,6 +49,11 @@ welch_psd <- function(x, freq, seg = NULL, detrend = TRUE) {
        df = freq / seg, k = k)
 }
 
+# The Welch PSD of the centred series, not detrended: what find_bands() and
+# measure_band() read (`welch` arguments, so that one avrefine() call makes
+# it once: raw_welch()).
+centred_welch <- function(x, freq, seg) welch_psd(x - mean(x), freq, seg, detrend = FALSE)
+
 # ---- backgrounds ----------------------------------------------------------------
 
 # Running median of `v` with an odd window `width[i]` centred on each bin
@@ -479,11 +484,12 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
 #' sigma^2) and `share` of the series' variance.
 #' Cost O(n log seg).
 #' @noRd
-find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
+find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
+                       welch = centred_welch) {
   n <- length(x)
   tau0 <- 1 / freq
   seg <- as.integer(min(seg, 2^floor(log2(n / 8))))
-  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
+  w <- welch(x, freq, seg)
   p <- w$psd
   nb <- length(p)
   lp <- log(pmax(p, .Machine$double.xmin))
