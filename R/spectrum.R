@@ -369,7 +369,6 @@ lines_outside_bands <- function(lines, bands) {
 remove_lines <- function(x, freq, f0) {
   if (!length(f0)) return(x)
   n <- length(x)
-  t <- (seq_len(n) - 1) / freq
   xc <- x - mean(x)
   # least-squares amplitudes on sin and cos at f from their sums (C++,
   # src/lines.cpp: no trig per sample, no n x 2 matrix); the fitted power
@@ -386,7 +385,8 @@ remove_lines <- function(x, freq, f0) {
                          c(max(bin / 2, f - 2 * bin), f + 2 * bin),
                          tol = bin * 1e-3)
     b <- amps(o$minimum, xc)$b
-    xc <- xc - b[1L] * sin(2 * pi * o$minimum * t) - b[2L] * cos(2 * pi * o$minimum * t)
+    # xc - b1 sin(2 pi f t) - b2 cos(2 pi f t), t = (0..n-1) / freq (C++)
+    xc <- line_subtract(xc, o$minimum, freq, b[1L], b[2L])
   }
   as.numeric(xc) + mean(x)
 }
