@@ -401,16 +401,31 @@ remove_lines <- function(x, freq, f0) {
 # primes); `res` is the record's resolution freq / n, `df` the bin spacing.
 record_periodogram <- function(x, freq) {
   n <- length(x)
-  k <- 2 * pi * (seq_len(n) - 1) / n
-  w <- 0.35875 - 0.48829 * cos(k) + 0.14128 * cos(2 * k) - 0.01168 * cos(3 * k)
+  tp <- record_taper(n)
+  w <- tp$w
   np <- stats::nextn(n, c(2L, 3L, 5L))
   y <- detrend_linear(x) * w
   X <- stats::fft(c(y, numeric(np - n)))
   half <- np %/% 2L + 1L
-  p <- Mod(X[seq_len(half)])^2 / (freq * sum(w^2))
+  p <- Mod(X[seq_len(half)])^2 / (freq * tp$w2)
   p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
   list(f = (seq_len(half) - 1) * freq / np, psd = p, df = freq / np,
        res = freq / n, lobe = ceiling(4 * np / n) + 1L)
+}
+
+# The taper of record_periodogram() for n samples and its sum of squares.
+# Its cosines cost more than the record's FFT, and the loop reads records
+# of one length axis after axis: the last length's taper is kept.
+taper_store <- new.env(parent = emptyenv())
+record_taper <- function(n) {
+  if (!identical(taper_store$n, n)) {
+    k <- 2 * pi * (seq_len(n) - 1) / n
+    w <- 0.35875 - 0.48829 * cos(k) + 0.14128 * cos(2 * k) - 0.01168 * cos(3 * k)
+    taper_store$w <- w
+    taper_store$w2 <- sum(w^2)
+    taper_store$n <- n
+  }
+  list(w = taper_store$w, w2 = taper_store$w2)
 }
 
 # What a peak region [f_lo, f_hi] of a coarser spectrum holds at the
