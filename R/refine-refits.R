@@ -111,6 +111,11 @@ refit_memo_put <- function(args, fit, conditions) {
 # shares, never their SEs; the fit it returns gets its full covariance at
 # the end (complete_covariance(), stage_assemble()).
 refit_curve <- function(args) {
+  # an argument avfit() does not name exactly (a user's avrefine(...)) is
+  # left to avfit() to match or refuse
+  if (!all(names(args) %in% setdiff(names(formals(avfit)), "..."))) {
+    return(do.call(avfit, args))
+  }
   cl <- refit_call(args)
   a <- c(formals(avfit)[setdiff(names(formals(avfit)), c("av", "..."))], list(av = NULL))
   a[names(args)] <- args
