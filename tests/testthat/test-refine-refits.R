@@ -34,8 +34,9 @@ test_that("within a call a refit is made once and its conditions replayed", {
   args <- refit_args(fit, c("N", "K", "gm"), refit_settings(fit, list()))
   cnt <- new.env()
   cnt$n <- 0L
-  trace("fit_curve", bquote(assign("n", get("n", envir = .(cnt)) + 1L, envir = .(cnt))),
-        print = FALSE, where = asNamespace("allanvar"))
+  suppressMessages(trace("fit_curve", bquote(assign("n", get("n", envir = .(cnt)) + 1L,
+                                                     envir = .(cnt))),
+                         print = FALSE, where = asNamespace("allanvar")))
   on.exit(suppressMessages(untrace("fit_curve", where = asNamespace("allanvar"))),
           add = TRUE)
   refit_memo_open()
