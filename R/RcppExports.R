@@ -105,6 +105,10 @@ line_sums <- function(y, f, freq) {
     .Call(`_allanvar_line_sums`, y, f, freq)
 }
 
+line_subtract <- function(y, f, freq, a, b) {
+    .Call(`_allanvar_line_subtract`, y, f, freq, a, b)
+}
+
 lz4_decompress_cpp <- function(x, expected) {
     .Call(`_allanvar_lz4_decompress_cpp`, x, expected)
 }

@@ -150,9 +150,21 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
                   control = avfit_control(), ...) {
   cl <- match.call()
   check_dots_empty(...)
+  check_present(missing(av), "av", "an Allan variance curve")
+  fit_curve(av, terms, n, freq, type, channel, start, fixed, tau_range,
+            bias_correct, correlation, control, cl)
+}
+
+# avfit()'s work. `covariance = FALSE` (the loop's refits, read for their
+# criterion and shares only): the reported covariance leaves out the
+# sandwich (the points' model correlation, the costly part), so that its
+# SEs still say which are not finite (check_fit_finite()'s warnings, which
+# the loop records); complete_covariance() gives the fit the loop returns
+# its full covariance.
+fit_curve <- function(av, terms, n, freq, type, channel, start, fixed, tau_range,
+                      bias_correct, correlation, control, cl, covariance = TRUE) {
   check_flag(bias_correct, "bias_correct")
   check_flag(correlation, "correlation")
-  check_present(missing(av), "av", "an Allan variance curve")
   terms <- check_terms(terms %||% datasheet_terms())
   control <- check_control(control)
   curve <- as_av_curve(av, n = n, freq = freq, type = type, channel = channel)
@@ -249,13 +261,14 @@ avfit <- function(av, terms = NULL, n = NULL, freq = NULL,
       res <- fit_search(pr, start, res, control)
     }
   }
-  out <- finish_fit(res, pr, curve, terms, control, cl)
+  out <- finish_fit(res, pr, curve, terms, control, cl, covariance)
   out$model_error <- sqrt(model_var)
   out
 }
 
-# Everything a fit reports, from the search result `res` on problem `pr`.
-finish_fit <- function(res, pr, curve, terms, control, cl) {
+# Everything a fit reports, from the search result `res` on problem `pr`
+# (`covariance`: see fit_curve()).
+finish_fit <- function(res, pr, curve, terms, control, cl, covariance = TRUE) {
   lay <- res$layout
   data <- pr$data
   tau0 <- pr$tau0
@@ -266,7 +279,8 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
   nfree <- sum(!lay$fixed)
   dfres <- nrow(data) - nfree
   chi2 <- if (dfres > 0) objective / dfres else NA_real_
-  vc <- fit_covariance(pr, curve, lay, chi2)
+  vc <- if (covariance) fit_covariance(pr, curve, lay, chi2) else
+    fit_vcov(lay, data$tau, tau0, pr$W, chi2, pr$plan)
   data$fitted <- fitted
   data$z <- z
   input <- curve
@@ -276,7 +290,7 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
   # err about (its SE is NA by design, see fit_vcov())
   absent <- lay$role == "nonlinear" & is.na(diag(vc))
   check_fit_finite(stats::setNames(lay$value, lay$name), se[!absent])
-  new_avfit(
+  out <- new_avfit(
     coefficients = stats::setNames(lay$value, lay$name),
     se = se, vcov = vc,
     chi2 = chi2, rms = 100 * sqrt(mean((sqrt(data$avar / fitted) - 1)^2)),
@@ -287,6 +301,25 @@ finish_fit <- function(res, pr, curve, terms, control, cl) {
     bias_correct = pr$bias_correct, correlation = !is.null(pr$corr),
     corr = pr$corr, steps = new_steps(), input = input,
     convergence = res$convergence, control = control, call = cl)
+  if (!covariance) out$partial_vcov <- TRUE
+  out
+}
+
+# The full covariance (and SEs) of a fit finish_fit() gave a partial one;
+# any other fit is returned as it is. The problem is rebuilt from the fit's
+# own points, EDF and layout, as the fit's last pass had it (the loop's
+# refits carry no model-error term).
+complete_covariance <- function(fit) {
+  if (!isTRUE(fit$partial_vcov)) return(fit)
+  lay <- fit$layout
+  data <- fit$data[, setdiff(names(fit$data), c("fitted", "z")), drop = FALSE]
+  tau0 <- if (is.null(fit$freq)) NULL else 1 / fit$freq
+  pr <- fit_problem(data, tau0, lay, fit$bias_correct, fit$corr)
+  vc <- fit_covariance(pr, fit$input, lay, fit$chi2)
+  fit$vcov <- vc
+  fit$se <- stats::setNames(sqrt(pmax(diag(vc), 0)), lay$name)
+  fit$partial_vcov <- NULL
+  fit
 }
 
 # The covariance a fit of layout `lay` on problem `pr` reports (the

@@ -151,6 +151,9 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
   # the refits share the basis columns they build (R/coef.R)
   basis_store_open()
   on.exit(basis_store_close(), add = TRUE)
+  # and each refit is made once (R/refine-refits.R)
+  refit_memo_open()
+  on.exit(refit_memo_close(), add = TRUE)
   # the stages in order (R/refine-stages.R), each taking and returning the state
   for (stage in refine_stages()) st <- validate_refine_state(stage(st))
   st$result

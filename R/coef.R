@@ -236,26 +236,34 @@ basis_store_close <- function() {
 }
 
 stored_basis <- function(entry, tau, tau0, nl) {
-  if (basis_store$depth == 0L || length(tau) > 2048L) {
-    return(entry$basis(tau, tau0, nl))
-  }
+  stored_basis_in(basis_store_env(tau, tau0), entry, basis_key(entry), tau, tau0, nl)
+}
+
+# The store's environment for one tau grid (NULL: no store, outside a loop
+# or on a long grid), made when first asked for.
+basis_store_env <- function(tau, tau0) {
+  if (basis_store$depth == 0L || length(tau) > 2048L) return(NULL)
   slots <- basis_store$slots
-  env <- NULL
   for (s in slots) {
-    if (identical(s$tau, tau) && identical(s$tau0, tau0)) {
-      env <- s$env
-      break
-    }
+    if (identical(s$tau, tau) && identical(s$tau0, tau0)) return(s$env)
   }
-  if (is.null(env)) {
-    env <- new.env(hash = TRUE, parent = emptyenv())
-    # a few tau grids per call (the curve, a trimmed range); oldest out
-    if (length(slots) >= 8L) slots <- slots[-1L]
-    basis_store$slots <- c(slots, list(list(tau = tau, tau0 = tau0, env = env)))
-  }
-  # [[ ]]: `$variant` would partially match `variants` on a bare entry
-  key <- paste0(entry[["name"]], ":", entry[["variant"]], "|",
-                paste(sprintf("%a", nl), collapse = ","))
+  env <- new.env(hash = TRUE, parent = emptyenv())
+  # a few tau grids per call (the curve, a trimmed range); oldest out
+  if (length(slots) >= 8L) slots <- slots[-1L]
+  basis_store$slots <- c(slots, list(list(tau = tau, tau0 = tau0, env = env)))
+  env
+}
+
+# The entry's part of a store key.
+# [[ ]]: `$variant` would partially match `variants` on a bare entry
+basis_key <- function(entry) paste0(entry[["name"]], ":", entry[["variant"]], "|")
+
+# stored_basis() with the grid's environment `env` (or NULL) and the
+# entry's key part `key` found beforehand (a search asks for one term's
+# columns at many values on one grid).
+stored_basis_in <- function(env, entry, key, tau, tau0, nl) {
+  if (is.null(env)) return(entry$basis(tau, tau0, nl))
+  key <- paste0(key, paste(sprintf("%a", nl), collapse = ","))
   b <- env[[key]]
   if (is.null(b)) {
     b <- entry$basis(tau, tau0, nl)

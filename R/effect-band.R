@@ -76,8 +76,9 @@ sim_band <- function(n, tau0, scale, f_lo, f_hi, s) {
 # flanks (one band width either side, below 0.49 freq); a log-linear one
 # gives the systematic spread. Returns list(f_lo, f_hi, s, u, power) or
 # NULL when the band has no measurable excess.
-measure_band <- function(x, freq, b, seg = 512L, knots = band_knots) {
-  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
+measure_band <- function(x, freq, b, seg = 512L, knots = band_knots,
+                         welch = centred_welch) {
+  w <- welch(x, freq, seg)
   wd <- max(b$f_to - b$f_from, 4 * w$df)
   fl <- (w$f > b$f_from - wd & w$f < b$f_from & w$f > 0) |
     (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))
@@ -212,7 +213,7 @@ effect_band <- function() {
       make = function(x, freq, dg) {
         bands <- diag_part(dg, "bands")
         Filter(Negate(is.null), lapply(seq_len(nrow(bands)), function(j) {
-          measure_band(x, freq, bands[j, ])
+          measure_band(x, freq, bands[j, ], welch = raw_welch(dg))
         }))
       }),
     describe = function(values) {

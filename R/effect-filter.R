@@ -96,7 +96,7 @@ effect_filter <- function() {
         # series, read once
         filter_raw_support(sp, par[["Nf"]],
                            diag_part(raw, "filter") %||% filter_evidence(x, freq),
-                           stats::var(x), freq)
+                           diag_var(raw, x), freq)
       }
     ))
   }
@@ -231,7 +231,7 @@ effect_resonance <- function() {
     # the broad bands of the raw periodogram; the checks of the other
     # effects see them brought down to their background
     diagnose = list(part = "bands", reads = "raw",
-                    make = function(x, freq, dg) find_bands(x, freq),
+                    make = function(x, freq, dg) find_bands(x, freq, welch = raw_welch(dg)),
                     clean = function(x, freq, bands) remove_bands(x, freq, bands)),
     describe = function(values) {
       sprintf("resonance (%s Hz)", paste(signif(values$fr, 3), collapse = ", "))

@@ -64,7 +64,7 @@ evidence_gm <- function(par, raw, x, freq) {
     # Tc of a few samples or less: the GM is the sample-to-sample
     # correlation itself; compare its lag-1 ACF with the raw one.
     phi <- exp(-1 / (tc * freq))
-    pred <- if (is.finite(sigma)) sigma^2 * phi / stats::var(x) else NA_real_
+    pred <- if (is.finite(sigma)) sigma^2 * phi / diag_var(raw, x) else NA_real_
     r1 <- diag_value(raw, "acf1")
     z1 <- diag_value(raw, "acf1_z")
     ok <- is.finite(pred) && z1 > 3 && r1 > pred / 3 && r1 < 3 * pred

@@ -144,12 +144,18 @@ fit_problem <- function(data, tau0, lay, bias_correct, corr, model_var = 0) {
   B0 <- matrix(0, nrow(data), length(cols), dimnames = list(NULL, cols))
   B0[, seq_len(ncol(basis0))] <- basis0
   amp$col <- match(amp$name, cols)
+  # what every solve reads, worked out once: the fixed amplitudes, the
+  # free ones' template, the store's grid and each searched term's key
+  amp$fixed_idx <- which(amp$fixed)
+  amp$cc0 <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
+  for (k in seq_along(plan_nl)) plan_nl[[k]]$key <- basis_key(plan_nl[[k]]$entry)
   list(data = data, tau0 = tau0, lay = lay, plan = plan, y = y,
        s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct,
        amp = amp, plan_nl = plan_nl, basis0 = basis0, B0 = B0,
        nl_cols = lapply(plan_nl, function(p) match(p$amp, cols)),
        values = stats::setNames(lay$value, lay$name),
-       memo = new.env(parent = emptyenv()))
+       memo = new.env(parent = emptyenv()), tau = data$tau,
+       store = basis_store_env(data$tau, tau0), zero = numeric(nrow(data)))
 }
 
 # The basis of a solve: the problem's constant columns and the searched
@@ -161,10 +167,15 @@ solve_basis <- function(pr, values) {
   memo <- pr$memo
   for (k in seq_along(pr$plan_nl)) {
     p <- pr$plan_nl[[k]]
-    nl <- if (length(p$nl)) stats::setNames(values[p$nl], p$nl_param) else NULL
+    nl <- NULL
+    if (length(p$nl)) {
+      nl <- values[p$nl]
+      names(nl) <- p$nl_param
+    }
     hit <- memo[[p$label]]
     if (is.null(hit) || !identical(hit$nl, nl)) {
-      hit <- list(nl = nl, b = stored_basis(p$entry, pr$data$tau, pr$tau0, nl))
+      hit <- list(nl = nl, b = stored_basis_in(pr$store, p$entry, p$key, pr$tau,
+                                               pr$tau0, nl))
       assign(p$label, hit, envir = memo)
     }
     Bm[, pr$nl_cols[[k]]] <- hit$b
@@ -182,11 +193,11 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE) {
   if (length(nlv)) values[names(nlv)] <- nlv
   amp <- pr$amp
   Bm <- solve_basis(pr, values)
-  on <- !amp$fixed & !amp$label %in% off
+  on <- if (is.null(off)) !amp$fixed else !amp$fixed & !amp$label %in% off
   free <- amp$name[on]
-  offset <- numeric(nrow(pr$data))
-  for (i in which(amp$fixed)) offset <- offset + amp$value[i]^2 * Bm[, amp$col[i]]
-  cc <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
+  offset <- pr$zero
+  for (i in amp$fixed_idx) offset <- offset + amp$value[i]^2 * Bm[, amp$col[i]]
+  cc <- amp$cc0
   lay <- NULL
   if (layout) {
     lay <- pr$lay
@@ -214,6 +225,7 @@ fit_search <- function(pr, start, prev, control) {
   freq <- if (is.null(pr$tau0)) NULL else 1 / pr$tau0
   nlrows <- which(lay$role == "nonlinear" & !lay$fixed)
   nlv <- stats::setNames(numeric(length(nlrows)), lay$name[nlrows])
+  nl_names <- names(nlv)
   evals <- 0L
   # Every nonlinear parameter stays within its entry's hard bounds (what
   # the curve and the record can see): outside them the objective is
@@ -222,8 +234,9 @@ fit_search <- function(pr, start, prev, control) {
   obj <- function(lognl, off = NULL) {
     if (any(lognl < lb | lognl > ub)) return(Inf)
     evals <<- evals + 1L
-    solve_amps(pr, stats::setNames(exp(lognl), names(nlv)), control, off,
-               layout = FALSE)$objective
+    v <- exp(lognl)
+    names(v) <- nl_names
+    solve_amps(pr, v, control, off, layout = FALSE)$objective
   }
   nm <- NULL
   if (length(nlrows)) {

@@ -14,7 +14,9 @@
 #           with each part's `clean()` applied in catalogue order (the
 #           lines taken out, the bands brought to their background)
 #   cache   an environment for statistics of `series` that many candidate
-#           checks share (the block-mean ACF of each block size)
+#           checks share (the block-mean ACF of each block size, its
+#           variance), and the raw series' Welch PSD the parts share
+#           (raw_welch())
 #
 # An entry's `diagnose` field: list(part, reads = "raw" or "clean", needs
 # (parts made first), make(x, freq, dg) -> the part, clean(x, freq, part)
@@ -105,6 +107,30 @@ diag_value <- function(dg, field) {
 # loop).
 diag_cache <- function(dg) {
   if (inherits(dg, "refine_diagnostics")) dg$cache else NULL
+}
+
+# The variance of `x`, kept in the call's store when `x` is the series the
+# checks see (every candidate's evidence reads it).
+diag_var <- function(dg, x) {
+  cache <- diag_cache(dg)
+  if (is.null(cache) || !identical(x, diag_series(dg))) return(stats::var(x))
+  if (is.null(cache$var)) cache$var <- stats::var(x)
+  cache$var
+}
+
+# centred_welch() of the raw series for the parts that read it (the bands
+# and the measured bands' spectra), made once per call and segment length:
+# returns a function(x, freq, seg) for their `welch` argument.
+raw_welch <- function(dg) {
+  cache <- diag_cache(dg)
+  function(x, freq, seg) {
+    key <- paste0("raw_welch.", seg)
+    hit <- if (!is.null(cache)) cache[[key]]
+    if (!is.null(hit) && identical(hit$x, x) && identical(hit$freq, freq)) return(hit$w)
+    w <- centred_welch(x, freq, seg)
+    if (!is.null(cache)) cache[[key]] <- list(x = x, freq = freq, w = w)
+    w
+  }
 }
 
 # The series the raw-data checks see.

@@ -31,13 +31,22 @@ refit_args <- function(fit, terms, settings, start = NULL, hold = NULL) {
 # they came, each error or (muffled) warning as list(condition, stage), for
 # the caller to record (record_conditions()).
 try_refit <- function(args, stage) {
+  hit <- refit_memo_get(args)
+  if (!is.null(hit)) {
+    fit <- hit$fit
+    if (!is.null(fit)) fit$call <- refit_call(args)
+    return(list(fit = fit, conditions = lapply(hit$conditions, function(cd) {
+      cd$stage <- stage
+      cd
+    })))
+  }
   log <- new.env(parent = emptyenv())
   log$conditions <- list()
   keep <- function(cnd) {
     log$conditions[[length(log$conditions) + 1L]] <- list(condition = cnd, stage = stage)
   }
   res <- withCallingHandlers(
-    tryCatch(do.call(avfit, args), error = function(e) {
+    tryCatch(refit_curve(args), error = function(e) {
       keep(e)
       NULL
     }),
@@ -49,8 +58,75 @@ try_refit <- function(args, stage) {
     keep(simpleCondition("no degrees of freedom left for chi2"))
     res <- NULL
   }
+  refit_memo_put(args, res, log$conditions)
   list(fit = res, conditions = log$conditions)
 }
+
+# The refits of one avrefine() call, each made once. A refit is a pure
+# function of its arguments: the previous fit enters only through its
+# curve, its EDF source and its layout (the EDF the curve gets from that
+# model, curve_of_fit()), the rest are the terms, start and held values,
+# tau range and settings. The loop asks for the same refit again (a
+# candidate screened at the next step against an unchanged model, the
+# free refit that repeats a screen): the first result is given, with its
+# conditions replayed under the asking stage, so the failures recorded are
+# those of a second run. avrefine() opens the memo for its call.
+refit_memo <- new.env(parent = emptyenv())
+refit_memo$depth <- 0L
+refit_memo$entries <- list()
+
+refit_memo_open <- function() {
+  refit_memo$depth <- refit_memo$depth + 1L
+  invisible(NULL)
+}
+
+refit_memo_close <- function() {
+  refit_memo$depth <- max(refit_memo$depth - 1L, 0L)
+  if (refit_memo$depth == 0L) refit_memo$entries <- list()
+  invisible(NULL)
+}
+
+refit_key <- function(args) {
+  av <- args$av
+  list(input = av$input, edf_source = av$edf_source, layout = av$layout,
+       rest = args[names(args) != "av"])
+}
+
+refit_memo_get <- function(args) {
+  if (refit_memo$depth == 0L || !length(refit_memo$entries)) return(NULL)
+  key <- refit_key(args)
+  for (e in refit_memo$entries) if (identical(e$key, key)) return(e)
+  NULL
+}
+
+refit_memo_put <- function(args, fit, conditions) {
+  if (refit_memo$depth == 0L) return(invisible(NULL))
+  refit_memo$entries[[length(refit_memo$entries) + 1L]] <- list(
+    key = refit_key(args), fit = fit, conditions = conditions)
+  invisible(NULL)
+}
+
+# avfit() with `args` (as do.call(avfit, args) calls it), without the
+# covariance's costly part: the loop reads its refits' criterion, chi2 and
+# shares, never their SEs; the fit it returns gets its full covariance at
+# the end (complete_covariance(), stage_assemble()).
+refit_curve <- function(args) {
+  # an argument avfit() does not name exactly (a user's avrefine(...)) is
+  # left to avfit() to match or refuse
+  if (!all(names(args) %in% setdiff(names(formals(avfit)), "..."))) {
+    return(do.call(avfit, args))
+  }
+  cl <- refit_call(args)
+  a <- c(formals(avfit)[setdiff(names(formals(avfit)), c("av", "..."))], list(av = NULL))
+  a[names(args)] <- args
+  if (is.call(a$control)) a$control <- avfit_control()
+  fit_curve(a$av, a$terms, a$n, a$freq, a$type, a$channel, a$start, a$fixed,
+            a$tau_range, a$bias_correct, a$correlation, a$control, cl,
+            covariance = FALSE)
+}
+
+# The call a fit made by do.call(avfit, args) records.
+refit_call <- function(args) match.call(avfit, as.call(c(list(avfit), args)))
 
 # Refit the curve with one more term. avfit() profiles the nonlinear
 # parameters on its own grid; when the tracing gives a start value for the

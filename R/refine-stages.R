@@ -146,7 +146,7 @@ stage_trim <- function(st) {
 
 stage_assemble <- function(st) {
   fit <- st$fit
-  out <- st$current
+  out <- complete_covariance(st$current)
   all_steps <- Reduce(bind_steps, st$steps, fit$steps)
   out$steps <- all_steps
   out$unexplained <- st$unexplained

@@ -49,6 +49,11 @@ welch_psd <- function(x, freq, seg = NULL, detrend = TRUE) {
        df = freq / seg, k = k)
 }
 
+# The Welch PSD of the centred series, not detrended: what find_bands() and
+# measure_band() read (`welch` arguments, so that one avrefine() call makes
+# it once: raw_welch()).
+centred_welch <- function(x, freq, seg) welch_psd(x - mean(x), freq, seg, detrend = FALSE)
+
 # ---- backgrounds ----------------------------------------------------------------
 
 # Running median of `v` with an odd window `width[i]` centred on each bin
@@ -364,7 +369,6 @@ lines_outside_bands <- function(lines, bands) {
 remove_lines <- function(x, freq, f0) {
   if (!length(f0)) return(x)
   n <- length(x)
-  t <- (seq_len(n) - 1) / freq
   xc <- x - mean(x)
   # least-squares amplitudes on sin and cos at f from their sums (C++,
   # src/lines.cpp: no trig per sample, no n x 2 matrix); the fitted power
@@ -381,7 +385,8 @@ remove_lines <- function(x, freq, f0) {
                          c(max(bin / 2, f - 2 * bin), f + 2 * bin),
                          tol = bin * 1e-3)
     b <- amps(o$minimum, xc)$b
-    xc <- xc - b[1L] * sin(2 * pi * o$minimum * t) - b[2L] * cos(2 * pi * o$minimum * t)
+    # xc - b1 sin(2 pi f t) - b2 cos(2 pi f t), t = (0..n-1) / freq (C++)
+    xc <- line_subtract(xc, o$minimum, freq, b[1L], b[2L])
   }
   as.numeric(xc) + mean(x)
 }
@@ -396,16 +401,31 @@ remove_lines <- function(x, freq, f0) {
 # primes); `res` is the record's resolution freq / n, `df` the bin spacing.
 record_periodogram <- function(x, freq) {
   n <- length(x)
-  k <- 2 * pi * (seq_len(n) - 1) / n
-  w <- 0.35875 - 0.48829 * cos(k) + 0.14128 * cos(2 * k) - 0.01168 * cos(3 * k)
+  tp <- record_taper(n)
+  w <- tp$w
   np <- stats::nextn(n, c(2L, 3L, 5L))
   y <- detrend_linear(x) * w
   X <- stats::fft(c(y, numeric(np - n)))
   half <- np %/% 2L + 1L
-  p <- Mod(X[seq_len(half)])^2 / (freq * sum(w^2))
+  p <- Mod(X[seq_len(half)])^2 / (freq * tp$w2)
   p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
   list(f = (seq_len(half) - 1) * freq / np, psd = p, df = freq / np,
        res = freq / n, lobe = ceiling(4 * np / n) + 1L)
+}
+
+# The taper of record_periodogram() for n samples and its sum of squares.
+# Its cosines cost more than the record's FFT, and the loop reads records
+# of one length axis after axis: the last length's taper is kept.
+taper_store <- new.env(parent = emptyenv())
+record_taper <- function(n) {
+  if (!identical(taper_store$n, n)) {
+    k <- 2 * pi * (seq_len(n) - 1) / n
+    w <- 0.35875 - 0.48829 * cos(k) + 0.14128 * cos(2 * k) - 0.01168 * cos(3 * k)
+    taper_store$w <- w
+    taper_store$w2 <- sum(w^2)
+    taper_store$n <- n
+  }
+  list(w = taper_store$w, w2 = taper_store$w2)
 }
 
 # What a peak region [f_lo, f_hi] of a coarser spectrum holds at the
@@ -479,11 +499,12 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
 #' sigma^2) and `share` of the series' variance.
 #' Cost O(n log seg).
 #' @noRd
-find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3) {
+find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
+                       welch = centred_welch) {
   n <- length(x)
   tau0 <- 1 / freq
   seg <- as.integer(min(seg, 2^floor(log2(n / 8))))
-  w <- welch_psd(x - mean(x), freq, seg, detrend = FALSE)
+  w <- welch(x, freq, seg)
   p <- w$psd
   nb <- length(p)
   lp <- log(pmax(p, .Machine$double.xmin))

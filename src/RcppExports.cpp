@@ -337,6 +337,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// line_subtract
+Rcpp::NumericVector line_subtract(const Rcpp::NumericVector& y, double f, double freq, double a, double b);
+RcppExport SEXP _allanvar_line_subtract(SEXP ySEXP, SEXP fSEXP, SEXP freqSEXP, SEXP aSEXP, SEXP bSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< double >::type f(fSEXP);
+    Rcpp::traits::input_parameter< double >::type freq(freqSEXP);
+    Rcpp::traits::input_parameter< double >::type a(aSEXP);
+    Rcpp::traits::input_parameter< double >::type b(bSEXP);
+    rcpp_result_gen = Rcpp::wrap(line_subtract(y, f, freq, a, b));
+    return rcpp_result_gen;
+END_RCPP
+}
 // lz4_decompress_cpp
 Rcpp::RawVector lz4_decompress_cpp(const Rcpp::RawVector& x, double expected);
 RcppExport SEXP _allanvar_lz4_decompress_cpp(SEXP xSEXP, SEXP expectedSEXP) {
@@ -703,6 +717,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_gchisq_quantile_cpp", (DL_FUNC) &_allanvar_gchisq_quantile_cpp, 2},
     {"_allanvar_info_kalman", (DL_FUNC) &_allanvar_info_kalman, 3},
     {"_allanvar_line_sums", (DL_FUNC) &_allanvar_line_sums, 3},
+    {"_allanvar_line_subtract", (DL_FUNC) &_allanvar_line_subtract, 5},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
     {"_allanvar_mcap_index_cpp", (DL_FUNC) &_allanvar_mcap_index_cpp, 1},
     {"_allanvar_mcap_read_cpp", (DL_FUNC) &_allanvar_mcap_read_cpp, 6},

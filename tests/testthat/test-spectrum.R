@@ -134,6 +134,23 @@ test_that("line_sums() (phase rotation in blocks) equals the sums of sin and cos
   }
 })
 
+test_that("line_subtract() takes out a sinusoid exactly as the R expression does", {
+  set.seed(15)
+  n <- 100003
+  freq <- 81.92
+  y <- rnorm(n)
+  t <- (seq_len(n) - 1) / freq
+  for (f in c(0.013, 1.3, 40.7)) {
+    ref <- y - 0.3 * sin(2 * pi * f * t) - (-0.7) * cos(2 * pi * f * t)
+    # the same operations in the same order: equal to rounding (on x86-64
+    # without fused multiply-add, to the bit)
+    expect_equal(line_subtract(y, f, freq, 0.3, -0.7), ref, tolerance = 1e-14)
+  }
+  # a line of known amplitude comes out to the noise
+  x <- 2 * sin(2 * pi * 1.3 * t + 0.4)
+  expect_lt(max(abs(line_subtract(x, 1.3, freq, 2 * cos(0.4), 2 * sin(0.4)))), 1e-9)
+})
+
 test_that("at the record's own resolution a line is a line and a band a band", {
   set.seed(23)
   freq <- 100
