@@ -188,8 +188,9 @@ edf_rule_mtot <- function(e, m, n, L, alpha) {
     out[small] <- allan_edf_direct("modified", m[small],
                                    L - 3 * m[small] + 1, L, a[small])
   }
-  # short windows: the exact two-moment EDF (R/edf-windows.R), 0.97-1.05
-  # of the Monte Carlo EDF at m = 1-16 where these were 0.72-1.20 of it
+  # short windows: the exact two-moment EDF (R/edf-windows.R), 0.95-1.09
+  # of the Monte Carlo EDF at m = 1-16 (N = 1024, five noises) where these
+  # were 0.77-1.20 of it
   out <- edf_windows_over(out, "window_form_mtot", m, L - 3 * m + 1, a)
   edf_floor_terms(out, n)
 }
