@@ -149,11 +149,11 @@ avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
                             min_gain, level, remove, series)
   st <- new_refine_state(fit, args, refit_settings(fit, list(...)))
   # the refits share the basis columns they build (R/coef.R)
-  basis_store_open()
-  on.exit(basis_store_close(), add = TRUE)
+  call_store_open(basis_store)
+  on.exit(call_store_close(basis_store, "slots"), add = TRUE)
   # and each refit is made once (R/refine-refits.R)
-  refit_memo_open()
-  on.exit(refit_memo_close(), add = TRUE)
+  call_store_open(refit_memo)
+  on.exit(call_store_close(refit_memo, "entries"), add = TRUE)
   # the stages in order (R/refine-stages.R), each taking and returning the state
   for (stage in refine_stages()) st <- validate_refine_state(stage(st))
   st$result

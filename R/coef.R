@@ -224,14 +224,18 @@ basis_store <- new.env(parent = emptyenv())
 basis_store$depth <- 0L
 basis_store$slots <- list()
 
-basis_store_open <- function() {
-  basis_store$depth <- basis_store$depth + 1L
+# A store that lives for one call of the outermost function that opens it
+# (the basis store above, the refit memo of R/refine-refits.R): `depth`
+# counts the opens, and the store's `field` is emptied when the last one
+# closes.
+call_store_open <- function(store) {
+  store$depth <- store$depth + 1L
   invisible(NULL)
 }
 
-basis_store_close <- function() {
-  basis_store$depth <- max(basis_store$depth - 1L, 0L)
-  if (basis_store$depth == 0L) basis_store$slots <- list()
+call_store_close <- function(store, field) {
+  store$depth <- max(store$depth - 1L, 0L)
+  if (store$depth == 0L) store[[field]] <- list()
   invisible(NULL)
 }
 

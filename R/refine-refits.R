@@ -71,20 +71,10 @@ try_refit <- function(args, stage) {
 # free refit that repeats a screen): the first result is given, with its
 # conditions replayed under the asking stage, so the failures recorded are
 # those of a second run. avrefine() opens the memo for its call.
+# Opened and closed with call_store_open() / call_store_close() (R/coef.R).
 refit_memo <- new.env(parent = emptyenv())
 refit_memo$depth <- 0L
 refit_memo$entries <- list()
-
-refit_memo_open <- function() {
-  refit_memo$depth <- refit_memo$depth + 1L
-  invisible(NULL)
-}
-
-refit_memo_close <- function() {
-  refit_memo$depth <- max(refit_memo$depth - 1L, 0L)
-  if (refit_memo$depth == 0L) refit_memo$entries <- list()
-  invisible(NULL)
-}
 
 refit_key <- function(args) {
   av <- args$av

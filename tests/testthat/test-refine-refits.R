@@ -39,7 +39,7 @@ test_that("within a call a refit is made once and its conditions replayed", {
                          print = FALSE, where = asNamespace("allanvar")))
   on.exit(suppressMessages(untrace("fit_curve", where = asNamespace("allanvar"))),
           add = TRUE)
-  refit_memo_open()
+  call_store_open(refit_memo)
   a <- try_refit(args, "first")
   b <- try_refit(args, "second")
   args2 <- args
@@ -55,7 +55,7 @@ test_that("within a call a refit is made once and its conditions replayed", {
   expect_identical(cnt$n, 2L)
   expect_identical(r$conditions[[1L]]$stage, "again")
   expect_identical(conditionMessage(r$conditions[[1L]]$condition), "w")
-  refit_memo_close()
+  call_store_close(refit_memo, "entries")
   # outside a call nothing is kept
   expect_identical(length(refit_memo$entries), 0L)
   e <- try_refit(args, "outside")
