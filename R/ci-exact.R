@@ -78,7 +78,10 @@
 #' Theo1 take their law at the same \eqn{N/m} on at most 513 phase points
 #' under FM noise and, under PM noise, as it is up to 1100 points (beyond,
 #' the chi-square interval); such a problem costs about a second the first
-#' time (Theo1's union over plausible types several).
+#' time (Theo1's union over plausible types several). On a dense grid of an
+#' overlapping type (`taus = "all"`) the factors are computed at knots 5%
+#' apart in \eqn{m} and in the number of terms and interpolated in
+#' \eqn{\log m} between them (within 1% of each row's own).
 NULL
 
 exact_nmax <- 300L
