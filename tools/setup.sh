@@ -7,10 +7,14 @@ missing=$(Rscript --vanilla -e "p <- strsplit('$pkgs', ' ')[[1]]; cat(p[!vapply(
 if [ -n "$missing" ]; then
   echo "setup: installing $missing"
   debs=""
-  for p in $missing; do debs="$debs r-cran-$(echo "$p" | tr 'A-Z' 'a-z')"; done
   if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -qq >/dev/null || true
+    # only the packages Debian has: one unknown name fails the whole install
+    for p in $missing; do
+      d="r-cran-$(echo "$p" | tr 'A-Z' 'a-z')"
+      if apt-cache show "$d" >/dev/null 2>&1; then debs="$debs $d"; fi
+    done
     apt-get install -y -qq --no-install-recommends $debs >/dev/null || true
   fi
   still=$(Rscript --vanilla -e "p <- strsplit('$missing', ' ')[[1]]; cat(p[!vapply(p, requireNamespace, logical(1), quietly = TRUE)])")
