@@ -330,13 +330,6 @@ extra_channel <- function(v, freq, m, theo_row, e, rate, L, conf, debias,
   lim <- stat_interval(av, edf, conf, limits, unbiased)
   lower <- lim$lower
   upper <- lim$upper
-  if (limits && isTRUE(e$exact_ci)) {
-    # rows at few averages: the exact limits (R/ci-exact.R)
-    ex <- allan_limits_exact(e$name, m, n, L, alpha, conf)
-    ok <- !is.na(ex$lower)
-    lower[ok] <- sqrt(av[ok]) * ex$lower[ok]
-    upper[ok] <- sqrt(av[ok]) * ex$upper[ok]
-  }
   if (limits && !is.null(r$limits)) {
     lower[r$limits$rows] <- r$limits$lower
     upper[r$limits$rows] <- r$limits$upper

@@ -48,7 +48,12 @@
 #' quadratic form in the phase under that noise started at rest), and the
 #' interval is
 #' \eqn{[\sigma / \sqrt{q_{1-p}}, \sigma / \sqrt{q_p}]} with its quantiles
-#' \eqn{q} (Imhof's integral). The noise type read at a few averages is
+#' \eqn{q} (Imhof's integral). `"theobr"`, and TheoH's TheoBR rows, are Theo1 times
+#' the bias factor estimated from the same record: their law is Theo1's
+#' with the factor's spread joined in log scale (a normal variable with the
+#' factor's EDF, correlated with \eqn{\log} Theo1 as the Monte Carlo
+#' tables of its EDF give), where the chi-square with their two-moment EDF
+#' was too skewed (68% coverage 0.79-0.93 at \eqn{N/m \le 4}). The noise type read at a few averages is
 #' weak (B1 from a handful of averages reads an FM type as its whiter
 #' neighbour in a third to all of the records), so a row rests on the
 #' type read at the nearest shorter tau with \eqn{N/m \ge 64} (the lag-1

@@ -255,6 +255,15 @@ kernel_theo <- function(own_type) {
             u <- theobr_union(ctx$entry$name, t1, mt, L, attr(ta, "alts"),
                               ctx$n[theo_row],
                               ctx$conf, attr(kf, "kappa"))
+            # rows at few averages: Theo1's exact law with the factor's
+            # spread (R/theobr-exact.R)
+            # (the types as Theo1's exact rows take them: a reading at few
+            # averages leans on the one at a shorter tau, exact_sets())
+            ex <- theobr_limits_exact(sqrt(t1), mt, L,
+                                      exact_sets(mt, L, alpha[theo_row], -2L),
+                                      ctx$conf, attr(kf, "kappa"))
+            u$lower[ex$rows] <- ex$lower
+            u$upper[ex$rows] <- ex$upper
             limits <- list(rows = theo_row, lower = u$lower, upper = u$upper)
           }
         }

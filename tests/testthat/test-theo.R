@@ -274,3 +274,57 @@ test_that("TheoBR's intervals carry its bias factor's uncertainty", {
     }
   }
 })
+
+test_that("TheoBR's law at few averages matches a simulation of its parts", {
+  # Theo1's exact weights, the factor's EDF and correlation as the package
+  # takes them; the law of kappa * Theo1 over its mean by simulation
+  # (rchisq, rnorm), against the grid-and-quadrature of theobr_exact_factors()
+  skip_on_cran()
+  set.seed(77)
+  for (a in c(0L, -2L)) {
+    m <- 128
+    L <- 257
+    lam <- exact_dense_weights("exact_form_theo1", m, L, a)
+    sk <- sqrt(2 / theobr_nu_kappa(a, L, "N/6"))
+    rho <- theobr_rho(a, m, L, "N/6")
+    n <- 2e5
+    t <- colSums(lam * matrix(stats::rchisq(length(lam) * n, 1), length(lam)))
+    x <- log(t)
+    z <- (x - mean(x)) / stats::sd(x)
+    b <- t * exp(sk * (rho * z + sqrt(1 - rho^2) * stats::rnorm(n)))
+    b <- b / mean(b)
+    for (conf in c(0.683, 0.95)) {
+      p <- (1 - conf) / 2
+      sim <- sqrt(1 / stats::quantile(b, c(1 - p, p), names = FALSE))
+      f <- theobr_exact_factors(m, L, a, a, "N/6", L, conf)
+      expect_equal(f, sim, tolerance = 0.02,
+                   label = paste("alpha", a, "conf", conf))
+    }
+  }
+})
+
+test_that("TheoBR's intervals cover at two and four averages", {
+  # own generators, the truth the ensemble mean; the chi-square with the
+  # two-moment EDF it replaced covered 0.79-0.93 (68%) at N/m <= 4
+  skip_on_cran()
+  N <- 256L
+  reps <- 300L
+  gens <- list(wfm = function() rnorm(N), rwfm = function() cumsum(rnorm(N)))
+  set.seed(4141)
+  for (g in names(gens)) {
+    runs <- lapply(seq_len(reps), function(i) {
+      y <- gens[[g]]()
+      list(allan(y, 1, type = "theobr", taus = I(c(48, 96))),
+           allan(y, 1, type = "theobr", taus = I(c(48, 96)), conf = 0.95))
+    })
+    for (j in 1:2) {
+      get <- function(col) sapply(runs, function(r) r[[j]][[col]])
+      truth <- sqrt(rowMeans(get("avar")))
+      cover <- rowMeans(get("lower") <= truth & truth <= get("upper"))
+      band <- if (j == 1L) c(0.6, 0.77) else c(0.915, 0.985)
+      expect_true(all(cover > band[1L] & cover < band[2L]),
+                  label = paste(g, c("68%", "95%")[j],
+                                paste(cover, collapse = " ")))
+    }
+  }
+})
