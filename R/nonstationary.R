@@ -509,30 +509,15 @@ warmup_whiten <- function(Y, model) {
   m <- length(phi)
   big <- 1e6 * (model$h + sum(model$s) + model$q * nb)
   # the gains first (they do not depend on the data): m x m work only
-  P <- diag(c(big, model$s), m)
-  K <- matrix(0, m, nb)
-  sF <- numeric(nb)
-  PP <- phi %o% phi
-  for (j in seq_len(nb)) {
-    Pz <- rowSums(P)
-    F <- sum(Pz) + model$h
-    K[, j] <- phi * Pz / F
-    sF[j] <- sqrt(F)
-    # steady state: the remaining gains are this one
-    if (j > 2L && abs(sF[j] / sF[j - 1L] - 1) < 1e-12 &&
-        max(abs(K[, j] - K[, j - 1L])) < 1e-12 * max(abs(K[, j]))) {
-      K[, j:nb] <- K[, j]
-      sF[j:nb] <- sF[j]
-      break
-    }
-    P <- PP * (P - (Pz %o% Pz) / F)
-    diag(P) <- diag(P) + Q
-  }
-  # then every column at once: a(j+1) = phi a(j) + K(j) v(j)
-  # (src/series.cpp: the R loop's operations in its order, without its
-  # thousand row iterations)
+  # (src/series.cpp: each step, Pz = rowSums(P), F = sum(Pz) + h,
+  # K = phi Pz / F, sF = sqrt(F); at the steady state (sF and K still to
+  # 1e-12) the remaining gains are this one; else P = PP (P - Pz Pz' / F)
+  # plus Q on its diagonal; the R loop's operations in its order)
+  g <- warmup_gains(diag(c(big, model$s), m), phi %o% phi, as.double(Q), phi,
+                    model$h, nb)
+  # then every column at once: a(j+1) = phi a(j) + K(j) v(j), the same way
   storage.mode(Y) <- "double"
-  warmup_whiten_data(Y, K, sF, phi)
+  warmup_whiten_data(Y, g$K, g$sF, phi)
 }
 
 # Profile of the warm-up's time constant: GLS of the block means on each

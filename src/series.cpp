@@ -8,6 +8,7 @@
 // are identical to the R expressions they replace.
 #include <Rcpp.h>
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 // Segment k of x - level runs from sample at[k - 1] - 1 (0-based) to
@@ -123,4 +124,55 @@ Rcpp::NumericMatrix warmup_whiten_data(const Rcpp::NumericMatrix& Y,
     if ((j & 255) == 255) Rcpp::checkUserInterrupt();
   }
   return E;
+}
+
+// The gain half of warmup_whiten(): the Kalman gains K (m x nb) and the
+// innovation sds sF from the initial covariance P (m x m), PP = phi phi',
+// the state noise Q and the white variance h, as the R loop made them:
+// Pz = rowSums(P) and F = sum(Pz) + h in long double sums, K = phi Pz / F,
+// stopped at the steady state (the remaining gains are the last one).
+// [[Rcpp::export(rng = false)]]
+Rcpp::List warmup_gains(const Rcpp::NumericMatrix& P0, const Rcpp::NumericMatrix& PP,
+                        const Rcpp::NumericVector& Q, const Rcpp::NumericVector& phi,
+                        double h, R_xlen_t nb) {
+  const R_xlen_t m = phi.size();
+  std::vector<double> P(P0.begin(), P0.end()), Pz(m);
+  const double* pp = PP.begin();
+  Rcpp::NumericMatrix K(m, nb);
+  Rcpp::NumericVector sF(nb);
+  double* k = K.begin();
+  for (R_xlen_t j = 0; j < nb; ++j) {
+    for (R_xlen_t i = 0; i < m; ++i) {
+      long double r = 0;
+      for (R_xlen_t c = 0; c < m; ++c) r += P[i + c * m];
+      Pz[i] = static_cast<double>(r);
+    }
+    long double t = 0;
+    for (R_xlen_t i = 0; i < m; ++i) t += Pz[i];
+    const double F = static_cast<double>(t) + h;
+    double* kj = k + j * m;
+    for (R_xlen_t i = 0; i < m; ++i) kj[i] = phi[i] * Pz[i] / F;
+    sF[j] = std::sqrt(F);
+    if (j > 1 && std::fabs(sF[j] / sF[j - 1] - 1) < 1e-12) {
+      double dmax = 0, kmax = 0;
+      for (R_xlen_t i = 0; i < m; ++i) {
+        dmax = std::max(dmax, std::fabs(kj[i] - kj[i - m]));
+        kmax = std::max(kmax, std::fabs(kj[i]));
+      }
+      if (dmax < 1e-12 * kmax) {
+        for (R_xlen_t q = j + 1; q < nb; ++q) {
+          std::copy(kj, kj + m, k + q * m);
+          sF[q] = sF[j];
+        }
+        break;
+      }
+    }
+    for (R_xlen_t c = 0; c < m; ++c) {
+      for (R_xlen_t i = 0; i < m; ++i) {
+        P[i + c * m] = pp[i + c * m] * (P[i + c * m] - (Pz[i] * Pz[c]) / F);
+      }
+    }
+    for (R_xlen_t i = 0; i < m; ++i) P[i + i * m] = P[i + i * m] + Q[i];
+  }
+  return Rcpp::List::create(Rcpp::Named("K") = K, Rcpp::Named("sF") = sF);
 }
