@@ -24,8 +24,8 @@ block_avg <- function(x, b) {
 
 # Allan differences of y at window w (blocks) for every split point i
 # (mean of y[i+1..i+w] minus mean of y[i-w+1..i]), i = w..length(y)-w.
-allan_differences <- function(y, w) {
-  cs <- c(0, cumsum(y))
+# (`cs`: c(0, cumsum(y)), when the caller has it for several w)
+allan_differences <- function(y, w, cs = c(0, cumsum(y))) {
   n <- length(y)
   i <- w:(n - w)
   (cs[i + w + 1L] - 2 * cs[i + 1L] + cs[i - w + 1L]) / w
@@ -86,7 +86,8 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   # changing noise levels): never below min_z.
   zc <- max(min_z, stats::qnorm(1 - alpha / (2 * M)))
   # Null scale at each window, from the series as given (robust to steps).
-  scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w)), 0)
+  cy <- c(0, cumsum(y))
+  scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w, cy)), 0)
   v <- scale^2 / 2
   wbest <- ws[which.min(v)] * b
   idx <- integer(0)
@@ -115,11 +116,12 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     if (done != length(idx)) {
       lv <- step_levels(data.frame(index = idx, size = sizes), n)
       r <- steps_block_means(x, lv, b, nb)
+      cr <- c(0, cumsum(r))            # shared by every window below
       done <- length(idx)
     }
     best <- list(z = 0)
     for (j in seq_along(ws)) {
-      d <- allan_differences(r, ws[j])
+      d <- allan_differences(r, ws[j], cr)
       d[excluded[ws[j]:(nb - ws[j])]] <- 0
       # a noiseless series (scale 0): any difference at all is a step, at
       # the largest difference
