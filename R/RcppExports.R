@@ -185,6 +185,22 @@ rosbag_decode_cpp <- function(raw, conns, from, to) {
     .Call(`_allanvar_rosbag_decode_cpp`, raw, conns, from, to)
 }
 
+shifted_block_means <- function(x, at, level, b, nb) {
+    .Call(`_allanvar_shifted_block_means`, x, at, level, b, nb)
+}
+
+shifted_prefix <- function(x, at, level, lo, hi) {
+    .Call(`_allanvar_shifted_prefix`, x, at, level, lo, hi)
+}
+
+warmup_whiten_data <- function(Y, K, sF, phi) {
+    .Call(`_allanvar_warmup_whiten_data`, Y, K, sF, phi)
+}
+
+warmup_gains <- function(P0, PP, Q, phi, h, nb) {
+    .Call(`_allanvar_warmup_gains`, P0, PP, Q, phi, h, nb)
+}
+
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }

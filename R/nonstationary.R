@@ -24,8 +24,8 @@ block_avg <- function(x, b) {
 
 # Allan differences of y at window w (blocks) for every split point i
 # (mean of y[i+1..i+w] minus mean of y[i-w+1..i]), i = w..length(y)-w.
-allan_differences <- function(y, w) {
-  cs <- c(0, cumsum(y))
+# (`cs`: c(0, cumsum(y)), when the caller has it for several w)
+allan_differences <- function(y, w, cs = c(0, cumsum(y))) {
   n <- length(y)
   i <- w:(n - w)
   (cs[i + w + 1L] - 2 * cs[i + 1L] + cs[i - w + 1L]) / w
@@ -86,7 +86,8 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   # changing noise levels): never below min_z.
   zc <- max(min_z, stats::qnorm(1 - alpha / (2 * M)))
   # Null scale at each window, from the series as given (robust to steps).
-  scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w)), 0)
+  cy <- c(0, cumsum(y))
+  scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w, cy)), 0)
   v <- scale^2 / 2
   wbest <- ws[which.min(v)] * b
   idx <- integer(0)
@@ -98,12 +99,14 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   # Each step found is removed by its local size (the difference of the
   # means over the least-noisy window on each side), not by segment means:
   # under red noise a segment's mean is far from the level next to the step.
-  local_size <- function(xs, at, others) {
+  # (lv: the steps' levels, step_levels(); only the 2 W samples read)
+  local_size <- function(lv, at, others) {
     bounds <- sort(c(1L, others, n + 1L))
     left <- max(bounds[bounds <= at - 1L])
     right <- min(bounds[bounds > at])
     W <- max(1L, min(wbest, at - left, right - at))
-    c(size = mean(xs[at:(at + W - 1L)]) - mean(xs[(at - W):(at - 1L)]), W = W)
+    xw <- steps_window(x, lv, at - W, at + W - 1L)
+    c(size = mean(xw[W + seq_len(W)]) - mean(xw[seq_len(W)]), W = W)
   }
   done <- -1L
   for (k in seq_len(max_steps + 20L)) {
@@ -111,13 +114,14 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     # a candidate set aside leaves the steps as they were: the series and
     # its block means are made again only when a step was added
     if (done != length(idx)) {
-      xs <- remove_steps(x, data.frame(index = idx, size = sizes))
-      r <- block_avg(xs, b)
+      lv <- step_levels(data.frame(index = idx, size = sizes), n)
+      r <- steps_block_means(x, lv, b, nb)
+      cr <- c(0, cumsum(r))            # shared by every window below
       done <- length(idx)
     }
     best <- list(z = 0)
     for (j in seq_along(ws)) {
-      d <- allan_differences(r, ws[j])
+      d <- allan_differences(r, ws[j], cr)
       d[excluded[ws[j]:(nb - ws[j])]] <- 0
       # a noiseless series (scale 0): any difference at all is a step, at
       # the largest difference
@@ -149,15 +153,17 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
       excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
       next
     }
-    cs <- c(0, cumsum(xs))
-    cand <- lo:hi
+    # c(0, cumsum(xs)) at lo - W .. hi + W only
+    cs <- steps_prefix(x, lv, lo - W, hi + W)
+    cand <- lo:hi - (lo - W) + 1L
     dd <- (cs[cand + W] - 2 * cs[cand] + cs[cand - W]) / W
+    cand <- lo:hi
     at <- cand[which.max(abs(dd))]      # first sample after the step
     if (any(abs(idx - at) < b)) {       # the same step again: set aside
       excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
       next
     }
-    sz <- local_size(xs, at, idx)
+    sz <- local_size(lv, at, idx)
     idx <- c(idx, at)
     zs <- c(zs, best$z)
     sizes <- c(sizes, sz[["size"]])
@@ -173,8 +179,8 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   sizes <- sizes[o]
   # final sizes, each with the other steps removed
   rows <- lapply(seq_along(idx), function(k) {
-    xs <- remove_steps(x, data.frame(index = idx[-k], size = sizes[-k]))
-    sz <- local_size(xs, idx[k], idx[-k])
+    lv <- step_levels(data.frame(index = idx[-k], size = sizes[-k]), n)
+    sz <- local_size(lv, idx[k], idx[-k])
     W <- sz[["W"]]
     # standard error: sqrt(2 AV) at the window used (interpolated in log)
     se <- sqrt(2 * exp(stats::approx(log(ws * b), log(v), log(W), rule = 2)$y))
@@ -242,8 +248,12 @@ step_return <- function(x, steps, k, gap, alpha, tau0) {
   if (!is.finite(steps$se[k]) || steps$se[k] <= 0) return(NULL)
   W0 <- max(1L, as.integer(round(steps$window[k] / tau0)))
   Ws <- unique(pmin(W0 * 2L^(0:8), max(W0, gap %/% 4L)))
-  xs <- remove_steps(x, steps[-k, c("index", "size"), drop = FALSE])
-  cs <- c(0, cumsum(xs))
+  lv <- step_levels(steps[-k, c("index", "size"), drop = FALSE], n)
+  # c(0, cumsum(xs)) only where the windows below read it (every
+  # candidate lies within max(gap, W) of the step)
+  reach <- max(gap, max(Ws)) + max(Ws)
+  c0 <- max(1L, at - reach)
+  cs <- steps_prefix(x, lv, c0, min(n + 1L, at + reach))
   best <- NULL
   M <- 0
   for (W in Ws) {
@@ -251,7 +261,8 @@ step_return <- function(x, steps, k, gap, alpha, tau0) {
     cand <- cand[cand >= W + 1L & cand <= n - W + 1L & abs(cand - at) >= W]
     if (!length(cand)) next
     M <- M + length(cand) / W
-    d <- (cs[cand + W] - 2 * cs[cand] + cs[cand - W]) / W
+    p <- cand - c0 + 1L
+    d <- (cs[p + W] - 2 * cs[p] + cs[p - W]) / W
     se <- steps$se[k] * sqrt(W0 / W)
     z <- -sign(steps$size[k]) * d / se
     j <- which.max(z)
@@ -270,27 +281,51 @@ step_return <- function(x, steps, k, gap, alpha, tau0) {
 # sample after it (the level before the first step is kept).
 remove_steps <- function(x, steps) {
   if (!nrow(steps)) return(x)
-  # the sizes summed at their indices, then their cumulative sum (cumsum()
-  # of the sparse jumps only: the zeros between them add nothing, so the
-  # levels are those of the cumsum() of the full jump series) held
-  # constant from each index on: O(n)
   n <- length(x)
+  lv <- step_levels(steps, n)
+  if (is.null(lv$at)) return(x - lv$shift)
+  x - rep.int(lv$level, diff(c(1L, lv$at, n + 1L)))
+}
+
+# What remove_steps() subtracts: the sizes summed at their indices, then
+# their cumulative sum (cumsum() of the sparse jumps only: the zeros
+# between them add nothing, so the levels are those of the cumsum() of the
+# full jump series) held constant from each index on: `at` (sorted step
+# indices) and `level` (length(at) + 1 values, the first 0). Indices that
+# are not samples: `shift`, the full jump series' cumsum, as before.
+step_levels <- function(steps, n) {
   at <- sort(unique(steps$index))
   if (any(at < 1 | at > n | at != floor(at))) {
-    # not sample indices: the full jump series, as before
     jump <- numeric(n)
     for (k in seq_len(nrow(steps))) {
       i <- steps$index[k]
       jump[i] <- jump[i] + steps$size[k]
     }
-    return(x - cumsum(jump))
+    return(list(shift = cumsum(jump)))
   }
   jump <- numeric(length(at))
   for (k in seq_len(nrow(steps))) {
     i <- match(steps$index[k], at)
     jump[i] <- jump[i] + steps$size[k]
   }
-  x - rep.int(c(0, cumsum(jump)), diff(c(1L, at, n + 1L)))
+  list(at = as.integer(at), level = c(0, cumsum(jump)))
+}
+
+# x with the steps of `lv` (step_levels()) removed, read in place: samples
+# from..to, block means (block_avg()), c(0, cumsum())[lo:hi]. The same
+# values as from remove_steps()' copy (src/series.cpp), without the copy.
+steps_window <- function(x, lv, from, to) {
+  i <- from:to
+  if (is.null(lv$at)) return(x[i] - lv$shift[i])
+  x[i] - lv$level[findInterval(i, lv$at) + 1L]
+}
+steps_block_means <- function(x, lv, b, nb) {
+  if (is.null(lv$at)) return(block_avg(x - lv$shift, b))
+  shifted_block_means(x, lv$at, lv$level, max(1L, as.integer(b)), nb)
+}
+steps_prefix <- function(x, lv, lo, hi) {
+  if (is.null(lv$at)) return(c(0, cumsum(x - lv$shift))[lo:hi])
+  shifted_prefix(x, lv$at, lv$level, lo, hi)
 }
 
 #' Exponential warm-up (internal)
@@ -476,35 +511,15 @@ warmup_whiten <- function(Y, model) {
   m <- length(phi)
   big <- 1e6 * (model$h + sum(model$s) + model$q * nb)
   # the gains first (they do not depend on the data): m x m work only
-  P <- diag(c(big, model$s), m)
-  K <- matrix(0, m, nb)
-  sF <- numeric(nb)
-  PP <- phi %o% phi
-  for (j in seq_len(nb)) {
-    Pz <- rowSums(P)
-    F <- sum(Pz) + model$h
-    K[, j] <- phi * Pz / F
-    sF[j] <- sqrt(F)
-    # steady state: the remaining gains are this one
-    if (j > 2L && abs(sF[j] / sF[j - 1L] - 1) < 1e-12 &&
-        max(abs(K[, j] - K[, j - 1L])) < 1e-12 * max(abs(K[, j]))) {
-      K[, j:nb] <- K[, j]
-      sF[j:nb] <- sF[j]
-      break
-    }
-    P <- PP * (P - (Pz %o% Pz) / F)
-    diag(P) <- diag(P) + Q
-  }
-  # then every column at once: a(j+1) = phi a(j) + K(j) v(j)
-  a <- matrix(0, m, ncol(Y))
-  E <- matrix(0, nb, ncol(Y))
-  one <- rep(1, m)
-  for (j in seq_len(nb)) {
-    v <- Y[j, ] - as.vector(one %*% a)
-    E[j, ] <- v / sF[j]
-    a <- phi * a + tcrossprod(K[, j], v)
-  }
-  E[-1L, , drop = FALSE]
+  # (src/series.cpp: each step, Pz = rowSums(P), F = sum(Pz) + h,
+  # K = phi Pz / F, sF = sqrt(F); at the steady state (sF and K still to
+  # 1e-12) the remaining gains are this one; else P = PP (P - Pz Pz' / F)
+  # plus Q on its diagonal; the R loop's operations in its order)
+  g <- warmup_gains(diag(c(big, model$s), m), phi %o% phi, as.double(Q), phi,
+                    model$h, nb)
+  # then every column at once: a(j+1) = phi a(j) + K(j) v(j), the same way
+  storage.mode(Y) <- "double"
+  warmup_whiten_data(Y, g$K, g$sF, phi)
 }
 
 # Profile of the warm-up's time constant: GLS of the block means on each

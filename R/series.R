@@ -167,9 +167,11 @@ series_kept <- function(s) {
 # Allan deviation before and after taking out every instance found, and
 # per kind, on allan()'s octave grid.
 series_adev <- function(x, freq, table) {
-  a <- allan(x, freq)
+  # only the deviations are read: no limits (ci = FALSE leaves adev as is)
+  a <- allan(x, freq, ci = FALSE)
   one <- function(tab) {
-    b <- if (nrow(tab)) allan(remove_series(x, freq, tab), freq, taus = I(a$tau))$adev
+    b <- if (nrow(tab)) allan(remove_series(x, freq, tab), freq, taus = I(a$tau),
+                              ci = FALSE)$adev
          else a$adev
     # a noiseless series: no change where both are 0, unknown where only
     # the corrected one is
@@ -177,11 +179,13 @@ series_adev <- function(x, freq, table) {
     data.frame(tau = a$tau, before = a$adev, after = b, change = change)
   }
   kinds <- unique(table$kind)
+  all <- one(table)
   per <- lapply(kinds, function(k) {
-    cbind(kind = k, one(table[table$kind == k, , drop = FALSE]),
-          stringsAsFactors = FALSE)
+    # one kind found: its rows are the whole table, its curve `all`
+    d <- if (length(kinds) == 1L) all else one(table[table$kind == k, , drop = FALSE])
+    cbind(kind = k, d, stringsAsFactors = FALSE)
   })
-  list(all = one(table),
+  list(all = all,
        kinds = if (length(per)) do.call(rbind, per) else
          data.frame(kind = character(), tau = numeric(), before = numeric(),
                     after = numeric(), change = numeric(),

@@ -579,6 +579,62 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// shifted_block_means
+Rcpp::NumericVector shifted_block_means(const Rcpp::NumericVector& x, const Rcpp::IntegerVector& at, const Rcpp::NumericVector& level, int b, R_xlen_t nb);
+RcppExport SEXP _allanvar_shifted_block_means(SEXP xSEXP, SEXP atSEXP, SEXP levelSEXP, SEXP bSEXP, SEXP nbSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type at(atSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type level(levelSEXP);
+    Rcpp::traits::input_parameter< int >::type b(bSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type nb(nbSEXP);
+    rcpp_result_gen = Rcpp::wrap(shifted_block_means(x, at, level, b, nb));
+    return rcpp_result_gen;
+END_RCPP
+}
+// shifted_prefix
+Rcpp::NumericVector shifted_prefix(const Rcpp::NumericVector& x, const Rcpp::IntegerVector& at, const Rcpp::NumericVector& level, R_xlen_t lo, R_xlen_t hi);
+RcppExport SEXP _allanvar_shifted_prefix(SEXP xSEXP, SEXP atSEXP, SEXP levelSEXP, SEXP loSEXP, SEXP hiSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type at(atSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type level(levelSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type lo(loSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type hi(hiSEXP);
+    rcpp_result_gen = Rcpp::wrap(shifted_prefix(x, at, level, lo, hi));
+    return rcpp_result_gen;
+END_RCPP
+}
+// warmup_whiten_data
+Rcpp::NumericMatrix warmup_whiten_data(const Rcpp::NumericMatrix& Y, const Rcpp::NumericMatrix& K, const Rcpp::NumericVector& sF, const Rcpp::NumericVector& phi);
+RcppExport SEXP _allanvar_warmup_whiten_data(SEXP YSEXP, SEXP KSEXP, SEXP sFSEXP, SEXP phiSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type Y(YSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type K(KSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type sF(sFSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phi(phiSEXP);
+    rcpp_result_gen = Rcpp::wrap(warmup_whiten_data(Y, K, sF, phi));
+    return rcpp_result_gen;
+END_RCPP
+}
+// warmup_gains
+Rcpp::List warmup_gains(const Rcpp::NumericMatrix& P0, const Rcpp::NumericMatrix& PP, const Rcpp::NumericVector& Q, const Rcpp::NumericVector& phi, double h, R_xlen_t nb);
+RcppExport SEXP _allanvar_warmup_gains(SEXP P0SEXP, SEXP PPSEXP, SEXP QSEXP, SEXP phiSEXP, SEXP hSEXP, SEXP nbSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type P0(P0SEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type PP(PPSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type Q(QSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phi(phiSEXP);
+    Rcpp::traits::input_parameter< double >::type h(hSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type nb(nbSEXP);
+    rcpp_result_gen = Rcpp::wrap(warmup_gains(P0, PP, Q, phi, h, nb));
+    return rcpp_result_gen;
+END_RCPP
+}
 // theo1_sums_cpp
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -737,6 +793,10 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_rosbag_read_cpp", (DL_FUNC) &_allanvar_rosbag_read_cpp, 5},
     {"_allanvar_rosbag_chunk_cpp", (DL_FUNC) &_allanvar_rosbag_chunk_cpp, 2},
     {"_allanvar_rosbag_decode_cpp", (DL_FUNC) &_allanvar_rosbag_decode_cpp, 4},
+    {"_allanvar_shifted_block_means", (DL_FUNC) &_allanvar_shifted_block_means, 5},
+    {"_allanvar_shifted_prefix", (DL_FUNC) &_allanvar_shifted_prefix, 5},
+    {"_allanvar_warmup_whiten_data", (DL_FUNC) &_allanvar_warmup_whiten_data, 4},
+    {"_allanvar_warmup_gains", (DL_FUNC) &_allanvar_warmup_gains, 6},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},
