@@ -258,10 +258,15 @@ kernel_theo <- function(own_type) {
             # rows at few averages: Theo1's exact law with the factor's
             # spread (R/theobr-exact.R)
             # (the types as Theo1's exact rows take them: a reading at few
-            # averages leans on the one at a shorter tau, exact_sets())
-            ex <- theobr_limits_exact(sqrt(t1), mt, L,
-                                      exact_sets(mt, L, alpha[theo_row], -2L),
-                                      ctx$conf, attr(kf, "kappa"))
+            # averages leans on the one at a shorter tau, exact_sets(); on
+            # TheoH's curve the Allan rows' readings are such taus, at
+            # Theo1's m of the same tau)
+            a_all <- alpha
+            if (any(!theo_row)) a_all[!theo_row] <- ctx$identify(m[!theo_row])
+            m_eq <- ifelse(theo_row, m, m / 0.75)
+            sets <- exact_sets(m_eq, L, a_all, -2L)[theo_row]
+            ex <- theobr_limits_exact(sqrt(t1), mt, L, sets, ctx$conf,
+                                      attr(kf, "kappa"))
             u$lower[ex$rows] <- ex$lower
             u$upper[ex$rows] <- ex$upper
             limits <- list(rows = theo_row, lower = u$lower, upper = u$upper)

@@ -152,7 +152,8 @@ check_stable32_run <- function(x, tau0, kind, run, path) {
     data.frame(file = path, type = type, af = af, n_s32 = n_s32, n = n,
                s32 = s32, ours = ours, digits = digits, lo_s32 = lo_s32,
                hi_s32 = hi_s32, lo = lo, hi = hi, alpha_s32 = alpha_s32,
-               alpha = alpha, convention = convention)
+               alpha = alpha, convention = convention,
+               L = if (kind == "phase") length(x) else length(x) + 1)
   }
   if (ncol(v) == 8L) {
     # TheoH: AF, tau, #, TheoH tau, sigma, Theo1 dev, min, max
