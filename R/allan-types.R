@@ -104,8 +104,10 @@
 #' ladder (as Theo1's slope reads it at five points of the ladder). Theo1's
 #' EDF alone ignored \eqn{\kappa}: 68% coverage 0.10-0.35 under FM noise,
 #' 7 of 50 Monte Carlo rows (N = 1024, five noise types) inside both bands
-#' (68% in 0.60-0.76, 95% in 0.92-0.975); now 41 of 46, the misses at
-#' \eqn{N/m \le 4}, all over-covering. The noise type of a Theo1 or
+#' (68% in 0.60-0.76, 95% in 0.92-0.975); with this EDF 41 of 46, the
+#' misses at \eqn{N/m \le 4}, all over-covering; with the exact law at
+#' \eqn{N/m \le 32} (see "Exact intervals at few averages" in [allan()])
+#' 46 of 46 (1000 records). The noise type of a Theo1 or
 #' TheoBR row starts from the
 #' overlapping Allan variance's at \eqn{0.75 m}, or at \eqn{(L - 1)/3}
 #' beyond it (no fewer than three cluster averages; TheoBR there: the
