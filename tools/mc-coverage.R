@@ -20,14 +20,16 @@ mc_generators <- function(N) {
   filters <- list()  # the filter's transform, built once per length
   flicker <- function(n) {
     key <- as.character(n)
+    # zero-padded to a length FFT likes (2 (N + 1) can be twice a prime)
+    len <- stats::nextn(2 * n)
     if (is.null(filters[[key]])) {
       h <- numeric(n)
       h[1] <- 1
       for (k in 2:n) h[k] <- h[k - 1] * (k - 1.5) / (k - 1)
-      filters[[key]] <<- stats::fft(c(h, rep(0, n)))
+      filters[[key]] <<- stats::fft(c(h, rep(0, len - n)))
     }
-    Re(stats::fft(filters[[key]] * stats::fft(c(stats::rnorm(n), rep(0, n))),
-                  inverse = TRUE))[1:n] / (2 * n)
+    Re(stats::fft(filters[[key]] * stats::fft(c(stats::rnorm(n), rep(0, len - n))),
+                  inverse = TRUE))[1:n] / len
   }
   list(wfm = function() stats::rnorm(N), ffm = function() flicker(N),
        rwfm = function() cumsum(stats::rnorm(N)),
