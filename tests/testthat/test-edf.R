@@ -774,32 +774,24 @@ test_that("the total variance's EDF under white PM is the exact two-moment one",
     fast <- allan_edf_cpp(code, m, L - 2 * m, L, 2L, FALSE)
     expect_equal(fast, dense, tolerance = 1e-10)
   }
-  # own Monte Carlo (iid normal phase), N = 512, m = 32 (N/m = 16):
-  # Table 5's simple EDF would claim 248
+  # own Monte Carlo (iid normal phase): the Monte Carlo EDF of the total
+  # variance's sum over the reflected record, reps records of L points
+  mc_edf <- function(L, m, reps) {
+    v <- replicate(reps, {
+      x <- stats::rnorm(L)
+      xs <- c(2 * x[1] - x[(m + 1):2], x, 2 * x[L] - x[(L - 1):(L - m)])
+      i <- (m + 2):(m + L - 1)
+      sum((xs[i - m] - 2 * xs[i] + xs[i + m])^2)
+    })
+    2 * mean(v)^2 / stats::var(v)
+  }
   set.seed(2903)
-  L <- 512
-  m <- 32
-  v <- replicate(1500, {
-    x <- stats::rnorm(L)
-    xs <- c(2 * x[1] - x[(m + 1):2], x, 2 * x[L] - x[(L - 1):(L - m)])
-    i <- (m + 2):(m + L - 1)
-    sum((xs[i - m] - 2 * xs[i] + xs[i + m])^2)
-  })
-  mc <- 2 * mean(v)^2 / stats::var(v)
-  e <- allan_edf_cpp(code, m, L - 2 * m, L, 2L, FALSE)
+  # N = 512, m = 32 (N/m = 16): Table 5's simple EDF would claim 248
+  e <- allan_edf_cpp(code, 32, 512 - 64, 512, 2L, FALSE)
   expect_lt(e, 0.7 * 248)
-  expect_equal(e, mc, tolerance = 0.15)
+  expect_equal(e, mc_edf(512, 32, 1500), tolerance = 0.15)
   # beyond m = 4096 (the exact EDF at m = 4096 and the same N/m; Table 5's
-  # simple EDF claimed 1e4 here): own Monte Carlo, N/m = 3.7
-  L <- 30000
-  m <- 8192
-  v <- replicate(400, {
-    x <- stats::rnorm(L)
-    xs <- c(2 * x[1] - x[(m + 1):2], x, 2 * x[L] - x[(L - 1):(L - m)])
-    i <- (m + 2):(m + L - 1)
-    sum((xs[i - m] - 2 * xs[i] + xs[i + m])^2)
-  })
-  mc <- 2 * mean(v)^2 / stats::var(v)
-  e <- allan_edf_cpp(code, m, L - 2 * m, L, 2L, FALSE)
-  expect_equal(e, mc, tolerance = 0.2)
+  # simple EDF claimed 1e4 here): N/m = 3.7
+  e <- allan_edf_cpp(code, 8192, 30000 - 2 * 8192, 30000, 2L, FALSE)
+  expect_equal(e, mc_edf(30000, 8192, 400), tolerance = 0.2)
 })
