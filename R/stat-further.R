@@ -256,10 +256,9 @@ kernel_theo <- function(own_type) {
                               ctx$n[theo_row],
                               ctx$conf, attr(kf, "kappa"))
             # rows at few averages: Theo1's exact law with the factor's
-            # spread (R/theobr-exact.R)
-            # (the types as Theo1's exact rows take them: a reading at few
-            # averages leans on the one at a shorter tau, exact_sets(); on
-            # TheoH's curve the Allan rows' readings are such taus, at
+            # spread (R/theobr-exact.R), the types as Theo1's exact rows
+            # take them (exact_sets(): a weak reading leans on a shorter
+            # tau's; on TheoH's curve the Allan rows are such taus, at
             # Theo1's m of the same tau)
             a_all <- alpha
             if (any(!theo_row)) a_all[!theo_row] <- ctx$identify(m[!theo_row])
