@@ -205,6 +205,16 @@ kernel_theo <- function(own_type) {
     alpha <- rep(NA_integer_, length(m))
     edf <- rep(NA_real_, length(m))
     limits <- NULL
+    # TheoH's Allan rows first: their noise types serve the TheoBR rows'
+    # exact limits below
+    if (any(!theo_row)) {
+      a <- allan(ctx$v, ctx$freq, taus = I(m[!theo_row] / ctx$freq),
+                 type = "overlapping", input = ctx$input, conf = ctx$conf,
+                 ci = ctx$ci)
+      av[!theo_row] <- a$avar
+      alpha[!theo_row] <- a$alpha
+      edf[!theo_row] <- a$edf
+    }
     mt <- m[theo_row]
     if (length(mt)) {
       # many m: the recurrence over k (O(L log^2 L + kmax^2)) beats
@@ -260,10 +270,8 @@ kernel_theo <- function(own_type) {
             # take them (exact_sets(): a weak reading leans on a shorter
             # tau's; on TheoH's curve the Allan rows are such taus, at
             # Theo1's m of the same tau)
-            a_all <- alpha
-            if (any(!theo_row)) a_all[!theo_row] <- ctx$identify(m[!theo_row])
             m_eq <- ifelse(theo_row, m, m / 0.75)
-            sets <- exact_sets(m_eq, L, a_all, -2L)[theo_row]
+            sets <- exact_sets(m_eq, L, alpha, -2L)[theo_row]
             ex <- theobr_limits_exact(sqrt(t1), mt, L, sets, ctx$conf,
                                       attr(kf, "kappa"))
             u$lower[ex$rows] <- ex$lower
@@ -280,14 +288,6 @@ kernel_theo <- function(own_type) {
         extra_edf(ctx$entry$name, mt, L, alpha[theo_row], ctx$n[theo_row],
                   kappa = attr(kf, "kappa"))
       }
-    }
-    if (any(!theo_row)) {
-      a <- allan(ctx$v, ctx$freq, taus = I(m[!theo_row] / ctx$freq),
-                 type = "overlapping", input = ctx$input, conf = ctx$conf,
-                 ci = ctx$ci)
-      av[!theo_row] <- a$avar
-      alpha[!theo_row] <- a$alpha
-      edf[!theo_row] <- a$edf
     }
     list(av = av, alpha = alpha, edf = edf, limits = limits)
   }
