@@ -155,9 +155,9 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     }
     # c(0, cumsum(xs)) at lo - W .. hi + W only
     cs <- steps_prefix(x, lv, lo - W, hi + W)
-    cand <- lo:hi - (lo - W) + 1L
-    dd <- (cs[cand + W] - 2 * cs[cand] + cs[cand - W]) / W
     cand <- lo:hi
+    p <- cand - (lo - W) + 1L           # their places in cs
+    dd <- (cs[p + W] - 2 * cs[p] + cs[p - W]) / W
     at <- cand[which.max(abs(dd))]      # first sample after the step
     if (any(abs(idx - at) < b)) {       # the same step again: set aside
       excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
