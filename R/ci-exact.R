@@ -183,6 +183,29 @@ exact_alpha <- function(m, L, alpha, min_avg = exact_read_min) {
   out
 }
 
+# The reading of another statistic (`base`, the entry's exact_id) at the
+# rows exact_sets() reads: the exact rows, those with N/m below
+# exact_read_sure, and the longest tau at or above it (the fill-forward
+# stops there when it reads a type); NA elsewhere. At stride 1 each row
+# costs a pass over the samples, so reading the whole curve doubled the
+# total type's cost at 1e7. Where that row reads nothing, or the curve is
+# long enough that extra_alpha() identifies through allan(), every row is
+# read, as before.
+exact_id_alpha <- function(v, freq, m, base, input, L) {
+  few <- (L - 1) / m < exact_read_sure | exact_rows(m, L)
+  keep <- few
+  if (any(!few)) keep[which(!few)[which.max(m[!few])]] <- TRUE
+  if (all(keep) || length(unique(m)) > 200L) {
+    return(extra_alpha(v, freq, m, base, input, L))
+  }
+  out <- rep(NA_integer_, length(m))
+  out[keep] <- extra_alpha(v, freq, m[keep], base, input, L)
+  if (any(!few) && anyNA(out[keep & !few])) {
+    return(extra_alpha(v, freq, m, base, input, L))
+  }
+  out
+}
+
 # The noise exponents a row's interval rests on. Where the curve has a row
 # with N/m >= exact_read_sure at a shorter tau (the lag-1 ACF reading from
 # 64 or more averages: right in 97-100% of records under white FM and,
