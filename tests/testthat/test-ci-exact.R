@@ -136,9 +136,16 @@ test_that("exact_sets() rests few-average rows on the reading at many averages",
   # an own reading redder than it: both, with the own one's neighbour
   expect_identical(exact_sets(m, L, c(0L, 0L, -1L, -1L, NA), -2L)[3:5],
                    list(-2:0, -2:0, -2:0))
-  # a PM reading at many averages, or none: the own reading's set
+  # a PM reading at many averages: the own reading's set where they agree,
+  # else both and the types between (flicker PM read as white FM at a few
+  # averages)
   expect_identical(exact_sets(m, L, c(2L, 2L, 2L, 0L, NA), -2L)[3:5],
-                   list(2L, -1:0, -1:0))
+                   list(2L, -1:2, -1:2))
+  expect_identical(exact_sets(m, L, c(1L, 1L, 1L, 0L, NA), -2L)[3:5],
+                   list(1L, -1:1, -1:1))
+  expect_identical(exact_sets(m, L, c(1L, 1L, 2L, 2L, NA), -2L)[3:5],
+                   list(1:2, 1:2, 1:2))
+  # no reading at many averages: the own reading's set
   expect_identical(exact_sets(m[3:5], L, c(0L, -1L, NA), -2L),
                    list(-1:0, -2:-1, -2:-1))
   expect_identical(exact_sets(m[3:5], L, c(NA, NA, NA), -2L)[[1]], -2:2)
@@ -186,4 +193,20 @@ test_that("a dense grid's exact factors come from knots, interpolated", {
   }
   # with few terms every row is a knot (the law moves with each one)
   expect_true(all(which(n <= 20) %in% k))
+})
+
+test_that("the total type reads the overlapping variance only where exact_sets() looks", {
+  set.seed(31)
+  recs <- list(rnorm(4000), cumsum(rnorm(4000)), diff(rnorm(4001)),
+               rnorm(20000))
+  for (x in recs) {
+    L <- length(x) + 1
+    m <- allan(x, 1, type = "total", ci = FALSE)$m
+    full <- extra_alpha(x, 1, m, "overlapping", "rate", L)
+    part <- exact_id_alpha(x, 1, m, "overlapping", "rate", L)
+    rows <- exact_rows(m, L)
+    expect_identical(exact_sets(m, L, part, -2L)[rows],
+                     exact_sets(m, L, full, -2L)[rows])
+    expect_lt(sum(!is.na(part)), length(m))
+  }
 })
