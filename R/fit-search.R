@@ -286,6 +286,21 @@ fit_search <- function(pr, start, prev, control) {
             lay$label[nlrows[j[!has_start[j]]]]
           } else NULL
           f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
+          if (lay$label[nlrows[k]] %in% later &&
+              !any(lay$fixed[lay$label == lay$label[nlrows[k]] & lay$role == "amp"])) {
+            # this parameter's own term is left out (its other parameter
+            # enters later): the objective does not depend on v, so one
+            # solve gives every value (each still counted as an evaluation)
+            flat <- NULL
+            f1 <- function(v) {
+              l <- lognl
+              l[k] <- v
+              if (any(l < lb | l > ub)) return(Inf)
+              if (is.null(flat)) return(flat <<- obj(l, later))
+              evals <<- evals + 1L
+              flat
+            }
+          }
           if (cy > 1L || !is.null(prev)) {
             lo <- clamp(lognl[k] - log(control$local_span), k)
             hi <- clamp(lognl[k] + log(control$local_span), k)
