@@ -161,8 +161,9 @@ fit_problem <- function(data, tau0, lay, bias_correct, corr, model_var = 0) {
 # The basis of a solve: the problem's constant columns and the searched
 # terms' columns at `values`, each term's kept in the problem's memo while
 # its values do not move (what plan_basis() does with a memo, without
-# rebuilding the constant part per solve).
-solve_basis <- function(pr, values) {
+# rebuilding the constant part per solve). `store`: the call's store of
+# columns (pr$store), or NULL for values no later search meets again.
+solve_basis <- function(pr, values, store = pr$store) {
   Bm <- pr$B0
   memo <- pr$memo
   for (k in seq_along(pr$plan_nl)) {
@@ -174,7 +175,7 @@ solve_basis <- function(pr, values) {
     }
     hit <- memo[[p$label]]
     if (is.null(hit) || !identical(hit$nl, nl)) {
-      hit <- list(nl = nl, b = stored_basis_in(pr$store, p$entry, p$key, pr$tau,
+      hit <- list(nl = nl, b = stored_basis_in(store, p$entry, p$key, pr$tau,
                                                pr$tau0, nl))
       assign(p$label, hit, envir = memo)
     }
@@ -187,12 +188,13 @@ solve_basis <- function(pr, values) {
 # coefficient). `off`: instance labels left out (amplitude 0) for this
 # solve. Returns c (named by free amplitude coefficient), objective,
 # iterations, converged and (unless `layout = FALSE`, as in the search's
-# objective) the layout with the nonlinear values set.
-solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE) {
+# objective) the layout with the nonlinear values set. `store`: see
+# solve_basis().
+solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$store) {
   values <- pr$values
   if (length(nlv)) values[names(nlv)] <- nlv
   amp <- pr$amp
-  Bm <- solve_basis(pr, values)
+  Bm <- solve_basis(pr, values, store)
   on <- if (is.null(off)) !amp$fixed else !amp$fixed & !amp$label %in% off
   free <- amp$name[on]
   offset <- pr$zero
@@ -231,12 +233,16 @@ fit_search <- function(pr, start, prev, control) {
   # the curve and the record can see): outside them the objective is
   # infinite, so neither a start, a grid nor Nelder-Mead can leave them.
   lb <- ub <- numeric(length(nlrows))
+  # The grids' columns go to the call's store (the same candidate's grid
+  # comes back at the next step); the values optimize() and Nelder-Mead
+  # visit are met by no other search, so they are not stored.
+  store <- NULL
   obj <- function(lognl, off = NULL) {
     if (any(lognl < lb | lognl > ub)) return(Inf)
     evals <<- evals + 1L
     v <- exp(lognl)
     names(v) <- nl_names
-    solve_amps(pr, v, control, off, layout = FALSE)$objective
+    solve_amps(pr, v, control, off, layout = FALSE, store = store)$objective
   }
   nm <- NULL
   if (length(nlrows)) {
@@ -280,6 +286,21 @@ fit_search <- function(pr, start, prev, control) {
             lay$label[nlrows[j[!has_start[j]]]]
           } else NULL
           f1 <- function(v) { l <- lognl; l[k] <- v; obj(l, later) }
+          if (lay$label[nlrows[k]] %in% later &&
+              !any(lay$fixed[lay$label == lay$label[nlrows[k]] & lay$role == "amp"])) {
+            # this parameter's own term is left out (its other parameter
+            # enters later): the objective does not depend on v, so one
+            # solve gives every value (each still counted as an evaluation)
+            flat <- NULL
+            f1 <- function(v) {
+              l <- lognl
+              l[k] <- v
+              if (any(l < lb | l > ub)) return(Inf)
+              if (is.null(flat)) return(flat <<- obj(l, later))
+              evals <<- evals + 1L
+              flat
+            }
+          }
           if (cy > 1L || !is.null(prev)) {
             lo <- clamp(lognl[k] - log(control$local_span), k)
             hi <- clamp(lognl[k] + log(control$local_span), k)
@@ -293,7 +314,9 @@ fit_search <- function(pr, start, prev, control) {
             } else {
               seq(log(ranges[[k]][1]), log(ranges[[k]][2]), length.out = ng)
             }
+            store <<- pr$store
             vals <- vapply(g, f1, 0)
+            store <<- NULL
             i <- which.min(vals)
             lo <- g[max(i - 1L, 1L)]; hi <- g[min(i + 1L, ng)]
             lognl[k] <- g[i]

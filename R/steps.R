@@ -19,14 +19,20 @@ new_steps <- function(effect = character(), label = character(),
                       chi2_after = numeric(), rms_before = numeric(),
                       rms_after = numeric(), crit_before = numeric(),
                       crit_after = numeric()) {
+  # every fit carries the empty table (each of the loop's refits builds
+  # one): made once
+  if (!nargs() && !is.null(steps_store$empty)) return(steps_store$empty)
   out <- data.frame(effect = effect, label = label, tau_from = tau_from,
                     tau_to = tau_to, params = params, evidence = evidence,
                     confirmed = as.logical(confirmed), chi2_before = chi2_before,
                     chi2_after = chi2_after, rms_before = rms_before,
                     rms_after = rms_after, crit_before = crit_before,
                     crit_after = crit_after, stringsAsFactors = FALSE)
-  validate_steps(out)
+  out <- validate_steps(out)
+  if (!nargs()) steps_store$empty <- out
+  out
 }
+steps_store <- new.env(parent = emptyenv())
 
 steps_columns <- c("effect", "label", "tau_from", "tau_to", "params",
                    "evidence", "confirmed", "chi2_before", "chi2_after",

@@ -17,7 +17,14 @@ namespace {
 
 // Lawson-Hanson non-negative least squares: min ||A x - b||, x >= 0.
 // Columns are scaled to unit norm first (the bases span many decades).
-VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500) {
+// `warm` (optional): the passive set of a previous, nearby problem (the
+// Gauss-Newton steps of one solve keep it): when the least squares on it
+// are strictly positive the search starts there instead of from the empty
+// set. The result is the least squares on the final passive set, so a
+// warm start that ends on the same set gives the same x to the bit; the
+// final set is written back.
+VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500,
+              std::vector<bool>* warm = nullptr) {
   const int p = static_cast<int>(A0.cols());
   VectorXd scale(p);
   MatrixXd A = A0;
@@ -29,6 +36,22 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500) {
   VectorXd x = VectorXd::Zero(p);
   std::vector<bool> passive(p, false);
   const double tol = 1e-12 * (1.0 + b.norm());
+  if (warm != nullptr && static_cast<int>(warm->size()) == p) {
+    std::vector<int> idx;
+    for (int k = 0; k < p; ++k) if ((*warm)[k]) idx.push_back(k);
+    const int q = static_cast<int>(idx.size());
+    if (q > 0) {
+      MatrixXd Ap(A.rows(), q);
+      for (int i = 0; i < q; ++i) Ap.col(i) = A.col(idx[i]);
+      VectorXd zp = Ap.colPivHouseholderQr().solve(b);
+      bool ok = true;
+      for (int i = 0; i < q; ++i) if (!(zp(i) > 0)) { ok = false; break; }
+      if (ok) {
+        for (int i = 0; i < q; ++i) x(idx[i]) = zp(i);
+        passive = *warm;
+      }
+    }
+  }
   for (int it = 0; it < maxit; ++it) {
     VectorXd w = A.transpose() * (b - A * x);
     int t = -1;
@@ -74,6 +97,7 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500) {
     if ((x - x_prev).norm() <= 1e-14 * (1.0 + x.norm())) break;
   }
   for (int k = 0; k < p; ++k) x(k) /= scale(k);
+  if (warm != nullptr) *warm = passive;
   return x;
 }
 
@@ -146,6 +170,9 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
   }
   int it = 0;
   bool converged = false;
+  // the NNLS of each Gauss-Newton step starts from the previous step's
+  // passive set (nnls(): the same result when the set is the same)
+  std::vector<bool> pset;
   for (; it < maxit && std::isfinite(S); ++it) {
     VectorXd av = offset + B * c;
     VectorXd bc = B * c;
@@ -155,7 +182,7 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
       A.row(j) = B.row(j) / av(j);
       t(j) = y(j) - std::log(av(j)) + bc(j) / av(j);
     }
-    VectorXd cn = nnls(w_times(W, A), w_times(W, t));
+    VectorXd cn = nnls(w_times(W, A), w_times(W, t), 500, &pset);
     VectorXd d = cn - c;
     double lambda = 1.0, Sn = objective(B, offset, y, W, c + d);
     while (!(Sn <= S) && lambda > 1e-10) {

@@ -42,6 +42,32 @@ test_that("NNLS kernel matches an exhaustive active-set reference", {
   }
 })
 
+test_that("the log-domain solve ends at its optimum whatever its start (KKT)", {
+  # Each Gauss-Newton step's NNLS starts from the previous step's passive
+  # set; a term that enters or leaves between steps must not stop it short.
+  # The optimum of sum(w^2 (y - log(B c))^2), c >= 0: the gradient vanishes
+  # for c_k > 0 and is >= 0 for c_k = 0.
+  set.seed(3)
+  tau <- 10^seq(-2, 3, length.out = 40)
+  B <- cbind(Q = 3 / tau^2, N = 1 / tau, B = rep(1, 40), K = tau / 3, Rr = tau^2 / 2)
+  for (i in 1:20) {
+    ctrue <- c(rexp(1) * 1e-6 * (i %% 3 == 0), rexp(1) * 1e-4, rexp(1) * 1e-6,
+               rexp(1) * 1e-8, rexp(1) * 1e-12 * (i %% 2 == 0))
+    s <- runif(40, 0.02, 0.3)
+    y <- log(drop(B %*% ctrue)) + rnorm(40, sd = s)
+    w <- 1 / s
+    for (start in list(numeric(5), ctrue, rev(ctrue) + 1e-9)) {
+      r <- avfit_log_nnls(B, numeric(40), y, matrix(w, ncol = 1), start, 200L, 1e-14)
+      av <- drop(B %*% r$c)
+      grad <- -2 * colSums(w^2 * (y - log(av)) * B / av)
+      scale <- sqrt(colSums((w * B / av)^2)) * sqrt(r$objective)
+      on <- r$c > 0
+      expect_true(all(abs(grad[on] * r$c[on]) <= 1e-5 * scale[on] * r$c[on]))
+      expect_true(all(grad[!on] >= -1e-5 * scale[!on]))
+    }
+  }
+})
+
 test_that("an exact theoretical curve gives back its parameters, chi2 ~ 0", {
   cases <- list(
     list(terms = c("N", "B", "K"), coef = c(N = 0.01, B = 0.002, K = 1e-4)),
