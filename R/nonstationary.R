@@ -423,30 +423,37 @@ detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1000L,
     }
     fixed <- list(X = matrix(expo(tc), nb), A = prof$A)
   }
+  # The profile's z rests on noise fitted with the warm-up out (optimistic:
+  # it screens). The judge is the likelihood ratio with the noise refitted
+  # on both sides (warmup_judge()), each exponential given the others; one
+  # that fails leaves the rest judged again without it.
   # A rate ramp (the catalogue's R) is a straight line in the rate, and a
   # slow exponential over a record fits much of a line (or of a random
   # walk's drift): an exponential is a warm-up only when it explains the
-  # block means better than a straight line in its place (the GLS z of
-  # each alone, beside the other exponential found). Both have one free
-  # amplitude; a long warm-up's curvature makes its own fit the better one.
+  # block means better than a straight line in its place, beside the other
+  # exponential found. Both have one free amplitude; a long warm-up's
+  # curvature makes its own fit the better one.
+  # A profile still rising at the longest time constant the grid allows
+  # (40% of the record) resolves no decay: a random walk's wander over
+  # the record, not a warm-up (a warm-up of up to 30% peaks inside).
+  lr_z <- 0
   if (nrow(found)) {
     ramp <- matrix(seq(-1, 1, length.out = nb), nb)
-    better <- vapply(seq_len(nrow(found)), function(i) {
-      others <- if (nrow(found) > 1L)
-        vapply(found$tc[-i], expo, numeric(nb)) else NULL
-      z_exp <- warmup_profile(y, matrix(expo(found$tc[i]), nb), found$tc[i],
-                              model, others)$z
-      z_line <- warmup_profile(y, ramp, 1, model, others)$z
-      is.finite(z_exp) && abs(z_exp) > abs(z_line)
-    }, TRUE)
-    # A profile still rising at the longest time constant the grid allows
-    # (40% of the record) resolves no decay: a random walk's wander over
-    # the record, not a warm-up (a warm-up of up to 30% peaks inside).
-    inside <- found$tc < grid[length(grid)] * (1 - 1e-9)
-    found <- found[better & inside, , drop = FALSE]
+    starts <- list(warmup_noise(y, dt), model)
+    found <- found[found$tc < grid[length(grid)] * (1 - 1e-9), , drop = FALSE]
+    while (nrow(found)) {
+      j <- warmup_judge(y, found$tc, expo, starts, ramp)
+      lr_z <- max(j$z)
+      ok <- j$z > z_level & j$beats_line
+      if (all(ok)) {
+        found <- j[, c("amplitude", "tc", "z")]
+        break
+      }
+      found <- found[ok, , drop = FALSE]
+    }
   }
   if (!nrow(found)) {
-    none$z <- if (exists("prof")) abs(prof$z) else 0
+    none$z <- if (lr_z > 0) lr_z else if (exists("prof")) abs(prof$z) else 0
     none$tc <- if (exists("prof")) prof$tc else NA_real_
     none$amplitude <- if (exists("prof")) prof$A * s else 0
     return(none)
@@ -519,7 +526,10 @@ warmup_whiten <- function(Y, model) {
                     model$h, nb)
   # then every column at once: a(j+1) = phi a(j) + K(j) v(j), the same way
   storage.mode(Y) <- "double"
-  warmup_whiten_data(Y, g$K, g$sF, phi)
+  E <- warmup_whiten_data(Y, g$K, g$sF, phi)
+  # the log-determinant the likelihood needs (warmup_ml())
+  attr(E, "logdet") <- sum(log(g$sF[-1L]))
+  E
 }
 
 # Profile of the warm-up's time constant: GLS of the block means on each
