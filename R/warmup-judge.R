@@ -60,23 +60,42 @@ warmup_ml <- function(y, X, starts) {
 # the log-likelihood it adds (the noise refitted by ML on both sides), and
 # whether it explains the block means better than a straight line `ramp`
 # in its place. `expo(tc)`: the block means of exp(-t / T); `starts`:
-# noise models to start from (the null's from the first, the others from
-# the rest). Returns data.frame `amplitude` (y's units, from the fit with
-# every exponential), `tc`, `z`, `beats_line`.
+# noise models to start from. The likelihood has local maxima (a slow
+# Gauss-Markov or the random walk can take the same wander): every model
+# starts from `starts` and from every other model's optimum, in two sweeps,
+# so that the null and the alternatives are maximised alike. Returns
+# data.frame `amplitude` (y's units, from the fit with every exponential),
+# `tc`, `z`, `beats_line`.
 warmup_judge <- function(y, tcs, expo, starts, ramp) {
   k <- length(tcs)
   E <- vapply(tcs, expo, numeric(length(y)))
-  null <- warmup_ml(y, NULL, starts[1L])
-  # the models with regressors also start from the null's optimum (nested:
-  # a regressor more is at least as likely from there)
-  st <- c(starts[-1L], list(null$model))
-  full <- warmup_ml(y, E, st)
+  # the regressors of each model: the null, all exponentials, each
+  # exponential's others alone, and the line in each exponential's place
+  others <- if (k > 1L) seq_len(k) else integer()
+  regs <- c(list(NULL, E), lapply(others, function(i) E[, -i, drop = FALSE]),
+            lapply(seq_len(k), function(i) cbind(E[, -i, drop = FALSE], ramp)))
+  fits <- vector("list", length(regs))
+  tried <- vector("list", length(regs))
+  pool <- starts
+  for (sweep in 1:2) {
+    for (f in seq_along(regs)) {
+      new <- setdiff(seq_along(pool), tried[[f]])
+      if (!length(new)) next
+      r <- warmup_ml(y, regs[[f]], pool[new])
+      tried[[f]] <- c(tried[[f]], new)
+      if (is.null(fits[[f]]) || r$ll > fits[[f]]$ll) {
+        fits[[f]] <- r
+        pool[[length(pool) + 1L]] <- r$model
+      }
+    }
+  }
+  ll <- vapply(fits, `[[`, 0, "ll")
+  full <- fits[[2L]]
   rows <- lapply(seq_len(k), function(i) {
-    rest <- if (k > 1L) warmup_ml(y, E[, -i, drop = FALSE], st) else null
-    lr <- max(0, 2 * (full$ll - rest$ll))
-    line <- warmup_ml(y, cbind(E[, -i, drop = FALSE], ramp), list(rest$model))
+    rest <- ll[if (k > 1L) 2L + i else 1L]
     data.frame(amplitude = full$beta[i], tc = tcs[i],
-               z = sqrt(lr), beats_line = full$ll > line$ll)
+               z = sqrt(max(0, 2 * (full$ll - rest))),
+               beats_line = full$ll > ll[2L + length(others) + i])
   })
   do.call(rbind, rows)
 }
