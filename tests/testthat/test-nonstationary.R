@@ -108,6 +108,33 @@ test_that("a random walk's wander and a rate ramp are not read as a warm-up", {
   expect_lte(hits, 2L)
 })
 
+test_that("a random walk's excursion is judged with the walk's own variance: no warm-up", {
+  # white + random walk (and a ramp), 5000 s: with its noise fitted after
+  # taking an exponential of tc 1906 s out, the walk's variance vanishes
+  # and the profile reads the excursion at z 8.4 (9.0 with the ramp); the
+  # likelihood ratio, each side fitting its own noise, does not
+  n <- 5e5
+  freq <- 100
+  set.seed(2714)
+  x <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+  b <- 500L
+  for (y in list(x, x + 2e-7 * seq_len(n) / freq)) {
+    yb <- block_avg(y, b)
+    nb <- length(yb)
+    dt <- b / freq
+    expo <- function(tc) {
+      exp(-(seq_len(nb) - 1) * dt / tc) * (1 - exp(-dt / tc)) / (b * (1 - exp(-1 / freq / tc)))
+    }
+    first <- warmup_profile(yb, cbind(expo(1906)), 1906, warmup_noise(yb, dt))
+    out <- warmup_profile(yb, cbind(expo(1906)), 1906, warmup_noise(yb - first$fitted, dt))
+    expect_gt(abs(out$z), 8)
+    j <- warmup_judge(yb, 1906, expo, list(warmup_noise(yb, dt)),
+                      cbind(seq(-1, 1, length.out = nb)))
+    expect_lt(j$z, 3.5)
+    expect_false(detect_warmup(y, freq)$present)
+  }
+})
+
 test_that("two warm-ups a decade apart are both named", {
   n <- 5e5
   freq <- 100
