@@ -605,14 +605,14 @@ robust_scale <- function(r, trim = 0.005) {
 #' statistic (Fox 1972; Chang, Tiao and Chen 1988) of every sample,
 #' w = sum_j pi_j e(t + j) / sum pi_j^2 over its standard error (the
 #' innovations' robust scale), is compared with the Gaussian Bonferroni
-#' level over the record (at least `min_z`); one spike per outlier (the
-#' largest |z| within `p` samples). Judged on the running median's residual
-#' instead, a line near Nyquist of the white noise's amplitude raised the
-#' scale 20% and took 85% of the count away. On the measured
-#' accelerometers the outliers' sizes are a heavy-tailed continuum (the
-#' count above z falls about as z^-7): a scale 2% larger moves about 10% of
-#' them below any level, which no choice of level avoids; the count is
-#' what N reads (series_reading_bias()).
+#' level over the record (at least `min_z`); a neighbour of an outlier is
+#' a spike only beyond what the outlier lends it (spike_distinct()).
+#' Judged on the running median's residual instead, a line near Nyquist of
+#' the white noise's amplitude raised the scale 20% and took 85% of the
+#' count away. On the measured accelerometers the outliers' sizes are a
+#' heavy-tailed continuum (the count above z falls about as z^-7): a scale
+#' 2% larger moves about 10% of them below any level, which no choice of
+#' level avoids; what they do to N is series_reading_bias()'s.
 #' @return data.frame `index`, `time` (s), `value` (the sample), `size`
 #'   (its excess over the running median of `k` samples), `z`; attribute
 #'   `threshold` (in robust sd).
@@ -632,10 +632,7 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
   z <- spike_ao_z(x, med[w] + pmax(pmin(r[w], 4 * s), -4 * s), p)
   if (is.null(z)) return(empty)
   zc <- max(min_z, stats::qnorm(1 - alpha / (2 * n)))
-  a <- abs(z)
-  i <- which(a > zc)
-  # an outlier raises its neighbours' statistic too: the largest within p
-  i <- i[vapply(i, function(t) a[t] >= max(a[max(1L, t - p):min(n, t + p)]), TRUE)]
+  i <- spike_distinct(z, which(abs(z) > zc), zc, attr(z, "pi"))
   out <- data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
                     z = z[i])
   attr(out, "threshold") <- zc
@@ -665,7 +662,26 @@ spike_ao_z <- function(x, xw, p = 20L) {
   a <- rev(as.numeric(stats::filter(rev(e), pi, sides = 1L)))
   a[is.na(a)] <- 0
   a[c(seq_len(2L * p), seq.int(max(1L, n - 2L * p + 1L), n))] <- 0
-  a / (sqrt(sum(pi^2)) * se)
+  structure(a / (sqrt(sum(pi^2)) * se), pi = pi)
+}
+
+# An outlier raises its neighbours' statistic too, by its own z times the
+# correlation of the two estimates (sum_j pi_j pi_(j+d) / sum pi_j^2 at d
+# samples): the candidates `i`, largest first, each kept when its z less
+# what the outliers kept before lend it still exceeds zc.
+spike_distinct <- function(z, i, zc, pi) {
+  if (length(i) < 2L) return(i)
+  p <- length(pi) - 1L
+  rho <- vapply(0:p, function(d) sum(pi[seq_len(p + 1L - d)] * pi[seq_len(p + 1L - d) + d]), 0) /
+    sum(pi^2)
+  i <- i[order(-abs(z[i]))]
+  keep <- logical(length(i))
+  for (k in seq_along(i)) {
+    near <- which(keep & abs(i - i[k]) <= p)
+    lent <- sum(z[i[near]] * rho[abs(i[near] - i[k]) + 1L])
+    keep[k] <- abs(z[i[k]] - lent) > zc
+  }
+  sort(i[keep])
 }
 
 # The series with spikes replaced by the running median around them.
