@@ -343,15 +343,20 @@ steps_prefix <- function(x, lv, lo, hi) {
 #' maximises the profile likelihood, refined by a parabola in log T. The
 #' noise model is fitted again with the warm-up found taken out (else its
 #' Gauss-Markov components would explain the warm-up) until T settles.
-#' z is the GLS estimate of A over its standard error, the error scaled by
-#' the whitened residual (a misfit noise model cannot make z larger than
-#' the data allow). Present when z exceeds `z_level`. A second exponential
-#' (an added warm-up on an axis that has one of its own) is looked for with
-#' the first in the regression, and kept when its own z also passes and
+#' The profile's z (the GLS estimate of A over its standard error) only
+#' screens: its noise was fitted with the warm-up out, which takes a random
+#' walk's variance with it. The warm-up is judged by warmup_judge(): z =
+#' sqrt(2 log LR), the block means with and without the exponential each
+#' fitting their own noise model by maximum likelihood; present when z
+#' exceeds `z_level`. A second exponential (an added warm-up on an axis
+#' that has one of its own) is looked for with the first in the
+#' regression, judged given the first, and kept when it also passes and
 #' the time constants are at least a factor 2 apart. An exponential is kept
 #' only when it explains the block means better than a straight line (a
-#' rate ramp) in its place, and when its time constant lies inside the grid
-#' (a profile still rising at 40% of the record is a random walk's wander).
+#' rate ramp) in its place (by likelihood, each fitting its noise), and
+#' when its time constant lies inside the grid (a profile still rising at
+#' 40% of the record is a random walk's wander). `amplitude`: the GLS
+#' amplitude under the judge's noise model.
 #' @return list `present`, `amplitude` (rate unit, the offset at t = 0),
 #'   `tc` (s), `z`, `level` (the settled level c; `NA` from the GLS
 #'   fit), and `all`: a data.frame (`amplitude`, `tc`, `z`) of every

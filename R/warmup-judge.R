@@ -3,7 +3,7 @@
 # detect_warmup() finds T with the noise fitted after taking the warm-up
 # out (else Gauss-Markov components would explain the warm-up), but that
 # fit cannot judge the warm-up: the exponential takes a random walk's
-# excursion with it, the walk's variance comes out at about half its value
+# excursion with it, the walk's variance comes out at half its value or less
 # and the excursion looks significant (z of 8 on white noise plus a random
 # walk). Under the likelihood ratio the null model keeps its own noise.
 
