@@ -8,21 +8,23 @@
 #'
 #' Runs the detectors of the catalogue's series effects ([av_terms()] rows
 #' with `component == "series"`) over a raw rate series, in catalogue
-#' order: isolated spikes (residual from a 7-sample running median against
-#' its robust scale), an exponential warm-up, bias steps (multi-scale
-#' changepoints of the Allan differences, standardised by the series' own
+#' order: isolated spikes (additive outliers of the series' own AR model;
+#' their size the excess over a 7-sample running median), an exponential
+#' warm-up, bias steps (multi-scale changepoints of the Allan differences,
+#' standardised by the series' own
 #' Allan variance so that red noise is not read as steps) and transients
 #' (two steps of opposite sign and similar size less than 120 s apart).
 #' Each detector sees the series with the instances found before it taken
 #' out (a spike does not disturb the step search). Thresholds are
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
-#' steps) standard deviations; the spike threshold sits in a gap of the
-#' sorted residuals near that level (so the count does not flip when the
-#' noise scale moves a little) and a spike must also be an additive outlier
-#' of the series' own AR model. The warm-up is fitted by generalised least
-#' squares under the series' own noise model (white, random walk and
-#' Gauss-Markov components from its Allan variance); up to two
-#' exponentials are named.
+#' steps) standard deviations. A spike is an additive outlier of the
+#' series' own AR model (its filter, lines and colour), so that a line or a
+#' filter does not hide it. The warm-up's time constant is fitted by
+#' generalised least squares under the series' own noise model (white,
+#' random walk and Gauss-Markov components from its Allan variance), and a
+#' warm-up is named by a likelihood ratio in which the series with and
+#' without it each fit their own noise model (a random walk's excursion is
+#' not a warm-up); up to two exponentials are named.
 #'
 #' The Allan deviation of the series as given is compared with that of the
 #' series with every effect found taken out, on the octave grid of

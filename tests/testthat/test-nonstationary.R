@@ -108,6 +108,33 @@ test_that("a random walk's wander and a rate ramp are not read as a warm-up", {
   expect_lte(hits, 2L)
 })
 
+test_that("a random walk's excursion is judged with the walk's own variance: no warm-up", {
+  # white + random walk (and a ramp), 5000 s: with its noise fitted after
+  # taking an exponential of tc 1906 s out, the walk's variance vanishes
+  # and the profile reads the excursion at z 8.4 (9.0 with the ramp); the
+  # likelihood ratio, each side fitting its own noise, does not
+  n <- 5e5
+  freq <- 100
+  set.seed(2714)
+  x <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+  b <- 500L
+  for (y in list(x, x + 2e-7 * seq_len(n) / freq)) {
+    yb <- block_avg(y, b)
+    nb <- length(yb)
+    dt <- b / freq
+    expo <- function(tc) {
+      exp(-(seq_len(nb) - 1) * dt / tc) * (1 - exp(-dt / tc)) / (b * (1 - exp(-1 / freq / tc)))
+    }
+    first <- warmup_profile(yb, cbind(expo(1906)), 1906, warmup_noise(yb, dt))
+    out <- warmup_profile(yb, cbind(expo(1906)), 1906, warmup_noise(yb - first$fitted, dt))
+    expect_gt(abs(out$z), 8)
+    j <- warmup_judge(yb, 1906, expo, list(warmup_noise(yb, dt)),
+                      cbind(seq(-1, 1, length.out = nb)))
+    expect_lt(j$z, 3.5)
+    expect_false(detect_warmup(y, freq)$present)
+  }
+})
+
 test_that("two warm-ups a decade apart are both named", {
   n <- 5e5
   freq <- 100
@@ -168,6 +195,25 @@ test_that("the spike count does not flip when the scale moves 2%; no spikes in c
       nrow(detect_spikes(0.1 * w + cumsum(rnorm(n, sd = 1e-3)), freq))
   }
   expect_lte(hits, 1L)
+})
+
+test_that("a line near Nyquist does not hide spikes: they are outliers of the series' own AR model", {
+  # 60 outliers of 6.5-10 sd; a 48.1 Hz line of the white's amplitude. On
+  # the running median's residual (the line stays in it, the scale grows
+  # 22%) the count fell from 57 to 27
+  n <- 2e5
+  freq <- 100
+  set.seed(43)
+  x <- rnorm(n, sd = 0.1)
+  at <- sample.int(n, 60)
+  x[at] <- x[at] + sample(c(-1, 1), 60, TRUE) * seq(0.65, 1, length.out = 60)
+  t <- (seq_len(n) - 1) / freq
+  sp0 <- detect_spikes(x, freq)
+  sp1 <- detect_spikes(x + 0.1 * sin(2 * pi * 48.1 * t + 1), freq)
+  expect_gte(sum(sp0$index %in% at), 57L)
+  expect_true(all(sp0$index %in% at))
+  expect_lte(abs(nrow(sp1) - nrow(sp0)), 0.05 * nrow(sp0))
+  expect_true(all(sp1$index %in% at))
 })
 
 test_that("spikes inflate the short-tau Allan deviation; the correction removes it", {
