@@ -650,6 +650,13 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
 # scale.
 spike_ao_z <- function(x, xw, p = 20L) {
   n <- length(x)
+  # scaled by a power of two (exact): the filters' squares of data near
+  # 1e300 overflow
+  top <- max(abs(xw))
+  if (!is.finite(top) || !(top > 0)) return(NULL)
+  sc <- 2^floor(log2(top))
+  x <- x / sc
+  xw <- xw / sc
   mu <- mean(xw)
   ar <- tryCatch(as.numeric(stats::ar.burg(xw - mu, aic = FALSE, order.max = p,
                                            demean = FALSE, var.method = 2L)$ar),
@@ -659,7 +666,7 @@ spike_ao_z <- function(x, xw, p = 20L) {
   p <- length(pi) - 1L
   ew <- as.numeric(stats::filter(xw - mu, pi, sides = 1L))
   se <- robust_scale(ew[-seq_len(p)])
-  if (!(se > 0)) return(NULL)
+  if (!isTRUE(se > 0)) return(NULL)
   # innovations e(t) = pi(B) x, then sum_j pi_j e(t + j) (the filter run
   # backwards)
   e <- as.numeric(stats::filter(x - mu, pi, sides = 1L))
