@@ -5,6 +5,7 @@
 // weights) by Gauss-Newton steps, each an NNLS problem, with step halving.
 // It is called once per grid point of the profiled nonlinear parameters.
 #include <RcppEigen.h>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -14,6 +15,23 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 namespace {
+
+// The least squares of b on A's columns in the passive set: their indices
+// in `idx`, the coefficients in `zp`; true when every one is positive.
+bool passive_ls(const MatrixXd& A, const VectorXd& b,
+                const std::vector<bool>& passive, std::vector<int>& idx,
+                VectorXd& zp) {
+  idx.clear();
+  for (int k = 0; k < static_cast<int>(passive.size()); ++k) {
+    if (passive[k]) idx.push_back(k);
+  }
+  const int q = static_cast<int>(idx.size());
+  MatrixXd Ap(A.rows(), q);
+  for (int i = 0; i < q; ++i) Ap.col(i) = A.col(idx[i]);
+  zp = Ap.colPivHouseholderQr().solve(b);
+  for (int i = 0; i < q; ++i) if (!(zp(i) > 0)) return false;
+  return true;
+}
 
 // Lawson-Hanson non-negative least squares: min ||A x - b||, x >= 0.
 // Columns are scaled to unit norm first (the bases span many decades).
@@ -36,21 +54,13 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500,
   VectorXd x = VectorXd::Zero(p);
   std::vector<bool> passive(p, false);
   const double tol = 1e-12 * (1.0 + b.norm());
-  if (warm != nullptr && static_cast<int>(warm->size()) == p) {
-    std::vector<int> idx;
-    for (int k = 0; k < p; ++k) if ((*warm)[k]) idx.push_back(k);
-    const int q = static_cast<int>(idx.size());
-    if (q > 0) {
-      MatrixXd Ap(A.rows(), q);
-      for (int i = 0; i < q; ++i) Ap.col(i) = A.col(idx[i]);
-      VectorXd zp = Ap.colPivHouseholderQr().solve(b);
-      bool ok = true;
-      for (int i = 0; i < q; ++i) if (!(zp(i) > 0)) { ok = false; break; }
-      if (ok) {
-        for (int i = 0; i < q; ++i) x(idx[i]) = zp(i);
-        passive = *warm;
-      }
-    }
+  std::vector<int> idx;
+  VectorXd zp;
+  if (warm != nullptr && static_cast<int>(warm->size()) == p &&
+      std::find(warm->begin(), warm->end(), true) != warm->end() &&
+      passive_ls(A, b, *warm, idx, zp)) {
+    for (int i = 0; i < static_cast<int>(idx.size()); ++i) x(idx[i]) = zp(i);
+    passive = *warm;
   }
   for (int it = 0; it < maxit; ++it) {
     VectorXd w = A.transpose() * (b - A * x);
@@ -63,14 +73,8 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500,
     passive[t] = true;
     const VectorXd x_prev = x;
     for (int inner = 0; inner < 3 * p + 3; ++inner) {
-      std::vector<int> idx;
-      for (int k = 0; k < p; ++k) if (passive[k]) idx.push_back(k);
+      const bool ok = passive_ls(A, b, passive, idx, zp);
       const int q = static_cast<int>(idx.size());
-      MatrixXd Ap(A.rows(), q);
-      for (int i = 0; i < q; ++i) Ap.col(i) = A.col(idx[i]);
-      VectorXd zp = Ap.colPivHouseholderQr().solve(b);
-      bool ok = true;
-      for (int i = 0; i < q; ++i) if (!(zp(i) > 0)) { ok = false; break; }
       if (ok) {
         x.setZero();
         for (int i = 0; i < q; ++i) x(idx[i]) = zp(i);
