@@ -338,7 +338,11 @@ if (sys.nframe() == 0L) {
   if (file.exists("DESCRIPTION") && requireNamespace("pkgload", quietly = TRUE)) {
     pkgload::load_all(quiet = TRUE)
   } else {
+    # an installed build: the internals the checks call (debias_factor(),
+    # allan_edf_direct()) on the search path too
     library(allanvar)
+    attach(asNamespace("allanvar"), name = "allanvar_internals",
+           warn.conflicts = FALSE)
   }
   d <- check_stable32_types()
   if (is.null(d)) {
