@@ -8,7 +8,7 @@
 //    v(B) (1 - B)^d x = v(B) u with u = (1 - B)^(d - delta) e stationary
 //    (fractionally differenced white noise, autocovariance in closed form);
 //  * CDF by Imhof (1961), his integral by QUADPACK's dqagi (R's Rdqagi);
-//    quantiles by false position (Illinois) in log q.
+//    quantiles from the saddlepoint's by secant steps on it in log q.
 #include <Rcpp.h>
 #include <RcppEigen.h>
 #include <R_ext/Applic.h>
@@ -139,8 +139,8 @@ double gchisq_cdf(const Weights& w, double q) {
 }
 
 // Lugannani-Rice's saddlepoint approximation of P(Q <= q) (Kuonen 1999):
-// about three digits, no integral. It only places the Imhof root's bracket
-// (most of the quantile's cost was the CDF evaluations that narrowed a wide
+// about three digits, no integral. It only starts the Imhof root (most of
+// the quantile's cost was the CDF evaluations that narrowed a wide
 // bracket: up to 20 ms each for random-walk FM's few dominant weights).
 // NaN near the mean, where the formula is singular.
 double saddle_cdf(const Weights& w, double q) {
@@ -257,16 +257,6 @@ double secant_root(F f, double x0, double x1, double tol, double ftol) {
   return NAN;
 }
 
-struct RootData {
-  const Weights* w;
-  double p;
-};
-
-double cdf_minus_p(double lq, void* info) {
-  const RootData* d = static_cast<const RootData*>(info);
-  return gchisq_cdf(*d->w, std::exp(lq)) - d->p;
-}
-
 }  // namespace
 
 // Eigenvalues, over their sum, of the covariance of the terms of estimator
@@ -314,8 +304,8 @@ Rcpp::NumericVector gchisq_cdf_cpp(const Rcpp::NumericVector& lambda,
 }
 
 // Quantiles of Q = sum lambda_i chi2_1 at probabilities p (in (0, 1)):
-// the root of the Imhof CDF in log q (false position), bracketed from the
-// two-moment chi-square's quantile.
+// the root of the Imhof CDF in log q by secant steps from the
+// saddlepoint's quantile (false position in a bracket where they stray).
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector gchisq_quantile_cpp(const Rcpp::NumericVector& lambda,
                                         const Rcpp::NumericVector& p) {
@@ -328,7 +318,6 @@ Rcpp::NumericVector gchisq_quantile_cpp(const Rcpp::NumericVector& lambda,
   const double nu = s1 * s1 / s2;  // the two-moment EDF
   Rcpp::NumericVector out(p.size());
   for (R_xlen_t i = 0; i < p.size(); ++i) {
-    RootData data{&w, p[i]};
     const double pi = p[i];
     // the start: the saddlepoint's quantile (else the two-moment
     // chi-square's), which the Imhof root then refines in a narrow bracket
@@ -340,7 +329,7 @@ Rcpp::NumericVector gchisq_quantile_cpp(const Rcpp::NumericVector& lambda,
     // to 1e-9 in probability or 1e-8 in log q: the CDF itself is good to
     // about 1e-8 (the integral's tolerances), so a tighter root only chases
     // its noise
-    auto f = [&](double lq) { return cdf_minus_p(lq, &data); };
+    auto f = [&](double lq) { return gchisq_cdf(w, std::exp(lq)) - pi; };
     double lr = secant_root(f, l0, l0 + 0.2 * half, 1e-8, 1e-9);
     if (ISNAN(lr)) lr = log_root(f, l0 - half, l0 + half, 2 * half, 1e-8, 1e-9);
     out[i] = ISNAN(lr) ? NA_REAL : std::exp(lr);
