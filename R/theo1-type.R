@@ -55,7 +55,7 @@ theo1_alpha <- function(v, rate, L, m, t1, alpha0, threads) {
   # intervals, 95% coverage 0.91)
   k <- pmax(3, round(0.75 * m))
   rn <- rep(NA_real_, length(m))
-  kk <- sort(unique(k[4 * k <= L - 1 & k >= 3]))
+  kk <- sort(unique(k[4 * k <= L - 1]))
   if (length(kk)) {
     input <- if (rate) "rate" else "integrated"
     r <- allan(v, 1, taus = I(kk), type = "modified", input = input)$avar /
