@@ -172,14 +172,21 @@ test_that("spikes are all found and none invented, also on quantized data", {
   expect_lte(hits, 1L)
 })
 
+# White noise of sd 0.1 with k outliers of sizes from..to (either sign) at
+# random places (attribute `at`).
+white_with_outliers <- function(n, k, from, to, seed) {
+  set.seed(seed)
+  x <- rnorm(n, sd = 0.1)
+  at <- sample.int(n, k)
+  x[at] <- x[at] + sample(c(-1, 1), k, TRUE) * seq(from, to, length.out = k)
+  structure(x, at = at)
+}
+
 test_that("the spike count does not flip when the scale moves 2%; no spikes in coloured Gaussian noise", {
   n <- 2e5
   freq <- 100
-  set.seed(41)
-  x <- rnorm(n, sd = 0.1)
-  at <- sample.int(n, 150)
   # 150 outliers spread from 5 to 12 sd, many near a fixed 6-sd cut
-  x[at] <- x[at] + sample(c(-1, 1), 150, TRUE) * seq(0.5, 1.2, length.out = 150)
+  x <- white_with_outliers(n, 150, 0.5, 1.2, seed = 41)
   n0 <- nrow(detect_spikes(x, freq))
   # an unrelated white part raising the robust scale by 2%
   n1 <- nrow(detect_spikes(x + rnorm(n, sd = 0.1 * sqrt(1.02^2 - 1)), freq))
@@ -203,10 +210,8 @@ test_that("a line near Nyquist does not hide spikes: they are outliers of the se
   # 22%) the count fell from 57 to 27
   n <- 2e5
   freq <- 100
-  set.seed(43)
-  x <- rnorm(n, sd = 0.1)
-  at <- sample.int(n, 60)
-  x[at] <- x[at] + sample(c(-1, 1), 60, TRUE) * seq(0.65, 1, length.out = 60)
+  x <- white_with_outliers(n, 60, 0.65, 1, seed = 43)
+  at <- attr(x, "at")
   t <- (seq_len(n) - 1) / freq
   sp0 <- detect_spikes(x, freq)
   sp1 <- detect_spikes(x + 0.1 * sin(2 * pi * 48.1 * t + 1), freq)
