@@ -133,6 +133,13 @@ test_that("exact_sets() rests few-average rows on the reading at many averages",
                    list(0L, 0L, 0L))
   expect_identical(exact_sets(m, L, c(-1L, -1L, 0L, 1L, NA), -2L)[3:5],
                    list(-1L, -1L, -1L))
+  # ... but for a value bias-corrected by the type read, a whiter own
+  # reading joins it (its correction moves the value)
+  expect_identical(exact_sets(m, L, c(-1L, -1L, 0L, 1L, NA), -2L,
+                              join_own = TRUE)[3:5],
+                   list(-1:0, -1:1, -1:1))
+  expect_identical(exact_sets(m, L, c(0L, 0L, 0L, 0L, NA), -2L,
+                              join_own = TRUE)[3:5], list(0L, 0L, 0L))
   # an own reading redder than it: both, with the own one's neighbour
   expect_identical(exact_sets(m, L, c(0L, 0L, -1L, -1L, NA), -2L)[3:5],
                    list(-2:0, -2:0, -2:0))

@@ -228,6 +228,10 @@ test_that("ThéoH: Allan deviation to 20% of the record, then ThéoBR", {
   expect_equal(h$tau[!avar_rows], 0.75 * c(256, 512))
   oa <- allan(x, 1, taus = I(2^(0:7)), type = "overlapping", input = "integrated")
   expect_equal(h$adev[avar_rows], oa$adev)
+  # the Allan rows' limits are the overlapping type's (exact at few
+  # averages), not a chi-square with the EDF of the type read
+  expect_identical(h$lower[avar_rows], oa$lower)
+  expect_identical(h$upper[avar_rows], oa$upper)
   br <- allan(x, 1, taus = I(0.75 * c(256, 512)), type = "theobr",
               input = "integrated")
   expect_equal(h$adev[!avar_rows], br$adev)
