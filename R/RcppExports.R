@@ -201,6 +201,14 @@ warmup_gains <- function(P0, PP, Q, phi, h, nb) {
     .Call(`_allanvar_warmup_gains`, P0, PP, Q, phi, h, nb)
 }
 
+spike_burg <- function(x, pmax) {
+    .Call(`_allanvar_spike_burg`, x, pmax)
+}
+
+ar_filter <- function(x, f, backward) {
+    .Call(`_allanvar_ar_filter`, x, f, backward)
+}
+
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }

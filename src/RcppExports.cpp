@@ -635,6 +635,29 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// spike_burg
+Rcpp::NumericVector spike_burg(const Rcpp::NumericVector& x, int pmax);
+RcppExport SEXP _allanvar_spike_burg(SEXP xSEXP, SEXP pmaxSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< int >::type pmax(pmaxSEXP);
+    rcpp_result_gen = Rcpp::wrap(spike_burg(x, pmax));
+    return rcpp_result_gen;
+END_RCPP
+}
+// ar_filter
+Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x, const Rcpp::NumericVector& f, bool backward);
+RcppExport SEXP _allanvar_ar_filter(SEXP xSEXP, SEXP fSEXP, SEXP backwardSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type f(fSEXP);
+    Rcpp::traits::input_parameter< bool >::type backward(backwardSEXP);
+    rcpp_result_gen = Rcpp::wrap(ar_filter(x, f, backward));
+    return rcpp_result_gen;
+END_RCPP
+}
 // theo1_sums_cpp
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -797,6 +820,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_shifted_prefix", (DL_FUNC) &_allanvar_shifted_prefix, 5},
     {"_allanvar_warmup_whiten_data", (DL_FUNC) &_allanvar_warmup_whiten_data, 4},
     {"_allanvar_warmup_gains", (DL_FUNC) &_allanvar_warmup_gains, 6},
+    {"_allanvar_spike_burg", (DL_FUNC) &_allanvar_spike_burg, 2},
+    {"_allanvar_ar_filter", (DL_FUNC) &_allanvar_ar_filter, 3},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},
