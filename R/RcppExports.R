@@ -161,6 +161,10 @@ stamp_repeats <- function(t) {
     .Call(`_allanvar_stamp_repeats`, t)
 }
 
+resonance_psd_cpp <- function(f, tau0, sigma, fr, tc) {
+    .Call(`_allanvar_resonance_psd_cpp`, f, tau0, sigma, fr, tc)
+}
+
 decode_imu_blobs <- function(blobs, encoding, recv_ns) {
     .Call(`_allanvar_decode_imu_blobs`, blobs, encoding, recv_ns)
 }

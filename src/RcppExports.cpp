@@ -507,6 +507,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// resonance_psd_cpp
+Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0, double sigma, double fr, double tc);
+RcppExport SEXP _allanvar_resonance_psd_cpp(SEXP fSEXP, SEXP tau0SEXP, SEXP sigmaSEXP, SEXP frSEXP, SEXP tcSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type f(fSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    Rcpp::traits::input_parameter< double >::type sigma(sigmaSEXP);
+    Rcpp::traits::input_parameter< double >::type fr(frSEXP);
+    Rcpp::traits::input_parameter< double >::type tc(tcSEXP);
+    rcpp_result_gen = Rcpp::wrap(resonance_psd_cpp(f, tau0, sigma, fr, tc));
+    return rcpp_result_gen;
+END_RCPP
+}
 // decode_imu_blobs
 Rcpp::NumericMatrix decode_imu_blobs(const Rcpp::List& blobs, int encoding, const Rcpp::NumericVector& recv_ns);
 RcppExport SEXP _allanvar_decode_imu_blobs(SEXP blobsSEXP, SEXP encodingSEXP, SEXP recv_nsSEXP) {
@@ -810,6 +824,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_col_block_avar", (DL_FUNC) &_allanvar_col_block_avar, 3},
     {"_allanvar_stamp_steps", (DL_FUNC) &_allanvar_stamp_steps, 1},
     {"_allanvar_stamp_repeats", (DL_FUNC) &_allanvar_stamp_repeats, 1},
+    {"_allanvar_resonance_psd_cpp", (DL_FUNC) &_allanvar_resonance_psd_cpp, 5},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_index_cpp", (DL_FUNC) &_allanvar_rosbag_index_cpp, 1},
