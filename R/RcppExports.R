@@ -161,6 +161,10 @@ stamp_repeats <- function(t) {
     .Call(`_allanvar_stamp_repeats`, t)
 }
 
+resonance_psd_cpp <- function(f, tau0, sigma, fr, tc) {
+    .Call(`_allanvar_resonance_psd_cpp`, f, tau0, sigma, fr, tc)
+}
+
 decode_imu_blobs <- function(blobs, encoding, recv_ns) {
     .Call(`_allanvar_decode_imu_blobs`, blobs, encoding, recv_ns)
 }
@@ -199,6 +203,14 @@ warmup_whiten_data <- function(Y, K, sF, phi) {
 
 warmup_gains <- function(P0, PP, Q, phi, h, nb) {
     .Call(`_allanvar_warmup_gains`, P0, PP, Q, phi, h, nb)
+}
+
+spike_burg <- function(x, pmax) {
+    .Call(`_allanvar_spike_burg`, x, pmax)
+}
+
+ar_filter <- function(x, f, backward) {
+    .Call(`_allanvar_ar_filter`, x, f, backward)
 }
 
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {

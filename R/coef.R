@@ -17,6 +17,21 @@ split_term <- function(terms) {
 # Validate a `terms` vector (repeatable kinds may repeat) and return it in
 # canonical (catalogue) order.
 check_terms <- function(terms, arg = "terms") {
+  # every refit of the loop checks its terms again: a set that passed is
+  # kept with the layouts (coef_layout(); emptied with them when the
+  # catalogue changes), so the checks run once per set
+  key <- if (is.character(terms) && length(terms) && !anyNA(terms))
+    paste0("\001", paste(terms, collapse = "\r"))
+  if (!is.null(key)) {
+    hit <- .catalogue$layouts[[key]]
+    if (!is.null(hit)) return(hit)
+  }
+  out <- check_terms_now(terms, arg)
+  if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
+  assign(key, out, envir = .catalogue$layouts)
+  out
+}
+check_terms_now <- function(terms, arg) {
   kinds <- effect_kinds()
   if (!is.character(terms) || length(terms) == 0L || anyNA(terms)) {
     abort("`", arg, "` must be a character vector of term names (",

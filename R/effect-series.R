@@ -74,7 +74,7 @@ effect_bias_step <- function() {
       amp[[1L]] * (seq_len(n) >= time_index(nl[["time"]], tau0, n))
     },
     detect = function(x, freq) {
-      st <- detect_steps(x, freq)
+      st <- pass_steps(x, freq)
       series_rows(size = st$size, time = st$time, index = st$index, z = st$z,
                   evidence = sprintf(
                     "Allan difference over %s s on each side at z = %s (size %s +- %s)",
@@ -115,7 +115,7 @@ effect_transient <- function() {
       amp[[1L]] * (i >= a & i < b)
     },
     detect = function(x, freq) {
-      pu <- attr(detect_steps(x, freq), "pulses")
+      pu <- attr(pass_steps(x, freq), "pulses")
       series_rows(size = pu$size, time = pu$start, duration = pu$end - pu$start,
                   index = time_index(pu$start, 1 / freq, length(x)),
                   z = rep(NA_real_, nrow(pu)),

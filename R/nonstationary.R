@@ -235,6 +235,29 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   steps
 }
 
+# detect_steps() of a series within one series pass (detect_series()
+# opens and closes it): the steps and the transients both read it, and
+# where no step was found they read it of the same series (then the
+# second is the first's result; identical() input, identical output).
+series_pass_memo <- new.env(parent = emptyenv())
+series_pass_open <- function() {
+  series_pass_memo$open <- TRUE
+  series_pass_memo$steps <- NULL
+}
+series_pass_close <- function() {
+  series_pass_memo$open <- FALSE
+  series_pass_memo$steps <- NULL
+}
+pass_steps <- function(x, freq) {
+  m <- series_pass_memo$steps
+  if (!is.null(m) && identical(m$freq, freq) && identical(m$x, x)) return(m$result)
+  r <- detect_steps(x, freq)
+  if (isTRUE(series_pass_memo$open)) {
+    series_pass_memo$steps <- list(x = x, freq = freq, result = r)
+  }
+  r
+}
+
 # The step of opposite sign within `gap` samples after (or before) step k
 # of `steps`, the other steps removed: at windows from the step's own up to
 # gap / 4 (octaves), the split maximising the opposite difference of means
@@ -658,20 +681,21 @@ spike_ao_z <- function(x, xw, p = 20L) {
   x <- x / sc
   xw <- xw / sc
   mu <- mean(xw)
-  ar <- tryCatch(as.numeric(stats::ar.burg(xw - mu, aic = FALSE, order.max = p,
-                                           demean = FALSE, var.method = 2L)$ar),
-                 error = function(e) numeric(0))
+  # Burg's AR(p) as ar.burg(aic = FALSE, demean = FALSE) gives it, numeric(0)
+  # where ar.burg() stops, and the filters as stats::filter(sides = 1)
+  # computes them (src/series.cpp: the same operations in their order)
+  ar <- spike_burg(xw - mu, p)
   if (!all(is.finite(ar))) ar <- numeric(0)
   pi <- c(1, -ar)
   p <- length(pi) - 1L
-  ew <- as.numeric(stats::filter(xw - mu, pi, sides = 1L))
+  ew <- ar_filter(xw - mu, pi, FALSE)
   se <- robust_scale(ew[-seq_len(p)])
   if (!isTRUE(se > 0)) return(NULL)
   # innovations e(t) = pi(B) x, then sum_j pi_j e(t + j) (the filter run
   # backwards)
-  e <- as.numeric(stats::filter(x - mu, pi, sides = 1L))
+  e <- ar_filter(x - mu, pi, FALSE)
   e[seq_len(p)] <- 0
-  a <- rev(as.numeric(stats::filter(rev(e), pi, sides = 1L)))
+  a <- ar_filter(e, pi, TRUE)
   a[is.na(a)] <- 0
   a[c(seq_len(2L * p), seq.int(max(1L, n - 2L * p + 1L), n))] <- 0
   structure(a / (sqrt(sum(pi^2)) * se), pi = pi)

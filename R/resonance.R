@@ -25,15 +25,12 @@ resonance_av <- function(m, tau0, sigma, fr, tc) {
 # Two-sided PSD (u^2/Hz) of the sampled process: tau0 sum_h g(h) e^{-i w' h}
 # = tau0 sigma^2 Re[(1 + q) / (1 - q)] summed over q = p e^{-iw'} and its
 # mirror, /2 each.
+# (src/resonance.cpp: r = exp(-tau0 / tc), w = 2 pi f tau0, w0 = 2 pi fr tau0,
+# one(d) = Re((1 + q) / (1 - q)) with q = r exp(1i d), and
+# tau0 sigma^2 0.5 (one(w0 - w) + one(-w0 - w)): R's operations in its
+# complex arithmetic, without its complex vectors)
 resonance_psd <- function(f, tau0, sigma, fr, tc) {
-  r <- exp(-tau0 / tc)
-  w <- 2 * pi * f * tau0
-  w0 <- 2 * pi * fr * tau0
-  one <- function(d) {
-    q <- r * exp(1i * d)
-    Re((1 + q) / (1 - q))
-  }
-  tau0 * sigma^2 * 0.5 * (one(w0 - w) + one(-w0 - w))
+  resonance_psd_cpp(as.double(f), tau0, sigma, fr, tc)
 }
 
 # n samples, started from the stationary law: x is the real part of z with

@@ -126,6 +126,9 @@ series_columns <- c("kind", "index", "time", "size", "tc", "duration", "z",
 # Every kind's instances, in catalogue order, each detector seeing the
 # series with the instances found before it removed.
 detect_series <- function(x, freq, kinds) {
+  # detectors that read the same thing of the same series compute it once
+  series_pass_open()
+  on.exit(series_pass_close(), add = TRUE)
   work <- x
   parts <- list()
   for (k in intersect(effect_kinds("series"), kinds)) {

@@ -507,6 +507,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// resonance_psd_cpp
+Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0, double sigma, double fr, double tc);
+RcppExport SEXP _allanvar_resonance_psd_cpp(SEXP fSEXP, SEXP tau0SEXP, SEXP sigmaSEXP, SEXP frSEXP, SEXP tcSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type f(fSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    Rcpp::traits::input_parameter< double >::type sigma(sigmaSEXP);
+    Rcpp::traits::input_parameter< double >::type fr(frSEXP);
+    Rcpp::traits::input_parameter< double >::type tc(tcSEXP);
+    rcpp_result_gen = Rcpp::wrap(resonance_psd_cpp(f, tau0, sigma, fr, tc));
+    return rcpp_result_gen;
+END_RCPP
+}
 // decode_imu_blobs
 Rcpp::NumericMatrix decode_imu_blobs(const Rcpp::List& blobs, int encoding, const Rcpp::NumericVector& recv_ns);
 RcppExport SEXP _allanvar_decode_imu_blobs(SEXP blobsSEXP, SEXP encodingSEXP, SEXP recv_nsSEXP) {
@@ -632,6 +646,29 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< double >::type h(hSEXP);
     Rcpp::traits::input_parameter< R_xlen_t >::type nb(nbSEXP);
     rcpp_result_gen = Rcpp::wrap(warmup_gains(P0, PP, Q, phi, h, nb));
+    return rcpp_result_gen;
+END_RCPP
+}
+// spike_burg
+Rcpp::NumericVector spike_burg(const Rcpp::NumericVector& x, int pmax);
+RcppExport SEXP _allanvar_spike_burg(SEXP xSEXP, SEXP pmaxSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< int >::type pmax(pmaxSEXP);
+    rcpp_result_gen = Rcpp::wrap(spike_burg(x, pmax));
+    return rcpp_result_gen;
+END_RCPP
+}
+// ar_filter
+Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x, const Rcpp::NumericVector& f, bool backward);
+RcppExport SEXP _allanvar_ar_filter(SEXP xSEXP, SEXP fSEXP, SEXP backwardSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type f(fSEXP);
+    Rcpp::traits::input_parameter< bool >::type backward(backwardSEXP);
+    rcpp_result_gen = Rcpp::wrap(ar_filter(x, f, backward));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -787,6 +824,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_col_block_avar", (DL_FUNC) &_allanvar_col_block_avar, 3},
     {"_allanvar_stamp_steps", (DL_FUNC) &_allanvar_stamp_steps, 1},
     {"_allanvar_stamp_repeats", (DL_FUNC) &_allanvar_stamp_repeats, 1},
+    {"_allanvar_resonance_psd_cpp", (DL_FUNC) &_allanvar_resonance_psd_cpp, 5},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_index_cpp", (DL_FUNC) &_allanvar_rosbag_index_cpp, 1},
@@ -797,6 +835,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_shifted_prefix", (DL_FUNC) &_allanvar_shifted_prefix, 5},
     {"_allanvar_warmup_whiten_data", (DL_FUNC) &_allanvar_warmup_whiten_data, 4},
     {"_allanvar_warmup_gains", (DL_FUNC) &_allanvar_warmup_gains, 6},
+    {"_allanvar_spike_burg", (DL_FUNC) &_allanvar_spike_burg, 2},
+    {"_allanvar_ar_filter", (DL_FUNC) &_allanvar_ar_filter, 3},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},

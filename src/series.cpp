@@ -176,3 +176,102 @@ Rcpp::List warmup_gains(const Rcpp::NumericMatrix& P0, const Rcpp::NumericMatrix
   }
   return Rcpp::List::create(Rcpp::Named("K") = K, Rcpp::Named("sF") = sF);
 }
+
+// The spike pass's AR model (R/nonstationary.R, spike_ao_z()): Burg's
+// coefficients of order p, the operations of R's stats burg.c in their
+// order, so that they are those of ar.burg(x, aic = FALSE, order.max = p,
+// demean = FALSE)$ar; without the residuals ar.burg() builds through
+// embed() (an n x (p + 1) matrix the pass never reads). numeric(0) where
+// ar.burg() stops: a NaN variance ("zero-variance series").
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector spike_burg(const Rcpp::NumericVector& x, int pmax) {
+  const int n = x.size();
+  // ar.burg() stops here too ("'order.max' must be >= 1" or "< 'n.used'")
+  if (pmax < 1 || pmax >= n) return Rcpp::NumericVector(0);
+  std::vector<double> u(n), v(n), u0(n), coefs(size_t(pmax) * pmax, 0.0),
+      var2(pmax + 1);
+  double sum = 0.0, d, phii;
+  for (int t = 0; t < n; t++) {
+    u[t] = v[t] = x[n - 1 - t];
+    sum += x[t] * x[t];
+  }
+  var2[0] = sum / n;
+  for (int p = 1; p <= pmax; p++) {
+    sum = 0.0;
+    d = 0;
+    for (int t = p; t < n; t++) {
+      sum += v[t] * u[t - 1];
+      d += v[t] * v[t] + u[t - 1] * u[t - 1];
+    }
+    phii = 2 * sum / d;
+    coefs[pmax * (p - 1) + (p - 1)] = phii;
+    if (p > 1)
+      for (int j = 1; j < p; j++)
+        coefs[p - 1 + pmax * (j - 1)] =
+            coefs[p - 2 + pmax * (j - 1)] - phii * coefs[p - 2 + pmax * (p - j - 1)];
+    for (int t = 0; t < n; t++) u0[t] = u[t];
+    for (int t = p; t < n; t++) {
+      u[t] = u0[t - 1] - phii * v[t];
+      v[t] = v[t] - phii * u0[t - 1];
+    }
+    d = 0.0;
+    for (int t = p; t < n; t++) d += v[t] * v[t] + u[t] * u[t];
+    var2[p] = d / (2.0 * (n - p));
+  }
+  for (int p = 0; p <= pmax; p++)
+    if (std::isnan(var2[p])) return Rcpp::NumericVector(0);
+  Rcpp::NumericVector ar(pmax);
+  for (int j = 0; j < pmax; j++) ar[j] = coefs[pmax - 1 + size_t(pmax) * j];
+  return ar;
+}
+
+// The AR filter f over x as stats::filter(x, f, sides = 1) computes it
+// (R's cfilter: z = 0, then z += f[j] * x[i - j] for j = 0, 1, ...; NA for
+// the first length(f) - 1 samples and wherever a term is NaN), or with
+// `backward` as rev(filter(rev(x), f, sides = 1)): sum_j f[j] x[i + j], NA
+// for the last length(f) - 1. Without the ts and its reversed copies; in
+// blocks of outputs, each output's sum still in the order of j (one
+// running sum per output: the compiler may then run outputs side by side).
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x,
+                              const Rcpp::NumericVector& f, bool backward) {
+  const R_xlen_t n = x.size(), nf = f.size();
+  Rcpp::NumericVector out(n, NA_REAL);
+  if (nf > n) return out;
+  const double* xp = x.begin();
+  const double* fp = f.begin();
+  double* op = out.begin();
+  bool finite = true;
+  for (R_xlen_t i = 0; i < n && finite; i++) finite = !ISNAN(xp[i]);
+  // the outputs defined: i = lo .. hi - 1
+  const R_xlen_t lo = backward ? 0 : nf - 1, hi = backward ? n - nf + 1 : n;
+  if (!finite) {
+    for (R_xlen_t i = lo; i < hi; i++) {
+      double z = 0;
+      bool ok = true;
+      for (R_xlen_t j = 0; j < nf; j++) {
+        const double tmp = backward ? xp[i + j] : xp[i - j];
+        if (ISNAN(tmp)) {
+          ok = false;
+          break;
+        }
+        z += fp[j] * tmp;
+      }
+      op[i] = ok ? z : NA_REAL;
+    }
+    return out;
+  }
+  const R_xlen_t B = 512;
+  double acc[512];
+  for (R_xlen_t b0 = lo; b0 < hi; b0 += B) {
+    const R_xlen_t m = std::min(B, hi - b0);
+    for (R_xlen_t k = 0; k < m; k++) acc[k] = 0;
+    for (R_xlen_t j = 0; j < nf; j++) {
+      const double fj = fp[j];
+      const double* xs = backward ? xp + b0 + j : xp + b0 - j;
+      for (R_xlen_t k = 0; k < m; k++) acc[k] += fj * xs[k];
+    }
+    for (R_xlen_t k = 0; k < m; k++) op[b0 + k] = acc[k];
+  }
+  return out;
+}

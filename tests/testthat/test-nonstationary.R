@@ -279,3 +279,43 @@ test_that("remove_steps() gives the values of the full jump series' cumsum", {
   }
   expect_identical(remove_steps(x, st[0, ]), x)
 })
+
+test_that("the spike pass's AR model and filters are ar.burg()'s and stats::filter()'s to the bit", {
+  # independent series: AR(2) noise by stats::filter, sizes over 10 decades,
+  # output blocks cut at and off 512, missing values where filter() gives NA
+  set.seed(12)
+  for (k in 1:12) {
+    n <- c(50L, 511L, 512L, 513L, 2000L, 20000L)[(k - 1L) %% 6L + 1L]
+    x <- as.numeric(stats::filter(stats::rnorm(n), c(0.5, -0.2), method = "recursive")) *
+      10^stats::runif(1, -5, 5)
+    f <- c(1, stats::rnorm(k %% 21L) / 3)
+    if (k %% 4L == 0L) x[sample.int(n, 2L)] <- c(NA, NaN)
+    expect_identical(ar_filter(x, f, FALSE), as.numeric(stats::filter(x, f, sides = 1L)))
+    expect_identical(ar_filter(x, f, TRUE),
+                     rev(as.numeric(stats::filter(rev(x), f, sides = 1L))))
+    if (!anyNA(x)) {
+      ref <- as.numeric(stats::ar.burg(x, aic = FALSE, order.max = 20L, demean = FALSE,
+                                       var.method = 2L)$ar)
+      expect_identical(spike_burg(x, 20L), ref)
+    }
+  }
+  # where ar.burg() stops (a zero-variance series), no model
+  expect_error(stats::ar.burg(rep(0, 100), aic = FALSE, order.max = 5L, demean = FALSE,
+                              var.method = 2L))
+  expect_identical(spike_burg(rep(0, 100), 5L), numeric(0))
+})
+
+test_that("the steps and the transients read one step search where no step was found", {
+  set.seed(13)
+  x <- stats::rnorm(1e5, sd = 0.1)                # white: no step, no transient
+  calls <- new.env()
+  calls$n <- 0L
+  suppressMessages(trace("detect_steps", bquote(assign("n", .(calls)$n + 1L, envir = .(calls))),
+                         print = FALSE, where = asNamespace("allanvar")))
+  on.exit(suppressMessages(untrace("detect_steps", where = asNamespace("allanvar"))))
+  se <- detect_series_effects(x, 100, kinds = c("steps", "transients"))
+  expect_identical(calls$n, 1L)
+  expect_identical(nrow(se$table), 0L)
+  # and outside a pass nothing is kept
+  expect_null(series_pass_memo$steps)
+})

@@ -45,6 +45,34 @@ test_that("the resonance PSD integrates to its variance and peaks at f_r", {
   expect_equal(f[pos][which.max(p[pos])], 19, tolerance = 0.01)
 })
 
+test_that("the resonance PSD is the R expression's value to the bit", {
+  # the expression in R's complex arithmetic, as the C++ documents it
+  psd_r <- function(f, tau0, sigma, fr, tc) {
+    r <- exp(-tau0 / tc)
+    w <- 2 * pi * f * tau0
+    w0 <- 2 * pi * fr * tau0
+    one <- function(d) {
+      q <- r * exp(1i * d)
+      Re((1 + q) / (1 - q))
+    }
+    tau0 * sigma^2 * 0.5 * (one(w0 - w) + one(-w0 - w))
+  }
+  set.seed(32)
+  for (k in 1:20) {
+    freq <- c(100, 200, 1000, 97.65625)[(k - 1L) %% 4L + 1L]
+    n <- sample(c(1L, 7L, 1000L, 50001L), 1L)
+    f <- (seq_len(n) - 1) * freq / n
+    f <- pmin(f, freq - f)
+    if (k %% 3L == 0L) f <- stats::runif(n, -freq, freq)
+    sigma <- 10^stats::runif(1, -6, 3)
+    fr <- stats::runif(1, 0, freq / 2)
+    tc <- 10^stats::runif(1, -3, 2)
+    expect_identical(resonance_psd(f, 1 / freq, sigma, fr, tc),
+                     psd_r(f, 1 / freq, sigma, fr, tc))
+  }
+  expect_identical(resonance_psd(numeric(), 0.01, 1, 5, 0.1), numeric())
+})
+
 test_that("simulated resonance has the stated variance and autocorrelation", {
   set.seed(31)
   x <- sim_resonance(2e5, 0.01, 0.7, 19, 0.05)
