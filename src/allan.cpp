@@ -111,6 +111,32 @@ void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
     }
   };
   R_xlen_t i = i0;
+  if (Store) {
+    // four values a step: the running sums advance once per four (one chain
+    // of additions at a time bounded this pass); hi is exact in any order,
+    // lo rounds within a group as ((r0 + r1) + r2) + r3 from the group's
+    // start
+    for (; i + 4 <= i1; i += 4) {
+      double a[4], r[4];
+      for (int u = 0; u < 4; ++u) {
+        grid_split(v[i + u], c, C, a[u], r[u]);
+        hl[u] += a[u];
+        ll[u] += r[u];
+      }
+      const double a01 = a[0] + a[1], a012 = a01 + a[2], a4 = a012 + a[3];
+      const double r01 = r[0] + r[1], r012 = r01 + r[2], r4 = r012 + r[3];
+      hi[i + 1] = h + a[0];
+      hi[i + 2] = h + a01;
+      hi[i + 3] = h + a012;
+      hi[i + 4] = h + a4;
+      lo[i + 1] = l0 + (l + r[0]);
+      lo[i + 2] = l0 + (l + r01);
+      lo[i + 3] = l0 + (l + r012);
+      lo[i + 4] = l0 + (l + r4);
+      h += a4;
+      l += r4;
+    }
+  }
   for (; i + 4 <= i1; i += 4) {
     step(i, 0);
     step(i + 1, 1);
@@ -325,6 +351,51 @@ __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
          ((a0[1] + a1[1]) + (a0[3] + a1[3]));
 }
 
+// The same lanes with fused multiply-adds where the CPU has them: half the
+// floating-point operations of the loop above, which bounds it. The hi
+// parts' weights are exact either way, and 2 l is exact, so the difference
+// is the same number; the squares' sum (and 3 (l1 - l2) for D = 3) round
+// once less, a last-bit change of the sum (not the SSE2 path's bits).
+__attribute__((target("avx2,fma"))) inline v4d fma4(v4d a, v4d b, v4d c) {
+  return __builtin_ia32_vfmaddpd256(a, b, c);
+}
+
+template <int D>
+__attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
+                                                        const double* l,
+                                                        R_xlen_t m, R_xlen_t k) {
+  auto ld = ld4;
+  if (D == 2) {
+    const v4d w = {-2.0, -2.0, -2.0, -2.0};
+    return fma4(w, ld(h + m + k), ld(h + 2 * m + k) + ld(h + k)) +
+           fma4(w, ld(l + m + k), ld(l + 2 * m + k) + ld(l + k));
+  }
+  const v4d w = {3.0, 3.0, 3.0, 3.0};
+  return fma4(w, ld(h + m + k) - ld(h + 2 * m + k), ld(h + 3 * m + k) - ld(h + k)) +
+         fma4(w, ld(l + m + k) - ld(l + 2 * m + k), ld(l + 3 * m + k) - ld(l + k));
+}
+
+template <int D>
+__attribute__((target("avx2,fma"))) double sumsq8_fma(const double* h,
+                                                     const double* l, R_xlen_t m,
+                                                     R_xlen_t& k, R_xlen_t k1) {
+  v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
+  for (; k + 8 <= k1; k += 8) {
+    const v4d d0 = diff4_fma<D>(h, l, m, k);
+    const v4d d1 = diff4_fma<D>(h, l, m, k + 4);
+    a0 = fma4(d0, d0, a0);
+    a1 = fma4(d1, d1, a1);
+  }
+  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
+         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
+}
+
+inline bool have_fma() {
+  static const bool ok =
+      __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return ok;
+}
+
 inline bool have_avx2() {
   static const bool ok = __builtin_cpu_supports("avx2");
   return ok;
@@ -338,8 +409,9 @@ inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
   double tail = 0;
   R_xlen_t k = k0;
 #if defined(ALLANVAR_AVX2)
-  tail = have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
-                     : sumsq8_sse2<D>(h, l, m, k, k1);
+  tail = have_fma()    ? sumsq8_fma<D>(h, l, m, k, k1)
+         : have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
+                       : sumsq8_sse2<D>(h, l, m, k, k1);
 #elif defined(__GNUC__)
   tail = sumsq8_sse2<D>(h, l, m, k, k1);
 #endif
@@ -1305,12 +1377,27 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   // centre (mid-range) and bound of the data; NaN/Inf poison z (the octave
   // pass above has both already)
   if (!have_range) {
-    double z = 0;
-    for (R_xlen_t i = 0; i < N; ++i) {
-      range[0] = std::min(range[0], v[i]);
-      range[1] = std::max(range[1], v[i]);
-      z += v[i] * 0.0;
+    // four lanes: one chain of additions cost 4 cycles a sample, a quarter
+    // of the overlapping sums
+    double lo4[4] = {v[0], v[0], v[0], v[0]}, hi4[4] = {v[0], v[0], v[0], v[0]};
+    double z4[4] = {0, 0, 0, 0};
+    R_xlen_t i = 0;
+    for (; i + 4 <= N; i += 4) {
+      for (int u = 0; u < 4; ++u) {
+        const double a = v[i + u];
+        lo4[u] = a < lo4[u] ? a : lo4[u];
+        hi4[u] = a > hi4[u] ? a : hi4[u];
+        z4[u] += a * 0.0;
+      }
     }
+    for (; i < N; ++i) {
+      lo4[0] = std::min(lo4[0], v[i]);
+      hi4[0] = std::max(hi4[0], v[i]);
+      z4[0] += v[i] * 0.0;
+    }
+    range[0] = std::min(std::min(lo4[0], lo4[1]), std::min(lo4[2], lo4[3]));
+    range[1] = std::max(std::max(hi4[0], hi4[1]), std::max(hi4[2], hi4[3]));
+    const double z = (z4[0] + z4[1]) + (z4[2] + z4[3]);
     if (z != 0) {
       out.bad = allanvar::first_nonfinite(v, N);
       return;
