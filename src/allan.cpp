@@ -878,6 +878,101 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
   L.nv += n;
 }
 
+// level_step()'s two loops four values a vector, the same operations in
+// every lane: AVX2 where the CPU has it, else the same vectors in SSE2
+// halves (the same bits). Scalar they bounded the standard octave pass.
+#if defined(__GNUC__)
+#define ALLANVAR_LEVEL_VEC 1
+typedef double vd4 __attribute__((vector_size(32)));
+typedef long long vi4 __attribute__((vector_size(32)));
+// (no vector passed by value: the ABI of a vector argument differs
+// between SSE2 and AVX)
+typedef double vd4u __attribute__((vector_size(32), aligned(8), may_alias));
+inline const vd4u& ldv4(const double* p) {
+  return *reinterpret_cast<const vd4u*>(p);
+}
+inline void stv4(double* p, const vd4& v) { std::memcpy(p, &v, sizeof v); }
+
+// Squared first differences at [i, n) (i >= 1), eight a step in two
+// accumulators (lanes k mod 8); i is advanced past them.
+template <bool Exact>
+__attribute__((always_inline)) inline double diffsq8_body(const double* h,
+                                                          const double* l,
+                                                          R_xlen_t& i,
+                                                          R_xlen_t n) {
+  vd4 a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
+  for (; i + 8 <= n; i += 8) {
+    vd4 d0 = ldv4(h + i) - ldv4(h + i - 1);
+    vd4 d1 = ldv4(h + i + 4) - ldv4(h + i + 3);
+    if (Exact) {
+      d0 += ldv4(l + i) - ldv4(l + i - 1);
+      d1 += ldv4(l + i + 4) - ldv4(l + i + 3);
+    }
+    a0 += d0 * d0;
+    a1 += d1 * d1;
+  }
+  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
+         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
+}
+
+// Pairs 2k, 2k + 1 into k for k in [0, n2), four a step, in place (each
+// step reads its eight values before it writes four below them): TwoSum
+// of the hi parts, the lo parts added to its error, FastTwoSum back (Exact),
+// or the plain sum of h. Returns the first k not done.
+template <bool Exact>
+__attribute__((always_inline)) inline R_xlen_t pair4_body(double* h, double* l,
+                                                          R_xlen_t n2) {
+  const vi4 ev = {0, 2, 4, 6}, od = {1, 3, 5, 7};
+  R_xlen_t k = 0;
+  for (; k + 4 <= n2; k += 4) {
+    const vd4 hA = ldv4(h + 2 * k), hB = ldv4(h + 2 * k + 4);
+    const vd4 a = __builtin_shuffle(hA, hB, ev), b = __builtin_shuffle(hA, hB, od);
+    if (!Exact) {
+      stv4(h + k, a + b);
+      continue;
+    }
+    const vd4 lA = ldv4(l + 2 * k), lB = ldv4(l + 2 * k + 4);
+    const vd4 t = a + b, bb = t - a;
+    vd4 e = (a - (t - bb)) + (b - bb);
+    e += __builtin_shuffle(lA, lB, ev) + __builtin_shuffle(lA, lB, od);
+    const vd4 hs = t + e;
+    stv4(h + k, hs);
+    stv4(l + k, e - (hs - t));
+  }
+  return k;
+}
+
+#if defined(ALLANVAR_AVX2)
+template <bool Exact>
+__attribute__((target("avx2"))) double diffsq8_avx2(const double* h,
+                                                    const double* l,
+                                                    R_xlen_t& i, R_xlen_t n) {
+  return diffsq8_body<Exact>(h, l, i, n);
+}
+template <bool Exact>
+__attribute__((target("avx2"))) R_xlen_t pair4_avx2(double* h, double* l,
+                                                    R_xlen_t n2) {
+  return pair4_body<Exact>(h, l, n2);
+}
+#endif
+
+template <bool Exact>
+inline double diffsq8(const double* h, const double* l, R_xlen_t& i,
+                      R_xlen_t n) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) return diffsq8_avx2<Exact>(h, l, i, n);
+#endif
+  return diffsq8_body<Exact>(h, l, i, n);
+}
+template <bool Exact>
+inline R_xlen_t pair4(double* h, double* l, R_xlen_t n2) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) return pair4_avx2<Exact>(h, l, n2);
+#endif
+  return pair4_body<Exact>(h, l, n2);
+}
+#endif
+
 template <bool Exact>
 inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
                            bool pair) {
@@ -893,6 +988,9 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
       s = d * d;
     }
     R_xlen_t i = 1;
+#if defined(ALLANVAR_LEVEL_VEC)
+    s1 = diffsq8<Exact>(h, l, i, n);
+#endif
     for (; i + 2 <= n; i += 2) {
       const double d0 = level_diff<Exact>(h, l, i, i - 1);
       const double d1 = level_diff<Exact>(h, l, i + 1, i);
@@ -940,11 +1038,15 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
   }
   if (!pair) return 0;
   const R_xlen_t n2 = n / 2;
+  R_xlen_t k0 = 0;
+#if defined(ALLANVAR_LEVEL_VEC)
+  k0 = pair4<Exact>(h, l, n2);
+#endif
   if (!Exact) {
-    for (R_xlen_t k = 0; k < n2; ++k) h[k] = h[2 * k] + h[2 * k + 1];
+    for (R_xlen_t k = k0; k < n2; ++k) h[k] = h[2 * k] + h[2 * k + 1];
     return n2;
   }
-  for (R_xlen_t k = 0; k < n2; ++k) {
+  for (R_xlen_t k = k0; k < n2; ++k) {
     double t, e;
     two_sum(h[2 * k], h[2 * k + 1], t, e);
     e += l[2 * k] + l[2 * k + 1];
