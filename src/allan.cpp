@@ -730,6 +730,159 @@ inline double last_diff(const Level& L, int k) {
 // the last values of earlier calls carried in L; called before the values
 // are paired. The terms reaching back into earlier calls are summed one by
 // one, the others from this call's values, two per vector.
+// level_extra()'s moments and level_step()'s two loops four values a vector, the same operations in
+// every lane: AVX2 where the CPU has it, else the same vectors in SSE2
+// halves (the same bits). Scalar they bounded the standard octave pass.
+#if defined(__GNUC__)
+#define ALLANVAR_LEVEL_VEC 1
+typedef double vd4 __attribute__((vector_size(32)));
+typedef long long vi4 __attribute__((vector_size(32)));
+// (no vector passed by value: the ABI of a vector argument differs
+// between SSE2 and AVX)
+typedef double vd4u __attribute__((vector_size(32), aligned(8), may_alias));
+inline const vd4u& ldv4(const double* p) {
+  return *reinterpret_cast<const vd4u*>(p);
+}
+inline void stv4(double* p, const vd4& v) { std::memcpy(p, &v, sizeof v); }
+
+// Squared first differences at [i, n) (i >= 1), eight a step in two
+// accumulators (lanes k mod 8); i is advanced past them.
+template <bool Exact>
+__attribute__((always_inline)) inline double diffsq8_body(const double* h,
+                                                          const double* l,
+                                                          R_xlen_t& i,
+                                                          R_xlen_t n) {
+  vd4 a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
+  for (; i + 8 <= n; i += 8) {
+    vd4 d0 = ldv4(h + i) - ldv4(h + i - 1);
+    vd4 d1 = ldv4(h + i + 4) - ldv4(h + i + 3);
+    if (Exact) {
+      d0 += ldv4(l + i) - ldv4(l + i - 1);
+      d1 += ldv4(l + i + 4) - ldv4(l + i + 3);
+    }
+    a0 += d0 * d0;
+    a1 += d1 * d1;
+  }
+  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
+         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
+}
+
+// Pairs 2k, 2k + 1 into k for k in [0, n2), four a step, in place (each
+// step reads its eight values before it writes four below them): TwoSum
+// of the hi parts, the lo parts added to its error, FastTwoSum back (Exact),
+// or the plain sum of h. Returns the first k not done.
+template <bool Exact>
+__attribute__((always_inline)) inline R_xlen_t pair4_body(double* h, double* l,
+                                                          R_xlen_t n2) {
+  const vi4 ev = {0, 2, 4, 6}, od = {1, 3, 5, 7};
+  R_xlen_t k = 0;
+  for (; k + 4 <= n2; k += 4) {
+    const vd4 hA = ldv4(h + 2 * k), hB = ldv4(h + 2 * k + 4);
+    const vd4 a = __builtin_shuffle(hA, hB, ev), b = __builtin_shuffle(hA, hB, od);
+    if (!Exact) {
+      stv4(h + k, a + b);
+      continue;
+    }
+    const vd4 lA = ldv4(l + 2 * k), lB = ldv4(l + 2 * k + 4);
+    const vd4 t = a + b, bb = t - a;
+    vd4 e = (a - (t - bb)) + (b - bb);
+    e += __builtin_shuffle(lA, lB, ev) + __builtin_shuffle(lA, lB, od);
+    const vd4 hs = t + e;
+    stv4(h + k, hs);
+    stv4(l + k, e - (hs - t));
+  }
+  return k;
+}
+
+// level_extra()'s moments of the values at [i, n) (i >= 4): sums of z,
+// (t + k) z, z^2 and the squared 2nd, 3rd (and with K4 4th) differences,
+// four values a vector (lanes k mod 4); i is advanced past them.
+template <bool K4>
+__attribute__((always_inline)) inline void moments4_body(const double* h,
+                                                         R_xlen_t& i,
+                                                         R_xlen_t n, double t,
+                                                         double* out) {
+  const vd4 zero = {0, 0, 0, 0};
+  vd4 a0 = zero, pp = zero, s2 = zero, a2 = zero, a3 = zero, a4 = zero;
+  vd4 tv = {t, t + 1, t + 2, t + 3};
+  for (; i + 4 <= n; i += 4) {
+    const vd4 z0 = ldv4(h + i), z1 = ldv4(h + i - 1), z2 = ldv4(h + i - 2),
+              z3 = ldv4(h + i - 3);
+    const vd4 d2 = (z0 + z2) - 2.0 * z1;
+    const vd4 d3 = (z0 - z3) + 3.0 * (z2 - z1);
+    a0 += z0;
+    pp += tv * z0;
+    tv += 4.0;
+    s2 += z0 * z0;
+    a2 += d2 * d2;
+    a3 += d3 * d3;
+    if (K4) {
+      const vd4 d4 = ((z0 + ldv4(h + i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
+      a4 += d4 * d4;
+    }
+  }
+  const vd4* v[6] = {&s2, &a0, &pp, &a2, &a3, &a4};
+  for (int u = 0; u < 6; ++u) {
+    out[u] = ((*v[u])[0] + (*v[u])[2]) + ((*v[u])[1] + (*v[u])[3]);
+  }
+}
+
+#if defined(ALLANVAR_AVX2)
+template <bool Exact>
+__attribute__((target("avx2"))) double diffsq8_avx2(const double* h,
+                                                    const double* l,
+                                                    R_xlen_t& i, R_xlen_t n) {
+  return diffsq8_body<Exact>(h, l, i, n);
+}
+template <bool K4>
+__attribute__((target("avx2"))) void moments4_avx2(const double* h,
+                                                   R_xlen_t& i, R_xlen_t n,
+                                                   double t, double* out) {
+  moments4_body<K4>(h, i, n, t, out);
+}
+template <bool Exact>
+__attribute__((target("avx2"))) R_xlen_t pair4_avx2(double* h, double* l,
+                                                    R_xlen_t n2) {
+  return pair4_body<Exact>(h, l, n2);
+}
+#endif
+
+template <bool Exact>
+inline double diffsq8(const double* h, const double* l, R_xlen_t& i,
+                      R_xlen_t n) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) return diffsq8_avx2<Exact>(h, l, i, n);
+#endif
+  return diffsq8_body<Exact>(h, l, i, n);
+}
+// out: z^2, z, (t + k) z, squared 2nd, 3rd, 4th differences (0 without K4)
+inline void moments4(const double* h, R_xlen_t& i, R_xlen_t n, double t,
+                     bool k4, double* out) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) {
+    if (k4) {
+      moments4_avx2<true>(h, i, n, t, out);
+    } else {
+      moments4_avx2<false>(h, i, n, t, out);
+    }
+    return;
+  }
+#endif
+  if (k4) {
+    moments4_body<true>(h, i, n, t, out);
+  } else {
+    moments4_body<false>(h, i, n, t, out);
+  }
+}
+template <bool Exact>
+inline R_xlen_t pair4(double* h, double* l, R_xlen_t n2) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) return pair4_avx2<Exact>(h, l, n2);
+#endif
+  return pair4_body<Exact>(h, l, n2);
+}
+#endif
+
 template <bool Exact>
 inline void level_extra(const double* h, const double* l, R_xlen_t n,
                         Level& L) {
@@ -810,33 +963,16 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
       p3 = d3;
     }
     // the rest from this call's values alone
-#if defined(__GNUC__)
-    {
-      const v2d zero = {0, 0};
-      v2d a0 = zero, pp = zero, s2 = zero, a2 = zero, a3 = zero, a4 = zero;
-      v2d t = {t0 + static_cast<double>(i), t0 + static_cast<double>(i + 1)};
-      for (; i + 2 <= n; i += 2) {
-        const v2d z0 = ld2(h + i), z1 = ld2(h + i - 1), z2 = ld2(h + i - 2),
-                  z3 = ld2(h + i - 3);
-        const v2d d2 = (z0 + z2) - 2.0 * z1;
-        const v2d d3 = (z0 - z3) + 3.0 * (z2 - z1);
-        a0 += z0;
-        pp += t * z0;
-        t += 2.0;
-        s2 += z0 * z0;
-        a2 += d2 * d2;
-        a3 += d3 * d3;
-        if (k4) {
-          const v2d d4 = ((z0 + ld2(h + i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
-          a4 += d4 * d4;
-        }
-      }
-      q0 += s2[0] + s2[1];
-      a += a0[0] + a0[1];
-      p += pp[0] + pp[1];
-      q2 += a2[0] + a2[1];
-      q3 += a3[0] + a3[1];
-      q4 += a4[0] + a4[1];
+#if defined(ALLANVAR_LEVEL_VEC)
+    if (i >= 4) {
+      double mo[6];
+      moments4(h, i, n, t0 + static_cast<double>(i), k4, mo);
+      q0 += mo[0];
+      a += mo[1];
+      p += mo[2];
+      q2 += mo[3];
+      q3 += mo[4];
+      q4 += mo[5];
     }
 #endif
     for (; i < n; ++i) {
@@ -877,101 +1013,6 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
   }
   L.nv += n;
 }
-
-// level_step()'s two loops four values a vector, the same operations in
-// every lane: AVX2 where the CPU has it, else the same vectors in SSE2
-// halves (the same bits). Scalar they bounded the standard octave pass.
-#if defined(__GNUC__)
-#define ALLANVAR_LEVEL_VEC 1
-typedef double vd4 __attribute__((vector_size(32)));
-typedef long long vi4 __attribute__((vector_size(32)));
-// (no vector passed by value: the ABI of a vector argument differs
-// between SSE2 and AVX)
-typedef double vd4u __attribute__((vector_size(32), aligned(8), may_alias));
-inline const vd4u& ldv4(const double* p) {
-  return *reinterpret_cast<const vd4u*>(p);
-}
-inline void stv4(double* p, const vd4& v) { std::memcpy(p, &v, sizeof v); }
-
-// Squared first differences at [i, n) (i >= 1), eight a step in two
-// accumulators (lanes k mod 8); i is advanced past them.
-template <bool Exact>
-__attribute__((always_inline)) inline double diffsq8_body(const double* h,
-                                                          const double* l,
-                                                          R_xlen_t& i,
-                                                          R_xlen_t n) {
-  vd4 a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
-  for (; i + 8 <= n; i += 8) {
-    vd4 d0 = ldv4(h + i) - ldv4(h + i - 1);
-    vd4 d1 = ldv4(h + i + 4) - ldv4(h + i + 3);
-    if (Exact) {
-      d0 += ldv4(l + i) - ldv4(l + i - 1);
-      d1 += ldv4(l + i + 4) - ldv4(l + i + 3);
-    }
-    a0 += d0 * d0;
-    a1 += d1 * d1;
-  }
-  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
-         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
-}
-
-// Pairs 2k, 2k + 1 into k for k in [0, n2), four a step, in place (each
-// step reads its eight values before it writes four below them): TwoSum
-// of the hi parts, the lo parts added to its error, FastTwoSum back (Exact),
-// or the plain sum of h. Returns the first k not done.
-template <bool Exact>
-__attribute__((always_inline)) inline R_xlen_t pair4_body(double* h, double* l,
-                                                          R_xlen_t n2) {
-  const vi4 ev = {0, 2, 4, 6}, od = {1, 3, 5, 7};
-  R_xlen_t k = 0;
-  for (; k + 4 <= n2; k += 4) {
-    const vd4 hA = ldv4(h + 2 * k), hB = ldv4(h + 2 * k + 4);
-    const vd4 a = __builtin_shuffle(hA, hB, ev), b = __builtin_shuffle(hA, hB, od);
-    if (!Exact) {
-      stv4(h + k, a + b);
-      continue;
-    }
-    const vd4 lA = ldv4(l + 2 * k), lB = ldv4(l + 2 * k + 4);
-    const vd4 t = a + b, bb = t - a;
-    vd4 e = (a - (t - bb)) + (b - bb);
-    e += __builtin_shuffle(lA, lB, ev) + __builtin_shuffle(lA, lB, od);
-    const vd4 hs = t + e;
-    stv4(h + k, hs);
-    stv4(l + k, e - (hs - t));
-  }
-  return k;
-}
-
-#if defined(ALLANVAR_AVX2)
-template <bool Exact>
-__attribute__((target("avx2"))) double diffsq8_avx2(const double* h,
-                                                    const double* l,
-                                                    R_xlen_t& i, R_xlen_t n) {
-  return diffsq8_body<Exact>(h, l, i, n);
-}
-template <bool Exact>
-__attribute__((target("avx2"))) R_xlen_t pair4_avx2(double* h, double* l,
-                                                    R_xlen_t n2) {
-  return pair4_body<Exact>(h, l, n2);
-}
-#endif
-
-template <bool Exact>
-inline double diffsq8(const double* h, const double* l, R_xlen_t& i,
-                      R_xlen_t n) {
-#if defined(ALLANVAR_AVX2)
-  if (have_avx2()) return diffsq8_avx2<Exact>(h, l, i, n);
-#endif
-  return diffsq8_body<Exact>(h, l, i, n);
-}
-template <bool Exact>
-inline R_xlen_t pair4(double* h, double* l, R_xlen_t n2) {
-#if defined(ALLANVAR_AVX2)
-  if (have_avx2()) return pair4_avx2<Exact>(h, l, n2);
-#endif
-  return pair4_body<Exact>(h, l, n2);
-}
-#endif
 
 template <bool Exact>
 inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
