@@ -1347,6 +1347,8 @@ struct Channel {
   std::vector<double> alpha;
   std::vector<int> alpha_int, id_method;
   R_xlen_t bad = 0;  // 1-based position of the first NA/NaN/Inf, or 0
+  // min and max of the samples where the sums' kernel read them, else NaN
+  double range[2] = {std::nan(""), std::nan("")};
 };
 
 inline void store_id(const allanvar::NoiseId& id, Channel& out, size_t j) {
@@ -1547,6 +1549,8 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
     }
   }
   const double vmin = range[0], vmax = range[1];
+  out.range[0] = vmin;
+  out.range[1] = vmax;
   const double c = 0.5 * vmin + 0.5 * vmax;
   const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
 
@@ -1647,12 +1651,18 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
     }
   }
   Rcpp::NumericVector bad(nc);
-  for (R_xlen_t i = 0; i < nc; ++i) bad[i] = static_cast<double>(ch[i].bad);
+  Rcpp::NumericMatrix range(2, nc);
+  for (R_xlen_t i = 0; i < nc; ++i) {
+    bad[i] = static_cast<double>(ch[i].bad);
+    range(0, i) = ch[i].range[0];
+    range(1, i) = ch[i].range[1];
+  }
   return Rcpp::List::create(Rcpp::Named("sums") = sums,
                             Rcpp::Named("alpha") = alpha,
                             Rcpp::Named("alpha_int") = alpha_int,
                             Rcpp::Named("id_method") = id_method,
-                            Rcpp::Named("bad") = bad);
+                            Rcpp::Named("bad") = bad,
+                            Rcpp::Named("range") = range);
 }
 
 // ---- test reference: direct evaluation in quadruple precision ----
