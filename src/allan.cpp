@@ -351,8 +351,8 @@ __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
          ((a0[1] + a1[1]) + (a0[3] + a1[3]));
 }
 
-// The same lanes with fused multiply-adds where the CPU has them: half the
-// floating-point operations of the loop above, which bounds it. The hi
+// The same lanes with fused multiply-adds where the CPU has them: six
+// floating-point operations a term instead of nine. The hi
 // parts' weights are exact either way, and 2 l is exact, so the difference
 // is the same number; the squares' sum (and 3 (l1 - l2) for D = 3) round
 // once less, a last-bit change of the sum (not the SSE2 path's bits).
@@ -363,7 +363,8 @@ __attribute__((target("avx2,fma"))) inline v4d fma4(v4d a, v4d b, v4d c) {
 template <int D>
 __attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
                                                         const double* l,
-                                                        R_xlen_t m, R_xlen_t k) {
+                                                        R_xlen_t m,
+                                                        R_xlen_t k) {
   auto ld = ld4;
   if (D == 2) {
     const v4d w = {-2.0, -2.0, -2.0, -2.0};
@@ -371,14 +372,17 @@ __attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
            fma4(w, ld(l + m + k), ld(l + 2 * m + k) + ld(l + k));
   }
   const v4d w = {3.0, 3.0, 3.0, 3.0};
-  return fma4(w, ld(h + m + k) - ld(h + 2 * m + k), ld(h + 3 * m + k) - ld(h + k)) +
-         fma4(w, ld(l + m + k) - ld(l + 2 * m + k), ld(l + 3 * m + k) - ld(l + k));
+  return fma4(w, ld(h + m + k) - ld(h + 2 * m + k),
+              ld(h + 3 * m + k) - ld(h + k)) +
+         fma4(w, ld(l + m + k) - ld(l + 2 * m + k),
+              ld(l + 3 * m + k) - ld(l + k));
 }
 
 template <int D>
 __attribute__((target("avx2,fma"))) double sumsq8_fma(const double* h,
-                                                     const double* l, R_xlen_t m,
-                                                     R_xlen_t& k, R_xlen_t k1) {
+                                                     const double* l,
+                                                     R_xlen_t m, R_xlen_t& k,
+                                                     R_xlen_t k1) {
   v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
   for (; k + 8 <= k1; k += 8) {
     const v4d d0 = diff4_fma<D>(h, l, m, k);
@@ -726,13 +730,10 @@ inline double last_diff(const Level& L, int k) {
   return t[0];
 }
 
-// The Hadamard sum and the moments of the values [0, n) of a level, with
-// the last values of earlier calls carried in L; called before the values
-// are paired. The terms reaching back into earlier calls are summed one by
-// one, the others from this call's values, two per vector.
-// level_extra()'s moments and level_step()'s two loops four values a vector, the same operations in
-// every lane: AVX2 where the CPU has it, else the same vectors in SSE2
-// halves (the same bits). Scalar they bounded the standard octave pass.
+// level_extra()'s moments and level_step()'s two loops four values a
+// vector, the same operations in every lane: AVX2 where the CPU has it,
+// else the same vectors in SSE2 halves (the same bits). Scalar (or two a
+// vector) they bounded the standard octave pass.
 #if defined(__GNUC__)
 #define ALLANVAR_LEVEL_VEC 1
 typedef double vd4 __attribute__((vector_size(32)));
@@ -778,7 +779,8 @@ __attribute__((always_inline)) inline R_xlen_t pair4_body(double* h, double* l,
   R_xlen_t k = 0;
   for (; k + 4 <= n2; k += 4) {
     const vd4 hA = ldv4(h + 2 * k), hB = ldv4(h + 2 * k + 4);
-    const vd4 a = __builtin_shuffle(hA, hB, ev), b = __builtin_shuffle(hA, hB, od);
+    const vd4 a = __builtin_shuffle(hA, hB, ev);
+    const vd4 b = __builtin_shuffle(hA, hB, od);
     if (!Exact) {
       stv4(h + k, a + b);
       continue;
@@ -883,6 +885,10 @@ inline R_xlen_t pair4(double* h, double* l, R_xlen_t n2) {
 }
 #endif
 
+// The Hadamard sum and the moments of the values [0, n) of a level, with
+// the last values of earlier calls carried in L; called before the values
+// are paired. The terms reaching back into earlier calls are summed one by
+// one, the others from this call's values in vectors.
 template <bool Exact>
 inline void level_extra(const double* h, const double* l, R_xlen_t n,
                         Level& L) {
