@@ -111,32 +111,6 @@ void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
     }
   };
   R_xlen_t i = i0;
-  if (Store) {
-    // four values a step: the running sums advance once per four (one chain
-    // of additions at a time bounded this pass); hi is exact in any order,
-    // lo rounds within a group as ((r0 + r1) + r2) + r3 from the group's
-    // start
-    for (; i + 4 <= i1; i += 4) {
-      double a[4], r[4];
-      for (int u = 0; u < 4; ++u) {
-        grid_split(v[i + u], c, C, a[u], r[u]);
-        hl[u] += a[u];
-        ll[u] += r[u];
-      }
-      const double a01 = a[0] + a[1], a012 = a01 + a[2], a4 = a012 + a[3];
-      const double r01 = r[0] + r[1], r012 = r01 + r[2], r4 = r012 + r[3];
-      hi[i + 1] = h + a[0];
-      hi[i + 2] = h + a01;
-      hi[i + 3] = h + a012;
-      hi[i + 4] = h + a4;
-      lo[i + 1] = l0 + (l + r[0]);
-      lo[i + 2] = l0 + (l + r01);
-      lo[i + 3] = l0 + (l + r012);
-      lo[i + 4] = l0 + (l + r4);
-      h += a4;
-      l += r4;
-    }
-  }
   for (; i + 4 <= i1; i += 4) {
     step(i, 0);
     step(i + 1, 1);
