@@ -327,7 +327,8 @@ allan <- function(x, freq, taus = "octave", type = "overlapping",
       xj <- ch$values
       if (ch$nc > 1L) xj <- xj[(j - 1) * N + seq_len(N)]
       ex_alpha <- exact_id_alpha(as.double(xj), freq, m, e$exact_id,
-                                 if (rate) "rate" else "integrated", L)
+                                 if (rate) "rate" else "integrated", L,
+                                 max(-res$range[1L, j], res$range[2L, j]))
     }
     lim <- stat_limits(e, av, m, nterms, L, res$alpha_int[, j], sub, conf,
                        ci, unbiased, ex_alpha)

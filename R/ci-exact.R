@@ -191,17 +191,18 @@ exact_alpha <- function(m, L, alpha, min_avg = exact_read_min) {
 # total type's cost at 1e7. Where that row reads nothing, or the curve is
 # long enough that extra_alpha() identifies through allan(), every row is
 # read, as before.
-exact_id_alpha <- function(v, freq, m, base, input, L) {
+# `mx`: max(abs(v)) where the caller has it (NA: read here).
+exact_id_alpha <- function(v, freq, m, base, input, L, mx = NA) {
   few <- (L - 1) / m < exact_read_sure | exact_rows(m, L)
   keep <- few
   if (any(!few)) keep[which(!few)[which.max(m[!few])]] <- TRUE
   if (all(keep) || length(unique(m)) > 200L) {
-    return(extra_alpha(v, freq, m, base, input, L))
+    return(extra_alpha(v, freq, m, base, input, L, mx))
   }
   out <- rep(NA_integer_, length(m))
-  out[keep] <- extra_alpha(v, freq, m[keep], base, input, L)
+  out[keep] <- extra_alpha(v, freq, m[keep], base, input, L, mx)
   if (any(!few) && anyNA(out[keep & !few])) {
-    return(extra_alpha(v, freq, m, base, input, L))
+    return(extra_alpha(v, freq, m, base, input, L, mx))
   }
   out
 }

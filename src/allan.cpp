@@ -325,6 +325,55 @@ __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
          ((a0[1] + a1[1]) + (a0[3] + a1[3]));
 }
 
+// The same lanes with fused multiply-adds where the CPU has them: six
+// floating-point operations a term instead of nine. The hi
+// parts' weights are exact either way, and 2 l is exact, so the difference
+// is the same number; the squares' sum (and 3 (l1 - l2) for D = 3) round
+// once less, a last-bit change of the sum (not the SSE2 path's bits).
+__attribute__((target("avx2,fma"))) inline v4d fma4(v4d a, v4d b, v4d c) {
+  return __builtin_ia32_vfmaddpd256(a, b, c);
+}
+
+template <int D>
+__attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
+                                                        const double* l,
+                                                        R_xlen_t m,
+                                                        R_xlen_t k) {
+  auto ld = ld4;
+  if (D == 2) {
+    const v4d w = {-2.0, -2.0, -2.0, -2.0};
+    return fma4(w, ld(h + m + k), ld(h + 2 * m + k) + ld(h + k)) +
+           fma4(w, ld(l + m + k), ld(l + 2 * m + k) + ld(l + k));
+  }
+  const v4d w = {3.0, 3.0, 3.0, 3.0};
+  return fma4(w, ld(h + m + k) - ld(h + 2 * m + k),
+              ld(h + 3 * m + k) - ld(h + k)) +
+         fma4(w, ld(l + m + k) - ld(l + 2 * m + k),
+              ld(l + 3 * m + k) - ld(l + k));
+}
+
+template <int D>
+__attribute__((target("avx2,fma"))) double sumsq8_fma(const double* h,
+                                                     const double* l,
+                                                     R_xlen_t m, R_xlen_t& k,
+                                                     R_xlen_t k1) {
+  v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
+  for (; k + 8 <= k1; k += 8) {
+    const v4d d0 = diff4_fma<D>(h, l, m, k);
+    const v4d d1 = diff4_fma<D>(h, l, m, k + 4);
+    a0 = fma4(d0, d0, a0);
+    a1 = fma4(d1, d1, a1);
+  }
+  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
+         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
+}
+
+inline bool have_fma() {
+  static const bool ok =
+      __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return ok;
+}
+
 inline bool have_avx2() {
   static const bool ok = __builtin_cpu_supports("avx2");
   return ok;
@@ -338,8 +387,9 @@ inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
   double tail = 0;
   R_xlen_t k = k0;
 #if defined(ALLANVAR_AVX2)
-  tail = have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
-                     : sumsq8_sse2<D>(h, l, m, k, k1);
+  tail = have_fma()    ? sumsq8_fma<D>(h, l, m, k, k1)
+         : have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
+                       : sumsq8_sse2<D>(h, l, m, k, k1);
 #elif defined(__GNUC__)
   tail = sumsq8_sse2<D>(h, l, m, k, k1);
 #endif
@@ -654,10 +704,165 @@ inline double last_diff(const Level& L, int k) {
   return t[0];
 }
 
+// level_extra()'s moments and level_step()'s two loops four values a
+// vector, the same operations in every lane: AVX2 where the CPU has it,
+// else the same vectors in SSE2 halves (the same bits). Scalar (or two a
+// vector) they bounded the standard octave pass.
+#if defined(__GNUC__)
+#define ALLANVAR_LEVEL_VEC 1
+typedef double vd4 __attribute__((vector_size(32)));
+typedef long long vi4 __attribute__((vector_size(32)));
+// (no vector passed by value: the ABI of a vector argument differs
+// between SSE2 and AVX)
+typedef double vd4u __attribute__((vector_size(32), aligned(8), may_alias));
+inline const vd4u& ldv4(const double* p) {
+  return *reinterpret_cast<const vd4u*>(p);
+}
+inline void stv4(double* p, const vd4& v) { std::memcpy(p, &v, sizeof v); }
+
+// Squared first differences at [i, n) (i >= 1), eight a step in two
+// accumulators (lanes k mod 8); i is advanced past them.
+template <bool Exact>
+__attribute__((always_inline)) inline double diffsq8_body(const double* h,
+                                                          const double* l,
+                                                          R_xlen_t& i,
+                                                          R_xlen_t n) {
+  vd4 a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
+  for (; i + 8 <= n; i += 8) {
+    vd4 d0 = ldv4(h + i) - ldv4(h + i - 1);
+    vd4 d1 = ldv4(h + i + 4) - ldv4(h + i + 3);
+    if (Exact) {
+      d0 += ldv4(l + i) - ldv4(l + i - 1);
+      d1 += ldv4(l + i + 4) - ldv4(l + i + 3);
+    }
+    a0 += d0 * d0;
+    a1 += d1 * d1;
+  }
+  return ((a0[0] + a1[0]) + (a0[2] + a1[2])) +
+         ((a0[1] + a1[1]) + (a0[3] + a1[3]));
+}
+
+// Pairs 2k, 2k + 1 into k for k in [0, n2), four a step, in place (each
+// step reads its eight values before it writes four below them): TwoSum
+// of the hi parts, the lo parts added to its error, FastTwoSum back (Exact),
+// or the plain sum of h. Returns the first k not done.
+template <bool Exact>
+__attribute__((always_inline)) inline R_xlen_t pair4_body(double* h, double* l,
+                                                          R_xlen_t n2) {
+  const vi4 ev = {0, 2, 4, 6}, od = {1, 3, 5, 7};
+  R_xlen_t k = 0;
+  for (; k + 4 <= n2; k += 4) {
+    const vd4 hA = ldv4(h + 2 * k), hB = ldv4(h + 2 * k + 4);
+    const vd4 a = __builtin_shuffle(hA, hB, ev);
+    const vd4 b = __builtin_shuffle(hA, hB, od);
+    if (!Exact) {
+      stv4(h + k, a + b);
+      continue;
+    }
+    const vd4 lA = ldv4(l + 2 * k), lB = ldv4(l + 2 * k + 4);
+    const vd4 t = a + b, bb = t - a;
+    vd4 e = (a - (t - bb)) + (b - bb);
+    e += __builtin_shuffle(lA, lB, ev) + __builtin_shuffle(lA, lB, od);
+    const vd4 hs = t + e;
+    stv4(h + k, hs);
+    stv4(l + k, e - (hs - t));
+  }
+  return k;
+}
+
+// level_extra()'s moments of the values at [i, n) (i >= 4): sums of z,
+// (t + k) z, z^2 and the squared 2nd, 3rd (and with K4 4th) differences,
+// four values a vector (lanes k mod 4); i is advanced past them.
+template <bool K4>
+__attribute__((always_inline)) inline void moments4_body(const double* h,
+                                                         R_xlen_t& i,
+                                                         R_xlen_t n, double t,
+                                                         double* out) {
+  const vd4 zero = {0, 0, 0, 0};
+  vd4 a0 = zero, pp = zero, s2 = zero, a2 = zero, a3 = zero, a4 = zero;
+  vd4 tv = {t, t + 1, t + 2, t + 3};
+  for (; i + 4 <= n; i += 4) {
+    const vd4 z0 = ldv4(h + i), z1 = ldv4(h + i - 1), z2 = ldv4(h + i - 2),
+              z3 = ldv4(h + i - 3);
+    const vd4 d2 = (z0 + z2) - 2.0 * z1;
+    const vd4 d3 = (z0 - z3) + 3.0 * (z2 - z1);
+    a0 += z0;
+    pp += tv * z0;
+    tv += 4.0;
+    s2 += z0 * z0;
+    a2 += d2 * d2;
+    a3 += d3 * d3;
+    if (K4) {
+      const vd4 d4 = ((z0 + ldv4(h + i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
+      a4 += d4 * d4;
+    }
+  }
+  const vd4* v[6] = {&s2, &a0, &pp, &a2, &a3, &a4};
+  for (int u = 0; u < 6; ++u) {
+    out[u] = ((*v[u])[0] + (*v[u])[2]) + ((*v[u])[1] + (*v[u])[3]);
+  }
+}
+
+#if defined(ALLANVAR_AVX2)
+template <bool Exact>
+__attribute__((target("avx2"))) double diffsq8_avx2(const double* h,
+                                                    const double* l,
+                                                    R_xlen_t& i, R_xlen_t n) {
+  return diffsq8_body<Exact>(h, l, i, n);
+}
+template <bool K4>
+__attribute__((target("avx2"))) void moments4_avx2(const double* h,
+                                                   R_xlen_t& i, R_xlen_t n,
+                                                   double t, double* out) {
+  moments4_body<K4>(h, i, n, t, out);
+}
+template <bool Exact>
+__attribute__((target("avx2"))) R_xlen_t pair4_avx2(double* h, double* l,
+                                                    R_xlen_t n2) {
+  return pair4_body<Exact>(h, l, n2);
+}
+#endif
+
+template <bool Exact>
+inline double diffsq8(const double* h, const double* l, R_xlen_t& i,
+                      R_xlen_t n) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) return diffsq8_avx2<Exact>(h, l, i, n);
+#endif
+  return diffsq8_body<Exact>(h, l, i, n);
+}
+// out: z^2, z, (t + k) z, squared 2nd, 3rd, 4th differences (0 without K4)
+inline void moments4(const double* h, R_xlen_t& i, R_xlen_t n, double t,
+                     bool k4, double* out) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) {
+    if (k4) {
+      moments4_avx2<true>(h, i, n, t, out);
+    } else {
+      moments4_avx2<false>(h, i, n, t, out);
+    }
+    return;
+  }
+#endif
+  if (k4) {
+    moments4_body<true>(h, i, n, t, out);
+  } else {
+    moments4_body<false>(h, i, n, t, out);
+  }
+}
+template <bool Exact>
+inline R_xlen_t pair4(double* h, double* l, R_xlen_t n2) {
+#if defined(ALLANVAR_AVX2)
+  if (have_avx2()) return pair4_avx2<Exact>(h, l, n2);
+#endif
+  return pair4_body<Exact>(h, l, n2);
+}
+#endif
+
 // The Hadamard sum and the moments of the values [0, n) of a level, with
 // the last values of earlier calls carried in L; called before the values
 // are paired. The terms reaching back into earlier calls are summed one by
-// one, the others from this call's values, two per vector.
+// one, the others from this call's values in vectors.
 template <bool Exact>
 inline void level_extra(const double* h, const double* l, R_xlen_t n,
                         Level& L) {
@@ -738,33 +943,16 @@ inline void level_extra(const double* h, const double* l, R_xlen_t n,
       p3 = d3;
     }
     // the rest from this call's values alone
-#if defined(__GNUC__)
-    {
-      const v2d zero = {0, 0};
-      v2d a0 = zero, pp = zero, s2 = zero, a2 = zero, a3 = zero, a4 = zero;
-      v2d t = {t0 + static_cast<double>(i), t0 + static_cast<double>(i + 1)};
-      for (; i + 2 <= n; i += 2) {
-        const v2d z0 = ld2(h + i), z1 = ld2(h + i - 1), z2 = ld2(h + i - 2),
-                  z3 = ld2(h + i - 3);
-        const v2d d2 = (z0 + z2) - 2.0 * z1;
-        const v2d d3 = (z0 - z3) + 3.0 * (z2 - z1);
-        a0 += z0;
-        pp += t * z0;
-        t += 2.0;
-        s2 += z0 * z0;
-        a2 += d2 * d2;
-        a3 += d3 * d3;
-        if (k4) {
-          const v2d d4 = ((z0 + ld2(h + i - 4)) + 6.0 * z2) - 4.0 * (z1 + z3);
-          a4 += d4 * d4;
-        }
-      }
-      q0 += s2[0] + s2[1];
-      a += a0[0] + a0[1];
-      p += pp[0] + pp[1];
-      q2 += a2[0] + a2[1];
-      q3 += a3[0] + a3[1];
-      q4 += a4[0] + a4[1];
+#if defined(ALLANVAR_LEVEL_VEC)
+    if (i >= 4) {
+      double mo[6];
+      moments4(h, i, n, t0 + static_cast<double>(i), k4, mo);
+      q0 += mo[0];
+      a += mo[1];
+      p += mo[2];
+      q2 += mo[3];
+      q3 += mo[4];
+      q4 += mo[5];
     }
 #endif
     for (; i < n; ++i) {
@@ -821,6 +1009,9 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
       s = d * d;
     }
     R_xlen_t i = 1;
+#if defined(ALLANVAR_LEVEL_VEC)
+    s1 = diffsq8<Exact>(h, l, i, n);
+#endif
     for (; i + 2 <= n; i += 2) {
       const double d0 = level_diff<Exact>(h, l, i, i - 1);
       const double d1 = level_diff<Exact>(h, l, i + 1, i);
@@ -868,11 +1059,15 @@ inline R_xlen_t level_step(double* h, double* l, R_xlen_t n, Level& L,
   }
   if (!pair) return 0;
   const R_xlen_t n2 = n / 2;
+  R_xlen_t k0 = 0;
+#if defined(ALLANVAR_LEVEL_VEC)
+  k0 = pair4<Exact>(h, l, n2);
+#endif
   if (!Exact) {
-    for (R_xlen_t k = 0; k < n2; ++k) h[k] = h[2 * k] + h[2 * k + 1];
+    for (R_xlen_t k = k0; k < n2; ++k) h[k] = h[2 * k] + h[2 * k + 1];
     return n2;
   }
-  for (R_xlen_t k = 0; k < n2; ++k) {
+  for (R_xlen_t k = k0; k < n2; ++k) {
     double t, e;
     two_sum(h[2 * k], h[2 * k + 1], t, e);
     e += l[2 * k] + l[2 * k + 1];
@@ -1132,6 +1327,8 @@ struct Channel {
   std::vector<double> alpha;
   std::vector<int> alpha_int, id_method;
   R_xlen_t bad = 0;  // 1-based position of the first NA/NaN/Inf, or 0
+  // min and max of the samples where the sums' kernel read them, else NaN
+  double range[2] = {std::nan(""), std::nan("")};
 };
 
 inline void store_id(const allanvar::NoiseId& id, Channel& out, size_t j) {
@@ -1305,18 +1502,35 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   // centre (mid-range) and bound of the data; NaN/Inf poison z (the octave
   // pass above has both already)
   if (!have_range) {
-    double z = 0;
-    for (R_xlen_t i = 0; i < N; ++i) {
-      range[0] = std::min(range[0], v[i]);
-      range[1] = std::max(range[1], v[i]);
-      z += v[i] * 0.0;
+    // four lanes: one chain of additions cost 4 cycles a sample, a quarter
+    // of the overlapping sums
+    double lo4[4] = {v[0], v[0], v[0], v[0]}, hi4[4] = {v[0], v[0], v[0], v[0]};
+    double z4[4] = {0, 0, 0, 0};
+    R_xlen_t i = 0;
+    for (; i + 4 <= N; i += 4) {
+      for (int u = 0; u < 4; ++u) {
+        const double a = v[i + u];
+        lo4[u] = a < lo4[u] ? a : lo4[u];
+        hi4[u] = a > hi4[u] ? a : hi4[u];
+        z4[u] += a * 0.0;
+      }
     }
+    for (; i < N; ++i) {
+      lo4[0] = std::min(lo4[0], v[i]);
+      hi4[0] = std::max(hi4[0], v[i]);
+      z4[0] += v[i] * 0.0;
+    }
+    range[0] = std::min(std::min(lo4[0], lo4[1]), std::min(lo4[2], lo4[3]));
+    range[1] = std::max(std::max(hi4[0], hi4[1]), std::max(hi4[2], hi4[3]));
+    const double z = (z4[0] + z4[1]) + (z4[2] + z4[3]);
     if (z != 0) {
       out.bad = allanvar::first_nonfinite(v, N);
       return;
     }
   }
   const double vmin = range[0], vmax = range[1];
+  out.range[0] = vmin;
+  out.range[1] = vmax;
   const double c = 0.5 * vmin + 0.5 * vmax;
   const double bound = std::max(std::fabs(vmax - c), std::fabs(vmin - c));
 
@@ -1417,12 +1631,18 @@ Rcpp::List allan_sums_cpp(const Rcpp::NumericVector& x, double nrow,
     }
   }
   Rcpp::NumericVector bad(nc);
-  for (R_xlen_t i = 0; i < nc; ++i) bad[i] = static_cast<double>(ch[i].bad);
+  Rcpp::NumericMatrix range(2, nc);
+  for (R_xlen_t i = 0; i < nc; ++i) {
+    bad[i] = static_cast<double>(ch[i].bad);
+    range(0, i) = ch[i].range[0];
+    range(1, i) = ch[i].range[1];
+  }
   return Rcpp::List::create(Rcpp::Named("sums") = sums,
                             Rcpp::Named("alpha") = alpha,
                             Rcpp::Named("alpha_int") = alpha_int,
                             Rcpp::Named("id_method") = id_method,
-                            Rcpp::Named("bad") = bad);
+                            Rcpp::Named("bad") = bad,
+                            Rcpp::Named("range") = range);
 }
 
 // ---- test reference: direct evaluation in quadruple precision ----
