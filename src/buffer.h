@@ -2,10 +2,10 @@
 // (src/allan.cpp, src/dynamic.cpp). On Linux it is 2 MiB aligned and marked
 // for transparent huge pages: a fresh 100 MB prefix array otherwise costs
 // tens of thousands of page faults, more than the sums themselves. Large
-// buffers are kept when freed and handed to the next one that fits (a few,
-// 640 MB in all): the system zeroes every fresh page, which took 50 ms of
-// 250 per overlapping AV of 1e7 samples; the price is memory held between
-// calls.
+// buffers are kept when freed and handed to the next one that fits (two,
+// 320 MiB in all: one call's prefix arrays at 1e7): the system zeroes
+// every fresh page, which took 50 ms of 250 per overlapping AV of 1e7
+// samples; the price is memory held between calls.
 #ifndef ALLANVAR_BUFFER_H
 #define ALLANVAR_BUFFER_H
 
@@ -22,8 +22,8 @@
 namespace allanvar {
 
 // Freed buffers of at least 2 MiB and at most 256 MiB, for requests they
-// fit at most twice over (best fit); the oldest dropped beyond four or
-// 640 MiB; any thread.
+// fit at most twice over (best fit); the oldest dropped beyond two or
+// 320 MiB; any thread.
 class BufferPool {
  public:
   ~BufferPool() {
@@ -55,7 +55,7 @@ class BufferPool {
     std::lock_guard<std::mutex> lock(mu_);
     blocks_.emplace_back(p, bytes);
     held_ += bytes;
-    while (blocks_.size() > 4 || held_ > kHeld) {
+    while (blocks_.size() > 2 || held_ > kHeld) {
       std::free(blocks_.front().first);
       held_ -= blocks_.front().second;
       blocks_.erase(blocks_.begin());
@@ -65,7 +65,7 @@ class BufferPool {
  private:
   static const size_t kMin = static_cast<size_t>(1) << 21;
   static const size_t kMax = static_cast<size_t>(1) << 28;
-  static const size_t kHeld = static_cast<size_t>(640) << 20;
+  static const size_t kHeld = static_cast<size_t>(320) << 20;
   std::mutex mu_;
   std::vector<std::pair<void*, size_t>> blocks_;
   size_t held_ = 0;
