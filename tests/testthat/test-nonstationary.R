@@ -301,7 +301,8 @@ test_that("the spike pass's AR model and filters are ar.burg()'s and stats::filt
   }
   # where ar.burg() stops (a zero-variance series), no model
   expect_error(stats::ar.burg(rep(0, 100), aic = FALSE, order.max = 5L, demean = FALSE,
-                              var.method = 2L))
+                              var.method = 2L),
+               "zero-variance", class = "simpleError")
   expect_identical(spike_burg(rep(0, 100), 5L), numeric(0))
 })
 
