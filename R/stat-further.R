@@ -204,8 +204,7 @@ kernel_theo <- function(own_type) {
     av <- rep(NA_real_, length(m))
     alpha <- rep(NA_integer_, length(m))
     edf <- rep(NA_real_, length(m))
-    limits <- NULL
-    lower <- upper <- rep(NA_real_, length(m))
+    lower <- upper <- rep(NA_real_, length(m))  # with ctx$ci: the limits
     # TheoH's Allan rows first: their noise types serve the TheoBR rows'
     # exact limits below, and their limits are the overlapping type's (at
     # few averages its exact law over the plausible types: a chi-square
@@ -221,7 +220,6 @@ kernel_theo <- function(own_type) {
       if (ctx$ci) {
         lower[!theo_row] <- a$lower
         upper[!theo_row] <- a$upper
-        limits <- list(rows = !theo_row, lower = a$lower, upper = a$upper)
       }
     }
     mt <- m[theo_row]
@@ -242,7 +240,8 @@ kernel_theo <- function(own_type) {
         if (ctx$ci) {
           u <- theo1_union(t1, mt, L, attr(ta, "alts"), ctx$n[theo_row],
                            ctx$conf, ctx$debias)
-          limits <- list(rows = theo_row, lower = u$lower, upper = u$upper)
+          lower[theo_row] <- u$lower
+          upper[theo_row] <- u$upper
         }
         if (ctx$debias) {
           t1 <- t1 * debias_factor(ctx$entry$name, alpha[theo_row], mt)
@@ -287,8 +286,6 @@ kernel_theo <- function(own_type) {
             u$upper[ex$rows] <- ex$upper
             lower[theo_row] <- u$lower
             upper[theo_row] <- u$upper
-            limits <- list(rows = rep(TRUE, length(m)), lower = lower,
-                           upper = upper)
           }
         }
       }
@@ -300,6 +297,9 @@ kernel_theo <- function(own_type) {
         extra_edf(ctx$entry$name, mt, L, alpha[theo_row], ctx$n[theo_row],
                   kappa = attr(kf, "kappa"))
       }
+    }
+    limits <- if (ctx$ci) {
+      list(rows = rep(TRUE, length(m)), lower = lower, upper = upper)
     }
     list(av = av, alpha = alpha, edf = edf, limits = limits)
   }
