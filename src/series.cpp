@@ -185,21 +185,21 @@ Rcpp::List warmup_gains(const Rcpp::NumericMatrix& P0, const Rcpp::NumericMatrix
 // ar.burg() stops: a NaN variance ("zero-variance series").
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector spike_burg(const Rcpp::NumericVector& x, int pmax) {
-  const int n = x.size();
+  const R_xlen_t n = x.size();
   // ar.burg() stops here too ("'order.max' must be >= 1" or "< 'n.used'")
   if (pmax < 1 || pmax >= n) return Rcpp::NumericVector(0);
   std::vector<double> u(n), v(n), u0(n), coefs(size_t(pmax) * pmax, 0.0),
       var2(pmax + 1);
   double sum = 0.0, d, phii;
-  for (int t = 0; t < n; t++) {
+  for (R_xlen_t t = 0; t < n; t++) {
     u[t] = v[t] = x[n - 1 - t];
     sum += x[t] * x[t];
   }
-  var2[0] = sum / n;
+  var2[0] = sum / static_cast<double>(n);
   for (int p = 1; p <= pmax; p++) {
     sum = 0.0;
     d = 0;
-    for (int t = p; t < n; t++) {
+    for (R_xlen_t t = p; t < n; t++) {
       sum += v[t] * u[t - 1];
       d += v[t] * v[t] + u[t - 1] * u[t - 1];
     }
@@ -209,14 +209,14 @@ Rcpp::NumericVector spike_burg(const Rcpp::NumericVector& x, int pmax) {
       for (int j = 1; j < p; j++)
         coefs[p - 1 + pmax * (j - 1)] =
             coefs[p - 2 + pmax * (j - 1)] - phii * coefs[p - 2 + pmax * (p - j - 1)];
-    for (int t = 0; t < n; t++) u0[t] = u[t];
-    for (int t = p; t < n; t++) {
+    for (R_xlen_t t = 0; t < n; t++) u0[t] = u[t];
+    for (R_xlen_t t = p; t < n; t++) {
       u[t] = u0[t - 1] - phii * v[t];
       v[t] = v[t] - phii * u0[t - 1];
     }
     d = 0.0;
-    for (int t = p; t < n; t++) d += v[t] * v[t] + u[t] * u[t];
-    var2[p] = d / (2.0 * (n - p));
+    for (R_xlen_t t = p; t < n; t++) d += v[t] * v[t] + u[t] * u[t];
+    var2[p] = d / (2.0 * static_cast<double>(n - p));
   }
   for (int p = 0; p <= pmax; p++)
     if (std::isnan(var2[p])) return Rcpp::NumericVector(0);
