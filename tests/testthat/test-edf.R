@@ -655,9 +655,9 @@ test_that("the total type's EDF under flicker PM follows a Monte Carlo of its ow
   edf <- vapply(m, function(mm) {
     allan_edf_direct("total", mm, L - 2 * mm, L, 1L)
   }, 0)
-  # within the Monte Carlo's own spread (about 10% with 300 records), on
-  # the conservative side
-  expect_true(all(edf / edf_mc > 0.7 & edf / edf_mc < 1.1))
+  # within the Monte Carlo's own spread (about 10% with 300 records):
+  # 1.07, 1.02, 1.02 here; Greenhall's EDF, used before, 0.90, 0.86, 0.88
+  expect_true(all(edf / edf_mc > 0.88 & edf / edf_mc < 1.15))
   # NIST SP 1065 Table 5's simple formula, used before, claims 1.5-2x
   simple <- exp(sqrt(log((L - 1) / (2 * m)) * log((2 * m + 1) * (L - 1) / 4)))
   expect_true(all(simple / edf_mc > 1.3))
