@@ -217,3 +217,42 @@ test_that("the total type reads the overlapping variance only where exact_sets()
     expect_lt(sum(!is.na(part)), length(m))
   }
 })
+
+test_that("exact_minimax() is the shortest interval holding every law", {
+  minimax <- allanvar:::exact_minimax
+  # two chi-square laws of the variance ratio, the second shifted by its
+  # correction s (sigma_hat^2 s / sigma^2 ~ chi2_nu / nu)
+  nu <- c(12, 15)
+  s <- c(1, 1.35)
+  conf <- 0.68
+  cdfs <- lapply(nu, function(v) function(q) stats::pchisq(q * v, v))
+  eq <- vapply(1:2, function(k) {
+    q <- stats::qchisq(c(1 + conf, 1 - conf) / 2, nu[k]) / nu[k]
+    sqrt(s[k] / q)
+  }, numeric(2))
+  f <- minimax(cdfs, s, eq, conf)
+  # coverage of [sigma_hat f1, sigma_hat f2] under law k
+  cover <- function(f, k) {
+    stats::pchisq(s[k] / f[1]^2 * nu[k], nu[k]) -
+      stats::pchisq(s[k] / f[2]^2 * nu[k], nu[k])
+  }
+  cov <- c(cover(f, 1), cover(f, 2))
+  expect_true(all(cov > conf - 1e-3))
+  expect_lt(min(cov), conf + 1e-3)  # tight under one law at least
+  union <- c(min(eq[1, ]), max(eq[2, ]))
+  expect_gt(min(cover(union, 1), cover(union, 2)), conf + 0.03)
+  expect_lt(f[2] / f[1], 0.97 * union[2] / union[1])
+  # the brute-force optimum over lower ends on a fine grid
+  t <- exp(seq(log(1 / union[2]^2), log(1 / union[1]^2), length.out = 4000))
+  upper_end <- function(k) {
+    p <- stats::pchisq(t * s[k] * nu[k], nu[k]) + conf
+    ifelse(p < 1, stats::qchisq(pmin(p, 1 - 1e-12), nu[k]) / nu[k] / s[k],
+           NA)
+  }
+  w <- pmax(upper_end(1), upper_end(2))
+  best <- min(log(w / t), na.rm = TRUE)
+  expect_equal(2 * log(f[2] / f[1]), best, tolerance = 2e-3)
+  # one law, or laws that coincide: no wider than its equal-tailed interval
+  g <- minimax(cdfs[c(1, 1)], c(1, 1), eq[, c(1, 1)], conf)
+  expect_lte(g[2] / g[1], eq[2, 1] / eq[1, 1] + 1e-9)
+})
