@@ -204,6 +204,31 @@ test_that("the spike count does not flip when the scale moves 2%; no spikes in c
   expect_lte(hits, 1L)
 })
 
+test_that("heavy-tailed noise is the noise, not spikes: gross outliers beyond its tail are", {
+  skip_on_cran()
+  n <- 5e5
+  freq <- 100
+  set.seed(77)
+  # Student t with 8 degrees of freedom, through a first-order filter
+  x <- as.numeric(stats::filter(0.1 * rt(n, 8), 0.5, method = "recursive"))
+  sp <- detect_spikes(x, freq)
+  # a Gaussian level (6 sd) would name hundreds of its tail samples
+  expect_equal(nrow(sp), 0L)
+  expect_gt(attr(sp, "threshold"), 10)
+  # ... and a scale 2% larger changes next to nothing (the added Gaussian
+  # part lightens the body: 1 here)
+  expect_lte(nrow(detect_spikes(x + rnorm(n, sd = 0.2 * sqrt(1.02^2 - 1)),
+                                freq)), 1L)
+  at <- sort(sample.int(n - 200, 15) + 100)
+  y <- x
+  y[at] <- y[at] + sample(c(-1, 1), 15, TRUE) * runif(15, 4, 6)
+  expect_equal(detect_spikes(y, freq)$index, at)
+  # the t table: Gaussian z gives B = 2.82, its scale 1
+  tab <- spike_t_table()
+  expect_equal(tab$B[length(tab$B)], 2.818, tolerance = 2e-3)
+  expect_true(all(diff(tab$B) < 0))
+})
+
 test_that("a line near Nyquist does not hide spikes: they are outliers of the series' own AR model", {
   # 60 outliers of 6.5-10 sd; a 48.1 Hz line of the white's amplitude. On
   # the running median's residual (the line stays in it, the scale grows

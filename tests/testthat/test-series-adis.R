@@ -37,13 +37,13 @@ test_that("ADIS16405 unit 1 accel_z: the transient at 2154 s", {
   expect_gte(nrow(tr), 1L)
   expect_true(any(abs(tr$time - 2154) < 10))
   expect_true(all(abs(tr$size) > 0.001 & abs(tr$size) < 0.005))
-  # spikes of about 10 LSB (0.0033 g each): many, typically 7-10 LSB, none
-  # as large as a tenth of a g
+  # its many outliers of 7-10 LSB (0.0033 g each) are the tail of the
+  # axis's own heavy-tailed noise (a t body, spike_tail_level()): the
+  # spikes are the few beyond it, none as large as a tenth of a g
   sp <- se$table[se$table$kind == "spikes", ]
-  expect_gt(nrow(sp), 10L)
-  expect_true(all(abs(sp$size) < 0.1))
-  expect_gt(stats::median(abs(sp$size)), 6 * 0.00333)
-  expect_lt(stats::median(abs(sp$size)), 12 * 0.00333)
+  expect_gte(nrow(sp), 1L)
+  expect_lte(nrow(sp), 5L)
+  expect_true(all(abs(sp$size) > 10 * 0.00333 & abs(sp$size) < 0.1))
   expect_true(all(sp$removed))
   expect_false(any(se$table$kind %in% c("steps", "warmup")))
 })
@@ -60,4 +60,23 @@ test_that("ADIS16405 unit 2 gyro_z: an added warm-up of tc 5% of the record is n
   w <- detect_series_effects(x + amp * exp(-t / tc), freq, kinds = "warmup")$table
   expect_equal(nrow(w), 1L)
   expect_lt(abs(w$tc / tc - 1), 0.25)
+})
+
+test_that("ADIS16405 accelerometers: the spike count holds when white noise moves the scale 2%", {
+  skip_if_no_shared()
+  skip_on_cran()
+  m <- readRDS(shared_file("adis16405_unit1.rds"))
+  freq <- attr(m, "freq")
+  set.seed(27)
+  for (ax in c("accel_x", "accel_z")) {
+    x <- m[, ax]
+    sdw <- stats::sd(diff(x)) / sqrt(2)
+    n0 <- nrow(detect_spikes(x, freq))
+    n1 <- nrow(detect_spikes(x + rnorm(length(x), sd = sdw * sqrt(1.02^2 - 1)),
+                             freq))
+    # a level inside the heavy tail moved these counts 4-14% (tens of
+    # samples on 20-80); beyond it they are a few and stay
+    expect_lte(n0, 8L)
+    expect_lte(abs(n1 - n0), 1L)
+  }
 })
