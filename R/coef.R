@@ -194,13 +194,20 @@ check_coef <- function(coef, arg = "coef") {
 # fit's many evaluations do not re-read the layout.
 model_plan <- function(lay) {
   labs <- unique(lay$label)
+  # the layout's columns as vectors (every fit of the loop plans its
+  # layout; data frame row subsets per label cost more than the rest)
+  label <- lay$label
+  name <- lay$name
+  role <- lay$role
+  param <- lay$param
   lapply(labs, function(l) {
-    rows <- lay[lay$label == l, , drop = FALSE]
-    e <- effect_entry(rows$kind[1L], rows$variant[1L])
+    i <- which(label == l)
+    r <- role[i]
+    e <- effect_entry(lay$kind[i[1L]], lay$variant[i[1L]])
     list(label = l, entry = e,
-         amp = rows$name[rows$role == "amp"],
-         nl = rows$name[rows$role == "nonlinear"],
-         nl_param = rows$param[rows$role == "nonlinear"])
+         amp = name[i][r == "amp"],
+         nl = name[i][r == "nonlinear"],
+         nl_param = param[i][r == "nonlinear"])
   })
 }
 
