@@ -165,6 +165,10 @@ resonance_psd_cpp <- function(f, tau0, sigma, fr, tc) {
     .Call(`_allanvar_resonance_psd_cpp`, f, tau0, sigma, fr, tc)
 }
 
+resonance_av_cpp <- function(m, tau0, sigma, fr, tc) {
+    .Call(`_allanvar_resonance_av_cpp`, m, tau0, sigma, fr, tc)
+}
+
 decode_imu_blobs <- function(blobs, encoding, recv_ns) {
     .Call(`_allanvar_decode_imu_blobs`, blobs, encoding, recv_ns)
 }

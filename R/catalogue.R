@@ -310,6 +310,20 @@ effect_entry <- function(kind, variant = NULL) {
     abort("Unknown noise term \"", kind, "\".", class = "model")
   }
   if (is.null(variant) || is.na(variant) || !nzchar(variant)) return(e)
+  # a variant's entry is built from the kind's (a data frame of parameters
+  # and closures per call) and the loop's refits ask for it thousands of
+  # times: kept with the layouts, emptied with them when the catalogue
+  # changes
+  key <- paste0("\002", kind, ":", variant)
+  hit <- .catalogue$layouts[[key]]
+  if (!is.null(hit)) return(hit)
+  out <- variant_entry(e, kind, variant)
+  if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
+  assign(key, out, envir = .catalogue$layouts)
+  out
+}
+
+variant_entry <- function(e, kind, variant) {
   if (is.null(e$variants)) {
     abort("The effect \"", kind, "\" has no variants; \"", kind, ":",
           variant, "\" is not a term.", class = "model")

@@ -114,14 +114,16 @@ build_coef_layout <- function(terms) {
   terms <- check_terms(terms)
   labs <- term_labels(terms)
   sp <- split_term(terms)
-  rows <- lapply(seq_along(terms), function(i) {
-    e <- effect_entry(sp$kind[i], sp$variant[i])
-    p <- e$params
-    data.frame(name = coef_names(e, labs[i]), label = labs[i], kind = sp$kind[i],
-               variant = sp$variant[i], param = p$name, role = p$role,
-               unit = p$unit, hidden = p$hidden, stringsAsFactors = FALSE)
-  })
-  do.call(rbind, rows)
+  # the columns concatenated over the terms, one data frame (a data frame
+  # per term bound by rbind() cost more than the loop's refits using it)
+  ents <- lapply(seq_along(terms), function(i) effect_entry(sp$kind[i], sp$variant[i]))
+  np <- vapply(ents, function(e) nrow(e$params), 0L)
+  col <- function(f) unlist(lapply(ents, function(e) e$params[[f]]), use.names = FALSE)
+  data.frame(name = unlist(lapply(seq_along(ents), function(i) coef_names(ents[[i]], labs[i])),
+                           use.names = FALSE),
+             label = rep(labs, np), kind = rep(sp$kind, np), variant = rep(sp$variant, np),
+             param = col("name"), role = col("role"), unit = col("unit"),
+             hidden = col("hidden"), stringsAsFactors = FALSE)
 }
 
 # The terms a layout was built from, e.g. c("N", "gm", "gm").
@@ -194,13 +196,20 @@ check_coef <- function(coef, arg = "coef") {
 # fit's many evaluations do not re-read the layout.
 model_plan <- function(lay) {
   labs <- unique(lay$label)
+  # the layout's columns as vectors (every fit of the loop plans its
+  # layout; data frame row subsets per label cost more than the rest)
+  label <- lay$label
+  name <- lay$name
+  role <- lay$role
+  param <- lay$param
   lapply(labs, function(l) {
-    rows <- lay[lay$label == l, , drop = FALSE]
-    e <- effect_entry(rows$kind[1L], rows$variant[1L])
+    i <- which(label == l)
+    r <- role[i]
+    e <- effect_entry(lay$kind[i[1L]], lay$variant[i[1L]])
     list(label = l, entry = e,
-         amp = rows$name[rows$role == "amp"],
-         nl = rows$name[rows$role == "nonlinear"],
-         nl_param = rows$param[rows$role == "nonlinear"])
+         amp = name[i][r == "amp"],
+         nl = name[i][r == "nonlinear"],
+         nl_param = param[i][r == "nonlinear"])
   })
 }
 

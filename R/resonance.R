@@ -17,10 +17,23 @@ resonance_acf <- function(h, tau0, sigma, fr, tc) {
 # Exact discrete AV at cluster sizes m: g(h) = Re(sigma^2 p^|h|) with
 # p = r e^{iw}, so AV = Re(geometric_av(m, sigma^2, p)) (the AR(1) form,
 # noise-models.md section 1, with a complex pole).
+# The searches evaluate it at every value they visit: in C++ (src/resonance.cpp,
+# the R expression's operations in R's complex arithmetic), the R expression
+# for anything but plain numbers.
 resonance_av <- function(m, tau0, sigma, fr, tc) {
+  if (is.double(m) && is.null(attributes(m)) && !anyNA(m) && is_plain_number(tau0) && is_plain_number(sigma) &&
+      is_plain_number(fr) && is_plain_number(tc)) {
+    return(resonance_av_cpp(m, tau0, sigma, fr, tc))
+  }
+  resonance_av_r(m, tau0, sigma, fr, tc)
+}
+
+resonance_av_r <- function(m, tau0, sigma, fr, tc) {
   p <- exp(-tau0 / tc) * exp(1i * 2 * pi * fr * tau0)
   Re(geometric_av(m, sigma^2, p))
 }
+
+is_plain_number <- function(v) is.double(v) && length(v) == 1L && !is.na(v)
 
 # Two-sided PSD (u^2/Hz) of the sampled process: tau0 sum_h g(h) e^{-i w' h}
 # = tau0 sigma^2 Re[(1 + q) / (1 - q)] summed over q = p e^{-iw'} and its

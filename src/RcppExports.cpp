@@ -521,6 +521,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// resonance_av_cpp
+Rcpp::NumericVector resonance_av_cpp(const Rcpp::NumericVector& m, double tau0, double sigma, double fr, double tc);
+RcppExport SEXP _allanvar_resonance_av_cpp(SEXP mSEXP, SEXP tau0SEXP, SEXP sigmaSEXP, SEXP frSEXP, SEXP tcSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    Rcpp::traits::input_parameter< double >::type sigma(sigmaSEXP);
+    Rcpp::traits::input_parameter< double >::type fr(frSEXP);
+    Rcpp::traits::input_parameter< double >::type tc(tcSEXP);
+    rcpp_result_gen = Rcpp::wrap(resonance_av_cpp(m, tau0, sigma, fr, tc));
+    return rcpp_result_gen;
+END_RCPP
+}
 // decode_imu_blobs
 Rcpp::NumericMatrix decode_imu_blobs(const Rcpp::List& blobs, int encoding, const Rcpp::NumericVector& recv_ns);
 RcppExport SEXP _allanvar_decode_imu_blobs(SEXP blobsSEXP, SEXP encodingSEXP, SEXP recv_nsSEXP) {
@@ -825,6 +839,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_stamp_steps", (DL_FUNC) &_allanvar_stamp_steps, 1},
     {"_allanvar_stamp_repeats", (DL_FUNC) &_allanvar_stamp_repeats, 1},
     {"_allanvar_resonance_psd_cpp", (DL_FUNC) &_allanvar_resonance_psd_cpp, 5},
+    {"_allanvar_resonance_av_cpp", (DL_FUNC) &_allanvar_resonance_av_cpp, 5},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},
     {"_allanvar_rosbag_index_cpp", (DL_FUNC) &_allanvar_rosbag_index_cpp, 1},

@@ -30,3 +30,68 @@ Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
   }
   return out;
 }
+
+// R's complex power X^Y (src/main/complex.c, mycpow(), R 4.2): powers by
+// repeated products for whole exponents up to 65536, else the C library's
+// cpow; 0^Y is R_pow(0, Re Y).
+static std::complex<double> r_cpow(std::complex<double> X, double yr) {
+  typedef std::complex<double> cplx;
+  if (X == cplx(0.0, 0.0)) {
+    const double z = yr == 0 ? 1.0 : (yr > 0 ? 0.0 : R_PosInf);
+    return cplx(ISNAN(yr) ? yr : z, 0.0);
+  }
+  if (std::fabs(yr) <= 65536 && yr == static_cast<double>(static_cast<int>(yr))) {
+    int k = static_cast<int>(yr);
+    if (k == 0) return cplx(1.0, 0.0);
+    if (k == 1) return X;
+    const bool neg = k < 0;
+    if (neg) k = -k;
+    cplx z(1.0, 0.0);
+    while (k > 0) {
+      if (k & 1) z = z * X;
+      if (k == 1) break;
+      k >>= 1;
+      X = X * X;
+    }
+    return neg ? cplx(1.0, 0.0) / z : z;
+  }
+  return std::pow(X, cplx(yr, 0.0));
+}
+
+// A resonance's Allan variance at cluster sizes m (R/resonance.R,
+// resonance_av()): Re(geometric_av(m, sigma^2, p)), p = exp(-tau0 / tc) *
+// exp(1i * 2 * pi * fr * tau0), the R expressions' operations in their
+// order and in R's complex arithmetic (each real promoted to complex before
+// a product or sum), so the values are R's; the loop's searches evaluate it
+// at every value they visit.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector resonance_av_cpp(const Rcpp::NumericVector& m, double tau0,
+                                     double sigma, double fr, double tc) {
+  typedef std::complex<double> cplx;
+  const double pi = 3.141592653589793238462643383279502884;
+  cplx w = cplx(0.0, 1.0) * cplx(2.0, 0.0);
+  w = w * cplx(pi, 0.0);
+  w = w * cplx(fr, 0.0);
+  w = w * cplx(tau0, 0.0);
+  const cplx p = cplx(std::exp(-tau0 / tc), 0.0) * std::exp(w);
+  const cplx A(sigma * sigma, 0.0);
+  const cplx p2 = r_cpow(p, 2.0);
+  const cplx p3 = cplx(3.0, 0.0) * p;
+  const cplx q2 = r_cpow(cplx(1.0, 0.0) - p, 2.0);
+  const R_xlen_t n = m.size();
+  Rcpp::NumericVector out(n);
+  for (R_xlen_t i = 0; i < n; i++) {
+    const double mi = m[i];
+    const cplx mc(mi, 0.0);
+    // A * (m - 3 * p - m * p^2 + 4 * p^(m + 1) - p^(2 * m + 1)) /
+    //   (m^2 * (1 - p)^2)
+    cplx t = mc - p3;
+    t = t - mc * p2;
+    t = t + cplx(4.0, 0.0) * r_cpow(p, mi + 1);
+    t = t - r_cpow(p, 2 * mi + 1);
+    const cplx num = A * t;
+    const cplx den = cplx(mi * mi, 0.0) * q2;
+    out[i] = (num / den).real();
+  }
+  return out;
+}

@@ -203,3 +203,26 @@ test_that("coef_layout()'s store of layouts follows the catalogue", {
                class = "allanvar_error_argument")
   expect_identical(coef_layout(c("N", "K")), build_coef_layout(c("N", "K")))
 })
+
+test_that("the coefficient layout is the per-term data frames bound together", {
+  # the layout as one data frame per term, bound by rbind()
+  by_rows <- function(terms) {
+    labs <- term_labels(terms)
+    sp <- split_term(terms)
+    do.call(rbind, lapply(seq_along(terms), function(i) {
+      e <- effect_entry(sp$kind[i], sp$variant[i])
+      p <- e$params
+      data.frame(name = coef_names(e, labs[i]), label = labs[i], kind = sp$kind[i],
+                 variant = sp$variant[i], param = p$name, role = p$role,
+                 unit = p$unit, hidden = p$hidden, stringsAsFactors = FALSE)
+    }))
+  }
+  sets <- list(c("N", "B", "K"), c("Q", "N", "gm", "gm", "R"),
+               c("filter:lp2", "B", "K", "sinusoid", "sinusoid", "resonance"),
+               c("filter", "band", "K"), c("filter:lp1", "gm", "resonance", "resonance"),
+               effect_kinds())
+  for (t in sets) {
+    t <- check_terms(t)
+    expect_identical(build_coef_layout(t), by_rows(t))
+  }
+})

@@ -73,6 +73,29 @@ test_that("the resonance PSD is the R expression's value to the bit", {
   expect_identical(resonance_psd(numeric(), 0.01, 1, 5, 0.1), numeric())
 })
 
+test_that("resonance_av() in C++ is the R expression to the bit", {
+  ns_r <- function(m, tau0, sigma, fr, tc) {
+    p <- exp(-tau0 / tc) * exp(1i * 2 * pi * fr * tau0)
+    Re(geometric_av(m, sigma^2, p))
+  }
+  set.seed(27)
+  for (i in 1:200) {
+    freq <- sample(c(100, 819.2, 1000), 1)
+    tau0 <- 1 / freq
+    # whole cluster sizes below and above 65536 (R's repeated products and
+    # cpow), fractional ones
+    m <- switch(i %% 3 + 1, 2^(0:20), unique(round(exp(runif(30, 0, log(3e5))))),
+                runif(25, 1, 1e6))
+    fr <- exp(runif(1, log(1e-3), log(0.5 * freq)))
+    tc <- exp(runif(1, log(tau0 / 4), log(1e5)))
+    sg <- exp(rnorm(1))
+    expect_identical(resonance_av(m, tau0, sg, fr, tc), ns_r(m, tau0, sg, fr, tc))
+  }
+  # anything but plain numbers takes the R expression
+  m <- c(a = 1, b = 2, c = 4)
+  expect_identical(resonance_av(m, 0.01, 1, 3, 2), ns_r(m, 0.01, 1, 3, 2))
+})
+
 test_that("simulated resonance has the stated variance and autocorrelation", {
   set.seed(31)
   x <- sim_resonance(2e5, 0.01, 0.7, 19, 0.05)
