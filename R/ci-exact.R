@@ -401,15 +401,24 @@ allan_limits_exact <- function(type, m, n, L, alpha, conf, sets = NULL,
       # laws shifted by their corrections: the shortest interval holding
       # every one (exact_minimax()), not the union
       a <- sets[[i]]
-      s <- debias_factor(type, a, rep(m[i], length(a))) /
-        debias_factor(type, alpha[i], m[i])
-      cdfs <- lapply(sets[[i]], function(a) {
-        cdf <- law(i, a)
-        if (!is.null(cdf)) return(cdf)
-        ed <- rule(e, m[i], n[i], L, a)
-        function(q) stats::pchisq(q * ed, ed)
-      })
-      f <- matrix(exact_minimax(cdfs, s, f, conf), 2L)
+      key <- paste(type, m[i], n[i], L, paste(a, collapse = ","), alpha[i],
+                   format(conf, digits = 15), paste(format(f, digits = 15),
+                                                    collapse = ","),
+                   "minimax", sep = ":")
+      hit <- exact_cache[[key]]
+      if (is.null(hit)) {
+        s <- debias_factor(type, a, rep(m[i], length(a))) /
+          debias_factor(type, alpha[i], m[i])
+        cdfs <- lapply(a, function(al) {
+          cdf <- law(i, al)
+          if (!is.null(cdf)) return(cdf)
+          ed <- rule(e, m[i], n[i], L, al)
+          function(q) stats::pchisq(q * ed, ed)
+        })
+        hit <- exact_minimax(cdfs, s, f, conf)
+        assign(key, hit, envir = exact_cache)
+      }
+      f <- matrix(hit, 2L)
     }
     lower[i] <- min(f[1L, ])
     upper[i] <- max(f[2L, ])
