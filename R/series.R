@@ -19,7 +19,10 @@
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
 #' steps) standard deviations. A spike is an additive outlier of the
 #' series' own AR model (its filter, lines and colour), so that a line or a
-#' filter does not hide it. The warm-up's time constant is fitted by
+#' filter does not hide it; where that model's statistic has heavy tails
+#' (a non-Gaussian body, as on many accelerometers), the level is the
+#' Bonferroni quantile of a Student t fitted to its body: outliers that
+#' belong to the noise's own tail are not spikes. The warm-up's time constant is fitted by
 #' generalised least squares under the series' own noise model (white,
 #' random walk and Gauss-Markov components from its Allan variance), and a
 #' warm-up is named by a likelihood ratio in which the series with and
