@@ -2,11 +2,15 @@
 //
 // Every estimator is a sum of squares of small integer combinations of a
 // phase sequence X (the running sum of the rate samples, or the integrated
-// input itself). X is held as hi + lo, where hi lies on a grid of step q with
-// |hi| <= 2^50 q: any combination with integer weights of total size <= 8 is
-// then exact in double, and lo carries the rest (at most q/2 per point, or
-// per summed increment for the running sums of rate data: far below the
-// data's own scale, since q is 2^-50 of the largest |X|). Differences of
+// input itself). X is held as hi + q lo, where hi lies on a grid of step q
+// with |hi| <= 2^50 q: any combination with integer weights of total size
+// <= 8 is then exact in double. lo is the rest in units of q (at most 1/2
+// and a rounding: each point's grid part is moved into hi) stored as a float,
+// 12 bytes a point instead of 16 (the far taus' streams come from memory).
+// The float's rounding, at most 2^-25 of 1/2, leaves q lo within 2^-26 q =
+// 2^-76 of the largest |X| of the exact value: below the double rounding of
+// the differences at every tau for records of up to 2^23 times the data's
+// range over their scale, and a random-signed part of it beyond. Differences of
 // huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
 // drift or length of the record.
 #include "buffer.h"
@@ -33,6 +37,7 @@ namespace {
 
 using allanvar::AllanOptions;
 using allanvar::Buffer;
+using allanvar::FloatBuffer;
 using allanvar::STANDARD;
 using allanvar::OVERLAPPING;
 using allanvar::MODIFIED;
@@ -60,8 +65,11 @@ void run_items(R_xlen_t n, int threads, bool main, F f) {
   }
 }
 
+// X = hi + q lo (the file's head)
 struct Split {
-  Buffer hi, lo;
+  Buffer hi;
+  FloatBuffer lo;
+  double q = 1;
 };
 
 // Single passes over the samples ask for interrupts every 2^20 samples.
@@ -72,7 +80,8 @@ inline double grid_step(double bound) {
   if (!(bound > 0) || !std::isfinite(bound)) return 1.0;
   int e;
   std::frexp(bound, &e);
-  return std::ldexp(1.0, e - 50);
+  // at least the smallest normal double: 1 / q stays finite
+  return std::max(std::ldexp(1.0, e - 50), 2.2250738585072014e-308);
 }
 
 // x - c as a on the grid of C (C = 1.5 q 2^52: ulp(C) = q) plus the rest
@@ -92,11 +101,13 @@ const R_xlen_t kPrefixBlock = static_cast<R_xlen_t>(1) << 16;
 // One block [i0, i1) of build_prefix(levels = 1): the exact sum of its grid
 // parts and the sum of its remainders in four lanes (the last (i1 - i0) % 4
 // in lane 0: the same additions whether or not the values are stored), and
-// with Store its X values from h + (l0 + l) on.
+// with Store its X values from h + (l0 + l) on, the grid part of l0 + l
+// moved into hi (exact: both on the grid) and the rest, at most q/2, times
+// rq = 1/q into lo.
 template <bool Store>
 void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
-                  double C, double h, double l0, double* hi, double* lo,
-                  double& hsum, double& lsum) {
+                  double C, double rq, double h, double l0, double* hi,
+                  float* lo, double& hsum, double& lsum) {
   double hl[4] = {0, 0, 0, 0}, ll[4] = {0, 0, 0, 0}, l = 0;
   auto step = [&](R_xlen_t i, int u) {
     double a, rem;
@@ -106,8 +117,10 @@ void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
     if (Store) {
       h += a;
       l += rem;
-      hi[i + 1] = h;
-      lo[i + 1] = l0 + l;
+      const double t = l0 + l;
+      const double g = (t + C) - C;
+      hi[i + 1] = h + g;
+      lo[i + 1] = static_cast<float>((t - g) * rq);
     }
   };
   R_xlen_t i = i0;
@@ -128,7 +141,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   out.hi.resize(len);
   out.lo.resize(len);
   double* hi = out.hi.data();
-  double* lo = out.lo.data();
+  float* lo = out.lo.data();
   hi[0] = lo[0] = 0;
   if (levels == 2) hi[1] = lo[1] = 0;
   const double nn = static_cast<double>(n);
@@ -138,12 +151,15 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   if (levels == 1) b *= 1 + nn * 1.7763568394002505e-15;  // 2^-49
   const double q = grid_step(b);
   const double C = 1.5 * q * 4503599627370496.0;  // 1.5 q 2^52: ulp(C) = q
+  const double rq = 1 / q;  // exact: q is a power of two
+  out.q = q;
   if (levels == 1) {
     // X_{i+1} = X_i + (v_i - c). Each increment v_i - c = r + re (TwoSum)
     // is split into a on the grid q and the remainder (r - a) + re (at most
     // q/2 and an ulp): hi sums the a exactly (multiples of q below 2^50 q,
     // in any order), lo the remainders in plain double (rounding about
-    // eps n q, far below q). hi being exact, the record is cut into fixed
+    // eps n q, far below q), whose running grid part is stored in hi and
+    // the rest in lo. hi being exact, the record is cut into fixed
     // blocks: on two threads their sums first, then each block's prefix
     // from its start; on one, a single pass making the same additions. The
     // result does not depend on the thread count.
@@ -160,7 +176,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
         R_xlen_t i0, i1;
         ends(k, i0, i1);
         double hs, ls;
-        prefix_block<true>(v, i0, i1, c, C, h, l0, hi, lo, hs, ls);
+        prefix_block<true>(v, i0, i1, c, C, rq, h, l0, hi, lo, hs, ls);
         h += hs;
         l0 += ls;
       }
@@ -171,7 +187,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     run_items(nb, threads, main, [&](R_xlen_t k) {
       R_xlen_t i0, i1;
       ends(k, i0, i1);
-      prefix_block<false>(v, i0, i1, c, C, 0, 0, hi, lo, hbase[k + 1],
+      prefix_block<false>(v, i0, i1, c, C, rq, 0, 0, hi, lo, hbase[k + 1],
                           lbase[k + 1]);
     });
     if (allanvar::interrupt_state().stop.load()) return;
@@ -183,12 +199,21 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
       R_xlen_t i0, i1;
       ends(k, i0, i1);
       double hs, ls;
-      prefix_block<true>(v, i0, i1, c, C, hbase[k], lbase[k], hi, lo, hs, ls);
+      prefix_block<true>(v, i0, i1, c, C, rq, hbase[k], lbase[k], hi, lo, hs,
+                         ls);
     });
     return;
   }
-  // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c)
+  // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c); P's
+  // rest (s2 - h) + e2 split again, its grid part into hi
   double s1 = 0, e1 = 0, s2 = 0, e2 = 0;
+  auto put = [&](R_xlen_t i) {
+    const double h = (s2 + C) - C;
+    const double t = (s2 - h) + e2;
+    const double g = (t + C) - C;
+    hi[i] = h + g;
+    lo[i] = static_cast<float>((t - g) * rq);
+  };
   for (R_xlen_t i = 0; i < n; ++i) {
     if ((i & kPoll) == kPoll && allanvar::interrupted()) return;
     double r, re, t, te;
@@ -196,9 +221,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     two_sum(s2, s1, t, te);
     s2 = t;
     e2 += te + e1;
-    const double h = (s2 + C) - C;
-    hi[i + 1] = h;
-    lo[i + 1] = (s2 - h) + e2;
+    put(i + 1);
     two_sum(s1, r, t, te);
     s1 = t;
     e1 += te + re;
@@ -208,9 +231,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     two_sum(s2, s1, t, te);
     s2 = t;
     e2 += te + e1;
-    const double h = (s2 + C) - C;
-    hi[n + 1] = h;
-    lo[n + 1] = (s2 - h) + e2;
+    put(n + 1);
   }
 }
 
@@ -221,25 +242,33 @@ void build_split(const double* v, R_xlen_t n, double c, double bound,
   out.lo.resize(n);
   const double q = grid_step(bound * (1 + 1e-9));
   const double C = 1.5 * q * 4503599627370496.0;
-  for (R_xlen_t i = 0; i < n; ++i) grid_split(v[i], c, C, out.hi[i], out.lo[i]);
+  const double rq = 1 / q;
+  out.q = q;
+  for (R_xlen_t i = 0; i < n; ++i) {
+    double rem;
+    grid_split(v[i], c, C, out.hi[i], rem);
+    out.lo[i] = static_cast<float>(rem * rq);
+  }
 }
 
 // Sum of squared second (D = 2) or third (D = 3) differences at stride 1,
-// for k in [k0, k1): two terms per vector (GCC/Clang vector extensions,
-// plain SSE2 on x86-64), two independent accumulators.
+// for k in [k0, k1): each difference is the hi parts' (exact) plus q times
+// the lo parts' (floats widened to double).
 #if defined(__GNUC__)
 using allanvar::v2d;
 using allanvar::ld2;
 #endif
 
 template <int D>
-inline double diff_at(const double* h, const double* l, R_xlen_t m, R_xlen_t k) {
+inline double diff_at(const double* h, const float* f, double q, R_xlen_t m,
+                      R_xlen_t k) {
+  auto l = [f](R_xlen_t i) { return static_cast<double>(f[i]); };
   if (D == 2) {
     return ((h[k + 2 * m] + h[k]) - 2.0 * h[k + m]) +
-           ((l[k + 2 * m] + l[k]) - 2.0 * l[k + m]);
+           q * ((l(k + 2 * m) + l(k)) - 2.0 * l(k + m));
   }
   return ((h[k + 3 * m] - h[k]) + 3.0 * (h[k + m] - h[k + 2 * m])) +
-         ((l[k + 3 * m] - l[k]) + 3.0 * (l[k + m] - l[k + 2 * m]));
+         q * ((l(k + 3 * m) - l(k)) + 3.0 * (l(k + m) - l(k + 2 * m)));
 }
 
 // Sum of squared differences for k in [k0, k1): eight terms per step in
@@ -249,32 +278,37 @@ inline double diff_at(const double* h, const double* l, R_xlen_t m, R_xlen_t k) 
 // additions and no fused multiply-add, so both give the same bits), then the
 // last k1 - k0 mod 8 terms one by one.
 #if defined(__GNUC__)
-template <int D, class V>
-inline V diff_vec(const double* h, const double* l, R_xlen_t m, R_xlen_t k) {
-  auto ld = [](const double* p) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
-  if (D == 2) {
-    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
-           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
-  }
-  return ((ld(h + 3 * m + k) - ld(h + k)) +
-          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
-         ((ld(l + 3 * m + k) - ld(l + k)) +
-          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+typedef float v2f __attribute__((vector_size(8)));
+
+inline v2d ldf2(const float* p) {
+  v2f v;
+  std::memcpy(&v, p, sizeof v);
+  return __builtin_convertvector(v, v2d);
 }
 
 template <int D>
-inline double sumsq8_sse2(const double* h, const double* l, R_xlen_t m,
-                          R_xlen_t& k, R_xlen_t k1) {
+inline v2d diff_vec(const double* h, const float* l, v2d q, R_xlen_t m,
+                    R_xlen_t k) {
+  if (D == 2) {
+    return ((ld2(h + 2 * m + k) + ld2(h + k)) - 2.0 * ld2(h + m + k)) +
+           q * ((ldf2(l + 2 * m + k) + ldf2(l + k)) - 2.0 * ldf2(l + m + k));
+  }
+  return ((ld2(h + 3 * m + k) - ld2(h + k)) +
+          3.0 * (ld2(h + m + k) - ld2(h + 2 * m + k))) +
+         q * ((ldf2(l + 3 * m + k) - ldf2(l + k)) +
+              3.0 * (ldf2(l + m + k) - ldf2(l + 2 * m + k)));
+}
+
+template <int D>
+inline double sumsq8_sse2(const double* h, const float* l, double q,
+                          R_xlen_t m, R_xlen_t& k, R_xlen_t k1) {
+  const v2d qv = {q, q};
   v2d a0 = {0, 0}, a1 = {0, 0}, a2 = {0, 0}, a3 = {0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v2d d0 = diff_vec<D, v2d>(h, l, m, k);
-    const v2d d1 = diff_vec<D, v2d>(h, l, m, k + 2);
-    const v2d d2 = diff_vec<D, v2d>(h, l, m, k + 4);
-    const v2d d3 = diff_vec<D, v2d>(h, l, m, k + 6);
+    const v2d d0 = diff_vec<D>(h, l, qv, m, k);
+    const v2d d1 = diff_vec<D>(h, l, qv, m, k + 2);
+    const v2d d2 = diff_vec<D>(h, l, qv, m, k + 4);
+    const v2d d3 = diff_vec<D>(h, l, qv, m, k + 6);
     a0 += d0 * d0;
     a1 += d1 * d1;
     a2 += d2 * d2;
@@ -287,6 +321,7 @@ inline double sumsq8_sse2(const double* h, const double* l, R_xlen_t m,
 #if defined(__x86_64__)
 #define ALLANVAR_AVX2 1
 typedef double v4d __attribute__((vector_size(32)));
+typedef float v4f __attribute__((vector_size(16)));
 
 __attribute__((target("avx2"))) inline v4d ld4(const double* p) {
   v4d v;
@@ -294,29 +329,37 @@ __attribute__((target("avx2"))) inline v4d ld4(const double* p) {
   return v;
 }
 
+// one vcvtps2pd (__builtin_convertvector gave two halves and a shuffle)
+__attribute__((target("avx2"))) inline v4d ldf4(const float* p) {
+  v4f v;
+  std::memcpy(&v, p, sizeof v);
+  return __builtin_ia32_cvtps2pd256(v);
+}
+
 template <int D>
 __attribute__((target("avx2"))) inline v4d diff4(const double* h,
-                                                 const double* l, R_xlen_t m,
-                                                 R_xlen_t k) {
-  auto ld = ld4;
+                                                 const float* l, v4d q,
+                                                 R_xlen_t m, R_xlen_t k) {
   if (D == 2) {
-    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
-           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
+    return ((ld4(h + 2 * m + k) + ld4(h + k)) - 2.0 * ld4(h + m + k)) +
+           q * ((ldf4(l + 2 * m + k) + ldf4(l + k)) - 2.0 * ldf4(l + m + k));
   }
-  return ((ld(h + 3 * m + k) - ld(h + k)) +
-          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
-         ((ld(l + 3 * m + k) - ld(l + k)) +
-          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+  return ((ld4(h + 3 * m + k) - ld4(h + k)) +
+          3.0 * (ld4(h + m + k) - ld4(h + 2 * m + k))) +
+         q * ((ldf4(l + 3 * m + k) - ldf4(l + k)) +
+              3.0 * (ldf4(l + m + k) - ldf4(l + 2 * m + k)));
 }
 
 template <int D>
 __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
-                                                   const double* l, R_xlen_t m,
-                                                   R_xlen_t& k, R_xlen_t k1) {
+                                                   const float* l, double q,
+                                                   R_xlen_t m, R_xlen_t& k,
+                                                   R_xlen_t k1) {
+  const v4d qv = {q, q, q, q};
   v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v4d d0 = diff4<D>(h, l, m, k);
-    const v4d d1 = diff4<D>(h, l, m, k + 4);
+    const v4d d0 = diff4<D>(h, l, qv, m, k);
+    const v4d d1 = diff4<D>(h, l, qv, m, k + 4);
     a0 += d0 * d0;
     a1 += d1 * d1;
   }
@@ -325,42 +368,45 @@ __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
          ((a0[1] + a1[1]) + (a0[3] + a1[3]));
 }
 
-// The same lanes with fused multiply-adds where the CPU has them: six
-// floating-point operations a term instead of nine. The hi
-// parts' weights are exact either way, and 2 l is exact, so the difference
-// is the same number; the squares' sum (and 3 (l1 - l2) for D = 3) round
-// once less, a last-bit change of the sum (not the SSE2 path's bits).
+// The same lanes with fused multiply-adds where the CPU has them: seven
+// floating-point operations a term instead of ten. The hi
+// parts' weights are exact either way, and 2 l is exact, so the hi and lo
+// differences are the same numbers; hi + q lo, the squares' sum (and
+// 3 (l1 - l2) for D = 3) round once less, a last-bit change of the sum (not
+// the SSE2 path's bits).
 __attribute__((target("avx2,fma"))) inline v4d fma4(v4d a, v4d b, v4d c) {
   return __builtin_ia32_vfmaddpd256(a, b, c);
 }
 
 template <int D>
 __attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
-                                                        const double* l,
-                                                        R_xlen_t m,
+                                                        const float* l,
+                                                        v4d q, R_xlen_t m,
                                                         R_xlen_t k) {
-  auto ld = ld4;
   if (D == 2) {
     const v4d w = {-2.0, -2.0, -2.0, -2.0};
-    return fma4(w, ld(h + m + k), ld(h + 2 * m + k) + ld(h + k)) +
-           fma4(w, ld(l + m + k), ld(l + 2 * m + k) + ld(l + k));
+    return fma4(q,
+                fma4(w, ldf4(l + m + k), ldf4(l + 2 * m + k) + ldf4(l + k)),
+                fma4(w, ld4(h + m + k), ld4(h + 2 * m + k) + ld4(h + k)));
   }
   const v4d w = {3.0, 3.0, 3.0, 3.0};
-  return fma4(w, ld(h + m + k) - ld(h + 2 * m + k),
-              ld(h + 3 * m + k) - ld(h + k)) +
-         fma4(w, ld(l + m + k) - ld(l + 2 * m + k),
-              ld(l + 3 * m + k) - ld(l + k));
+  return fma4(q,
+              fma4(w, ldf4(l + m + k) - ldf4(l + 2 * m + k),
+                   ldf4(l + 3 * m + k) - ldf4(l + k)),
+              fma4(w, ld4(h + m + k) - ld4(h + 2 * m + k),
+                   ld4(h + 3 * m + k) - ld4(h + k)));
 }
 
 template <int D>
 __attribute__((target("avx2,fma"))) double sumsq8_fma(const double* h,
-                                                     const double* l,
+                                                     const float* l, double q,
                                                      R_xlen_t m, R_xlen_t& k,
                                                      R_xlen_t k1) {
+  const v4d qv = {q, q, q, q};
   v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v4d d0 = diff4_fma<D>(h, l, m, k);
-    const v4d d1 = diff4_fma<D>(h, l, m, k + 4);
+    const v4d d0 = diff4_fma<D>(h, l, qv, m, k);
+    const v4d d1 = diff4_fma<D>(h, l, qv, m, k + 4);
     a0 = fma4(d0, d0, a0);
     a1 = fma4(d1, d1, a1);
   }
@@ -382,19 +428,19 @@ inline bool have_avx2() {
 #endif
 
 template <int D>
-inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
-                     R_xlen_t k1) {
+inline double sumsq1(const double* h, const float* l, double q, R_xlen_t m,
+                     R_xlen_t k0, R_xlen_t k1) {
   double tail = 0;
   R_xlen_t k = k0;
 #if defined(ALLANVAR_AVX2)
-  tail = have_fma()    ? sumsq8_fma<D>(h, l, m, k, k1)
-         : have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
-                       : sumsq8_sse2<D>(h, l, m, k, k1);
+  tail = have_fma()    ? sumsq8_fma<D>(h, l, q, m, k, k1)
+         : have_avx2() ? sumsq8_avx2<D>(h, l, q, m, k, k1)
+                       : sumsq8_sse2<D>(h, l, q, m, k, k1);
 #elif defined(__GNUC__)
-  tail = sumsq8_sse2<D>(h, l, m, k, k1);
+  tail = sumsq8_sse2<D>(h, l, q, m, k, k1);
 #endif
   for (; k < k1; ++k) {
-    const double d = diff_at<D>(h, l, m, k);
+    const double d = diff_at<D>(h, l, q, m, k);
     tail += d * d;
   }
   return tail;
@@ -430,7 +476,7 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
         if ((j & 63) == 63 && allanvar::interrupted()) return;
         const R_xlen_t e = std::min(b1, nterms[j]);
         if (e <= b0) continue;
-        p[j] += sumsq1<D>(X.hi.data(), X.lo.data(), ms[j], b0, e);
+        p[j] += sumsq1<D>(X.hi.data(), X.lo.data(), X.q, ms[j], b0, e);
       }
     }
   });
@@ -446,24 +492,25 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
 // Stride-m sum of squared differences of order D (2 or 3) over n terms: each
 // term loads one new point and reuses the previous ones.
 template <int D>
-double strided_sum(const double* h, const double* l, R_xlen_t m, R_xlen_t n) {
+double strided_sum(const double* h, const float* l, double q, R_xlen_t m,
+                   R_xlen_t n) {
   Acc a;
   double s0 = 0, s1 = 0;
   double h0 = h[0], l0 = l[0], h1 = h[m], l1 = l[m];
   double h2 = D == 3 ? h[2 * m] : 0, l2 = D == 3 ? l[2 * m] : 0;
   const double* ph = h + D * m;
-  const double* pl = l + D * m;
+  const float* pl = l + D * m;
   for (R_xlen_t i = 0; i < n; ++i, ph += m, pl += m) {
     const double hn = *ph, ln = *pl;
     double d;
     if (D == 2) {
-      d = ((hn + h0) - 2.0 * h1) + ((ln + l0) - 2.0 * l1);
+      d = ((hn + h0) - 2.0 * h1) + q * ((ln + l0) - 2.0 * l1);
       h0 = h1;
       l0 = l1;
       h1 = hn;
       l1 = ln;
     } else {
-      d = ((hn - h0) + 3.0 * (h1 - h2)) + ((ln - l0) + 3.0 * (l1 - l2));
+      d = ((hn - h0) + 3.0 * (h1 - h2)) + q * ((ln - l0) + 3.0 * (l1 - l2));
       h0 = h1;
       l0 = l1;
       h1 = h2;
@@ -512,7 +559,8 @@ void strided(const Split& X, const std::vector<R_xlen_t>& ms,
             [&](R_xlen_t r) {
               for (size_t j = cut[r]; j < cut[r + 1]; ++j) {
                 if (allanvar::interrupted()) return;
-                out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), ms[j], nterms[j]);
+                out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), X.q, ms[j],
+                                        nterms[j]);
               }
             });
 }
@@ -527,7 +575,8 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
            bool main, double* out) {
   const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
   const double* h = X.hi.data();
-  const double* l = X.lo.data();
+  const float* l = X.lo.data();
+  const double q = X.q;
   const size_t nt = ms.size();
   std::vector<R_xlen_t> inner(nt, 0);
   for (size_t j = 0; j < nt; ++j) inner[j] = std::max<R_xlen_t>(0, L - 2 * ms[j]);
@@ -539,25 +588,25 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
     const R_xlen_t m = ms[j];
     // one term has at most 5 points, total weight 8: exact on the hi grid
     auto term = [&](R_xlen_t i) {
-      double dh = -2.0 * h[i], dl = -2.0 * l[i];
+      double dh = -2.0 * h[i], dl = -2.0 * static_cast<double>(l[i]);
       const R_xlen_t a0 = i - m;
       if (a0 >= 0) {
         dh += h[a0];
-        dl += l[a0];
+        dl += static_cast<double>(l[a0]);
       } else {
         dh += 2.0 * h[0] - h[-a0];
-        dl += 2.0 * l[0] - l[-a0];
+        dl += 2.0 * static_cast<double>(l[0]) - l[-a0];
       }
       const R_xlen_t a1 = i + m;
       if (a1 <= L - 1) {
         dh += h[a1];
-        dl += l[a1];
+        dl += static_cast<double>(l[a1]);
       } else {
         const R_xlen_t r = 2 * (L - 1) - a1;
         dh += 2.0 * h[L - 1] - h[r];
-        dl += 2.0 * l[L - 1] - l[r];
+        dl += 2.0 * static_cast<double>(l[L - 1]) - l[r];
       }
-      return dh + dl;
+      return dh + q * dl;
     };
     // the centres outside [m, L-1-m]
     R_xlen_t r0[2] = {1, std::max(m, L - m)};
@@ -1559,9 +1608,12 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   // MODIFIED's sums built one more level. Frequency data at m = 1 are the
   // samples.
   const double* h = X.hi.data();
-  const double* l = X.lo.data();
-  auto phase = [h, l, two](R_xlen_t k) -> double {
-    return two ? (h[k + 1] - h[k]) + (l[k + 1] - l[k]) : h[k] + l[k];
+  const float* l = X.lo.data();
+  const double q = X.q;
+  auto phase = [h, l, q, two](R_xlen_t k) -> double {
+    const double lk = l[k];
+    return two ? (h[k + 1] - h[k]) + q * (static_cast<double>(l[k + 1]) - lk)
+               : h[k] + q * lk;
   };
   const R_xlen_t Lp = rate ? N + 1 : N;
   auto build = [&phase, Lp](allanvar::RnCache& r) { r.build(phase, Lp); };
@@ -1790,7 +1842,8 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
     Rcpp::stop("allanvar_out_of_memory");
   }
   const double* h = X.hi.data();
-  const double* l = X.lo.data();
+  const float* l = X.lo.data();
+  const double q = X.q;
   const bool stride1 = allanvar::estimator_info(type).overlapping;
   const int d = type == STANDARD || type == OVERLAPPING ? 2 : 3;
   const R_xlen_t L = rate ? N + 1 : N;
@@ -1814,7 +1867,8 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
         for (int t = 0; t <= d; ++t) skip = skip || missing(k + t * mm, k + t * mm + 1);
       }
       if (skip) continue;
-      const double dv = d == 2 ? diff_at<2>(h, l, mm, k) : diff_at<3>(h, l, mm, k);
+      const double dv = d == 2 ? diff_at<2>(h, l, q, mm, k)
+                              : diff_at<3>(h, l, q, mm, k);
       s += dv * dv;
       ++cnt;
       if (++blk == kBlock) {
