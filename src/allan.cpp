@@ -7,10 +7,11 @@
 // <= 8 is then exact in double. lo is the rest in units of q (at most 1/2
 // and a rounding: each point's grid part is moved into hi) stored as a float,
 // 12 bytes a point instead of 16 (the far taus' streams come from memory).
-// The float's rounding, at most 2^-25 of 1/2, leaves q lo within 2^-26 q =
-// 2^-76 of the largest |X| of the exact value: below the double rounding of
-// the differences at every tau for records of up to 2^23 times the data's
-// range over their scale, and a random-signed part of it beyond. Differences of
+// The float rounds q lo by at most 2^-25 q, about 2^-75 of the largest |X|
+// (for rate data up to N times the samples' half-range): a term's
+// difference moves by at most 2^-22 q (weights of total size 8), e.g. 1e-14
+// of a white-FM term at m = 1 and 1e7 samples, with a sign that varies from
+// term to term, so the sums of squares move far less. Differences of
 // huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
 // drift or length of the record.
 #include "buffer.h"
@@ -504,8 +505,8 @@ __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
          ((a0[1] + a1[1]) + (a0[3] + a1[3]));
 }
 
-// The same lanes with fused multiply-adds where the CPU has them: seven
-// floating-point operations a term instead of ten. The hi
+// The same lanes with fused multiply-adds where the CPU has them: six
+// floating-point operations a term (and three widenings) instead of ten. The hi
 // parts' weights are exact either way, and 2 l is exact, so the hi and lo
 // differences are the same numbers; hi + q lo, the squares' sum (and
 // 3 (l1 - l2) for D = 3) round once less, a last-bit change of the sum (not
