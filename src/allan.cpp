@@ -66,11 +66,24 @@ void run_items(R_xlen_t n, int threads, bool main, F f) {
   }
 }
 
-// X = hi + q lo (the file's head)
+// X = hi + q lo (the file's head). The prefix sums of X (levels = 2, the
+// modified type's sums) keep lo in double (wlo): their q, 2^-50 of N^2 times
+// the samples' range, is near a term's size at m = 1, too coarse for a
+// float's 24 bits.
 struct Split {
   Buffer hi;
   FloatBuffer lo;
+  Buffer wlo;
   double q = 1;
+  bool wide = false;
+  // f(lo) with the lo array in use
+  template <class F>
+  auto with_lo(F f) const -> decltype(f(lo.data())) {
+    return wide ? f(wlo.data()) : f(lo.data());
+  }
+  double lo_at(R_xlen_t i) const {
+    return wide ? wlo[i] : static_cast<double>(lo[i]);
+  }
 };
 
 // Single passes over the samples ask for interrupts every 2^20 samples.
@@ -276,11 +289,21 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
                   int levels, Split& out, int threads, bool main) {
   const R_xlen_t len = n + levels;
   out.hi.resize(len);
-  out.lo.resize(len);
+  out.wide = levels == 2;
+  if (out.wide) {
+    out.wlo.resize(len);
+  } else {
+    out.lo.resize(len);
+  }
   double* hi = out.hi.data();
   float* lo = out.lo.data();
-  hi[0] = lo[0] = 0;
-  if (levels == 2) hi[1] = lo[1] = 0;
+  double* wlo = out.wlo.data();
+  hi[0] = 0;
+  if (levels == 2) {
+    hi[1] = wlo[0] = wlo[1] = 0;
+  } else {
+    lo[0] = 0;
+  }
   const double nn = static_cast<double>(n);
   double b = bound * nn * (1 + 1e-9);
   if (levels == 2) b *= nn + 1;
@@ -349,7 +372,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     const double t = (s2 - h) + e2;
     const double g = (t + C) - C;
     hi[i] = h + g;
-    lo[i] = static_cast<float>((t - g) * rq);
+    wlo[i] = (t - g) * rq;
   };
   for (R_xlen_t i = 0; i < n; ++i) {
     if ((i & kPoll) == kPoll && allanvar::interrupted()) return;
@@ -377,6 +400,7 @@ void build_split(const double* v, R_xlen_t n, double c, double bound,
                  Split& out) {
   out.hi.resize(n);
   out.lo.resize(n);
+  out.wide = false;
   const double q = grid_step(bound * (1 + 1e-9));
   const double C = 1.5 * q * 4503599627370496.0;
   const double rq = 1 / q;
@@ -396,8 +420,8 @@ using allanvar::v2d;
 using allanvar::ld2;
 #endif
 
-template <int D>
-inline double diff_at(const double* h, const float* f, double q, R_xlen_t m,
+template <int D, class L>
+inline double diff_at(const double* h, const L* f, double q, R_xlen_t m,
                       R_xlen_t k) {
   auto l = [f](R_xlen_t i) { return static_cast<double>(f[i]); };
   if (D == 2) {
@@ -422,9 +446,10 @@ inline v2d ldf2(const float* p) {
   std::memcpy(&v, p, sizeof v);
   return __builtin_convertvector(v, v2d);
 }
+inline v2d ldf2(const double* p) { return ld2(p); }
 
-template <int D>
-inline v2d diff_vec(const double* h, const float* l, v2d q, R_xlen_t m,
+template <int D, class L>
+inline v2d diff_vec(const double* h, const L* l, v2d q, R_xlen_t m,
                     R_xlen_t k) {
   if (D == 2) {
     return ((ld2(h + 2 * m + k) + ld2(h + k)) - 2.0 * ld2(h + m + k)) +
@@ -436,16 +461,16 @@ inline v2d diff_vec(const double* h, const float* l, v2d q, R_xlen_t m,
               3.0 * (ldf2(l + m + k) - ldf2(l + 2 * m + k)));
 }
 
-template <int D>
-inline double sumsq8_sse2(const double* h, const float* l, double q,
+template <int D, class L>
+inline double sumsq8_sse2(const double* h, const L* l, double q,
                           R_xlen_t m, R_xlen_t& k, R_xlen_t k1) {
   const v2d qv = {q, q};
   v2d a0 = {0, 0}, a1 = {0, 0}, a2 = {0, 0}, a3 = {0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v2d d0 = diff_vec<D>(h, l, qv, m, k);
-    const v2d d1 = diff_vec<D>(h, l, qv, m, k + 2);
-    const v2d d2 = diff_vec<D>(h, l, qv, m, k + 4);
-    const v2d d3 = diff_vec<D>(h, l, qv, m, k + 6);
+    const v2d d0 = diff_vec<D, L>(h, l, qv, m, k);
+    const v2d d1 = diff_vec<D, L>(h, l, qv, m, k + 2);
+    const v2d d2 = diff_vec<D, L>(h, l, qv, m, k + 4);
+    const v2d d3 = diff_vec<D, L>(h, l, qv, m, k + 6);
     a0 += d0 * d0;
     a1 += d1 * d1;
     a2 += d2 * d2;
@@ -472,10 +497,13 @@ __attribute__((target("avx2"))) inline v4d ldf4(const float* p) {
   std::memcpy(&v, p, sizeof v);
   return __builtin_ia32_cvtps2pd256(v);
 }
+__attribute__((target("avx2"))) inline v4d ldf4(const double* p) {
+  return ld4(p);
+}
 
-template <int D>
+template <int D, class L>
 __attribute__((target("avx2"))) inline v4d diff4(const double* h,
-                                                 const float* l, v4d q,
+                                                 const L* l, v4d q,
                                                  R_xlen_t m, R_xlen_t k) {
   if (D == 2) {
     return ((ld4(h + 2 * m + k) + ld4(h + k)) - 2.0 * ld4(h + m + k)) +
@@ -487,16 +515,16 @@ __attribute__((target("avx2"))) inline v4d diff4(const double* h,
               3.0 * (ldf4(l + m + k) - ldf4(l + 2 * m + k)));
 }
 
-template <int D>
+template <int D, class L>
 __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
-                                                   const float* l, double q,
+                                                   const L* l, double q,
                                                    R_xlen_t m, R_xlen_t& k,
                                                    R_xlen_t k1) {
   const v4d qv = {q, q, q, q};
   v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v4d d0 = diff4<D>(h, l, qv, m, k);
-    const v4d d1 = diff4<D>(h, l, qv, m, k + 4);
+    const v4d d0 = diff4<D, L>(h, l, qv, m, k);
+    const v4d d1 = diff4<D, L>(h, l, qv, m, k + 4);
     a0 += d0 * d0;
     a1 += d1 * d1;
   }
@@ -515,9 +543,9 @@ __attribute__((target("avx2,fma"))) inline v4d fma4(v4d a, v4d b, v4d c) {
   return __builtin_ia32_vfmaddpd256(a, b, c);
 }
 
-template <int D>
+template <int D, class L>
 __attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
-                                                        const float* l,
+                                                        const L* l,
                                                         v4d q, R_xlen_t m,
                                                         R_xlen_t k) {
   if (D == 2) {
@@ -534,16 +562,16 @@ __attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
                    ld4(h + 3 * m + k) - ld4(h + k)));
 }
 
-template <int D>
+template <int D, class L>
 __attribute__((target("avx2,fma"))) double sumsq8_fma(const double* h,
-                                                     const float* l, double q,
+                                                     const L* l, double q,
                                                      R_xlen_t m, R_xlen_t& k,
                                                      R_xlen_t k1) {
   const v4d qv = {q, q, q, q};
   v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v4d d0 = diff4_fma<D>(h, l, qv, m, k);
-    const v4d d1 = diff4_fma<D>(h, l, qv, m, k + 4);
+    const v4d d0 = diff4_fma<D, L>(h, l, qv, m, k);
+    const v4d d1 = diff4_fma<D, L>(h, l, qv, m, k + 4);
     a0 = fma4(d0, d0, a0);
     a1 = fma4(d1, d1, a1);
   }
@@ -564,20 +592,20 @@ inline bool have_avx2() {
 #endif
 #endif
 
-template <int D>
-inline double sumsq1(const double* h, const float* l, double q, R_xlen_t m,
+template <int D, class L>
+inline double sumsq1(const double* h, const L* l, double q, R_xlen_t m,
                      R_xlen_t k0, R_xlen_t k1) {
   double tail = 0;
   R_xlen_t k = k0;
 #if defined(ALLANVAR_AVX2)
-  tail = have_fma()    ? sumsq8_fma<D>(h, l, q, m, k, k1)
-         : have_avx2() ? sumsq8_avx2<D>(h, l, q, m, k, k1)
-                       : sumsq8_sse2<D>(h, l, q, m, k, k1);
+  tail = have_fma()    ? sumsq8_fma<D, L>(h, l, q, m, k, k1)
+         : have_avx2() ? sumsq8_avx2<D, L>(h, l, q, m, k, k1)
+                       : sumsq8_sse2<D, L>(h, l, q, m, k, k1);
 #elif defined(__GNUC__)
-  tail = sumsq8_sse2<D>(h, l, q, m, k, k1);
+  tail = sumsq8_sse2<D, L>(h, l, q, m, k, k1);
 #endif
   for (; k < k1; ++k) {
-    const double d = diff_at<D>(h, l, q, m, k);
+    const double d = diff_at<D, L>(h, l, q, m, k);
     tail += d * d;
   }
   return tail;
@@ -613,7 +641,9 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
         if ((j & 63) == 63 && allanvar::interrupted()) return;
         const R_xlen_t e = std::min(b1, nterms[j]);
         if (e <= b0) continue;
-        p[j] += sumsq1<D>(X.hi.data(), X.lo.data(), X.q, ms[j], b0, e);
+        p[j] += X.with_lo([&](const auto* l) {
+          return sumsq1<D>(X.hi.data(), l, X.q, ms[j], b0, e);
+        });
       }
     }
   });
@@ -628,15 +658,15 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
 
 // Stride-m sum of squared differences of order D (2 or 3) over n terms: each
 // term loads one new point and reuses the previous ones.
-template <int D>
-double strided_sum(const double* h, const float* l, double q, R_xlen_t m,
+template <int D, class L>
+double strided_sum(const double* h, const L* l, double q, R_xlen_t m,
                    R_xlen_t n) {
   Acc a;
   double s0 = 0, s1 = 0;
   double h0 = h[0], l0 = l[0], h1 = h[m], l1 = l[m];
   double h2 = D == 3 ? h[2 * m] : 0, l2 = D == 3 ? l[2 * m] : 0;
   const double* ph = h + D * m;
-  const float* pl = l + D * m;
+  const L* pl = l + D * m;
   for (R_xlen_t i = 0; i < n; ++i, ph += m, pl += m) {
     const double hn = *ph, ln = *pl;
     double d;
@@ -696,8 +726,9 @@ void strided(const Split& X, const std::vector<R_xlen_t>& ms,
             [&](R_xlen_t r) {
               for (size_t j = cut[r]; j < cut[r + 1]; ++j) {
                 if (allanvar::interrupted()) return;
-                out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), X.q, ms[j],
-                                        nterms[j]);
+                out[j] = X.with_lo([&](const auto* l) {
+                  return strided_sum<D>(X.hi.data(), l, X.q, ms[j], nterms[j]);
+                });
               }
             });
 }
@@ -712,7 +743,7 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
            bool main, double* out) {
   const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
   const double* h = X.hi.data();
-  const float* l = X.lo.data();
+  auto l = [&X](R_xlen_t i) { return X.lo_at(i); };
   const double q = X.q;
   const size_t nt = ms.size();
   std::vector<R_xlen_t> inner(nt, 0);
@@ -725,23 +756,23 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
     const R_xlen_t m = ms[j];
     // one term has at most 5 points, total weight 8: exact on the hi grid
     auto term = [&](R_xlen_t i) {
-      double dh = -2.0 * h[i], dl = -2.0 * static_cast<double>(l[i]);
+      double dh = -2.0 * h[i], dl = -2.0 * l(i);
       const R_xlen_t a0 = i - m;
       if (a0 >= 0) {
         dh += h[a0];
-        dl += static_cast<double>(l[a0]);
+        dl += l(a0);
       } else {
         dh += 2.0 * h[0] - h[-a0];
-        dl += 2.0 * static_cast<double>(l[0]) - l[-a0];
+        dl += 2.0 * l(0) - l(-a0);
       }
       const R_xlen_t a1 = i + m;
       if (a1 <= L - 1) {
         dh += h[a1];
-        dl += static_cast<double>(l[a1]);
+        dl += l(a1);
       } else {
         const R_xlen_t r = 2 * (L - 1) - a1;
         dh += 2.0 * h[L - 1] - h[r];
-        dl += 2.0 * static_cast<double>(l[L - 1]) - l[r];
+        dl += 2.0 * l(L - 1) - l(r);
       }
       return dh + q * dl;
     };
@@ -1729,11 +1760,11 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   // MODIFIED's sums built one more level. Frequency data at m = 1 are the
   // samples.
   const double* h = X.hi.data();
-  const float* l = X.lo.data();
   const double q = X.q;
-  auto phase = [h, l, q, two](R_xlen_t k) -> double {
-    const double lk = l[k];
-    return two ? (h[k + 1] - h[k]) + q * (static_cast<double>(l[k + 1]) - lk)
+  const Split* Xp = &X;
+  auto phase = [h, Xp, q, two](R_xlen_t k) -> double {
+    const double lk = Xp->lo_at(k);
+    return two ? (h[k + 1] - h[k]) + q * (Xp->lo_at(k + 1) - lk)
                : h[k] + q * lk;
   };
   const R_xlen_t Lp = rate ? N + 1 : N;
@@ -1963,7 +1994,6 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
     Rcpp::stop("allanvar_out_of_memory");
   }
   const double* h = X.hi.data();
-  const float* l = X.lo.data();
   const double q = X.q;
   const bool stride1 = allanvar::estimator_info(type).overlapping;
   const int d = type == STANDARD || type == OVERLAPPING ? 2 : 3;
@@ -1988,8 +2018,9 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
         for (int t = 0; t <= d; ++t) skip = skip || missing(k + t * mm, k + t * mm + 1);
       }
       if (skip) continue;
-      const double dv = d == 2 ? diff_at<2>(h, l, q, mm, k)
-                              : diff_at<3>(h, l, q, mm, k);
+      const double dv = X.with_lo([&](const auto* l) {
+        return d == 2 ? diff_at<2>(h, l, q, mm, k) : diff_at<3>(h, l, q, mm, k);
+      });
       s += dv * dv;
       ++cnt;
       if (++blk == kBlock) {
