@@ -66,10 +66,11 @@ void run_items(R_xlen_t n, int threads, bool main, F f) {
   }
 }
 
-// X = hi + q lo (the file's head). The prefix sums of X (levels = 2, the
-// modified type's sums) keep lo in double (wlo): their q, 2^-50 of N^2 times
-// the samples' range, is near a term's size at m = 1, too coarse for a
-// float's 24 bits.
+// X = hi + q lo (the file's head). The modified type's extra level of sums
+// (the prefix sums of X for rate data, of the phase for integrated input)
+// keeps lo in double (wlo): its q, 2^-50 of N times the summed sequence's
+// range, can be near a term's size at m = 1 (N^2 times the samples' range,
+// or a phase with a slope), too coarse for a float's 24 bits.
 struct Split {
   Buffer hi;
   FloatBuffer lo;
@@ -132,10 +133,16 @@ typedef long long pv4i __attribute__((vector_size(32)));
 #define ALLANVAR_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, pv4i{i, j, k, l})
 #endif
 
-template <bool Store>
+inline void store_lo(float* p, pv4 x) {
+  const pv4f f = __builtin_convertvector(x, pv4f);
+  std::memcpy(p, &f, sizeof f);
+}
+inline void store_lo(double* p, pv4 x) { std::memcpy(p, &x, sizeof x); }
+
+template <bool Store, class L>
 inline __attribute__((always_inline)) void prefix_body(
     const double* v, R_xlen_t i0, R_xlen_t i1, double c, double C, double rq,
-    double h, double l0, double* hi, float* lo, double& hsum, double& lsum) {
+    double h, double l0, double* hi, L* lo, double& hsum, double& lsum) {
   const pv4 cv = {-c, -c, -c, -c}, Cv = {C, C, C, C}, z = {0, 0, 0, 0};
   const pv4 rqv = {rq, rq, rq, rq}, l0v = {l0, l0, l0, l0};
   pv4 hl = z, ll = z, hb = {h, h, h, h}, lb = z;
@@ -163,9 +170,8 @@ inline __attribute__((always_inline)) void prefix_body(
       lb += ALLANVAR_SHUF(pr, pr, 3, 3, 3, 3);
       const pv4 g = (t + Cv) - Cv;
       const pv4 hx = hv + g;
-      const pv4f lx = __builtin_convertvector((t - g) * rqv, pv4f);
       std::memcpy(hi + i + 1, &hx, sizeof hx);
-      std::memcpy(lo + i + 1, &lx, sizeof lx);
+      store_lo(lo + i + 1, (t - g) * rqv);
     }
   }
   double hs = hl[0], ls = ll[0], hh = hb[0], l = lb[0];
@@ -180,42 +186,43 @@ inline __attribute__((always_inline)) void prefix_body(
       const double t = l0 + l;
       const double g = (t + C) - C;
       hi[i + 1] = hh + g;
-      lo[i + 1] = static_cast<float>((t - g) * rq);
+      lo[i + 1] = static_cast<L>((t - g) * rq);
     }
   }
   hsum = (hs + hl[1]) + (hl[2] + hl[3]);
   lsum = (ls + ll[1]) + (ll[2] + ll[3]);
 }
 
-template <bool Store>
+template <bool Store, class L>
 void prefix_block_sse2(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
                        double C, double rq, double h, double l0, double* hi,
-                       float* lo, double& hsum, double& lsum) {
-  prefix_body<Store>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
+                       L* lo, double& hsum, double& lsum) {
+  prefix_body<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
 }
 
 #if defined(__x86_64__)
 // the same operations in one AVX2 instruction each (no FMA: the same bits)
-template <bool Store>
+template <bool Store, class L>
 __attribute__((target("avx2"))) void prefix_block_avx2(
     const double* v, R_xlen_t i0, R_xlen_t i1, double c, double C, double rq,
-    double h, double l0, double* hi, float* lo, double& hsum, double& lsum) {
-  prefix_body<Store>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
+    double h, double l0, double* hi, L* lo, double& hsum, double& lsum) {
+  prefix_body<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
 }
 #endif
 
-template <bool Store>
+template <bool Store, class L>
 void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
                   double C, double rq, double h, double l0, double* hi,
-                  float* lo, double& hsum, double& lsum) {
+                  L* lo, double& hsum, double& lsum) {
 #if defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2");
   if (avx2) {
-    prefix_block_avx2<Store>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
+    prefix_block_avx2<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum,
+                                lsum);
     return;
   }
 #endif
-  prefix_block_sse2<Store>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
+  prefix_block_sse2<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
 }
 
 // The samples' range on [i0, i1) (i1 > i0) and the sum of v * 0 (NaN when a
@@ -285,11 +292,66 @@ void sample_range(const double* v, R_xlen_t n, int threads, bool main,
   }
 }
 
+// build_prefix(levels = 1) into hi and lo (float, or double when wide).
+template <class L>
+void rate_prefix(const double* v, R_xlen_t n, double c, double C, double rq,
+                 double* hi, L* lo, int threads, bool main) {
+  // X_{i+1} = X_i + (v_i - c). Each increment v_i - c = r + re (TwoSum)
+  // is split into a on the grid q and the remainder (r - a) + re (at most
+  // q/2 and an ulp): hi sums the a exactly (multiples of q below 2^50 q,
+  // in any order), lo the remainders in plain double (rounding about
+  // eps n q, far below q), whose running grid part is stored in hi and
+  // the rest in lo. hi being exact, the record is cut into fixed
+  // blocks: on two threads their sums first, then each block's prefix
+  // from its start; on one, a single pass making the same additions. The
+  // result does not depend on the thread count.
+  const R_xlen_t nb = (n + kPrefixBlock - 1) / kPrefixBlock;
+  auto ends = [n](R_xlen_t k, R_xlen_t& i0, R_xlen_t& i1) {
+    i0 = k * kPrefixBlock;
+    i1 = std::min(n, i0 + kPrefixBlock);
+  };
+  if (threads < 2 || nb < 2) {
+    // one pass: each block from the running sums of those before it
+    double h = 0, l0 = 0;
+    for (R_xlen_t k = 0; k < nb; ++k) {
+      if ((k & 15) == 15 && allanvar::interrupted()) return;
+      R_xlen_t i0, i1;
+      ends(k, i0, i1);
+      double hs, ls;
+      prefix_block<true>(v, i0, i1, c, C, rq, h, l0, hi, lo, hs, ls);
+      h += hs;
+      l0 += ls;
+    }
+    return;
+  }
+  // two passes on the threads: block sums, then each block from its start
+  std::vector<double> hbase(nb + 1, 0.0), lbase(nb + 1, 0.0);
+  run_items(nb, threads, main, [&](R_xlen_t k) {
+    R_xlen_t i0, i1;
+    ends(k, i0, i1);
+    prefix_block<false>(v, i0, i1, c, C, rq, 0, 0, hi, lo, hbase[k + 1],
+                        lbase[k + 1]);
+  });
+  if (allanvar::interrupt_state().stop.load()) return;
+  for (R_xlen_t k = 0; k < nb; ++k) {
+    hbase[k + 1] += hbase[k];
+    lbase[k + 1] += lbase[k];
+  }
+  run_items(nb, threads, main, [&](R_xlen_t k) {
+    R_xlen_t i0, i1;
+    ends(k, i0, i1);
+    double hs, ls;
+    prefix_block<true>(v, i0, i1, c, C, rq, hbase[k], lbase[k], hi, lo, hs,
+                       ls);
+  });
+}
+
+// wide: lo in double (the modified type's extra level of sums, Split).
 void build_prefix(const double* v, R_xlen_t n, double c, double bound,
-                  int levels, Split& out, int threads, bool main) {
+                  int levels, bool wide, Split& out, int threads, bool main) {
   const R_xlen_t len = n + levels;
   out.hi.resize(len);
-  out.wide = levels == 2;
+  out.wide = wide || levels == 2;
   if (out.wide) {
     out.wlo.resize(len);
   } else {
@@ -299,11 +361,12 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   float* lo = out.lo.data();
   double* wlo = out.wlo.data();
   hi[0] = 0;
-  if (levels == 2) {
-    hi[1] = wlo[0] = wlo[1] = 0;
+  if (out.wide) {
+    wlo[0] = 0;
   } else {
     lo[0] = 0;
   }
+  if (levels == 2) hi[1] = wlo[1] = 0;
   const double nn = static_cast<double>(n);
   double b = bound * nn * (1 + 1e-9);
   if (levels == 2) b *= nn + 1;
@@ -314,54 +377,11 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   const double rq = 1 / q;  // exact: q is a power of two
   out.q = q;
   if (levels == 1) {
-    // X_{i+1} = X_i + (v_i - c). Each increment v_i - c = r + re (TwoSum)
-    // is split into a on the grid q and the remainder (r - a) + re (at most
-    // q/2 and an ulp): hi sums the a exactly (multiples of q below 2^50 q,
-    // in any order), lo the remainders in plain double (rounding about
-    // eps n q, far below q), whose running grid part is stored in hi and
-    // the rest in lo. hi being exact, the record is cut into fixed
-    // blocks: on two threads their sums first, then each block's prefix
-    // from its start; on one, a single pass making the same additions. The
-    // result does not depend on the thread count.
-    const R_xlen_t nb = (n + kPrefixBlock - 1) / kPrefixBlock;
-    auto ends = [n](R_xlen_t k, R_xlen_t& i0, R_xlen_t& i1) {
-      i0 = k * kPrefixBlock;
-      i1 = std::min(n, i0 + kPrefixBlock);
-    };
-    if (threads < 2 || nb < 2) {
-      // one pass: each block from the running sums of those before it
-      double h = 0, l0 = 0;
-      for (R_xlen_t k = 0; k < nb; ++k) {
-        if ((k & 15) == 15 && allanvar::interrupted()) return;
-        R_xlen_t i0, i1;
-        ends(k, i0, i1);
-        double hs, ls;
-        prefix_block<true>(v, i0, i1, c, C, rq, h, l0, hi, lo, hs, ls);
-        h += hs;
-        l0 += ls;
-      }
-      return;
+    if (out.wide) {
+      rate_prefix(v, n, c, C, rq, hi, wlo, threads, main);
+    } else {
+      rate_prefix(v, n, c, C, rq, hi, lo, threads, main);
     }
-    // two passes on the threads: block sums, then each block from its start
-    std::vector<double> hbase(nb + 1, 0.0), lbase(nb + 1, 0.0);
-    run_items(nb, threads, main, [&](R_xlen_t k) {
-      R_xlen_t i0, i1;
-      ends(k, i0, i1);
-      prefix_block<false>(v, i0, i1, c, C, rq, 0, 0, hi, lo, hbase[k + 1],
-                          lbase[k + 1]);
-    });
-    if (allanvar::interrupt_state().stop.load()) return;
-    for (R_xlen_t k = 0; k < nb; ++k) {
-      hbase[k + 1] += hbase[k];
-      lbase[k + 1] += lbase[k];
-    }
-    run_items(nb, threads, main, [&](R_xlen_t k) {
-      R_xlen_t i0, i1;
-      ends(k, i0, i1);
-      double hs, ls;
-      prefix_block<true>(v, i0, i1, c, C, rq, hbase[k], lbase[k], hi, lo, hs,
-                         ls);
-    });
     return;
   }
   // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c); P's
@@ -1743,7 +1763,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   if (level == 0) {
     build_split(v, N, c, bound, X);
   } else {
-    build_prefix(v, N, c, bound, level, X, threads, main);
+    build_prefix(v, N, c, bound, level, two, X, threads, main);
   }
   double* o = out.sums;
   // identification alone (other statistics' noise type) needs no sums
@@ -1988,7 +2008,7 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
     if (level == 0) {
       build_split(v.data(), N, c, bound, X);
     } else {
-      build_prefix(v.data(), N, c, bound, level, X, 1, true);
+      build_prefix(v.data(), N, c, bound, level, two, X, 1, true);
     }
   } catch (const std::bad_alloc&) {
     Rcpp::stop("allanvar_out_of_memory");
