@@ -29,6 +29,7 @@
 #include <cstring>
 #include <new>
 #include <memory>
+#include <type_traits>
 #include <vector>
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -68,9 +69,10 @@ void run_items(R_xlen_t n, int threads, bool main, F f) {
 
 // X = hi + q lo (the file's head). The modified type's extra level of sums
 // (the prefix sums of X for rate data, of the phase for integrated input)
-// keeps lo in double (wlo): its q, 2^-50 of N times the summed sequence's
-// range, can be near a term's size at m = 1 (N^2 times the samples' range,
-// or a phase with a slope), too coarse for a float's 24 bits.
+// keeps lo in double (wlo, in absolute units, q = 1 here: the running
+// remainders as they are): its grid step, 2^-50 of N times the summed
+// sequence's range, can be near a term's size at m = 1 (N^2 times the
+// samples' range, or a phase with a slope), too coarse for a float's 24 bits.
 struct Split {
   Buffer hi;
   FloatBuffer lo;
@@ -118,9 +120,9 @@ const R_xlen_t kPrefixBlock = static_cast<R_xlen_t>(1) << 16;
 // last (i1 - i0) % 4 in lane 0: the same additions whether or not the values
 // are stored), and with Store its X values from h + (l0 + l) on, the grid
 // part of l0 + l moved into hi (exact: both on the grid) and the rest, at
-// most q/2, times rq = 1/q into lo. Four samples a step in vectors: the
-// running sums carried in every lane and each step's prefix by two shifted
-// additions (the order of the remainders' additions is fixed: the result
+// most q/2, times rq = 1/q into a float lo (a double lo takes l0 + l as it
+// is, hi the running grid sum). Four samples a step in vectors: the running
+// sums carried in every lane and each step's prefix by two shifted additions (the order of the remainders' additions is fixed: the result
 // does not depend on the threads or the instruction set; one serial chain a
 // sample was the build's cost).
 // (GCC and Clang vector extensions)
@@ -168,10 +170,16 @@ inline __attribute__((always_inline)) void prefix_body(
       const pv4 t = l0v + (lb + pr);
       hb += ALLANVAR_SHUF(pa, pa, 3, 3, 3, 3);
       lb += ALLANVAR_SHUF(pr, pr, 3, 3, 3, 3);
-      const pv4 g = (t + Cv) - Cv;
-      const pv4 hx = hv + g;
-      std::memcpy(hi + i + 1, &hx, sizeof hx);
-      store_lo(lo + i + 1, (t - g) * rqv);
+      if (std::is_same<L, double>::value) {
+        // a double lo keeps the running remainder as it is (Split)
+        std::memcpy(hi + i + 1, &hv, sizeof hv);
+        store_lo(lo + i + 1, t);
+      } else {
+        const pv4 g = (t + Cv) - Cv;
+        const pv4 hx = hv + g;
+        std::memcpy(hi + i + 1, &hx, sizeof hx);
+        store_lo(lo + i + 1, (t - g) * rqv);
+      }
     }
   }
   double hs = hl[0], ls = ll[0], hh = hb[0], l = lb[0];
@@ -184,9 +192,14 @@ inline __attribute__((always_inline)) void prefix_body(
       hh += a;
       l += rem;
       const double t = l0 + l;
-      const double g = (t + C) - C;
-      hi[i + 1] = hh + g;
-      lo[i + 1] = static_cast<L>((t - g) * rq);
+      if (std::is_same<L, double>::value) {
+        hi[i + 1] = hh;
+        lo[i + 1] = static_cast<L>(t);
+      } else {
+        const double g = (t + C) - C;
+        hi[i + 1] = hh + g;
+        lo[i + 1] = static_cast<L>((t - g) * rq);
+      }
     }
   }
   hsum = (hs + hl[1]) + (hl[2] + hl[3]);
@@ -375,7 +388,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   const double q = grid_step(b);
   const double C = 1.5 * q * 4503599627370496.0;  // 1.5 q 2^52: ulp(C) = q
   const double rq = 1 / q;  // exact: q is a power of two
-  out.q = q;
+  out.q = out.wide ? 1.0 : q;  // a double lo in absolute units (Split)
   if (levels == 1) {
     if (out.wide) {
       rate_prefix(v, n, c, C, rq, hi, wlo, threads, main);
@@ -384,15 +397,12 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     }
     return;
   }
-  // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c); P's
-  // rest (s2 - h) + e2 split again, its grid part into hi
+  // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c)
   double s1 = 0, e1 = 0, s2 = 0, e2 = 0;
   auto put = [&](R_xlen_t i) {
     const double h = (s2 + C) - C;
-    const double t = (s2 - h) + e2;
-    const double g = (t + C) - C;
-    hi[i] = h + g;
-    wlo[i] = (t - g) * rq;
+    hi[i] = h;
+    wlo[i] = (s2 - h) + e2;
   };
   for (R_xlen_t i = 0; i < n; ++i) {
     if ((i & kPoll) == kPoll && allanvar::interrupted()) return;
