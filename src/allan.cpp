@@ -122,17 +122,19 @@ const R_xlen_t kPrefixBlock = static_cast<R_xlen_t>(1) << 16;
 // part of l0 + l moved into hi (exact: both on the grid) and the rest, at
 // most q/2, times rq = 1/q into a float lo (a double lo takes l0 + l as it
 // is, hi the running grid sum). Four samples a step in vectors: the running
-// sums carried in every lane and each step's prefix by two shifted additions (the order of the remainders' additions is fixed: the result
-// does not depend on the threads or the instruction set; one serial chain a
-// sample was the build's cost).
-// (GCC and Clang vector extensions)
+// sums carried in every lane and each step's prefix by two shifted
+// additions (GCC and Clang vector extensions). The order of the remainders'
+// additions is fixed: the result does not depend on the threads or the
+// instruction set. One serial chain a sample was the build's cost.
 typedef double pv4 __attribute__((vector_size(32)));
 typedef float pv4f __attribute__((vector_size(16)));
 #if defined(__clang__)
-#define ALLANVAR_SHUF(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#define ALLANVAR_SHUF(a, b, i, j, k, l) \
+  __builtin_shufflevector(a, b, i, j, k, l)
 #else
 typedef long long pv4i __attribute__((vector_size(32)));
-#define ALLANVAR_SHUF(a, b, i, j, k, l) __builtin_shuffle(a, b, pv4i{i, j, k, l})
+#define ALLANVAR_SHUF(a, b, i, j, k, l) \
+  __builtin_shuffle(a, b, pv4i{i, j, k, l})
 #endif
 
 inline void store_lo(float* p, pv4 x) {
@@ -773,7 +775,6 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
            bool main, double* out) {
   const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
   const double* h = X.hi.data();
-  auto l = [&X](R_xlen_t i) { return X.lo_at(i); };
   const double q = X.q;
   const size_t nt = ms.size();
   std::vector<R_xlen_t> inner(nt, 0);
@@ -781,55 +782,61 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
   overlapped<2>(X, ms, inner, threads, main, out);
   if (allanvar::interrupt_state().stop.load()) return;
   std::vector<double> edge(nt, 0.0);
-  run_items(static_cast<R_xlen_t>(nt), threads, main, [&](R_xlen_t j) {
-    if (allanvar::interrupted()) return;
-    const R_xlen_t m = ms[j];
-    // one term has at most 5 points, total weight 8: exact on the hi grid
-    auto term = [&](R_xlen_t i) {
-      double dh = -2.0 * h[i], dl = -2.0 * l(i);
-      const R_xlen_t a0 = i - m;
-      if (a0 >= 0) {
-        dh += h[a0];
-        dl += l(a0);
-      } else {
-        dh += 2.0 * h[0] - h[-a0];
-        dl += 2.0 * l(0) - l(-a0);
+  // lo's type fixed outside the loops (a branch a point cost a third of the
+  // end terms)
+  X.with_lo([&](const auto* lp) {
+    auto l = [lp](R_xlen_t i) { return static_cast<double>(lp[i]); };
+    run_items(static_cast<R_xlen_t>(nt), threads, main, [&](R_xlen_t j) {
+      if (allanvar::interrupted()) return;
+      const R_xlen_t m = ms[j];
+      // one term has at most 5 points, total weight 8: exact on the hi grid
+      auto term = [&](R_xlen_t i) {
+        double dh = -2.0 * h[i], dl = -2.0 * l(i);
+        const R_xlen_t a0 = i - m;
+        if (a0 >= 0) {
+          dh += h[a0];
+          dl += l(a0);
+        } else {
+          dh += 2.0 * h[0] - h[-a0];
+          dl += 2.0 * l(0) - l(-a0);
+        }
+        const R_xlen_t a1 = i + m;
+        if (a1 <= L - 1) {
+          dh += h[a1];
+          dl += l(a1);
+        } else {
+          const R_xlen_t r = 2 * (L - 1) - a1;
+          dh += 2.0 * h[L - 1] - h[r];
+          dl += 2.0 * l(L - 1) - l(r);
+        }
+        return dh + q * dl;
+      };
+      // the centres outside [m, L-1-m]
+      R_xlen_t r0[2] = {1, std::max(m, L - m)};
+      R_xlen_t r1[2] = {std::min(m - 1, L - 2), L - 2};
+      if (inner[j] == 0) {
+        r1[0] = L - 2;
+        r1[1] = -1;
       }
-      const R_xlen_t a1 = i + m;
-      if (a1 <= L - 1) {
-        dh += h[a1];
-        dl += l(a1);
-      } else {
-        const R_xlen_t r = 2 * (L - 1) - a1;
-        dh += 2.0 * h[L - 1] - h[r];
-        dl += 2.0 * l(L - 1) - l(r);
-      }
-      return dh + q * dl;
-    };
-    // the centres outside [m, L-1-m]
-    R_xlen_t r0[2] = {1, std::max(m, L - m)};
-    R_xlen_t r1[2] = {std::min(m - 1, L - 2), L - 2};
-    if (inner[j] == 0) {
-      r1[0] = L - 2;
-      r1[1] = -1;
-    }
-    Acc a;
-    double s = 0;
-    R_xlen_t cnt = 0;
-    for (int z = 0; z < 2; ++z) {
-      for (R_xlen_t i = r0[z]; i <= r1[z]; ++i) {
-        const double d = term(i);
-        s += d * d;
-        if (++cnt == kBlock) {
-          a.add(s);
-          s = 0;
-          cnt = 0;
-          if (allanvar::interrupted()) return;
+      Acc a;
+      double s = 0;
+      R_xlen_t cnt = 0;
+      for (int z = 0; z < 2; ++z) {
+        for (R_xlen_t i = r0[z]; i <= r1[z]; ++i) {
+          const double d = term(i);
+          s += d * d;
+          if (++cnt == kBlock) {
+            a.add(s);
+            s = 0;
+            cnt = 0;
+            if (allanvar::interrupted()) return;
+          }
         }
       }
-    }
-    a.add(s);
-    edge[j] = a.value();
+      a.add(s);
+      edge[j] = a.value();
+    });
+    return 0;
   });
   for (size_t j = 0; j < nt; ++j) {
     Acc a;
