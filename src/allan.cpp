@@ -2,11 +2,16 @@
 //
 // Every estimator is a sum of squares of small integer combinations of a
 // phase sequence X (the running sum of the rate samples, or the integrated
-// input itself). X is held as hi + lo, where hi lies on a grid of step q with
-// |hi| <= 2^50 q: any combination with integer weights of total size <= 8 is
-// then exact in double, and lo carries the rest (at most q/2 per point, or
-// per summed increment for the running sums of rate data: far below the
-// data's own scale, since q is 2^-50 of the largest |X|). Differences of
+// input itself). X is held as hi + q lo, where hi lies on a grid of step q
+// with |hi| <= 2^50 q: any combination with integer weights of total size
+// <= 8 is then exact in double. lo is the rest in units of q (at most 1/2
+// and a rounding: each point's grid part is moved into hi) stored as a float,
+// 12 bytes a point instead of 16 (the far taus' streams come from memory).
+// The float rounds q lo by at most 2^-25 q, about 2^-75 of the largest |X|
+// (for rate data up to N times the samples' half-range): a term's
+// difference moves by at most 2^-22 q (weights of total size 8), e.g. 1e-14
+// of a white-FM term at m = 1 and 1e7 samples, with a sign that varies from
+// term to term, so the sums of squares move far less. Differences of
 // huge, nearly equal prefix sums therefore lose nothing, whatever the bias,
 // drift or length of the record.
 #include "buffer.h"
@@ -24,6 +29,7 @@
 #include <cstring>
 #include <new>
 #include <memory>
+#include <type_traits>
 #include <vector>
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -33,6 +39,7 @@ namespace {
 
 using allanvar::AllanOptions;
 using allanvar::Buffer;
+using allanvar::FloatBuffer;
 using allanvar::STANDARD;
 using allanvar::OVERLAPPING;
 using allanvar::MODIFIED;
@@ -60,8 +67,26 @@ void run_items(R_xlen_t n, int threads, bool main, F f) {
   }
 }
 
+// X = hi + q lo (the file's head). The modified type's extra level of sums
+// (the prefix sums of X for rate data, of the phase for integrated input)
+// keeps lo in double (wlo, in absolute units, q = 1 here: the running
+// remainders as they are): its grid step, 2^-50 of N times the summed
+// sequence's range, can be near a term's size at m = 1 (N^2 times the
+// samples' range, or a phase with a slope), too coarse for a float's 24 bits.
 struct Split {
-  Buffer hi, lo;
+  Buffer hi;
+  FloatBuffer lo;
+  Buffer wlo;
+  double q = 1;
+  bool wide = false;
+  // f(lo) with the lo array in use
+  template <class F>
+  auto with_lo(F f) const -> decltype(f(lo.data())) {
+    return wide ? f(wlo.data()) : f(lo.data());
+  }
+  double lo_at(R_xlen_t i) const {
+    return wide ? wlo[i] : static_cast<double>(lo[i]);
+  }
 };
 
 // Single passes over the samples ask for interrupts every 2^20 samples.
@@ -72,7 +97,8 @@ inline double grid_step(double bound) {
   if (!(bound > 0) || !std::isfinite(bound)) return 1.0;
   int e;
   std::frexp(bound, &e);
-  return std::ldexp(1.0, e - 50);
+  // at least the smallest normal double: 1 / q stays finite
+  return std::max(std::ldexp(1.0, e - 50), 2.2250738585072014e-308);
 }
 
 // x - c as a on the grid of C (C = 1.5 q 2^52: ulp(C) = q) plus the rest
@@ -90,47 +116,272 @@ inline void grid_split(double x, double c, double C, double& a, double& rem) {
 const R_xlen_t kPrefixBlock = static_cast<R_xlen_t>(1) << 16;
 
 // One block [i0, i1) of build_prefix(levels = 1): the exact sum of its grid
-// parts and the sum of its remainders in four lanes (the last (i1 - i0) % 4
-// in lane 0: the same additions whether or not the values are stored), and
-// with Store its X values from h + (l0 + l) on.
-template <bool Store>
-void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
-                  double C, double h, double l0, double* hi, double* lo,
-                  double& hsum, double& lsum) {
-  double hl[4] = {0, 0, 0, 0}, ll[4] = {0, 0, 0, 0}, l = 0;
-  auto step = [&](R_xlen_t i, int u) {
-    double a, rem;
-    grid_split(v[i], c, C, a, rem);
-    hl[u] += a;
-    ll[u] += rem;
-    if (Store) {
-      h += a;
-      l += rem;
-      hi[i + 1] = h;
-      lo[i + 1] = l0 + l;
-    }
-  };
+// parts and the sum of its remainders in four lanes (i mod 4 from i0; the
+// last (i1 - i0) % 4 in lane 0: the same additions whether or not the values
+// are stored), and with Store its X values from h + (l0 + l) on, the grid
+// part of l0 + l moved into hi (exact: both on the grid) and the rest, at
+// most q/2, times rq = 1/q into a float lo (a double lo takes l0 + l as it
+// is, hi the running grid sum). Four samples a step in vectors: the running
+// sums carried in every lane and each step's prefix by two shifted
+// additions (GCC and Clang vector extensions). The order of the remainders'
+// additions is fixed: the result does not depend on the threads or the
+// instruction set. One serial chain a sample was the build's cost.
+typedef double pv4 __attribute__((vector_size(32)));
+typedef float pv4f __attribute__((vector_size(16)));
+#if defined(__clang__)
+#define ALLANVAR_SHUF(a, b, i, j, k, l) \
+  __builtin_shufflevector(a, b, i, j, k, l)
+#else
+typedef long long pv4i __attribute__((vector_size(32)));
+#define ALLANVAR_SHUF(a, b, i, j, k, l) \
+  __builtin_shuffle(a, b, pv4i{i, j, k, l})
+#endif
+
+inline void store_lo(float* p, pv4 x) {
+  const pv4f f = __builtin_convertvector(x, pv4f);
+  std::memcpy(p, &f, sizeof f);
+}
+inline void store_lo(double* p, pv4 x) { std::memcpy(p, &x, sizeof x); }
+
+template <bool Store, class L>
+inline __attribute__((always_inline)) void prefix_body(
+    const double* v, R_xlen_t i0, R_xlen_t i1, double c, double C, double rq,
+    double h, double l0, double* hi, L* lo, double& hsum, double& lsum) {
+  const pv4 cv = {-c, -c, -c, -c}, Cv = {C, C, C, C}, z = {0, 0, 0, 0};
+  const pv4 rqv = {rq, rq, rq, rq}, l0v = {l0, l0, l0, l0};
+  pv4 hl = z, ll = z, hb = {h, h, h, h}, lb = z;
   R_xlen_t i = i0;
   for (; i + 4 <= i1; i += 4) {
-    step(i, 0);
-    step(i + 1, 1);
-    step(i + 2, 2);
-    step(i + 3, 3);
+    pv4 x;
+    std::memcpy(&x, v + i, sizeof x);
+    // grid_split(x, c, C) lane by lane
+    const pv4 r = x + cv;
+    const pv4 bb = r - x;
+    const pv4 re = (x - (r - bb)) + (cv - bb);
+    const pv4 a = (r + Cv) - Cv;
+    const pv4 rem = (r - a) + re;
+    hl += a;
+    ll += rem;
+    if (Store) {
+      // inclusive prefix sums of the step (z's lanes are 4..7)
+      pv4 pa = a + ALLANVAR_SHUF(a, z, 4, 0, 1, 2);
+      pa += ALLANVAR_SHUF(pa, z, 4, 5, 0, 1);
+      pv4 pr = rem + ALLANVAR_SHUF(rem, z, 4, 0, 1, 2);
+      pr += ALLANVAR_SHUF(pr, z, 4, 5, 0, 1);
+      const pv4 hv = hb + pa;
+      const pv4 t = l0v + (lb + pr);
+      hb += ALLANVAR_SHUF(pa, pa, 3, 3, 3, 3);
+      lb += ALLANVAR_SHUF(pr, pr, 3, 3, 3, 3);
+      if (std::is_same<L, double>::value) {
+        // a double lo keeps the running remainder as it is (Split)
+        std::memcpy(hi + i + 1, &hv, sizeof hv);
+        store_lo(lo + i + 1, t);
+      } else {
+        const pv4 g = (t + Cv) - Cv;
+        const pv4 hx = hv + g;
+        std::memcpy(hi + i + 1, &hx, sizeof hx);
+        store_lo(lo + i + 1, (t - g) * rqv);
+      }
+    }
   }
-  for (; i < i1; ++i) step(i, 0);
-  hsum = (hl[0] + hl[1]) + (hl[2] + hl[3]);
-  lsum = (ll[0] + ll[1]) + (ll[2] + ll[3]);
+  double hs = hl[0], ls = ll[0], hh = hb[0], l = lb[0];
+  for (; i < i1; ++i) {
+    double a, rem;
+    grid_split(v[i], c, C, a, rem);
+    hs += a;
+    ls += rem;
+    if (Store) {
+      hh += a;
+      l += rem;
+      const double t = l0 + l;
+      if (std::is_same<L, double>::value) {
+        hi[i + 1] = hh;
+        lo[i + 1] = static_cast<L>(t);
+      } else {
+        const double g = (t + C) - C;
+        hi[i + 1] = hh + g;
+        lo[i + 1] = static_cast<L>((t - g) * rq);
+      }
+    }
+  }
+  hsum = (hs + hl[1]) + (hl[2] + hl[3]);
+  lsum = (ls + ll[1]) + (ll[2] + ll[3]);
 }
 
+template <bool Store, class L>
+void prefix_block_sse2(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
+                       double C, double rq, double h, double l0, double* hi,
+                       L* lo, double& hsum, double& lsum) {
+  prefix_body<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
+}
+
+#if defined(__x86_64__)
+// the same operations in one AVX2 instruction each (no FMA: the same bits)
+template <bool Store, class L>
+__attribute__((target("avx2"))) void prefix_block_avx2(
+    const double* v, R_xlen_t i0, R_xlen_t i1, double c, double C, double rq,
+    double h, double l0, double* hi, L* lo, double& hsum, double& lsum) {
+  prefix_body<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
+}
+#endif
+
+template <bool Store, class L>
+void prefix_block(const double* v, R_xlen_t i0, R_xlen_t i1, double c,
+                  double C, double rq, double h, double l0, double* hi,
+                  L* lo, double& hsum, double& lsum) {
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) {
+    prefix_block_avx2<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum,
+                                lsum);
+    return;
+  }
+#endif
+  prefix_block_sse2<Store, L>(v, i0, i1, c, C, rq, h, l0, hi, lo, hsum, lsum);
+}
+
+// The samples' range on [i0, i1) (i1 > i0) and the sum of v * 0 (NaN when a
+// sample is not finite: NaN compares false and keeps the running bound) in
+// four lanes, the tail in lane 0; r = {min, max, z}. Exact in any grouping:
+// blocks on the threads give the same result.
+inline __attribute__((always_inline)) void range_body(const double* v,
+                                                      R_xlen_t i0, R_xlen_t i1,
+                                                      double* r) {
+  pv4 lo = {v[i0], v[i0], v[i0], v[i0]}, hi = lo, z = {0, 0, 0, 0};
+  R_xlen_t i = i0;
+  for (; i + 4 <= i1; i += 4) {
+    pv4 a;
+    std::memcpy(&a, v + i, sizeof a);
+    lo = a < lo ? a : lo;
+    hi = a > hi ? a : hi;
+    z += a * 0.0;
+  }
+  double l = lo[0], h = hi[0], zz = z[0];
+  for (; i < i1; ++i) {
+    l = v[i] < l ? v[i] : l;
+    h = v[i] > h ? v[i] : h;
+    zz += v[i] * 0.0;
+  }
+  r[0] = std::min(std::min(l, lo[1]), std::min(lo[2], lo[3]));
+  r[1] = std::max(std::max(h, hi[1]), std::max(hi[2], hi[3]));
+  r[2] = (zz + z[1]) + (z[2] + z[3]);
+}
+
+void range_block_sse2(const double* v, R_xlen_t i0, R_xlen_t i1, double* r) {
+  range_body(v, i0, i1, r);
+}
+
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) void range_block_avx2(const double* v,
+                                                       R_xlen_t i0,
+                                                       R_xlen_t i1, double* r) {
+  range_body(v, i0, i1, r);
+}
+#endif
+
+// {min, max, z} of v[0, n) (n > 0) in blocks of 2^20 on the threads (one
+// pass over the samples on the main thread was 5-10% of an overlapping AV)
+void sample_range(const double* v, R_xlen_t n, int threads, bool main,
+                  double* r) {
+  const R_xlen_t B = static_cast<R_xlen_t>(1) << 20;
+  const R_xlen_t nb = (n + B - 1) / B;
+  std::vector<double> part(3 * nb);
+  run_items(nb, threads, main, [&](R_xlen_t k) {
+    const R_xlen_t i0 = k * B, i1 = std::min(n, i0 + B);
+#if defined(__x86_64__)
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    if (avx2) {
+      range_block_avx2(v, i0, i1, &part[3 * k]);
+      return;
+    }
+#endif
+    range_block_sse2(v, i0, i1, &part[3 * k]);
+  });
+  r[0] = part[0];
+  r[1] = part[1];
+  r[2] = part[2];
+  for (R_xlen_t k = 1; k < nb; ++k) {
+    r[0] = std::min(r[0], part[3 * k]);
+    r[1] = std::max(r[1], part[3 * k + 1]);
+    r[2] += part[3 * k + 2];
+  }
+}
+
+// build_prefix(levels = 1) into hi and lo (float, or double when wide).
+template <class L>
+void rate_prefix(const double* v, R_xlen_t n, double c, double C, double rq,
+                 double* hi, L* lo, int threads, bool main) {
+  // X_{i+1} = X_i + (v_i - c). Each increment v_i - c = r + re (TwoSum)
+  // is split into a on the grid q and the remainder (r - a) + re (at most
+  // q/2 and an ulp): hi sums the a exactly (multiples of q below 2^50 q,
+  // in any order), lo the remainders in plain double (rounding about
+  // eps n q, far below q), whose running grid part is stored in hi and
+  // the rest in lo. hi being exact, the record is cut into fixed
+  // blocks: on two threads their sums first, then each block's prefix
+  // from its start; on one, a single pass making the same additions. The
+  // result does not depend on the thread count.
+  const R_xlen_t nb = (n + kPrefixBlock - 1) / kPrefixBlock;
+  auto ends = [n](R_xlen_t k, R_xlen_t& i0, R_xlen_t& i1) {
+    i0 = k * kPrefixBlock;
+    i1 = std::min(n, i0 + kPrefixBlock);
+  };
+  if (threads < 2 || nb < 2) {
+    // one pass: each block from the running sums of those before it
+    double h = 0, l0 = 0;
+    for (R_xlen_t k = 0; k < nb; ++k) {
+      if ((k & 15) == 15 && allanvar::interrupted()) return;
+      R_xlen_t i0, i1;
+      ends(k, i0, i1);
+      double hs, ls;
+      prefix_block<true>(v, i0, i1, c, C, rq, h, l0, hi, lo, hs, ls);
+      h += hs;
+      l0 += ls;
+    }
+    return;
+  }
+  // two passes on the threads: block sums, then each block from its start
+  std::vector<double> hbase(nb + 1, 0.0), lbase(nb + 1, 0.0);
+  run_items(nb, threads, main, [&](R_xlen_t k) {
+    R_xlen_t i0, i1;
+    ends(k, i0, i1);
+    prefix_block<false>(v, i0, i1, c, C, rq, 0, 0, hi, lo, hbase[k + 1],
+                        lbase[k + 1]);
+  });
+  if (allanvar::interrupt_state().stop.load()) return;
+  for (R_xlen_t k = 0; k < nb; ++k) {
+    hbase[k + 1] += hbase[k];
+    lbase[k + 1] += lbase[k];
+  }
+  run_items(nb, threads, main, [&](R_xlen_t k) {
+    R_xlen_t i0, i1;
+    ends(k, i0, i1);
+    double hs, ls;
+    prefix_block<true>(v, i0, i1, c, C, rq, hbase[k], lbase[k], hi, lo, hs,
+                       ls);
+  });
+}
+
+// wide: lo in double (the modified type's extra level of sums, Split).
 void build_prefix(const double* v, R_xlen_t n, double c, double bound,
-                  int levels, Split& out, int threads, bool main) {
+                  int levels, bool wide, Split& out, int threads, bool main) {
   const R_xlen_t len = n + levels;
   out.hi.resize(len);
-  out.lo.resize(len);
+  out.wide = wide || levels == 2;
+  if (out.wide) {
+    out.wlo.resize(len);
+  } else {
+    out.lo.resize(len);
+  }
   double* hi = out.hi.data();
-  double* lo = out.lo.data();
-  hi[0] = lo[0] = 0;
-  if (levels == 2) hi[1] = lo[1] = 0;
+  float* lo = out.lo.data();
+  double* wlo = out.wlo.data();
+  hi[0] = 0;
+  if (out.wide) {
+    wlo[0] = 0;
+  } else {
+    lo[0] = 0;
+  }
+  if (levels == 2) hi[1] = wlo[1] = 0;
   const double nn = static_cast<double>(n);
   double b = bound * nn * (1 + 1e-9);
   if (levels == 2) b *= nn + 1;
@@ -138,57 +389,23 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
   if (levels == 1) b *= 1 + nn * 1.7763568394002505e-15;  // 2^-49
   const double q = grid_step(b);
   const double C = 1.5 * q * 4503599627370496.0;  // 1.5 q 2^52: ulp(C) = q
+  const double rq = 1 / q;  // exact: q is a power of two
+  out.q = out.wide ? 1.0 : q;  // a double lo in absolute units (Split)
   if (levels == 1) {
-    // X_{i+1} = X_i + (v_i - c). Each increment v_i - c = r + re (TwoSum)
-    // is split into a on the grid q and the remainder (r - a) + re (at most
-    // q/2 and an ulp): hi sums the a exactly (multiples of q below 2^50 q,
-    // in any order), lo the remainders in plain double (rounding about
-    // eps n q, far below q). hi being exact, the record is cut into fixed
-    // blocks: on two threads their sums first, then each block's prefix
-    // from its start; on one, a single pass making the same additions. The
-    // result does not depend on the thread count.
-    const R_xlen_t nb = (n + kPrefixBlock - 1) / kPrefixBlock;
-    auto ends = [n](R_xlen_t k, R_xlen_t& i0, R_xlen_t& i1) {
-      i0 = k * kPrefixBlock;
-      i1 = std::min(n, i0 + kPrefixBlock);
-    };
-    if (threads < 2 || nb < 2) {
-      // one pass: each block from the running sums of those before it
-      double h = 0, l0 = 0;
-      for (R_xlen_t k = 0; k < nb; ++k) {
-        if ((k & 15) == 15 && allanvar::interrupted()) return;
-        R_xlen_t i0, i1;
-        ends(k, i0, i1);
-        double hs, ls;
-        prefix_block<true>(v, i0, i1, c, C, h, l0, hi, lo, hs, ls);
-        h += hs;
-        l0 += ls;
-      }
-      return;
+    if (out.wide) {
+      rate_prefix(v, n, c, C, rq, hi, wlo, threads, main);
+    } else {
+      rate_prefix(v, n, c, C, rq, hi, lo, threads, main);
     }
-    // two passes on the threads: block sums, then each block from its start
-    std::vector<double> hbase(nb + 1, 0.0), lbase(nb + 1, 0.0);
-    run_items(nb, threads, main, [&](R_xlen_t k) {
-      R_xlen_t i0, i1;
-      ends(k, i0, i1);
-      prefix_block<false>(v, i0, i1, c, C, 0, 0, hi, lo, hbase[k + 1],
-                          lbase[k + 1]);
-    });
-    if (allanvar::interrupt_state().stop.load()) return;
-    for (R_xlen_t k = 0; k < nb; ++k) {
-      hbase[k + 1] += hbase[k];
-      lbase[k + 1] += lbase[k];
-    }
-    run_items(nb, threads, main, [&](R_xlen_t k) {
-      R_xlen_t i0, i1;
-      ends(k, i0, i1);
-      double hs, ls;
-      prefix_block<true>(v, i0, i1, c, C, hbase[k], lbase[k], hi, lo, hs, ls);
-    });
     return;
   }
   // levels == 2: P_{i+1} = P_i + X_i, then X_{i+1} = X_i + (v_i - c)
   double s1 = 0, e1 = 0, s2 = 0, e2 = 0;
+  auto put = [&](R_xlen_t i) {
+    const double h = (s2 + C) - C;
+    hi[i] = h;
+    wlo[i] = (s2 - h) + e2;
+  };
   for (R_xlen_t i = 0; i < n; ++i) {
     if ((i & kPoll) == kPoll && allanvar::interrupted()) return;
     double r, re, t, te;
@@ -196,9 +413,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     two_sum(s2, s1, t, te);
     s2 = t;
     e2 += te + e1;
-    const double h = (s2 + C) - C;
-    hi[i + 1] = h;
-    lo[i + 1] = (s2 - h) + e2;
+    put(i + 1);
     two_sum(s1, r, t, te);
     s1 = t;
     e1 += te + re;
@@ -208,9 +423,7 @@ void build_prefix(const double* v, R_xlen_t n, double c, double bound,
     two_sum(s2, s1, t, te);
     s2 = t;
     e2 += te + e1;
-    const double h = (s2 + C) - C;
-    hi[n + 1] = h;
-    lo[n + 1] = (s2 - h) + e2;
+    put(n + 1);
   }
 }
 
@@ -219,27 +432,36 @@ void build_split(const double* v, R_xlen_t n, double c, double bound,
                  Split& out) {
   out.hi.resize(n);
   out.lo.resize(n);
+  out.wide = false;
   const double q = grid_step(bound * (1 + 1e-9));
   const double C = 1.5 * q * 4503599627370496.0;
-  for (R_xlen_t i = 0; i < n; ++i) grid_split(v[i], c, C, out.hi[i], out.lo[i]);
+  const double rq = 1 / q;
+  out.q = q;
+  for (R_xlen_t i = 0; i < n; ++i) {
+    double rem;
+    grid_split(v[i], c, C, out.hi[i], rem);
+    out.lo[i] = static_cast<float>(rem * rq);
+  }
 }
 
 // Sum of squared second (D = 2) or third (D = 3) differences at stride 1,
-// for k in [k0, k1): two terms per vector (GCC/Clang vector extensions,
-// plain SSE2 on x86-64), two independent accumulators.
+// for k in [k0, k1): each difference is the hi parts' (exact) plus q times
+// the lo parts' (floats widened to double).
 #if defined(__GNUC__)
 using allanvar::v2d;
 using allanvar::ld2;
 #endif
 
-template <int D>
-inline double diff_at(const double* h, const double* l, R_xlen_t m, R_xlen_t k) {
+template <int D, class L>
+inline double diff_at(const double* h, const L* f, double q, R_xlen_t m,
+                      R_xlen_t k) {
+  auto l = [f](R_xlen_t i) { return static_cast<double>(f[i]); };
   if (D == 2) {
     return ((h[k + 2 * m] + h[k]) - 2.0 * h[k + m]) +
-           ((l[k + 2 * m] + l[k]) - 2.0 * l[k + m]);
+           q * ((l(k + 2 * m) + l(k)) - 2.0 * l(k + m));
   }
   return ((h[k + 3 * m] - h[k]) + 3.0 * (h[k + m] - h[k + 2 * m])) +
-         ((l[k + 3 * m] - l[k]) + 3.0 * (l[k + m] - l[k + 2 * m]));
+         q * ((l(k + 3 * m) - l(k)) + 3.0 * (l(k + m) - l(k + 2 * m)));
 }
 
 // Sum of squared differences for k in [k0, k1): eight terms per step in
@@ -249,32 +471,38 @@ inline double diff_at(const double* h, const double* l, R_xlen_t m, R_xlen_t k) 
 // additions and no fused multiply-add, so both give the same bits), then the
 // last k1 - k0 mod 8 terms one by one.
 #if defined(__GNUC__)
-template <int D, class V>
-inline V diff_vec(const double* h, const double* l, R_xlen_t m, R_xlen_t k) {
-  auto ld = [](const double* p) {
-    V v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
+typedef float v2f __attribute__((vector_size(8)));
+
+inline v2d ldf2(const float* p) {
+  v2f v;
+  std::memcpy(&v, p, sizeof v);
+  return __builtin_convertvector(v, v2d);
+}
+inline v2d ldf2(const double* p) { return ld2(p); }
+
+template <int D, class L>
+inline v2d diff_vec(const double* h, const L* l, v2d q, R_xlen_t m,
+                    R_xlen_t k) {
   if (D == 2) {
-    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
-           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
+    return ((ld2(h + 2 * m + k) + ld2(h + k)) - 2.0 * ld2(h + m + k)) +
+           q * ((ldf2(l + 2 * m + k) + ldf2(l + k)) - 2.0 * ldf2(l + m + k));
   }
-  return ((ld(h + 3 * m + k) - ld(h + k)) +
-          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
-         ((ld(l + 3 * m + k) - ld(l + k)) +
-          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+  return ((ld2(h + 3 * m + k) - ld2(h + k)) +
+          3.0 * (ld2(h + m + k) - ld2(h + 2 * m + k))) +
+         q * ((ldf2(l + 3 * m + k) - ldf2(l + k)) +
+              3.0 * (ldf2(l + m + k) - ldf2(l + 2 * m + k)));
 }
 
-template <int D>
-inline double sumsq8_sse2(const double* h, const double* l, R_xlen_t m,
-                          R_xlen_t& k, R_xlen_t k1) {
+template <int D, class L>
+inline double sumsq8_sse2(const double* h, const L* l, double q,
+                          R_xlen_t m, R_xlen_t& k, R_xlen_t k1) {
+  const v2d qv = {q, q};
   v2d a0 = {0, 0}, a1 = {0, 0}, a2 = {0, 0}, a3 = {0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v2d d0 = diff_vec<D, v2d>(h, l, m, k);
-    const v2d d1 = diff_vec<D, v2d>(h, l, m, k + 2);
-    const v2d d2 = diff_vec<D, v2d>(h, l, m, k + 4);
-    const v2d d3 = diff_vec<D, v2d>(h, l, m, k + 6);
+    const v2d d0 = diff_vec<D, L>(h, l, qv, m, k);
+    const v2d d1 = diff_vec<D, L>(h, l, qv, m, k + 2);
+    const v2d d2 = diff_vec<D, L>(h, l, qv, m, k + 4);
+    const v2d d3 = diff_vec<D, L>(h, l, qv, m, k + 6);
     a0 += d0 * d0;
     a1 += d1 * d1;
     a2 += d2 * d2;
@@ -287,6 +515,7 @@ inline double sumsq8_sse2(const double* h, const double* l, R_xlen_t m,
 #if defined(__x86_64__)
 #define ALLANVAR_AVX2 1
 typedef double v4d __attribute__((vector_size(32)));
+typedef float v4f __attribute__((vector_size(16)));
 
 __attribute__((target("avx2"))) inline v4d ld4(const double* p) {
   v4d v;
@@ -294,29 +523,40 @@ __attribute__((target("avx2"))) inline v4d ld4(const double* p) {
   return v;
 }
 
-template <int D>
-__attribute__((target("avx2"))) inline v4d diff4(const double* h,
-                                                 const double* l, R_xlen_t m,
-                                                 R_xlen_t k) {
-  auto ld = ld4;
-  if (D == 2) {
-    return ((ld(h + 2 * m + k) + ld(h + k)) - 2.0 * ld(h + m + k)) +
-           ((ld(l + 2 * m + k) + ld(l + k)) - 2.0 * ld(l + m + k));
-  }
-  return ((ld(h + 3 * m + k) - ld(h + k)) +
-          3.0 * (ld(h + m + k) - ld(h + 2 * m + k))) +
-         ((ld(l + 3 * m + k) - ld(l + k)) +
-          3.0 * (ld(l + m + k) - ld(l + 2 * m + k)));
+// one vcvtps2pd (__builtin_convertvector gave two halves and a shuffle)
+__attribute__((target("avx2"))) inline v4d ldf4(const float* p) {
+  v4f v;
+  std::memcpy(&v, p, sizeof v);
+  return __builtin_ia32_cvtps2pd256(v);
+}
+__attribute__((target("avx2"))) inline v4d ldf4(const double* p) {
+  return ld4(p);
 }
 
-template <int D>
+template <int D, class L>
+__attribute__((target("avx2"))) inline v4d diff4(const double* h,
+                                                 const L* l, v4d q,
+                                                 R_xlen_t m, R_xlen_t k) {
+  if (D == 2) {
+    return ((ld4(h + 2 * m + k) + ld4(h + k)) - 2.0 * ld4(h + m + k)) +
+           q * ((ldf4(l + 2 * m + k) + ldf4(l + k)) - 2.0 * ldf4(l + m + k));
+  }
+  return ((ld4(h + 3 * m + k) - ld4(h + k)) +
+          3.0 * (ld4(h + m + k) - ld4(h + 2 * m + k))) +
+         q * ((ldf4(l + 3 * m + k) - ldf4(l + k)) +
+              3.0 * (ldf4(l + m + k) - ldf4(l + 2 * m + k)));
+}
+
+template <int D, class L>
 __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
-                                                   const double* l, R_xlen_t m,
-                                                   R_xlen_t& k, R_xlen_t k1) {
+                                                   const L* l, double q,
+                                                   R_xlen_t m, R_xlen_t& k,
+                                                   R_xlen_t k1) {
+  const v4d qv = {q, q, q, q};
   v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v4d d0 = diff4<D>(h, l, m, k);
-    const v4d d1 = diff4<D>(h, l, m, k + 4);
+    const v4d d0 = diff4<D, L>(h, l, qv, m, k);
+    const v4d d1 = diff4<D, L>(h, l, qv, m, k + 4);
     a0 += d0 * d0;
     a1 += d1 * d1;
   }
@@ -326,41 +566,44 @@ __attribute__((target("avx2"))) double sumsq8_avx2(const double* h,
 }
 
 // The same lanes with fused multiply-adds where the CPU has them: six
-// floating-point operations a term instead of nine. The hi
-// parts' weights are exact either way, and 2 l is exact, so the difference
-// is the same number; the squares' sum (and 3 (l1 - l2) for D = 3) round
-// once less, a last-bit change of the sum (not the SSE2 path's bits).
+// floating-point operations a term (and three widenings) instead of ten. The hi
+// parts' weights are exact either way, and 2 l is exact, so the hi and lo
+// differences are the same numbers; hi + q lo, the squares' sum (and
+// 3 (l1 - l2) for D = 3) round once less, a last-bit change of the sum (not
+// the SSE2 path's bits).
 __attribute__((target("avx2,fma"))) inline v4d fma4(v4d a, v4d b, v4d c) {
   return __builtin_ia32_vfmaddpd256(a, b, c);
 }
 
-template <int D>
+template <int D, class L>
 __attribute__((target("avx2,fma"))) inline v4d diff4_fma(const double* h,
-                                                        const double* l,
-                                                        R_xlen_t m,
+                                                        const L* l,
+                                                        v4d q, R_xlen_t m,
                                                         R_xlen_t k) {
-  auto ld = ld4;
   if (D == 2) {
     const v4d w = {-2.0, -2.0, -2.0, -2.0};
-    return fma4(w, ld(h + m + k), ld(h + 2 * m + k) + ld(h + k)) +
-           fma4(w, ld(l + m + k), ld(l + 2 * m + k) + ld(l + k));
+    return fma4(q,
+                fma4(w, ldf4(l + m + k), ldf4(l + 2 * m + k) + ldf4(l + k)),
+                fma4(w, ld4(h + m + k), ld4(h + 2 * m + k) + ld4(h + k)));
   }
   const v4d w = {3.0, 3.0, 3.0, 3.0};
-  return fma4(w, ld(h + m + k) - ld(h + 2 * m + k),
-              ld(h + 3 * m + k) - ld(h + k)) +
-         fma4(w, ld(l + m + k) - ld(l + 2 * m + k),
-              ld(l + 3 * m + k) - ld(l + k));
+  return fma4(q,
+              fma4(w, ldf4(l + m + k) - ldf4(l + 2 * m + k),
+                   ldf4(l + 3 * m + k) - ldf4(l + k)),
+              fma4(w, ld4(h + m + k) - ld4(h + 2 * m + k),
+                   ld4(h + 3 * m + k) - ld4(h + k)));
 }
 
-template <int D>
+template <int D, class L>
 __attribute__((target("avx2,fma"))) double sumsq8_fma(const double* h,
-                                                     const double* l,
+                                                     const L* l, double q,
                                                      R_xlen_t m, R_xlen_t& k,
                                                      R_xlen_t k1) {
+  const v4d qv = {q, q, q, q};
   v4d a0 = {0, 0, 0, 0}, a1 = {0, 0, 0, 0};
   for (; k + 8 <= k1; k += 8) {
-    const v4d d0 = diff4_fma<D>(h, l, m, k);
-    const v4d d1 = diff4_fma<D>(h, l, m, k + 4);
+    const v4d d0 = diff4_fma<D, L>(h, l, qv, m, k);
+    const v4d d1 = diff4_fma<D, L>(h, l, qv, m, k + 4);
     a0 = fma4(d0, d0, a0);
     a1 = fma4(d1, d1, a1);
   }
@@ -381,20 +624,20 @@ inline bool have_avx2() {
 #endif
 #endif
 
-template <int D>
-inline double sumsq1(const double* h, const double* l, R_xlen_t m, R_xlen_t k0,
-                     R_xlen_t k1) {
+template <int D, class L>
+inline double sumsq1(const double* h, const L* l, double q, R_xlen_t m,
+                     R_xlen_t k0, R_xlen_t k1) {
   double tail = 0;
   R_xlen_t k = k0;
 #if defined(ALLANVAR_AVX2)
-  tail = have_fma()    ? sumsq8_fma<D>(h, l, m, k, k1)
-         : have_avx2() ? sumsq8_avx2<D>(h, l, m, k, k1)
-                       : sumsq8_sse2<D>(h, l, m, k, k1);
+  tail = have_fma()    ? sumsq8_fma<D, L>(h, l, q, m, k, k1)
+         : have_avx2() ? sumsq8_avx2<D, L>(h, l, q, m, k, k1)
+                       : sumsq8_sse2<D, L>(h, l, q, m, k, k1);
 #elif defined(__GNUC__)
-  tail = sumsq8_sse2<D>(h, l, m, k, k1);
+  tail = sumsq8_sse2<D, L>(h, l, q, m, k, k1);
 #endif
   for (; k < k1; ++k) {
-    const double d = diff_at<D>(h, l, m, k);
+    const double d = diff_at<D, L>(h, l, q, m, k);
     tail += d * d;
   }
   return tail;
@@ -430,7 +673,9 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
         if ((j & 63) == 63 && allanvar::interrupted()) return;
         const R_xlen_t e = std::min(b1, nterms[j]);
         if (e <= b0) continue;
-        p[j] += sumsq1<D>(X.hi.data(), X.lo.data(), ms[j], b0, e);
+        p[j] += X.with_lo([&](const auto* l) {
+          return sumsq1<D>(X.hi.data(), l, X.q, ms[j], b0, e);
+        });
       }
     }
   });
@@ -445,25 +690,26 @@ void overlapped(const Split& X, const std::vector<R_xlen_t>& ms,
 
 // Stride-m sum of squared differences of order D (2 or 3) over n terms: each
 // term loads one new point and reuses the previous ones.
-template <int D>
-double strided_sum(const double* h, const double* l, R_xlen_t m, R_xlen_t n) {
+template <int D, class L>
+double strided_sum(const double* h, const L* l, double q, R_xlen_t m,
+                   R_xlen_t n) {
   Acc a;
   double s0 = 0, s1 = 0;
   double h0 = h[0], l0 = l[0], h1 = h[m], l1 = l[m];
   double h2 = D == 3 ? h[2 * m] : 0, l2 = D == 3 ? l[2 * m] : 0;
   const double* ph = h + D * m;
-  const double* pl = l + D * m;
+  const L* pl = l + D * m;
   for (R_xlen_t i = 0; i < n; ++i, ph += m, pl += m) {
     const double hn = *ph, ln = *pl;
     double d;
     if (D == 2) {
-      d = ((hn + h0) - 2.0 * h1) + ((ln + l0) - 2.0 * l1);
+      d = ((hn + h0) - 2.0 * h1) + q * ((ln + l0) - 2.0 * l1);
       h0 = h1;
       l0 = l1;
       h1 = hn;
       l1 = ln;
     } else {
-      d = ((hn - h0) + 3.0 * (h1 - h2)) + ((ln - l0) + 3.0 * (l1 - l2));
+      d = ((hn - h0) + 3.0 * (h1 - h2)) + q * ((ln - l0) + 3.0 * (l1 - l2));
       h0 = h1;
       l0 = l1;
       h1 = h2;
@@ -512,7 +758,9 @@ void strided(const Split& X, const std::vector<R_xlen_t>& ms,
             [&](R_xlen_t r) {
               for (size_t j = cut[r]; j < cut[r + 1]; ++j) {
                 if (allanvar::interrupted()) return;
-                out[j] = strided_sum<D>(X.hi.data(), X.lo.data(), ms[j], nterms[j]);
+                out[j] = X.with_lo([&](const auto* l) {
+                  return strided_sum<D>(X.hi.data(), l, X.q, ms[j], nterms[j]);
+                });
               }
             });
 }
@@ -527,62 +775,68 @@ void total(const Split& X, const std::vector<R_xlen_t>& ms, int threads,
            bool main, double* out) {
   const R_xlen_t L = static_cast<R_xlen_t>(X.hi.size());
   const double* h = X.hi.data();
-  const double* l = X.lo.data();
+  const double q = X.q;
   const size_t nt = ms.size();
   std::vector<R_xlen_t> inner(nt, 0);
   for (size_t j = 0; j < nt; ++j) inner[j] = std::max<R_xlen_t>(0, L - 2 * ms[j]);
   overlapped<2>(X, ms, inner, threads, main, out);
   if (allanvar::interrupt_state().stop.load()) return;
   std::vector<double> edge(nt, 0.0);
-  run_items(static_cast<R_xlen_t>(nt), threads, main, [&](R_xlen_t j) {
-    if (allanvar::interrupted()) return;
-    const R_xlen_t m = ms[j];
-    // one term has at most 5 points, total weight 8: exact on the hi grid
-    auto term = [&](R_xlen_t i) {
-      double dh = -2.0 * h[i], dl = -2.0 * l[i];
-      const R_xlen_t a0 = i - m;
-      if (a0 >= 0) {
-        dh += h[a0];
-        dl += l[a0];
-      } else {
-        dh += 2.0 * h[0] - h[-a0];
-        dl += 2.0 * l[0] - l[-a0];
+  // lo's type fixed outside the loops (a branch a point cost a third of the
+  // end terms)
+  X.with_lo([&](const auto* lp) {
+    auto l = [lp](R_xlen_t i) { return static_cast<double>(lp[i]); };
+    run_items(static_cast<R_xlen_t>(nt), threads, main, [&](R_xlen_t j) {
+      if (allanvar::interrupted()) return;
+      const R_xlen_t m = ms[j];
+      // one term has at most 5 points, total weight 8: exact on the hi grid
+      auto term = [&](R_xlen_t i) {
+        double dh = -2.0 * h[i], dl = -2.0 * l(i);
+        const R_xlen_t a0 = i - m;
+        if (a0 >= 0) {
+          dh += h[a0];
+          dl += l(a0);
+        } else {
+          dh += 2.0 * h[0] - h[-a0];
+          dl += 2.0 * l(0) - l(-a0);
+        }
+        const R_xlen_t a1 = i + m;
+        if (a1 <= L - 1) {
+          dh += h[a1];
+          dl += l(a1);
+        } else {
+          const R_xlen_t r = 2 * (L - 1) - a1;
+          dh += 2.0 * h[L - 1] - h[r];
+          dl += 2.0 * l(L - 1) - l(r);
+        }
+        return dh + q * dl;
+      };
+      // the centres outside [m, L-1-m]
+      R_xlen_t r0[2] = {1, std::max(m, L - m)};
+      R_xlen_t r1[2] = {std::min(m - 1, L - 2), L - 2};
+      if (inner[j] == 0) {
+        r1[0] = L - 2;
+        r1[1] = -1;
       }
-      const R_xlen_t a1 = i + m;
-      if (a1 <= L - 1) {
-        dh += h[a1];
-        dl += l[a1];
-      } else {
-        const R_xlen_t r = 2 * (L - 1) - a1;
-        dh += 2.0 * h[L - 1] - h[r];
-        dl += 2.0 * l[L - 1] - l[r];
-      }
-      return dh + dl;
-    };
-    // the centres outside [m, L-1-m]
-    R_xlen_t r0[2] = {1, std::max(m, L - m)};
-    R_xlen_t r1[2] = {std::min(m - 1, L - 2), L - 2};
-    if (inner[j] == 0) {
-      r1[0] = L - 2;
-      r1[1] = -1;
-    }
-    Acc a;
-    double s = 0;
-    R_xlen_t cnt = 0;
-    for (int z = 0; z < 2; ++z) {
-      for (R_xlen_t i = r0[z]; i <= r1[z]; ++i) {
-        const double d = term(i);
-        s += d * d;
-        if (++cnt == kBlock) {
-          a.add(s);
-          s = 0;
-          cnt = 0;
-          if (allanvar::interrupted()) return;
+      Acc a;
+      double s = 0;
+      R_xlen_t cnt = 0;
+      for (int z = 0; z < 2; ++z) {
+        for (R_xlen_t i = r0[z]; i <= r1[z]; ++i) {
+          const double d = term(i);
+          s += d * d;
+          if (++cnt == kBlock) {
+            a.add(s);
+            s = 0;
+            cnt = 0;
+            if (allanvar::interrupted()) return;
+          }
         }
       }
-    }
-    a.add(s);
-    edge[j] = a.value();
+      a.add(s);
+      edge[j] = a.value();
+    });
+    return 0;
   });
   for (size_t j = 0; j < nt; ++j) {
     Acc a;
@@ -1502,28 +1756,12 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   // centre (mid-range) and bound of the data; NaN/Inf poison z (the octave
   // pass above has both already)
   if (!have_range) {
-    // four lanes: one chain of additions cost 4 cycles a sample, a quarter
-    // of the overlapping sums
-    double lo4[4] = {v[0], v[0], v[0], v[0]}, hi4[4] = {v[0], v[0], v[0], v[0]};
-    double z4[4] = {0, 0, 0, 0};
-    R_xlen_t i = 0;
-    for (; i + 4 <= N; i += 4) {
-      for (int u = 0; u < 4; ++u) {
-        const double a = v[i + u];
-        lo4[u] = a < lo4[u] ? a : lo4[u];
-        hi4[u] = a > hi4[u] ? a : hi4[u];
-        z4[u] += a * 0.0;
-      }
-    }
-    for (; i < N; ++i) {
-      lo4[0] = std::min(lo4[0], v[i]);
-      hi4[0] = std::max(hi4[0], v[i]);
-      z4[0] += v[i] * 0.0;
-    }
-    range[0] = std::min(std::min(lo4[0], lo4[1]), std::min(lo4[2], lo4[3]));
-    range[1] = std::max(std::max(hi4[0], hi4[1]), std::max(hi4[2], hi4[3]));
-    const double z = (z4[0] + z4[1]) + (z4[2] + z4[3]);
-    if (z != 0) {
+    double r[3];
+    sample_range(v, N, threads, main, r);
+    if (allanvar::interrupt_state().stop.load()) return;
+    range[0] = r[0];
+    range[1] = r[1];
+    if (r[2] != 0) {
       out.bad = allanvar::first_nonfinite(v, N);
       return;
     }
@@ -1542,7 +1780,7 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   if (level == 0) {
     build_split(v, N, c, bound, X);
   } else {
-    build_prefix(v, N, c, bound, level, X, threads, main);
+    build_prefix(v, N, c, bound, level, two, X, threads, main);
   }
   double* o = out.sums;
   // identification alone (other statistics' noise type) needs no sums
@@ -1559,9 +1797,12 @@ void one_channel(const double* v, R_xlen_t N, const std::vector<R_xlen_t>& ms,
   // MODIFIED's sums built one more level. Frequency data at m = 1 are the
   // samples.
   const double* h = X.hi.data();
-  const double* l = X.lo.data();
-  auto phase = [h, l, two](R_xlen_t k) -> double {
-    return two ? (h[k + 1] - h[k]) + (l[k + 1] - l[k]) : h[k] + l[k];
+  const double q = X.q;
+  const Split* Xp = &X;
+  auto phase = [h, Xp, q, two](R_xlen_t k) -> double {
+    const double lk = Xp->lo_at(k);
+    return two ? (h[k + 1] - h[k]) + q * (Xp->lo_at(k + 1) - lk)
+               : h[k] + q * lk;
   };
   const R_xlen_t Lp = rate ? N + 1 : N;
   auto build = [&phase, Lp](allanvar::RnCache& r) { r.build(phase, Lp); };
@@ -1784,13 +2025,13 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
     if (level == 0) {
       build_split(v.data(), N, c, bound, X);
     } else {
-      build_prefix(v.data(), N, c, bound, level, X, 1, true);
+      build_prefix(v.data(), N, c, bound, level, two, X, 1, true);
     }
   } catch (const std::bad_alloc&) {
     Rcpp::stop("allanvar_out_of_memory");
   }
   const double* h = X.hi.data();
-  const double* l = X.lo.data();
+  const double q = X.q;
   const bool stride1 = allanvar::estimator_info(type).overlapping;
   const int d = type == STANDARD || type == OVERLAPPING ? 2 : 3;
   const R_xlen_t L = rate ? N + 1 : N;
@@ -1814,7 +2055,9 @@ Rcpp::List allan_gap_sums_cpp(const Rcpp::NumericVector& x,
         for (int t = 0; t <= d; ++t) skip = skip || missing(k + t * mm, k + t * mm + 1);
       }
       if (skip) continue;
-      const double dv = d == 2 ? diff_at<2>(h, l, mm, k) : diff_at<3>(h, l, mm, k);
+      const double dv = X.with_lo([&](const auto* l) {
+        return d == 2 ? diff_at<2>(h, l, q, mm, k) : diff_at<3>(h, l, q, mm, k);
+      });
       s += dv * dv;
       ++cnt;
       if (++blk == kBlock) {

@@ -1,4 +1,4 @@
-// A large uninitialised double buffer shared by the estimator kernels
+// A large uninitialised double (or float) buffer shared by the estimator kernels
 // (src/allan.cpp, src/dynamic.cpp). On Linux it is 2 MiB aligned and marked
 // for transparent huge pages: a fresh 100 MB prefix array otherwise costs
 // tens of thousands of page faults, more than the sums themselves. Large
@@ -76,21 +76,22 @@ inline BufferPool& buffer_pool() {
   return p;
 }
 
-class Buffer {
+template <class T>
+class BasicBuffer {
  public:
-  Buffer() {}
-  Buffer(const Buffer&) = delete;
-  Buffer& operator=(const Buffer&) = delete;
-  ~Buffer() { buffer_pool().give(p_, bytes_); }
+  BasicBuffer() {}
+  BasicBuffer(const BasicBuffer&) = delete;
+  BasicBuffer& operator=(const BasicBuffer&) = delete;
+  ~BasicBuffer() { buffer_pool().give(p_, bytes_); }
   void resize(R_xlen_t n) {
     buffer_pool().give(p_, bytes_);
     p_ = nullptr;
     bytes_ = 0;
     n_ = n;
-    const size_t bytes = static_cast<size_t>(n > 0 ? n : 1) * sizeof(double);
+    const size_t bytes = static_cast<size_t>(n > 0 ? n : 1) * sizeof(T);
     size_t got = 0;
     if (void* q = buffer_pool().take(bytes, got)) {
-      p_ = static_cast<double*>(q);
+      p_ = static_cast<T*>(q);
       bytes_ = got;
       return;
     }
@@ -100,25 +101,28 @@ class Buffer {
       void* q = nullptr;
       if (posix_memalign(&q, align, bytes) == 0) {
         madvise(q, bytes, MADV_HUGEPAGE);
-        p_ = static_cast<double*>(q);
+        p_ = static_cast<T*>(q);
       }
     }
 #endif
-    if (!p_) p_ = static_cast<double*>(std::malloc(bytes));
+    if (!p_) p_ = static_cast<T*>(std::malloc(bytes));
     if (!p_) throw std::bad_alloc();
     bytes_ = bytes;
   }
-  double* data() { return p_; }
-  const double* data() const { return p_; }
-  double& operator[](R_xlen_t i) { return p_[i]; }
-  const double& operator[](R_xlen_t i) const { return p_[i]; }
+  T* data() { return p_; }
+  const T* data() const { return p_; }
+  T& operator[](R_xlen_t i) { return p_[i]; }
+  const T& operator[](R_xlen_t i) const { return p_[i]; }
   R_xlen_t size() const { return n_; }
 
  private:
-  double* p_ = nullptr;
+  T* p_ = nullptr;
   size_t bytes_ = 0;
   R_xlen_t n_ = 0;
 };
+
+using Buffer = BasicBuffer<double>;
+using FloatBuffer = BasicBuffer<float>;
 
 }  // namespace allanvar
 
