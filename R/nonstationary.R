@@ -674,16 +674,17 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
 # The level the series' own noise reaches over the record: a Student t
 # fitted to the body of z, the Bonferroni quantile of it. Its degrees of
 # freedom from B = the mean of |z| between its 95% and 99% quantiles
-# (by rank) over z's robust scale (robust_scale()): 2.24 for Gaussian z.
+# (by rank) over z's robust scale (robust_scale()): 2.20 for Gaussian z.
 # Means over ranks, not quantiles: quantization of 1-2 steps to the sd
 # makes |z| coarse (its median 20% off). Outliers in the top 1% leave B
 # alone (with the band at 99-99.9%, 200 outliers of 15 sd in 1e5 samples
-# read as a heavy tail and went unnamed). The
-# measured accelerometers' AO statistics have heavy tails throughout (t
-# with 11-38 degrees of freedom; their counts beyond 4, 5 and 6 sd fall
+# read as a heavy tail and went unnamed). The measured accelerometers' AO
+# statistics have heavy tails throughout (their 99% quantile of |z| over
+# its median 3.98-4.46, Gaussian 3.82; counts beyond 4, 5 and 6 sd fall
 # about as z^-6.5): a level inside that continuum moved the count 4-14%
-# when the scale moved 2%; beyond it (7-14 sd there) the count is a few.
-# 0 where the body is Gaussian or the record short (< 1e4 values).
+# when the scale moved 2%; beyond it (7-12.5 sd there) the count is a few
+# and moves by at most 2. 0 where the body is Gaussian or the record short
+# (< 1e4 values).
 spike_tail_level <- function(z, alpha) {
   a <- sort(abs(z[z != 0]))
   n <- length(a)
