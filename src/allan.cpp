@@ -527,7 +527,11 @@ __attribute__((target("avx2"))) inline v4d ld4(const double* p) {
 __attribute__((target("avx2"))) inline v4d ldf4(const float* p) {
   v4f v;
   std::memcpy(&v, p, sizeof v);
+#if defined(__clang__)
+  return __builtin_convertvector(v, v4d);  // Clang has no cvtps2pd builtin
+#else
   return __builtin_ia32_cvtps2pd256(v);
+#endif
 }
 __attribute__((target("avx2"))) inline v4d ldf4(const double* p) {
   return ld4(p);
@@ -965,7 +969,16 @@ inline double last_diff(const Level& L, int k) {
 #if defined(__GNUC__)
 #define ALLANVAR_LEVEL_VEC 1
 typedef double vd4 __attribute__((vector_size(32)));
+// the even and odd lanes of two vectors (Clang spells GCC's shuffle its
+// own way; macros, since a vector argument's ABI differs between SSE2 and AVX)
+#if defined(__clang__)
+#define ALLANVAR_EVEN(x, y) __builtin_shufflevector(x, y, 0, 2, 4, 6)
+#define ALLANVAR_ODD(x, y) __builtin_shufflevector(x, y, 1, 3, 5, 7)
+#else
 typedef long long vi4 __attribute__((vector_size(32)));
+#define ALLANVAR_EVEN(x, y) __builtin_shuffle(x, y, vi4{0, 2, 4, 6})
+#define ALLANVAR_ODD(x, y) __builtin_shuffle(x, y, vi4{1, 3, 5, 7})
+#endif
 // (no vector passed by value: the ABI of a vector argument differs
 // between SSE2 and AVX)
 typedef double vd4u __attribute__((vector_size(32), aligned(8), may_alias));
@@ -1003,12 +1016,11 @@ __attribute__((always_inline)) inline double diffsq8_body(const double* h,
 template <bool Exact>
 __attribute__((always_inline)) inline R_xlen_t pair4_body(double* h, double* l,
                                                           R_xlen_t n2) {
-  const vi4 ev = {0, 2, 4, 6}, od = {1, 3, 5, 7};
   R_xlen_t k = 0;
   for (; k + 4 <= n2; k += 4) {
     const vd4 hA = ldv4(h + 2 * k), hB = ldv4(h + 2 * k + 4);
-    const vd4 a = __builtin_shuffle(hA, hB, ev);
-    const vd4 b = __builtin_shuffle(hA, hB, od);
+    const vd4 a = ALLANVAR_EVEN(hA, hB);
+    const vd4 b = ALLANVAR_ODD(hA, hB);
     if (!Exact) {
       stv4(h + k, a + b);
       continue;
@@ -1016,7 +1028,7 @@ __attribute__((always_inline)) inline R_xlen_t pair4_body(double* h, double* l,
     const vd4 lA = ldv4(l + 2 * k), lB = ldv4(l + 2 * k + 4);
     const vd4 t = a + b, bb = t - a;
     vd4 e = (a - (t - bb)) + (b - bb);
-    e += __builtin_shuffle(lA, lB, ev) + __builtin_shuffle(lA, lB, od);
+    e += ALLANVAR_EVEN(lA, lB) + ALLANVAR_ODD(lA, lB);
     const vd4 hs = t + e;
     stv4(h + k, hs);
     stv4(l + k, e - (hs - t));
