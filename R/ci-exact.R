@@ -164,7 +164,7 @@ exact_weights_one <- function(code, pr, alpha) {
 # weights `lam` (sum lam_i chi2_1 over its mean) at confidence `conf`.
 gchisq_factors <- function(lam, conf) {
   p <- (1 - conf) / 2
-  if (length(lam) == 1L || max(lam) - min(lam) < 1e-12 * max(lam)) {
+  if (gchisq_equal(lam)) {
     nu <- length(lam)  # equal weights: the chi-square itself
     q <- stats::qchisq(c(p, 1 - p), nu) / nu
   } else {
@@ -173,10 +173,16 @@ gchisq_factors <- function(lam, conf) {
   c(sqrt(1 / q[2L]), sqrt(1 / q[1L]))
 }
 
+# Whether the weights are equal (the law is a chi-square with length(lam)
+# degrees of freedom).
+gchisq_equal <- function(lam) {
+  length(lam) == 1L || max(lam) - min(lam) < 1e-12 * max(lam)
+}
+
 # The CDF of the law with weights `lam` (over their sum; mean 1): the
 # chi-square where they are equal.
 gchisq_cdf_fun <- function(lam) {
-  if (length(lam) == 1L || max(lam) - min(lam) < 1e-12 * max(lam)) {
+  if (gchisq_equal(lam)) {
     nu <- length(lam)
     return(function(q) stats::pchisq(q * nu, nu))
   }

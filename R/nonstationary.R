@@ -686,10 +686,11 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
 # and moves by at most 2. 0 where the body is Gaussian or the record short
 # (< 1e4 values).
 spike_tail_level <- function(z, alpha) {
-  a <- sort(abs(z[z != 0]))
+  z <- z[z != 0]
+  a <- sort(abs(z))
   n <- length(a)
   if (n < 1e4) return(0)
-  S <- robust_scale(z[z != 0])
+  S <- robust_scale(z)
   if (!(S > 0)) return(0)
   B <- mean(a[seq.int(ceiling(0.95 * n), floor(0.99 * n))]) / S
   tab <- spike_t_table()
