@@ -7,6 +7,7 @@ refine_stages <- function() {
   list(prepare = stage_prepare,      # series pass, raw-data diagnostics
        steps = stage_steps,          # add effects, one step at a time
        rechoose = stage_rechoose,    # families chosen again on the final model
+       revisit = stage_revisit,      # the raw data's lines first, if the order failed
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
        assemble = stage_assemble)    # the refined avfit object
@@ -54,6 +55,7 @@ max_set_steps <- 10L
 
 stage_steps <- function(st) {
   budget <- st$args$max_steps
+  st$start <- st$start %||% st$current
   if (budget < 1L) return(st)
   step <- 0L
   free <- 0L
@@ -87,6 +89,70 @@ continues_set <- function(trial) {
 
 # The loop may have ended on a step that chose a family again.
 stage_rechoose <- function(st) rechoose_families(st)$st
+
+# A greedy order can lock in the weaker explanation: an effect taken early
+# for a bump that a periodogram line explains (a GM of tc 0.025 s for a
+# 1.7 Hz line) keeps its place, and the line, added later, cannot move it.
+# When the loop ends far from the curve (chi2/dof above `revisit_chi2`)
+# after taking values measured on the raw data (a line's frequency) at
+# steps behind effects that measured nothing, it is run once more from the
+# start with those values taken first, by the same rules; the run with the
+# lower criterion is kept and `$refine$revisit` says what was compared.
+revisit_chi2 <- 4
+
+stage_revisit <- function(st) {
+  if (is.null(st$data) || !length(st$steps) || !(st$current$chi2 > revisit_chi2)) {
+    return(st)
+  }
+  seeds <- late_pins(st)
+  if (!length(seeds)) return(st)
+  s2 <- st
+  s2$current <- st$start
+  s2$settings <- st$settings0
+  s2$steps <- list()
+  s2$pins <- list()
+  s2$failures <- new_failures()
+  s2$rejected <- new_rejected()
+  s2$duplicates <- new_duplicates()
+  s2$seeds <- seeds
+  s2 <- stage_rechoose(stage_steps(s2))
+  s2$seeds <- numeric(0)
+  c1 <- refine_crit(st, st$current)
+  c2 <- refine_crit(s2, s2$current)
+  taken <- is.finite(c2) && c2 < c1 - st$args$min_gain
+  rv <- data.frame(
+    order = c("greedy", "lines first"),
+    terms = c(paste(st$current$terms, collapse = " + "),
+              paste(s2$current$terms, collapse = " + ")),
+    chi2 = c(st$current$chi2, s2$current$chi2), criterion = c(c1, c2),
+    kept = c(!taken, taken), stringsAsFactors = FALSE)
+  message(sprintf(paste(
+    "avrefine(): the greedy order ended at chi2/dof %s; taking the raw data's",
+    "lines (%s Hz) first gave %s: %s kept."),
+    format_num(st$current$chi2), paste(format_num(seeds), collapse = ", "),
+    format_num(s2$current$chi2), if (taken) "that run is" else "the greedy run is"))
+  out <- if (taken) s2 else st
+  out$revisit <- rv
+  out
+}
+
+# The raw-data values (pins) of accepted steps taken after a step that
+# pinned nothing, still in the final model, in the order they were taken.
+late_pins <- function(st) {
+  pinned <- lengths(st$pins) > 0L
+  first_free <- match(FALSE, pinned)
+  if (is.na(first_free)) return(numeric(0))
+  late <- unlist(st$pins[seq_along(st$pins) > first_free & pinned])
+  held <- st$settings$fixed
+  late <- late[vapply(late, function(v) any(abs(held - v) <= 1e-9 * abs(v)), NA)]
+  unname(late)
+}
+
+# Does trial `tr` pin one of `values`?
+pins_one_of <- function(tr, values) {
+  p <- unlist(tr$pin)
+  length(p) > 0L && any(vapply(p, function(v) any(abs(values - v) <= 1e-9 * abs(v)), NA))
+}
 
 # What is left: residual structure no catalogue effect explained.
 stage_remaining <- function(st) {
@@ -160,7 +226,7 @@ stage_assemble <- function(st) {
                      diagnostics = diag_report(st$raw),
                      remaining = st$remaining, start_terms = fit$terms,
                      failures = st$failures, rejected = st$rejected,
-                     series_duplicates = st$duplicates,
+                     series_duplicates = st$duplicates, revisit = st$revisit,
                      unconfirmed = unconfirmed, tau_range = st$tau_range,
                      removed = if (is.null(st$series)) character() else st$series$removed)
   class(out) <- unique(c("avrefine", class(out)))
@@ -186,6 +252,10 @@ step_trace <- function(st) {
     keep <- vapply(seq_len(nrow(st$trials)), function(i) continues_set(st$trials[i, ]), NA)
     st$trials <- st$trials[keep, , drop = FALSE]
   }
+  if (length(st$seeds) && nrow(st$trials)) {
+    keep <- vapply(seq_len(nrow(st$trials)), function(i) pins_one_of(st$trials[i, ], st$seeds), NA)
+    if (any(keep)) st$trials <- st$trials[keep, , drop = FALSE] else st$seeds <- numeric(0)
+  }
   if (!nrow(st$trials)) st$flow <- "stop"
   st
 }
@@ -200,6 +270,17 @@ step_trace <- function(st) {
 # none of those pays. (Without any residual signature, only the screening
 # pass is run.)
 step_screen <- function(st) {
+  st <- screen_trials(st)
+  # a revisit's seeds that do not pay leave the step to every trial
+  if (is.null(st$best) && length(st$seeds)) {
+    st$seeds <- numeric(0)
+    st <- step_trace(st)
+    if (st$flow == "go") st <- screen_trials(st)
+  }
+  st
+}
+
+screen_trials <- function(st) {
   cur <- st$current
   st$c0 <- refine_crit(st, cur)
   st$best <- NULL
@@ -277,9 +358,15 @@ step_record <- function(st) {
     evidence <- paste0(evidence, "; raw data: ", best$ev$text,
                        if (isFALSE(best$ev$support)) " (NOT supported by the raw data)")
   }
+  if (length(st$seeds) && pins_one_of(best$trial, st$seeds)) {
+    evidence <- paste0(evidence, "; taken first on a revisit of the greedy order")
+    p <- unlist(best$trial$pin)
+    st$seeds <- st$seeds[!vapply(st$seeds, function(v) any(abs(p - v) <= 1e-9 * abs(v)), NA)]
+  }
   st$steps[[length(st$steps) + 1L]] <- step_row(
     best$trial$effect, best$label, loc, best$params, evidence, best$ev$support,
     st$current, best$fit, st$c0, best$crit)
+  st$pins[length(st$steps)] <- list(unlist(best$pin) %||% numeric(0))
   st$current <- best$fit
   st
 }

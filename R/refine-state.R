@@ -12,6 +12,7 @@ new_refine_state <- function(fit, args, settings) {
     args = args,               # candidates, max_steps, criterion, min_gain,
                                # level, remove, data, series, freq
     settings = settings,       # refit settings (refit_settings())
+    settings0 = settings,      # the same at the start (the user's fixed values)
     data = args$data,          # the raw series the loop sees (NULL: curve only)
     series = NULL,             # the series pass (detect_series_effects()) or NULL
     raw = NULL,                # refine_diagnostics() of `data`, or NULL
@@ -28,6 +29,10 @@ new_refine_state <- function(fit, args, settings) {
     c0 = NA_real_,             # the criterion before the step
     flow = "go",               # "go", "next" (on to the next step), "stop"
     only_sets = FALSE,         # budget spent: only further lines of held harmonic sets
+    start = NULL,              # the model the steps started from
+    pins = list(),             # per accepted step, the raw-data values it pinned
+    seeds = numeric(0),        # raw-data values a revisit takes first (stage_revisit())
+    revisit = NULL,            # what the revisit compared, or NULL
     remaining = NULL,          # signatures left when the loop stopped
     unexplained = NULL,
     tau_range = NULL,
