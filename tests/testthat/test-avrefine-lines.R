@@ -87,3 +87,43 @@ test_that("a harmonic set's further lines do not spend the step budget", {
   expect_false(any(abs(f0 / 1.3 - 1) < 0.03))
   expect_true(all(abs(f0 / 0.8 - round(f0 / 0.8)) < 0.01))
 })
+
+test_that("a line beside a measured axis's own: the greedy order is revisited with the line first", {
+  # unit 2 accel_y carries the sensor's filter, a 0.57 Hz line, a band near
+  # 10 Hz and a slow GM; a 1.7 Hz line (0.3 x the white sd a sample) added
+  # to it is first taken as a GM of tc 0.025 s, which then stays. The
+  # revisit takes the periodogram's lines first: the line is named, N
+  # stays where the run without it puts it, and the model fits.
+  skip_if_no_shared()
+  skip_on_cran()
+  m <- readRDS(shared_file("adis16405_unit2.rds"))
+  b <- as.numeric(m[, "accel_y"])
+  freq <- attr(m, "freq")
+  s <- stats::sd(diff(b)) / sqrt(2)
+  x <- b + 0.3 * s * sin(2 * pi * 1.7 * seq_along(b) / freq + 0.7)
+  r <- loop(x, freq)
+  cf <- coef(r)
+  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  expect_true(any(abs(f0 / 1.7 - 1) <= 0.03))
+  expect_false(any(r$steps$confirmed %in% FALSE))
+  expect_lt(r$chi2, 4)
+  rv <- r$refine$revisit
+  expect_s3_class(rv, "data.frame")
+  expect_identical(rv$kept, c(FALSE, TRUE))
+  expect_gt(rv$chi2[1], 4)
+  r0 <- loop(b, freq)
+  expect_null(r0$refine$revisit)
+  expect_equal(n_reading(r), n_reading(r0), tolerance = 0.05)
+})
+
+test_that("late_pins(): only raw-data values pinned behind a step that pinned nothing, still held", {
+  st <- list(pins = list(numeric(0), c(a.f0 = 1.7), numeric(0), c(b.f0 = 0.566)),
+             settings = list(fixed = c(x.f0 = 1.7, y.f0 = 0.566)))
+  expect_equal(allanvar:::late_pins(st), c(1.7, 0.566))
+  st$pins <- list(c(a.f0 = 1.7), numeric(0), c(b.f0 = 0.566))
+  expect_equal(allanvar:::late_pins(st), 0.566)
+  st$settings$fixed <- c(x.f0 = 1.7)
+  expect_equal(allanvar:::late_pins(st), numeric(0))
+  st$pins <- list(c(a.f0 = 1.7), c(b.f0 = 0.566))
+  expect_equal(allanvar:::late_pins(st), numeric(0))
+})
