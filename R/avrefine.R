@@ -81,6 +81,15 @@
 #' contradict is not accepted (see `$refine$rejected`), so `confirmed` is
 #' never `FALSE` for a step of this loop.
 #'
+#' The greedy order can lock in the weaker of two explanations (a short
+#' Gauss-Markov term taken at the first step for the bump of a line the
+#' periodogram shows plainly). When the loop ends far from the curve
+#' (\eqn{\chi^2} per degree of freedom above 4) after taking values the raw
+#' data measure (a line's frequency) at steps behind effects that measured
+#' nothing, it runs once more from the start with those values taken first,
+#' by the same rules, and keeps the run with the lower criterion (with a
+#' message; `$refine$revisit` compares the two).
+#'
 #' @param fit An [avfit()] result.
 #' @param data Optional raw rate series (numeric vector or `ts`) at the
 #'   fit's sampling frequency, used to confirm effects from the data itself.
@@ -125,7 +134,9 @@
 #'   ratio is 1 or more, `"refit"` when the term no longer pays on the
 #'   curve with the effect's excess taken out; the readings of such a run
 #'   carry that series effect's bias, see [series_reading_bias()]),
-#'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range) and
+#'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range),
+#'   `revisit` (NULL, or when the greedy order was revisited a data frame
+#'   `order`, `terms`, `chi2`, `criterion`, `kept`, one row per run) and
 #'   `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,
 #'   strength in sigma, size = largest ADEV error inside in percent,
 #'   description) and `series` the series pass (or NULL) without its
@@ -255,6 +266,13 @@ print_refine_notes <- function(x) {
   if (nr) {
     cat(nr, " candidate(s) rejected (contradicted by the raw data or not a valid ",
         "instance); see $refine$rejected.\n", sep = "")
+  }
+  rv <- r$revisit
+  if (NROW(rv)) {
+    cat(sprintf(paste("The greedy order ended at chi2/dof %s; with the raw data's lines",
+                      "first, %s: the %s run is kept (see $refine$revisit).\n"),
+                format_num(rv$chi2[1L]), format_num(rv$chi2[2L]),
+                rv$order[rv$kept][1L]))
   }
   d <- unique(r$series_duplicates[c("effect", "series_kind")])
   if (NROW(d)) {
