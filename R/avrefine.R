@@ -85,7 +85,7 @@
 #' Gauss-Markov term taken at the first step for the bump of a line the
 #' periodogram shows plainly). When the loop ends far from the curve
 #' (\eqn{\chi^2} per degree of freedom above 4) after taking values the raw
-#' data measure (a line's frequency) at steps behind effects that measured
+#' data measure (a line's frequency, a band's spectrum) at steps behind effects that measured
 #' nothing, it runs once more from the start with those values taken first,
 #' by the same rules, and keeps the run with the lower criterion (with a
 #' message; `$refine$revisit` compares the two).
@@ -269,7 +269,7 @@ print_refine_notes <- function(x) {
   }
   rv <- r$revisit
   if (NROW(rv)) {
-    cat(sprintf(paste("The greedy order ended at chi2/dof %s; with the raw data's lines",
+    cat(sprintf(paste("The greedy order ended at chi2/dof %s; with the raw data's measured values",
                       "first, %s: the %s run is kept (see $refine$revisit).\n"),
                 format_num(rv$chi2[1L]), format_num(rv$chi2[2L]),
                 rv$order[rv$kept][1L]))

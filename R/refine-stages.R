@@ -104,8 +104,8 @@ stage_revisit <- function(st) {
   if (is.null(st$data) || !length(st$steps) || !(st$current$chi2 > revisit_chi2)) {
     return(st)
   }
-  seeds <- late_pins(st)
-  if (!length(seeds)) return(st)
+  late <- late_pins(st)
+  if (!length(late)) return(st)
   s2 <- st
   s2$current <- st$start
   s2$settings <- st$settings0
@@ -114,44 +114,55 @@ stage_revisit <- function(st) {
   s2$failures <- new_failures()
   s2$rejected <- new_rejected()
   s2$duplicates <- new_duplicates()
-  s2$seeds <- seeds
+  s2$seeds <- st$pins[late]
   s2 <- stage_rechoose(stage_steps(s2))
-  s2$seeds <- numeric(0)
+  s2$seeds <- list()
   c1 <- refine_crit(st, st$current)
   c2 <- refine_crit(s2, s2$current)
   taken <- is.finite(c2) && c2 < c1 - st$args$min_gain
   rv <- data.frame(
-    order = c("greedy", "lines first"),
+    order = c("greedy", "raw-data values first"),
     terms = c(paste(st$current$terms, collapse = " + "),
               paste(s2$current$terms, collapse = " + ")),
     chi2 = c(st$current$chi2, s2$current$chi2), criterion = c(c1, c2),
     kept = c(!taken, taken), stringsAsFactors = FALSE)
+  first <- vapply(st$steps[late], function(s) sprintf("%s (%s)", s$effect, s$params), "")
   message(sprintf(paste(
-    "avrefine(): the greedy order ended at chi2/dof %s; taking the raw data's",
-    "lines (%s Hz) first gave %s: %s kept."),
-    format_num(st$current$chi2), paste(format_num(seeds), collapse = ", "),
+    "avrefine(): the greedy order ended at chi2/dof %s; taking %s first gave %s:",
+    "%s kept."), format_num(st$current$chi2), paste(first, collapse = ", "),
     format_num(s2$current$chi2), if (taken) "that run is" else "the greedy run is"))
   out <- if (taken) s2 else st
   out$revisit <- rv
   out
 }
 
-# The raw-data values (pins) of accepted steps taken after a step that
-# pinned nothing, still in the final model, in the order they were taken.
+# The accepted steps that pinned values measured on the raw data (a line's
+# frequency, a band's spectrum) behind a step that pinned nothing, whose
+# values the final model still holds: their indices, in the order taken.
 late_pins <- function(st) {
   pinned <- lengths(st$pins) > 0L
   first_free <- match(FALSE, pinned)
-  if (is.na(first_free)) return(numeric(0))
-  late <- unlist(st$pins[seq_along(st$pins) > first_free & pinned])
+  if (is.na(first_free)) return(integer(0))
   held <- st$settings$fixed
-  late <- late[vapply(late, function(v) any(abs(held - v) <= 1e-9 * abs(v)), NA)]
-  unname(late)
+  late <- which(seq_along(st$pins) > first_free & pinned)
+  late[vapply(st$pins[late], function(p) all(same_values(p, held)), NA)]
 }
 
-# Does trial `tr` pin one of `values`?
-pins_one_of <- function(tr, values) {
+# Which of `values` occur among `among` (to 1e-9 relative)?
+same_values <- function(values, among) {
+  vapply(unlist(values), function(v) any(abs(among - v) <= 1e-9 * abs(v)), NA)
+}
+
+# The seed (in `seeds`, a list of pinned value sets) whose values trial
+# `tr` pins, or 0.
+seed_of <- function(tr, seeds) {
   p <- unlist(tr$pin)
-  length(p) > 0L && any(vapply(p, function(v) any(abs(values - v) <= 1e-9 * abs(v)), NA))
+  if (!length(p)) return(0L)
+  for (j in seq_along(seeds)) {
+    s <- unlist(seeds[[j]])
+    if (length(s) && all(same_values(s, p))) return(j)
+  }
+  0L
 }
 
 # What is left: residual structure no catalogue effect explained.
@@ -253,8 +264,8 @@ step_trace <- function(st) {
     st$trials <- st$trials[keep, , drop = FALSE]
   }
   if (length(st$seeds) && nrow(st$trials)) {
-    keep <- vapply(seq_len(nrow(st$trials)), function(i) pins_one_of(st$trials[i, ], st$seeds), NA)
-    if (any(keep)) st$trials <- st$trials[keep, , drop = FALSE] else st$seeds <- numeric(0)
+    keep <- vapply(seq_len(nrow(st$trials)), function(i) seed_of(st$trials[i, ], st$seeds) > 0L, NA)
+    if (any(keep)) st$trials <- st$trials[keep, , drop = FALSE] else st$seeds <- list()
   }
   if (!nrow(st$trials)) st$flow <- "stop"
   st
@@ -273,7 +284,7 @@ step_screen <- function(st) {
   st <- screen_trials(st)
   # a revisit's seeds that do not pay leave the step to every trial
   if (is.null(st$best) && length(st$seeds)) {
-    st$seeds <- numeric(0)
+    st$seeds <- list()
     st <- step_trace(st)
     if (st$flow == "go") st <- screen_trials(st)
   }
@@ -358,10 +369,10 @@ step_record <- function(st) {
     evidence <- paste0(evidence, "; raw data: ", best$ev$text,
                        if (isFALSE(best$ev$support)) " (NOT supported by the raw data)")
   }
-  if (length(st$seeds) && pins_one_of(best$trial, st$seeds)) {
+  k <- if (length(st$seeds)) seed_of(best$trial, st$seeds) else 0L
+  if (k > 0L) {
     evidence <- paste0(evidence, "; taken first on a revisit of the greedy order")
-    p <- unlist(best$trial$pin)
-    st$seeds <- st$seeds[!vapply(st$seeds, function(v) any(abs(p - v) <= 1e-9 * abs(v)), NA)]
+    st$seeds <- st$seeds[-k]
   }
   st$steps[[length(st$steps) + 1L]] <- step_row(
     best$trial$effect, best$label, loc, best$params, evidence, best$ev$support,

@@ -31,7 +31,7 @@ new_refine_state <- function(fit, args, settings) {
     only_sets = FALSE,         # budget spent: only further lines of held harmonic sets
     start = NULL,              # the model the steps started from
     pins = list(),             # per accepted step, the raw-data values it pinned
-    seeds = numeric(0),        # raw-data values a revisit takes first (stage_revisit())
+    seeds = list(),            # pinned value sets a revisit takes first (stage_revisit())
     revisit = NULL,            # what the revisit compared, or NULL
     remaining = NULL,          # signatures left when the loop stopped
     unexplained = NULL,

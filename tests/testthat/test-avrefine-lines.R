@@ -116,14 +116,20 @@ test_that("a line beside a measured axis's own: the greedy order is revisited wi
   expect_equal(n_reading(r), n_reading(r0), tolerance = 0.05)
 })
 
-test_that("late_pins(): only raw-data values pinned behind a step that pinned nothing, still held", {
+test_that("late_pins(): steps that pinned raw-data values behind one that pinned nothing, still held", {
   st <- list(pins = list(numeric(0), c(a.f0 = 1.7), numeric(0), c(b.f0 = 0.566)),
              settings = list(fixed = c(x.f0 = 1.7, y.f0 = 0.566)))
-  expect_equal(allanvar:::late_pins(st), c(1.7, 0.566))
+  expect_identical(allanvar:::late_pins(st), c(2L, 4L))
   st$pins <- list(c(a.f0 = 1.7), numeric(0), c(b.f0 = 0.566))
-  expect_equal(allanvar:::late_pins(st), 0.566)
+  expect_identical(allanvar:::late_pins(st), 3L)
   st$settings$fixed <- c(x.f0 = 1.7)
-  expect_equal(allanvar:::late_pins(st), numeric(0))
+  expect_identical(allanvar:::late_pins(st), integer(0))
   st$pins <- list(c(a.f0 = 1.7), c(b.f0 = 0.566))
-  expect_equal(allanvar:::late_pins(st), numeric(0))
+  expect_identical(allanvar:::late_pins(st), integer(0))
+  # a trial matches the seed whose values it pins
+  seeds <- list(c(s.f0 = 1.7), c(b.s1 = 2, b.s2 = 3))
+  expect_identical(allanvar:::seed_of(list(pin = list(list(f0 = 1.7))), seeds), 1L)
+  expect_identical(allanvar:::seed_of(list(pin = list(list(s1 = 2, s2 = 3, u = 9))), seeds), 2L)
+  expect_identical(allanvar:::seed_of(list(pin = list(list(f0 = 1.8))), seeds), 0L)
+  expect_identical(allanvar:::seed_of(list(pin = list(NULL)), seeds), 0L)
 })
