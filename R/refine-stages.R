@@ -73,6 +73,8 @@ stage_steps <- function(st) {
       if (st$flow != "go") break
     }
     if (st$flow == "stop") break
+    # a revisit that has reached the greedy run's terms ends as it did
+    if (!is.null(st$until) && identical(sort(st$current$terms), st$until)) break
     if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
       free <- free + 1L
     } else if (st$only_sets) {
@@ -115,8 +117,10 @@ stage_revisit <- function(st) {
   s2$rejected <- new_rejected()
   s2$duplicates <- new_duplicates()
   s2$seeds <- st$pins[late]
+  s2$until <- sort(st$current$terms)
   s2 <- stage_rechoose(stage_steps(s2))
   s2$seeds <- list()
+  s2$until <- NULL
   c1 <- refine_crit(st, st$current)
   c2 <- refine_crit(s2, s2$current)
   taken <- is.finite(c2) && c2 < c1 - st$args$min_gain

@@ -32,6 +32,7 @@ new_refine_state <- function(fit, args, settings) {
     start = NULL,              # the model the steps started from
     pins = list(),             # per accepted step, the raw-data values it pinned
     seeds = list(),            # pinned value sets a revisit takes first (stage_revisit())
+    until = NULL,              # a revisit stops on reaching these terms (sorted)
     revisit = NULL,            # what the revisit compared, or NULL
     remaining = NULL,          # signatures left when the loop stopped
     unexplained = NULL,
