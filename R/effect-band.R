@@ -73,15 +73,21 @@ sim_band <- function(n, tau0, scale, f_lo, f_hi, s) {
 
 # The band's spectrum measured from the raw series: `b` a row of
 # find_bands(). The background under it is log-quadratic in f through the
-# flanks (one band width either side, below 0.49 freq); a log-linear one
+# flanks (one band width either side, below 0.49 freq, without the other
+# bands found, `others`: rows of find_bands()); a log-linear one
 # gives the systematic spread. Returns list(f_lo, f_hi, s, u, power) or
 # NULL when the band has no measurable excess.
 measure_band <- function(x, freq, b, seg = 512L, knots = band_knots,
-                         welch = centred_welch) {
+                         welch = centred_welch, others = NULL) {
   w <- welch(x, freq, seg)
   wd <- max(b$f_to - b$f_from, 4 * w$df)
   fl <- (w$f > b$f_from - wd & w$f < b$f_from & w$f > 0) |
     (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))
+  # the other bands found are not background (a band beside it would lift
+  # the background under this one; their leakage reaches 2 bins)
+  for (k in seq_len(NROW(others))) {
+    fl <- fl & !(w$f >= others$f_from[k] - 2 * w$df & w$f <= others$f_to[k] + 2 * w$df)
+  }
   # the band's bins, and 2 more either side: the Hann window spreads each
   # frequency over +-2 bins, so the band's edges leak that far
   inb <- which(w$f >= b$f_from - 2 * w$df & w$f <= b$f_to + 2 * w$df & w$f > 0)
@@ -213,7 +219,7 @@ effect_band <- function() {
       make = function(x, freq, dg) {
         bands <- diag_part(dg, "bands")
         Filter(Negate(is.null), lapply(seq_len(nrow(bands)), function(j) {
-          measure_band(x, freq, bands[j, ], welch = raw_welch(dg))
+          measure_band(x, freq, bands[j, ], welch = raw_welch(dg), others = bands[-j, ])
         }))
       }),
     describe = function(values) {
