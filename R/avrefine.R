@@ -85,8 +85,10 @@
 #' Gauss-Markov term taken at the first step for the bump of a line the
 #' periodogram shows plainly). When the loop ends far from the curve
 #' (\eqn{\chi^2} per degree of freedom above 4) after taking values the raw
-#' data measure (a line's frequency, a band's spectrum) at steps behind effects that measured
-#' nothing, it runs once more from the start with those values taken first,
+#' data measure (a line's frequency, a band's spectrum) at steps behind
+#' effects that measured nothing, or after refusing such values because they
+#' would move an earlier effect to values the raw data contradict, it runs
+#' once more from the start with those values taken first,
 #' by the same rules, and keeps the run with the lower criterion (with a
 #' message; `$refine$revisit` compares the two).
 #'

@@ -96,6 +96,8 @@ screen_trial <- function(st, tr, nl_now) {
   }
   if (!is.null(jd$why)) {
     st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, jd$why)
+    # raw-data values an earlier effect keeps out: a revisit takes them first
+    if (isTRUE(jd$moved) && length(pin)) st$blocked[[length(st$blocked) + 1L]] <- unlist(pin)
     if (!is.null(jd$dup)) {
       st$duplicates <- rbind(st$duplicates, cbind(
         data.frame(step = as.integer(st$step), effect = tr$effect,

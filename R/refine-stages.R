@@ -94,12 +94,14 @@ stage_rechoose <- function(st) rechoose_families(st)$st
 
 # A greedy order can lock in the weaker explanation: an effect taken early
 # for a bump that a periodogram line explains (a GM of tc 0.025 s for a
-# 1.7 Hz line) keeps its place, and the line, added later, cannot move it.
-# When the loop ends far from the curve (chi2/dof above `revisit_chi2`)
-# after taking values measured on the raw data (a line's frequency) at
-# steps behind effects that measured nothing, it is run once more from the
-# start with those values taken first, by the same rules; the run with the
-# lower criterion is kept and `$refine$revisit` says what was compared.
+# 1.7 Hz line) keeps its place, and the line, added later, cannot move it
+# (or is refused because it would move it). When the loop ends far from
+# the curve (chi2/dof above `revisit_chi2`) after taking values measured
+# on the raw data (a line's frequency) at steps behind effects that
+# measured nothing, or refusing such values for moving an earlier effect,
+# it is run once more from the start with those values taken first, by the
+# same rules; the run with the lower criterion is kept and
+# `$refine$revisit` says what was compared.
 revisit_chi2 <- 4
 
 stage_revisit <- function(st) {
@@ -107,7 +109,11 @@ stage_revisit <- function(st) {
     return(st)
   }
   late <- late_pins(st)
-  if (!length(late)) return(st)
+  blocked <- unique(st$blocked)
+  blocked <- blocked[!vapply(blocked, function(b) {
+    any(vapply(st$pins, function(p) length(p) > 0L && all(same_values(b, p)), NA))
+  }, NA)]
+  if (!length(late) && !length(blocked)) return(st)
   s2 <- st
   s2$current <- st$start
   s2$settings <- st$settings0
@@ -116,7 +122,8 @@ stage_revisit <- function(st) {
   s2$failures <- new_failures()
   s2$rejected <- new_rejected()
   s2$duplicates <- new_duplicates()
-  s2$seeds <- st$pins[late]
+  s2$blocked <- list()
+  s2$seeds <- c(st$pins[late], blocked)
   s2$until <- sort(st$current$terms)
   s2 <- stage_rechoose(stage_steps(s2))
   s2$seeds <- list()
@@ -130,7 +137,8 @@ stage_revisit <- function(st) {
               paste(s2$current$terms, collapse = " + ")),
     chi2 = c(st$current$chi2, s2$current$chi2), criterion = c(c1, c2),
     kept = c(!taken, taken), stringsAsFactors = FALSE)
-  first <- vapply(st$steps[late], function(s) sprintf("%s (%s)", s$effect, s$params), "")
+  first <- c(vapply(st$steps[late], function(s) sprintf("%s (%s)", s$effect, s$params), ""),
+             if (length(blocked)) sprintf("%d trial(s) an earlier effect kept out", length(blocked)))
   message(sprintf(paste(
     "avrefine(): the greedy order ended at chi2/dof %s; taking %s first gave %s:",
     "%s kept."), format_num(st$current$chi2), paste(first, collapse = ", "),
