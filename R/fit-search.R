@@ -210,9 +210,16 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
     return(list(c = cc, objective = obj, iterations = 0L, converged = TRUE,
                 layout = lay))
   }
+  # warm start: the last solve of this problem with the same free set (the
+  # search's next value is near its last one)
+  key <- paste(free, collapse = "\r")
+  prev <- pr$memo[["\001warm"]]
+  c0 <- if (!is.null(prev) && identical(prev$key, key)) prev$c else numeric(length(free))
   r <- avfit_log_nnls(Bm[, amp$col[on], drop = FALSE], offset, pr$y, pr$W,
-                      numeric(length(free)), control$inner_maxit,
-                      control$inner_tol)
+                      c0, control$inner_maxit, control$inner_tol)
+  if (all(is.finite(r$c)) && sum(r$c) > 0) {
+    assign("\001warm", list(key = key, c = r$c), envir = pr$memo)
+  }
   cc[free] <- r$c
   list(c = cc, objective = r$objective, iterations = r$iterations,
        converged = r$converged, layout = lay)
