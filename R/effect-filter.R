@@ -177,7 +177,9 @@ effect_resonance <- function() {
                       "damped; a broad periodogram band at fr of width 1/(pi tc)"),
     basis = function(tau, tau0, nl) {
       if (is.null(tau0)) tau0 <- min(tau) / 4
-      resonance_av(pmax(tau / tau0, 1), tau0, 1, nl[["fr"]], nl[["tc"]])
+      m <- tau / tau0
+      m[m < 1] <- 1  # pmax(tau / tau0, 1): a search calls this thousands of times
+      resonance_av(m, tau0, 1, nl[["fr"]], nl[["tc"]])
     },
     acf = function(h, tau0, nl) resonance_acf(h, tau0, 1, nl[["fr"]], nl[["tc"]]),
     sim = function(n, tau0, amp, nl) sim_resonance(n, tau0, amp[[1L]], nl[["fr"]], nl[["tc"]]),

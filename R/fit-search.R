@@ -195,8 +195,17 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
   if (length(nlv)) values[names(nlv)] <- nlv
   amp <- pr$amp
   Bm <- solve_basis(pr, values, store)
-  on <- if (is.null(off)) !amp$fixed else !amp$fixed & !amp$label %in% off
-  free <- amp$name[on]
+  # the free set, its columns and its warm-start key: kept in the memo for
+  # the solves without `off` (most of them)
+  fs <- if (is.null(off)) pr$memo[["\001free"]]
+  if (is.null(fs)) {
+    on <- if (is.null(off)) !amp$fixed else !amp$fixed & !amp$label %in% off
+    fs <- list(free = amp$name[on], cols = amp$col[on],
+               key = paste(amp$name[on], collapse = "\r"))
+    fs$all <- identical(fs$cols, seq_len(ncol(Bm)))
+    if (is.null(off)) assign("\001free", fs, envir = pr$memo)
+  }
+  free <- fs$free
   offset <- pr$zero
   for (i in amp$fixed_idx) offset <- offset + amp$value[i]^2 * Bm[, amp$col[i]]
   cc <- amp$cc0
@@ -210,9 +219,16 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
     return(list(c = cc, objective = obj, iterations = 0L, converged = TRUE,
                 layout = lay))
   }
-  r <- avfit_log_nnls(Bm[, amp$col[on], drop = FALSE], offset, pr$y, pr$W,
-                      numeric(length(free)), control$inner_maxit,
-                      control$inner_tol)
+  # warm start: the last solve of this problem with the same free set (the
+  # search's next value is near its last one)
+  key <- fs$key
+  prev <- pr$memo[["\001warm"]]
+  c0 <- if (!is.null(prev) && identical(prev$key, key)) prev$c else numeric(length(free))
+  r <- avfit_log_nnls(if (fs$all) Bm else Bm[, fs$cols, drop = FALSE], offset, pr$y,
+                      pr$W, c0, control$inner_maxit, control$inner_tol)
+  if (all(is.finite(r$c)) && sum(r$c) > 0) {
+    assign("\001warm", list(key = key, c = r$c), envir = pr$memo)
+  }
   cc[free] <- r$c
   list(c = cc, objective = r$objective, iterations = r$iterations,
        converged = r$converged, layout = lay)

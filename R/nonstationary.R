@@ -687,12 +687,16 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
 # (< 1e4 values).
 spike_tail_level <- function(z, alpha) {
   z <- z[z != 0]
-  a <- sort(abs(z))
-  n <- length(a)
+  n <- length(z)
   if (n < 1e4) return(0)
   S <- robust_scale(z)
   if (!(S > 0)) return(0)
-  B <- mean(a[seq.int(ceiling(0.95 * n), floor(0.99 * n))]) / S
+  # the ranks 95-99% of |z| in order: a partial sort places that band,
+  # which alone is then sorted (a full sort of 1e6 cost 0.17 s an axis)
+  lo <- ceiling(0.95 * n)
+  hi <- floor(0.99 * n)
+  a <- sort(abs(z), partial = c(lo, hi))
+  B <- mean(sort(a[seq.int(lo, hi)])) / S
   tab <- spike_t_table()
   if (B <= tab$B[length(tab$B)]) return(0)  # Gaussian or lighter
   lnu <- stats::approx(tab$B, log(tab$nu), B, rule = 2)$y

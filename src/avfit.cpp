@@ -16,19 +16,35 @@ using Eigen::VectorXd;
 
 namespace {
 
+using CRefM = Eigen::Ref<const MatrixXd>;
+using CRefV = Eigen::Ref<const VectorXd>;
+
+// The buffers of one amplitude solve, kept between solves of the same
+// sizes (the search makes thousands of small solves; allocating each
+// product's result cost about as much as the arithmetic). The arithmetic
+// is the same as with fresh objects.
+struct NnlsWork {
+  MatrixXd A, Ap;
+  VectorXd scale, x, w, r, x_prev, zp;
+  std::vector<bool> passive;
+  std::vector<int> idx;
+  Eigen::ColPivHouseholderQR<MatrixXd> qr;
+};
+
 // The least squares of b on A's columns in the passive set: their indices
 // in `idx`, the coefficients in `zp`; true when every one is positive.
-bool passive_ls(const MatrixXd& A, const VectorXd& b,
+bool passive_ls(const MatrixXd& A, const CRefV& b,
                 const std::vector<bool>& passive, std::vector<int>& idx,
-                VectorXd& zp) {
+                VectorXd& zp, NnlsWork& ws) {
   idx.clear();
   for (int k = 0; k < static_cast<int>(passive.size()); ++k) {
     if (passive[k]) idx.push_back(k);
   }
   const int q = static_cast<int>(idx.size());
-  MatrixXd Ap(A.rows(), q);
-  for (int i = 0; i < q; ++i) Ap.col(i) = A.col(idx[i]);
-  zp = Ap.colPivHouseholderQr().solve(b);
+  ws.Ap.resize(A.rows(), q);
+  for (int i = 0; i < q; ++i) ws.Ap.col(i) = A.col(idx[i]);
+  ws.qr.compute(ws.Ap);
+  zp = ws.qr.solve(b);
   for (int i = 0; i < q; ++i) if (!(zp(i) > 0)) return false;
   return true;
 }
@@ -40,30 +56,35 @@ bool passive_ls(const MatrixXd& A, const VectorXd& b,
 // are strictly positive the search starts there instead of from the empty
 // set. The result is the least squares on the final passive set, so a
 // warm start that ends on the same set gives the same x to the bit; the
-// final set is written back.
-VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500,
-              std::vector<bool>* warm = nullptr) {
+// final set is written back. The result is left in ws.x.
+void nnls_ws(const CRefM& A0, const CRefV& b, NnlsWork& ws, int maxit = 500,
+             std::vector<bool>* warm = nullptr) {
   const int p = static_cast<int>(A0.cols());
-  VectorXd scale(p);
-  MatrixXd A = A0;
+  ws.scale.resize(p);
+  ws.A = A0;
+  MatrixXd& A = ws.A;
   for (int k = 0; k < p; ++k) {
     double nk = A.col(k).norm();
-    scale(k) = nk > 0 ? nk : 1.0;
-    A.col(k) /= scale(k);
+    ws.scale(k) = nk > 0 ? nk : 1.0;
+    A.col(k) /= ws.scale(k);
   }
-  VectorXd x = VectorXd::Zero(p);
-  std::vector<bool> passive(p, false);
+  VectorXd& x = ws.x;
+  x.setZero(p);
+  std::vector<bool>& passive = ws.passive;
+  passive.assign(p, false);
   const double tol = 1e-12 * (1.0 + b.norm());
-  std::vector<int> idx;
-  VectorXd zp;
+  std::vector<int>& idx = ws.idx;
+  VectorXd& zp = ws.zp;
   if (warm != nullptr && static_cast<int>(warm->size()) == p &&
       std::find(warm->begin(), warm->end(), true) != warm->end() &&
-      passive_ls(A, b, *warm, idx, zp)) {
+      passive_ls(A, b, *warm, idx, zp, ws)) {
     for (int i = 0; i < static_cast<int>(idx.size()); ++i) x(idx[i]) = zp(i);
     passive = *warm;
   }
   for (int it = 0; it < maxit; ++it) {
-    VectorXd w = A.transpose() * (b - A * x);
+    ws.r.noalias() = b - A * x;
+    ws.w.noalias() = A.transpose() * ws.r;
+    const VectorXd& w = ws.w;
     int t = -1;
     double wmax = tol;
     for (int k = 0; k < p; ++k) {
@@ -71,9 +92,9 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500,
     }
     if (t < 0) break;
     passive[t] = true;
-    const VectorXd x_prev = x;
+    ws.x_prev = x;
     for (int inner = 0; inner < 3 * p + 3; ++inner) {
-      const bool ok = passive_ls(A, b, passive, idx, zp);
+      const bool ok = passive_ls(A, b, passive, idx, zp, ws);
       const int q = static_cast<int>(idx.size());
       if (ok) {
         x.setZero();
@@ -98,42 +119,72 @@ VectorXd nnls(const MatrixXd& A0, const VectorXd& b, int maxit = 500,
     }
     // Degenerate step (the variable just added was dropped again and x did
     // not move): Lawson-Hanson would cycle; x is optimal to rounding.
-    if ((x - x_prev).norm() <= 1e-14 * (1.0 + x.norm())) break;
+    if ((x - ws.x_prev).norm() <= 1e-14 * (1.0 + x.norm())) break;
   }
-  for (int k = 0; k < p; ++k) x(k) /= scale(k);
+  for (int k = 0; k < p; ++k) x(k) /= ws.scale(k);
   if (warm != nullptr) *warm = passive;
-  return x;
+}
+
+VectorXd nnls(const CRefM& A0, const CRefV& b, int maxit = 500,
+              std::vector<bool>* warm = nullptr) {
+  NnlsWork ws;
+  nnls_ws(A0, b, ws, maxit, warm);
+  return ws.x;
 }
 
 // W applied to a vector or a matrix. W is either the whitening matrix
 // (J x J) or, when the points are independent, its diagonal as one column
 // (J x 1): a dense J x J diagonal would cost O(J^2) memory and O(J^2 p)
 // time per product, 800 MB and seconds on a 10,000-tau curve.
-bool w_is_diag(const MatrixXd& W, R_xlen_t J) {
+bool w_is_diag(const CRefM& W, R_xlen_t J) {
   return W.cols() == 1 && W.rows() == J && J > 1;
 }
-VectorXd w_times(const MatrixXd& W, const VectorXd& v) {
+VectorXd w_times(const CRefM& W, const VectorXd& v) {
   if (w_is_diag(W, v.size())) return W.col(0).cwiseProduct(v);
   return W * v;
 }
-MatrixXd w_times(const MatrixXd& W, const MatrixXd& A) {
+MatrixXd w_times(const CRefM& W, const MatrixXd& A) {
   if (w_is_diag(W, A.rows())) return W.col(0).asDiagonal() * A;
   return W * A;
+}
+// the same into a kept buffer
+void w_times_to(const CRefM& W, const VectorXd& v, VectorXd& out) {
+  if (w_is_diag(W, v.size())) {
+    out = W.col(0).cwiseProduct(v);
+  } else {
+    out.noalias() = W * v;
+  }
+}
+void w_times_to(const CRefM& W, const MatrixXd& A, MatrixXd& out) {
+  if (w_is_diag(W, A.rows())) {
+    out.noalias() = W.col(0).asDiagonal() * A;
+  } else {
+    out.noalias() = W * A;
+  }
 }
 
 // S = || W (y - ln AV) ||^2; W whitens the log-AV errors (diag(1/s) when
 // the points are taken as independent, the inverse Cholesky factor of their
-// covariance otherwise).
-double objective(const MatrixXd& B, const VectorXd& offset, const VectorXd& y,
-                 const MatrixXd& W, const VectorXd& c) {
-  VectorXd av = offset + B * c;
-  VectorXd r(av.size());
+// covariance otherwise). `av`, `r`, `wr`: buffers.
+double objective(const CRefM& B, const CRefV& offset, const CRefV& y,
+                 const CRefM& W, const VectorXd& c, VectorXd& av, VectorXd& r,
+                 VectorXd& wr) {
+  av.noalias() = offset + B * c;
+  r.resize(av.size());
   for (R_xlen_t j = 0; j < av.size(); ++j) {
     if (!(av(j) > 0)) return std::numeric_limits<double>::infinity();
     r(j) = y(j) - std::log(av(j));
   }
-  return w_times(W, r).squaredNorm();
+  w_times_to(W, r, wr);
+  return wr.squaredNorm();
 }
+
+// The buffers of avfit_log_nnls(), one set per thread.
+struct SolveWork {
+  NnlsWork nn;
+  MatrixXd A, WA;
+  VectorXd av, bc, t, Wt, d, ctry, oav, or_, owr;
+};
 
 }  // namespace
 
@@ -147,10 +198,14 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
                           const Eigen::Map<Eigen::MatrixXd> W,
                           const Eigen::Map<Eigen::VectorXd> start,
                           int maxit, double tol) {
+  static thread_local SolveWork ws;
   const R_xlen_t J = B.rows();
   const int p = static_cast<int>(B.cols());
+  auto obj = [&](const VectorXd& cc) {
+    return objective(B, offset, y, W, cc, ws.oav, ws.or_, ws.owr);
+  };
   VectorXd c = start;
-  double S = objective(B, offset, y, W, c);
+  double S = obj(c);
   if (!std::isfinite(S) || c.sum() <= 0) {
     // Linear-domain start: min || W ((offset + B c) / AV-hat - 1) ||^2.
     MatrixXd A(J, p);
@@ -161,7 +216,7 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
       t(j) = 1.0 - offset(j) / avh;
     }
     c = nnls(w_times(W, A), w_times(W, t));
-    S = objective(B, offset, y, W, c);
+    S = obj(c);
     if (!std::isfinite(S)) {
       // Keep every term slightly on so that ln AV is finite everywhere.
       for (int k = 0; k < p; ++k) {
@@ -169,7 +224,7 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
         double floor_k = bk > 0 ? 1e-8 * std::exp(y.maxCoeff()) / bk : 0.0;
         if (c(k) < floor_k) c(k) = floor_k;
       }
-      S = objective(B, offset, y, W, c);
+      S = obj(c);
     }
   }
   int it = 0;
@@ -178,20 +233,27 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
   // passive set (nnls(): the same result when the set is the same)
   std::vector<bool> pset;
   for (; it < maxit && std::isfinite(S); ++it) {
-    VectorXd av = offset + B * c;
-    VectorXd bc = B * c;
-    MatrixXd A(J, p);
-    VectorXd t(J);
+    ws.av.noalias() = offset + B * c;
+    ws.bc.noalias() = B * c;
+    const VectorXd& av = ws.av;
+    const VectorXd& bc = ws.bc;
+    ws.A.resize(J, p);
+    ws.t.resize(J);
     for (R_xlen_t j = 0; j < J; ++j) {
-      A.row(j) = B.row(j) / av(j);
-      t(j) = y(j) - std::log(av(j)) + bc(j) / av(j);
+      ws.A.row(j) = B.row(j) / av(j);
+      ws.t(j) = y(j) - std::log(av(j)) + bc(j) / av(j);
     }
-    VectorXd cn = nnls(w_times(W, A), w_times(W, t), 500, &pset);
-    VectorXd d = cn - c;
-    double lambda = 1.0, Sn = objective(B, offset, y, W, c + d);
+    w_times_to(W, ws.A, ws.WA);
+    w_times_to(W, ws.t, ws.Wt);
+    nnls_ws(ws.WA, ws.Wt, ws.nn, 500, &pset);
+    ws.d = ws.nn.x - c;
+    const VectorXd& d = ws.d;
+    ws.ctry = c + d;
+    double lambda = 1.0, Sn = obj(ws.ctry);
     while (!(Sn <= S) && lambda > 1e-10) {
       lambda *= 0.5;
-      Sn = objective(B, offset, y, W, c + lambda * d);
+      ws.ctry = c + lambda * d;
+      Sn = obj(ws.ctry);
     }
     if (!(Sn <= S)) { converged = true; break; }  // no descent: at optimum
     c += lambda * d;
