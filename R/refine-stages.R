@@ -7,7 +7,7 @@ refine_stages <- function() {
   list(prepare = stage_prepare,      # series pass, raw-data diagnostics
        steps = stage_steps,          # add effects, one step at a time
        rechoose = stage_rechoose,    # families chosen again on the final model
-       revisit = stage_revisit,      # the raw data's lines first, if the order failed
+       revisit = stage_revisit,      # raw-data values first, if the greedy order failed
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
        assemble = stage_assemble)    # the refined avfit object
