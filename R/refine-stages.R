@@ -114,15 +114,13 @@ stage_revisit <- function(st) {
     any(vapply(st$pins, function(p) length(p) > 0L && all(same_values(b, p)), NA))
   }, NA)]
   if (!length(late) && !length(blocked)) return(st)
-  s2 <- st
-  s2$current <- st$start
-  s2$settings <- st$settings0
-  s2$steps <- list()
-  s2$pins <- list()
-  s2$failures <- new_failures()
-  s2$rejected <- new_rejected()
-  s2$duplicates <- new_duplicates()
-  s2$blocked <- list()
+  # a fresh state on what stage_prepare() made: the series, its diagnostics
+  # and the model the steps started from
+  s2 <- new_refine_state(st$fit, st$args, st$settings0)
+  s2$data <- st$data
+  s2$series <- st$series
+  s2$raw <- st$raw
+  s2$start <- s2$current <- st$start
   s2$seeds <- c(st$pins[late], blocked)
   s2$until <- sort(st$current$terms)
   s2 <- stage_rechoose(stage_steps(s2))
