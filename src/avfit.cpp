@@ -139,15 +139,6 @@ VectorXd nnls(const CRefM& A0, const CRefV& b, int maxit = 500,
 bool w_is_diag(const CRefM& W, R_xlen_t J) {
   return W.cols() == 1 && W.rows() == J && J > 1;
 }
-VectorXd w_times(const CRefM& W, const VectorXd& v) {
-  if (w_is_diag(W, v.size())) return W.col(0).cwiseProduct(v);
-  return W * v;
-}
-MatrixXd w_times(const CRefM& W, const MatrixXd& A) {
-  if (w_is_diag(W, A.rows())) return W.col(0).asDiagonal() * A;
-  return W * A;
-}
-// the same into a kept buffer
 void w_times_to(const CRefM& W, const VectorXd& v, VectorXd& out) {
   if (w_is_diag(W, v.size())) {
     out = W.col(0).cwiseProduct(v);
@@ -190,7 +181,7 @@ struct SolveWork {
 
 // Squared amplitudes c >= 0 minimising the log-domain weighted objective.
 // y = ln(AV-hat) minus the chi-square log bias; W the whitening matrix, or
-// its diagonal as a one-column matrix (see w_times()).
+// its diagonal as a one-column matrix (see w_times_to()).
 // [[Rcpp::export(rng = false)]]
 Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
                           const Eigen::Map<Eigen::VectorXd> offset,
@@ -215,7 +206,9 @@ Rcpp::List avfit_log_nnls(const Eigen::Map<Eigen::MatrixXd> B,
       A.row(j) = B.row(j) / avh;
       t(j) = 1.0 - offset(j) / avh;
     }
-    c = nnls(w_times(W, A), w_times(W, t));
+    w_times_to(W, A, ws.WA);
+    w_times_to(W, t, ws.Wt);
+    c = nnls(ws.WA, ws.Wt);
     S = obj(c);
     if (!std::isfinite(S)) {
       // Keep every term slightly on so that ln AV is finite everywhere.
