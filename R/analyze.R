@@ -12,9 +12,13 @@
 #' [datasheet()]).
 #'
 #' Channels are analysed in parallel with [future.apply::future_lapply()],
-#' so the call runs on whatever [future::plan()] is set (sequential by
-#' default, `multisession`, a cluster, ...), with `future.seed = TRUE`:
-#' results do not depend on the plan.
+#' one future per axis, with `future.seed = TRUE`: results do not depend on
+#' how they are run. They run on whatever [future::plan()] is set
+#' (`multisession`, a cluster, ...). Under the sequential plan (future's
+#' default) a record large enough to pay for it (at least 2 axes and
+#' 200,000 samples in all) runs its axes in `workers` forked processes
+#' (future's `multicore`, where the platform can fork: not on Windows, not
+#' in RStudio), each kernel then on one thread.
 #'
 #' Readings (typed columns `source`, `is_bound`, `folded`; the `method`
 #' column says the same in words): N is
@@ -58,6 +62,13 @@
 #'   Allan deviation is computed (see [detect_series_effects()]): e.g.
 #'   `c("spikes", "steps")`, or `"all"`; none by default. What was found
 #'   and removed is kept in each channel's `series` (without its series `x`).
+#' @param workers Forked processes for the axes under the sequential plan:
+#'   `NULL` (default) for `getOption("allanvar.threads", 2)` where the
+#'   platform can fork and the record is large enough; `1` runs the axes
+#'   one after another (or on the plan that is set); a number above 1
+#'   forks that many (or, where the platform cannot fork, runs them in as
+#'   many background R sessions). A plan other than sequential is used as
+#'   set unless `workers` is given.
 #' @param ... Further arguments passed to [avfit()].
 #' @return For one recording, an object of class `"imu_analysis"`: a list
 #'   with `name`, `freq`, `n` (samples used), `duration` (s), `record` (the
@@ -88,8 +99,15 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
                         progress = interactive() &&
                           isTRUE(getOption("allanvar.progress", TRUE)),
                         read_args = list(), refine_args = list(),
-                        remove = character(), ...) {
+                        remove = character(), workers = NULL, ...) {
   check_present(missing(x), "x", "an imu_record, a list of them or file paths")
+  if (!is.null(workers) &&
+      !(is.numeric(workers) && !is.object(workers) && length(workers) == 1L &&
+        is.finite(workers) && workers >= 1 && workers == round(workers))) {
+    abort("`workers` must be NULL or a whole number of at least 1, not ",
+          if (length(workers) == 1L && is.atomic(workers)) format_value(workers)
+          else describe_type(workers), ".", class = "argument")
+  }
   remove <- check_series_kinds(remove, "remove", c(effect_kinds("series"), "all"))
   if (!is.logical(refine) || length(refine) != 1L || is.na(refine)) {
     abort("`refine` must be TRUE or FALSE, not ", format_value(refine), ".",
@@ -167,6 +185,18 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   # with_progress()), so that the default stays silent.
   bar <- isTRUE(progress) && interactive()
   if (bar) opts$progress <- FALSE
+  w <- axis_workers(workers, n_jobs, sum(vapply(jobs, function(j) length(j$x), 1)))
+  if (w > 1L) {
+    # Two levels of threads would oversubscribe the cores: the workers
+    # run their kernels on one thread each.
+    opts$threads <- 1L
+    old_plan <- if (future::supportsMulticore()) {
+      future::plan(future::multicore, workers = w)
+    } else {
+      future::plan(future::multisession, workers = w)
+    }
+    on.exit(future::plan(old_plan), add = TRUE)
+  }
   run <- function() {
     p <- progressr::progressor(steps = n_jobs)
     future.apply::future_lapply(jobs, function(job, opts) {
@@ -227,9 +257,26 @@ progress_handlers <- function() {
   else progressr::handler_txtprogressbar()
 }
 
+# How many processes analyze_imu() starts for `n_jobs` axes of `n`
+# samples in all (1: none, the axes run on the plan that is set). By
+# default only under the sequential plan, where forking is possible and
+# the record large enough to pay for the workers' start.
+axis_workers <- function(workers, n_jobs, n) {
+  if (!is.null(workers)) return(as.integer(min(workers, n_jobs)))
+  if (n_jobs < 2L || n < 2e5 || !inherits(future::plan(), "sequential") ||
+      !future::supportsMulticore()) {
+    return(1L)
+  }
+  as.integer(max(1L, min(allanvar_threads(), n_jobs, future::availableCores())))
+}
+
 # The work for one axis; runs on a future worker, so it only uses its
 # arguments and the package's namespace.
 analyze_channel <- function(job, opts) {
+  if (!is.null(opts$threads)) {
+    old <- options(allanvar.threads = opts$threads)
+    on.exit(options(old), add = TRUE)
+  }
   if (isTRUE(opts$progress)) message("allanvar: analysing ", job$label)
   # The series pass runs on every axis: its effects mark the readings they
   # change; those the user asked to remove go before the curve (R/series.R).

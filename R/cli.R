@@ -43,8 +43,9 @@
 #'   by 600);
 #' * `--axis max|mean` which value goes into imu.yaml; `--average` adds the
 #'   mean of the axes to the datasheet;
-#' * `--workers N` analyse channels in N parallel R sessions
-#'   (`future::plan(multisession)`);
+#' * `--workers N` analyse the axes in N processes (`workers` of
+#'   [analyze_imu()]; by default as many as `allanvar.threads`, 2, where
+#'   the platform can fork; `--workers 1` one after another);
 #' * `--no-report` do not write `report.html`;
 #' * `--quiet` no progress messages; `--help`.
 #'
@@ -103,7 +104,7 @@ cli_usage <- function() {
     "  --average              add the mean of the axes to the datasheet",
     "  --width PX             PNG width (default 700 per sensor)",
     "  --height PX            PNG height (default 600)",
-    "  --workers N            parallel R sessions (future multisession)",
+    "  --workers N            processes for the axes (default 2 where R can fork)",
     "  --no-report            do not write report.html",
     "  --units-checked        the units are right though they fail the checks",
     "                         (else such a run writes marked files and exits with 3)",
@@ -284,15 +285,7 @@ cli_run <- function(args) {
     freq = if (is.null(opt$rate)) NULL else num(opt$rate, "rate"))
   width <- if (is.null(opt$width)) NULL else num(opt$width, "width", 99, TRUE)
   height <- if (is.null(opt$height)) 600 else num(opt$height, "height", 99, TRUE)
-  if (!is.null(opt$workers)) {
-    w <- num(opt$workers, "workers", 0, TRUE)
-    if (!requireNamespace("future", quietly = TRUE)) {
-      abort("--workers needs the 'future' package; install it or drop --workers.",
-            class = "cli")
-    }
-    old <- future::plan(future::multisession, workers = w)
-    on.exit(future::plan(old), add = TRUE)
-  }
+  workers <- if (is.null(opt$workers)) NULL else num(opt$workers, "workers", 0, TRUE)
   progress <- !isTRUE(opt$quiet)
   # Everything is written into `stage` first, and moved into `out` at the end.
   stage <- tempfile("allanvar-out-")
@@ -308,6 +301,7 @@ cli_run <- function(args) {
     # The guidance is printed below; no need to repeat it as a warning.
     a <- withCallingHandlers(cli_speak(analyze_imu(
       rec, terms = terms, refine = !isTRUE(opt$`no-refine`), progress = progress,
+      workers = workers,
       remove = if (is.null(opt$remove)) character()
                else trimws(strsplit(opt$remove, ",", fixed = TRUE)[[1L]]))),
       allanvar_guidance = function(m) invokeRestart("muffleMessage"))

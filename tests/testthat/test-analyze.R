@@ -33,6 +33,30 @@ test_that("several recordings through future multisession equal the sequential r
   }
 })
 
+test_that("forked workers give the run one after another; `workers` is checked", {
+  skip_on_cran()
+  skip_if_not(future::supportsMulticore(), "the platform cannot fork")
+  recs <- two_records()
+  threads <- getOption("allanvar.threads")
+  one <- suppressWarnings(analyze_imu(recs, progress = FALSE, workers = 1))
+  two <- suppressWarnings(analyze_imu(recs, progress = FALSE, workers = 2))
+  expect_identical(datasheet(two)$long, datasheet(one)$long)
+  for (i in 1:2) for (ch in c("gyro_x", "accel_x")) {
+    expect_identical(two[[i]]$channels[[ch]]$coef, one[[i]]$channels[[ch]]$coef)
+    expect_identical(two[[i]]$channels[[ch]]$readings, one[[i]]$channels[[ch]]$readings)
+  }
+  # the caller's plan is back, and the caller's thread option untouched
+  expect_true(inherits(future::plan(), "sequential"))
+  expect_identical(getOption("allanvar.threads"), threads)
+  # by default: forks only under the sequential plan, for a large record
+  expect_identical(axis_workers(NULL, 6L, 6e6), min(2L, as.integer(future::availableCores())))
+  expect_identical(axis_workers(NULL, 2L, 4e4), 1L)
+  expect_identical(axis_workers(NULL, 1L, 1e6), 1L)
+  expect_identical(axis_workers(5, 3L, 10), 3L)
+  expect_error(analyze_imu(recs, workers = 0), class = "allanvar_error_argument")
+  expect_snapshot(analyze_imu(recs, workers = 1.5), error = TRUE)
+})
+
 test_that("progress is reported per axis and can be silenced", {
   r <- two_records()[[1]]
   msg <- capture_messages(suppressWarnings(analyze_imu(r, progress = TRUE)))
