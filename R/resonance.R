@@ -40,8 +40,7 @@ is_plain_number <- function(v) is.double(v) && length(v) == 1L && !is.na(v)
 # mirror, /2 each.
 # (src/resonance.cpp: r = exp(-tau0 / tc), w = 2 pi f tau0, w0 = 2 pi fr tau0,
 # one(d) = Re((1 + q) / (1 - q)) with q = r exp(1i d), and
-# tau0 sigma^2 0.5 (one(w0 - w) + one(-w0 - w)): R's operations in its
-# complex arithmetic, without its complex vectors)
+# tau0 sigma^2 0.5 (one(w0 - w) + one(-w0 - w)), in real arithmetic)
 resonance_psd <- function(f, tau0, sigma, fr, tc) {
   resonance_psd_cpp(as.double(f), tau0, sigma, fr, tc)
 }

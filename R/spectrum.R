@@ -675,39 +675,26 @@ remove_bands <- function(x, freq, bands) {
   m <- mean(x)
   tau0 <- 1 / freq
   X <- stats::fft(x - m)
-  f <- (seq_len(n) - 1) * freq / n
-  fa <- pmin(f, freq - f)
-  P <- 2 * Mod(X)^2 / (n * freq)
+  # bins 1..h hold 0..freq/2; bin j > h is bin n + 2 - j's mirror
+  h <- n %/% 2L + 1L
+  fa <- (seq_len(h) - 1) * freq / n
+  mir <- c(seq_len(h), if (n > h) (n + 2L - (h + 1L):n))
+  fa <- fa[mir]
+  # the bands' gains multiply; each band's background is read on the
+  # series with the bands before it taken out
+  G <- 1
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
-    M <- mirrored(fa, function(v) 2 * resonance_psd(v, tau0, sqrt(b$power), b$f_center, b$tc))
+    M <- 2 * resonance_psd(fa[seq_len(h)], tau0, sqrt(b$power), b$f_center, b$tc)[mir]
     w <- max(b$width, b$f_to - b$f_from)
     d <- abs(fa - b$f_center)
-    near <- d > 3 * w & d < 6 * w
-    bg <- mean(P[near] - M[near])
+    near <- which(d > 3 * w & d < 6 * w)
+    Gn <- if (length(G) > 1L) G[near] else G
+    bg <- mean(2 * Mod(X[near])^2 * Gn^2 / (n * freq) - M[near])
     if (!is.finite(bg) || bg <= 0) next
-    g <- sqrt(bg / (bg + M))
-    X <- X * g
-    P <- P * g^2
+    G <- G * sqrt(bg / (bg + M))
   }
-  Re(stats::fft(X, inverse = TRUE)) / n + m
+  if (length(G) == 1L) return(x)
+  Re(stats::fft(X * G, inverse = TRUE)) / n + m
 }
 
-# fun(v) of an elementwise `fun` over folded FFT frequencies v: computed
-# on the lower half and copied to each upper bin whose folded frequency
-# equals its mirror's bit for bit (the others computed), so the result is
-# fun(v) exactly at half the cost.
-mirrored <- function(v, fun) {
-  n <- length(v)
-  lo <- seq_len(n %/% 2L + 1L)
-  out <- numeric(n)
-  out[lo] <- fun(v[lo])
-  if (n > length(lo)) {
-    hi <- (length(lo) + 1L):n
-    mir <- n + 2L - hi
-    same <- v[hi] == v[mir]
-    out[hi[same]] <- out[mir[same]]
-    if (!all(same)) out[hi[!same]] <- fun(v[hi[!same]])
-  }
-  out
-}

@@ -1,32 +1,35 @@
 // A resonance's two-sided PSD (R/resonance.R, resonance_psd()) at every
-// frequency: the R expression's operations in their order, in the complex
-// arithmetic R uses (C99: the compiler's complex product, libgcc's
-// division, the C library's cexp), so the values are R's; without R's
-// complex vectors (band removal evaluates it on half a million bins).
+// frequency, in real arithmetic (band removal evaluates it on every bin
+// of a record's FFT).
 #include <Rcpp.h>
 #include <complex>
 
 // tau0 * sigma^2 * 0.5 * (one(w0 - w) + one(-w0 - w)), w = 2 pi f tau0,
-// one(d) = Re((1 + q) / (1 - q)), q = r exp(1i * d), r = exp(-tau0 / tc)
+// one(d) = Re((1 + q) / (1 - q)), q = r exp(1i * d), r = exp(-tau0 / tc),
+// which is (1 - r^2) / |1 - q|^2 with |1 - q|^2 = (1 - r)^2 + 4 r sin(d/2)^2:
+// no cancellation where r is near 1 and d near 0 (a long tc at its peak),
+// where 1 - r cos(d) would lose digits.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
                                       double sigma, double fr, double tc) {
-  typedef std::complex<double> cplx;
   const double pi = 3.141592653589793238462643383279502884;
-  const double r = std::exp(-tau0 / tc);
-  const double w0 = 2 * pi * fr * tau0;
+  const double a = -std::expm1(-tau0 / tc);  // 1 - r
+  const double r = 1.0 - a;
+  const double num = a * (1.0 + r);
+  const double a2 = a * a, r4 = 4.0 * r;
   const double scale = tau0 * (sigma * sigma) * 0.5;
-  const cplx one_c(1.0, 0.0), i_c(0.0, 1.0), r_c(r, 0.0);
-  auto one = [&](double d) {
-    // R promotes the reals to complex before each product and sum
-    const cplx q = r_c * std::exp(i_c * cplx(d, 0.0));
-    return ((one_c + q) / (one_c - q)).real();
-  };
+  // d / 2 = (+-w0 - w) / 2: both sines from one sine and cosine of w / 2
+  const double h0 = pi * fr * tau0;
+  const double sa = std::sin(h0), ca = std::cos(h0);
   const R_xlen_t n = f.size();
   Rcpp::NumericVector out(n);
   for (R_xlen_t k = 0; k < n; k++) {
-    const double w = 2 * pi * f[k] * tau0;
-    out[k] = scale * (one(w0 - w) + one(-w0 - w));
+    const double b = pi * f[k] * tau0;
+    const double sb = std::sin(b), cb = std::cos(b);
+    const double h1 = sa * cb - ca * sb;  // sin((w0 - w) / 2)
+    const double h2 = sa * cb + ca * sb;  // -sin((-w0 - w) / 2)
+    out[k] = scale * (num / (a2 + r4 * h1 * h1) + num / (a2 + r4 * h2 * h2));
+    if ((k & 0xFFFFF) == 0) Rcpp::checkUserInterrupt();
   }
   return out;
 }

@@ -45,8 +45,8 @@ test_that("the resonance PSD integrates to its variance and peaks at f_r", {
   expect_equal(f[pos][which.max(p[pos])], 19, tolerance = 0.01)
 })
 
-test_that("the resonance PSD is the R expression's value to the bit", {
-  # the expression in R's complex arithmetic, as the C++ documents it
+test_that("the resonance PSD equals its complex form, and keeps its digits at a long tc", {
+  # the defining expression in R's complex arithmetic
   psd_r <- function(f, tau0, sigma, fr, tc) {
     r <- exp(-tau0 / tc)
     w <- 2 * pi * f * tau0
@@ -66,11 +66,20 @@ test_that("the resonance PSD is the R expression's value to the bit", {
     if (k %% 3L == 0L) f <- stats::runif(n, -freq, freq)
     sigma <- 10^stats::runif(1, -6, 3)
     fr <- stats::runif(1, 0, freq / 2)
-    tc <- 10^stats::runif(1, -3, 2)
-    expect_identical(resonance_psd(f, 1 / freq, sigma, fr, tc),
-                     psd_r(f, 1 / freq, sigma, fr, tc))
+    tc <- 10^stats::runif(1, -3, 0)
+    # the complex form's 1 - r cos(d) loses digits as r -> 1: at tc <= 1 s
+    # and tau0 >= 1 ms, 1 - r >= 1e-3, so it keeps 12 of them
+    expect_equal(resonance_psd(f, 1 / freq, sigma, fr, tc),
+                 psd_r(f, 1 / freq, sigma, fr, tc), tolerance = 1e-11)
   }
   expect_identical(resonance_psd(numeric(), 0.01, 1, 5, 0.1), numeric())
+  # tc = 1e4 s at 100 Hz: the peak is tau0 sigma^2 (1 + r) / (1 - r) / 2
+  # (+ the mirror term); exact from r's own expm1
+  tau0 <- 0.01
+  a <- -expm1(-tau0 / 1e4)
+  peak <- tau0 * 0.5 * ((2 - a) / a + (1 - (1 - a)^2) /
+                          ((a^2) + 4 * (1 - a) * sin(2 * pi * 10 * tau0)^2))
+  expect_equal(resonance_psd(10, tau0, 1, 10, 1e4), peak, tolerance = 1e-14)
 })
 
 test_that("resonance_av() in C++ is the R expression to the bit", {

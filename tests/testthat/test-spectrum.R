@@ -134,7 +134,7 @@ test_that("line_sums() (phase rotation in blocks) equals the sums of sin and cos
   }
 })
 
-test_that("line_subtract() takes out a sinusoid exactly as the R expression does", {
+test_that("line_subtract() (phases rotated in blocks) takes out a sinusoid as the R expression does", {
   set.seed(15)
   n <- 100003
   freq <- 81.92
@@ -142,9 +142,12 @@ test_that("line_subtract() takes out a sinusoid exactly as the R expression does
   t <- (seq_len(n) - 1) / freq
   for (f in c(0.013, 1.3, 40.7)) {
     ref <- y - 0.3 * sin(2 * pi * f * t) - (-0.7) * cos(2 * pi * f * t)
-    # the same operations in the same order: equal to rounding (on x86-64
-    # without fused multiply-add, to the bit)
-    expect_equal(line_subtract(y, f, freq, 0.3, -0.7), ref, tolerance = 1e-14)
+    # phases rotated within blocks of 256 from sin and cos at each block's
+    # start: equal to the direct evaluation to the rounding of the phase
+    # itself (a few ulp of 2 pi f t), also in the last, partial block
+    # (n = 100003)
+    ulp_phase <- 2 * pi * f * max(t) * .Machine$double.eps
+    expect_lt(max(abs(line_subtract(y, f, freq, 0.3, -0.7) - ref)), 4 * ulp_phase + 1e-13)
   }
   # a line of known amplitude comes out to the noise
   x <- 2 * sin(2 * pi * 1.3 * t + 0.4)
@@ -192,12 +195,3 @@ test_that("at the record's own resolution a line is a line and a band a band", {
   expect_false(is.na(match_line(12.21, l)))
 })
 
-test_that("mirrored() returns fun() of every folded frequency exactly", {
-  for (n in c(1L, 2L, 7L, 1000L, 1001L, 65537L)) {
-    freq <- 97.65625
-    f <- (seq_len(n) - 1) * freq / n
-    fa <- pmin(f, freq - f)
-    fun <- function(v) resonance_psd(v, 1 / freq, 0.3, 21.7, 0.05)
-    expect_identical(mirrored(fa, fun), fun(fa))
-  }
-})
