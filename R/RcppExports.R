@@ -217,6 +217,18 @@ ar_filter <- function(x, f, backward) {
     .Call(`_allanvar_ar_filter`, x, f, backward)
 }
 
+running_median_keep <- function(x, k) {
+    .Call(`_allanvar_running_median_keep`, x, k)
+}
+
+trimmed_mean_square <- function(r, k1, k2) {
+    .Call(`_allanvar_trimmed_mean_square`, r, k1, k2)
+}
+
+abs_rank_band_mean <- function(z, lo, hi) {
+    .Call(`_allanvar_abs_rank_band_mean`, z, lo, hi)
+}
+
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }

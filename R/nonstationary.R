@@ -616,11 +616,21 @@ warmup_profile <- function(y, X, grid, model, fixed = NULL) {
 # (values beyond the 0.5% and 99.5% quantiles dropped), corrected to a
 # standard deviation for Gaussian data.
 robust_scale <- function(r, trim = 0.005) {
-  q <- stats::quantile(r, c(trim, 1 - trim), names = FALSE, type = 1)
-  keep <- r[r >= q[1L] & r <= q[2L]]
   zq <- stats::qnorm(1 - trim)
   # variance of a standard normal truncated to [-zq, zq]
   vt <- 1 - 2 * zq * stats::dnorm(zq) / (1 - 2 * trim)
+  # the ranks stats::quantile(type = 1) reads (n p, or the next when n p is
+  # not whole), found by selection (src/series.cpp; a sort of 1e6 values
+  # and R's copies cost 0.1 s a call); R's own path where r has a NaN or
+  # an infinite sum
+  n <- length(r)
+  np <- n * c(trim, 1 - trim)
+  j <- floor(np)
+  k <- pmin(pmax(j + (np > j), 1), n)
+  v <- if (n) trimmed_mean_square(r, k[1L], k[2L]) else NA_real_
+  if (!is.na(v)) return(sqrt(v / vt))
+  q <- stats::quantile(r, c(trim, 1 - trim), names = FALSE, type = 1)
+  keep <- r[r >= q[1L] & r <= q[2L]]
   sqrt(mean((keep - mean(keep))^2) / vt)
 }
 
@@ -650,7 +660,7 @@ robust_scale <- function(r, trim = 0.005) {
 #' @noRd
 detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
   n <- length(x)
-  med <- stats::runmed(x, k, endrule = "median", algorithm = "Turlach")
+  med <- spike_runmed(x, k)
   r <- x - med
   s <- robust_scale(r)
   empty <- data.frame(index = integer(), time = numeric(), value = numeric(),
@@ -669,6 +679,20 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
                     z = z[i])
   attr(out, "threshold") <- zc
   out
+}
+
+# stats::runmed(x, k, endrule = "median"): the window medians by selection
+# in src/series.cpp (runmed's Turlach cost 0.04 s an axis), the ends by
+# runmed's own smoothEnds(); runmed itself where x has a NaN or is short.
+spike_runmed <- function(x, k) {
+  k <- as.integer(k)
+  med <- if (length(x) > 2L * k && k %% 2L == 1L) running_median_keep(x, k)
+  if (length(med) != length(x)) {
+    return(stats::runmed(x, k, endrule = "median", algorithm = "Turlach"))
+  }
+  med <- stats::smoothEnds(med, k)
+  attr(med, "k") <- k
+  med
 }
 
 # The level the series' own noise reaches over the record: a Student t
@@ -691,12 +715,14 @@ spike_tail_level <- function(z, alpha) {
   if (n < 1e4) return(0)
   S <- robust_scale(z)
   if (!(S > 0)) return(0)
-  # the ranks 95-99% of |z| in order: a partial sort places that band,
-  # which alone is then sorted (a full sort of 1e6 cost 0.17 s an axis)
+  # the ranks 95-99% of |z| in order: a selection places that band, which
+  # alone is then sorted (src/series.cpp; a full sort of 1e6 cost 0.17 s an
+  # axis, R's partial sort and copies 0.05 s)
   lo <- ceiling(0.95 * n)
   hi <- floor(0.99 * n)
-  a <- sort(abs(z), partial = c(lo, hi))
-  B <- mean(sort(a[seq.int(lo, hi)])) / S
+  B <- abs_rank_band_mean(z, lo, hi)
+  if (is.na(B)) B <- mean(sort(sort(abs(z), partial = c(lo, hi))[seq.int(lo, hi)]))
+  B <- B / S
   tab <- spike_t_table()
   if (B <= tab$B[length(tab$B)]) return(0)  # Gaussian or lighter
   lnu <- stats::approx(tab$B, log(tab$nu), B, rule = 2)$y

@@ -686,6 +686,41 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// running_median_keep
+Rcpp::NumericVector running_median_keep(const Rcpp::NumericVector& x, int k);
+RcppExport SEXP _allanvar_running_median_keep(SEXP xSEXP, SEXP kSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< int >::type k(kSEXP);
+    rcpp_result_gen = Rcpp::wrap(running_median_keep(x, k));
+    return rcpp_result_gen;
+END_RCPP
+}
+// trimmed_mean_square
+double trimmed_mean_square(const Rcpp::NumericVector& r, R_xlen_t k1, R_xlen_t k2);
+RcppExport SEXP _allanvar_trimmed_mean_square(SEXP rSEXP, SEXP k1SEXP, SEXP k2SEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type r(rSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type k1(k1SEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type k2(k2SEXP);
+    rcpp_result_gen = Rcpp::wrap(trimmed_mean_square(r, k1, k2));
+    return rcpp_result_gen;
+END_RCPP
+}
+// abs_rank_band_mean
+double abs_rank_band_mean(const Rcpp::NumericVector& z, R_xlen_t lo, R_xlen_t hi);
+RcppExport SEXP _allanvar_abs_rank_band_mean(SEXP zSEXP, SEXP loSEXP, SEXP hiSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type lo(loSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type hi(hiSEXP);
+    rcpp_result_gen = Rcpp::wrap(abs_rank_band_mean(z, lo, hi));
+    return rcpp_result_gen;
+END_RCPP
+}
 // theo1_sums_cpp
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -852,6 +887,9 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_warmup_gains", (DL_FUNC) &_allanvar_warmup_gains, 6},
     {"_allanvar_spike_burg", (DL_FUNC) &_allanvar_spike_burg, 2},
     {"_allanvar_ar_filter", (DL_FUNC) &_allanvar_ar_filter, 3},
+    {"_allanvar_running_median_keep", (DL_FUNC) &_allanvar_running_median_keep, 2},
+    {"_allanvar_trimmed_mean_square", (DL_FUNC) &_allanvar_trimmed_mean_square, 3},
+    {"_allanvar_abs_rank_band_mean", (DL_FUNC) &_allanvar_abs_rank_band_mean, 3},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},

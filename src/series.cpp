@@ -10,6 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <vector>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 // Segment k of x - level runs from sample at[k - 1] - 1 (0-based) to
 // at[k] - 2; walks the segments in order.
@@ -274,4 +277,152 @@ Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x,
     for (R_xlen_t k = 0; k < m; k++) op[b0 + k] = acc[k];
   }
   return out;
+}
+
+// min(q, p) and max(p, q) as SSE2's minpd and maxpd take them (the window
+// network of running_median_keep())
+static inline double median7_min(double q, double p) { return q < p ? q : p; }
+static inline double median7_max(double p, double q) { return q < p ? p : q; }
+
+// The spike pass's running median (R/nonstationary.R, spike_runmed()):
+// the median of the k samples centred on each sample, the first and last
+// k %/% 2 samples kept, as stats::runmed(endrule = "keep") returns them
+// (a median of an odd window is one of its samples, whatever the
+// algorithm). A zero-length result where x has a NaN (runmed's own NA
+// rules apply there).
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector running_median_keep(const Rcpp::NumericVector& x, int k) {
+  const R_xlen_t n = x.size(), h = k / 2;
+  const double* v = x.begin();
+  for (R_xlen_t i = 0; i < n; i++)
+    if (std::isnan(v[i])) return Rcpp::NumericVector(0);
+  Rcpp::NumericVector out(n);
+  double* o = out.begin();
+  std::copy(v, v + n, o);
+  if (n < k) return out;
+  if (k == 7) {
+    // the detector's window: a sorting network of 7 (16 exchanges, each a
+    // swap or not, so the window's values are kept), without branches:
+    // min(q, p) is q < p ? q : p and max(p, q) is q < p ? p : q, two
+    // samples at once where SSE2 is there (every x86-64)
+    R_xlen_t i = 3;
+#define SORT7(T, MIN, MAX)                                              \
+  {                                                                     \
+    auto cx = [](T& p, T& q) { const T l = MIN(q, p); q = MAX(p, q); p = l; }; \
+    cx(a0, a6); cx(a2, a3); cx(a4, a5);                                 \
+    cx(a0, a2); cx(a1, a4); cx(a3, a6);                                 \
+    cx(a0, a1); cx(a2, a5); cx(a3, a4);                                 \
+    cx(a1, a2); cx(a4, a6);                                             \
+    cx(a2, a3); cx(a4, a5);                                             \
+    cx(a1, a2); cx(a3, a4); cx(a5, a6);                                 \
+  }
+#ifdef __SSE2__
+    for (; i + 4 < n; i += 2) {
+      const double* c = v + i - 3;
+      __m128d a0 = _mm_loadu_pd(c), a1 = _mm_loadu_pd(c + 1), a2 = _mm_loadu_pd(c + 2),
+              a3 = _mm_loadu_pd(c + 3), a4 = _mm_loadu_pd(c + 4), a5 = _mm_loadu_pd(c + 5),
+              a6 = _mm_loadu_pd(c + 6);
+      SORT7(__m128d, _mm_min_pd, _mm_max_pd)
+      _mm_storeu_pd(o + i, a3);
+    }
+#endif
+    for (; i + 3 < n; i++) {
+      const double* c = v + i - 3;
+      double a0 = c[0], a1 = c[1], a2 = c[2], a3 = c[3], a4 = c[4], a5 = c[5], a6 = c[6];
+      SORT7(double, median7_min, median7_max)
+      o[i] = a3;
+    }
+#undef SORT7
+    return out;
+  }
+  // the window kept sorted: each step the sample leaving is replaced by the
+  // one entering, moved to its place (O(k) a sample, no sort)
+  std::vector<double> w(v, v + k);
+  std::sort(w.begin(), w.end());
+  o[h] = w[h];
+  for (R_xlen_t i = h + 1; i + h < n; i++) {
+    const double gone = v[i - h - 1], in = v[i + h];
+    int p = 0;
+    while (w[p] != gone) p++;
+    if (in >= gone) {
+      while (p + 1 < k && w[p + 1] < in) { w[p] = w[p + 1]; p++; }
+    } else {
+      while (p > 0 && w[p - 1] > in) { w[p] = w[p - 1]; p--; }
+    }
+    w[p] = in;
+    o[i] = w[h];
+    if ((i & 65535) == 0) Rcpp::checkUserInterrupt();
+  }
+  return out;
+}
+
+// mean() of double values as R's real_mean() makes it: the sum in long
+// double over n, then the mean residual added. false where the sum is not
+// finite (R then takes another path; the caller falls back to R).
+template <typename Get>
+static bool r_mean(R_xlen_t n, Get get, double* out) {
+  long double s = 0;
+  for (R_xlen_t i = 0; i < n; i++) s += get(i);
+  if (!std::isfinite(static_cast<double>(s))) return false;
+  s /= n;
+  if (std::isfinite(static_cast<double>(s))) {
+    long double t = 0;
+    for (R_xlen_t i = 0; i < n; i++) t += (get(i) - s);
+    s += t / n;
+  }
+  *out = static_cast<double>(s);
+  return true;
+}
+
+// robust_scale()'s mean square (R/nonstationary.R): with q1, q2 the order
+// statistics k1 <= k2 (1-based) of r (those stats::quantile(type = 1)
+// returns), keep = r[r >= q1 & r <= q2] and mean((keep - mean(keep))^2),
+// each mean() as R makes it, without sorting r. NA where r has a NaN or a
+// sum is not finite: the caller computes it in R then.
+// [[Rcpp::export(rng = false)]]
+double trimmed_mean_square(const Rcpp::NumericVector& r, R_xlen_t k1, R_xlen_t k2) {
+  const R_xlen_t n = r.size();
+  if (n < 1 || k1 < 1 || k2 < k1 || k2 > n) return NA_REAL;
+  const double* v = r.begin();
+  std::vector<double> w(v, v + n);
+  for (R_xlen_t i = 0; i < n; i++)
+    if (std::isnan(v[i])) return NA_REAL;
+  std::nth_element(w.begin(), w.begin() + (k2 - 1), w.end());
+  const double q2 = w[k2 - 1];
+  if (k1 < k2) std::nth_element(w.begin(), w.begin() + (k1 - 1), w.begin() + (k2 - 1));
+  const double q1 = w[k1 - 1];
+  // the kept values in their order (w is free again)
+  R_xlen_t m = 0;
+  for (R_xlen_t i = 0; i < n; i++)
+    if (v[i] >= q1 && v[i] <= q2) w[m++] = v[i];
+  const double* kp = w.data();
+  double mu, ms;
+  if (!r_mean(m, [kp](R_xlen_t i) { return kp[i]; }, &mu)) return NA_REAL;
+  // (keep - mu)^2 as R computes x^2: x * x in double
+  if (!r_mean(m, [kp, mu](R_xlen_t i) { const double d = kp[i] - mu; return d * d; }, &ms))
+    return NA_REAL;
+  return ms;
+}
+
+// spike_tail_level()'s band (R/nonstationary.R): mean(sort(a[lo:hi])) of
+// a = abs(z) placed by sort(partial = c(lo, hi)), i.e. the mean of the
+// order statistics lo..hi (1-based) of |z| in ascending order, as R's
+// mean() makes it. NA where z has a NaN or the sum is not finite.
+// [[Rcpp::export(rng = false)]]
+double abs_rank_band_mean(const Rcpp::NumericVector& z, R_xlen_t lo, R_xlen_t hi) {
+  const R_xlen_t n = z.size();
+  if (lo < 1 || hi < lo || hi > n) return NA_REAL;
+  std::vector<double> a(n);
+  const double* v = z.begin();
+  for (R_xlen_t i = 0; i < n; i++) {
+    if (std::isnan(v[i])) return NA_REAL;
+    a[i] = std::fabs(v[i]);
+  }
+  std::nth_element(a.begin(), a.begin() + (lo - 1), a.end());
+  if (hi > lo) std::nth_element(a.begin() + lo, a.begin() + (hi - 1), a.end());
+  std::sort(a.begin() + (lo - 1), a.begin() + hi);
+  const double* b = a.data() + (lo - 1);
+  double mu;
+  if (!r_mean(hi - lo + 1, [b](R_xlen_t i) { return b[i]; }, &mu)) return NA_REAL;
+  return mu;
 }
