@@ -374,6 +374,45 @@ static bool r_mean(R_xlen_t n, Get get, double* out) {
   return true;
 }
 
+// The order statistics lo..hi (1-based, lo <= hi <= n) of v[0..n), in
+// ascending order. A long v is first cut to the values between two of a
+// sorted sample's (every (n / 4096)th value) placed well outside the
+// ranks, whose count below is kept: a selection of a few percent of v
+// instead of all of it. Exact whatever the sample: where the cut misses
+// the ranks the whole of v is selected.
+static std::vector<double> order_stats(const double* v, R_xlen_t n, R_xlen_t lo,
+                                       R_xlen_t hi) {
+  std::vector<double> w;
+  R_xlen_t below = 0;
+  bool cut = false;
+  const R_xlen_t m = 4096, margin = 128;
+  if (n >= 16 * m) {
+    std::vector<double> sm(m);
+    const R_xlen_t stride = n / m;
+    for (R_xlen_t i = 0; i < m; i++) sm[i] = v[i * stride];
+    std::sort(sm.begin(), sm.end());
+    const R_xlen_t ia = static_cast<R_xlen_t>(std::floor(double(lo - 1) / n * m)) - margin,
+                   ib = static_cast<R_xlen_t>(std::ceil(double(hi) / n * m)) + margin;
+    const double ta = ia >= 0 ? sm[ia] : -INFINITY, tb = ib < m ? sm[ib] : INFINITY;
+    w.reserve(static_cast<size_t>((double(hi - lo + 1) / n + 3.0 * margin / m) * n) + 16);
+    for (R_xlen_t i = 0; i < n; i++) {
+      const double x = v[i];
+      if (x < ta) below++;
+      else if (x <= tb) w.push_back(x);
+    }
+    cut = below < lo && below + R_xlen_t(w.size()) >= hi;
+  }
+  if (!cut) {
+    w.assign(v, v + n);
+    below = 0;
+  }
+  const R_xlen_t a = lo - below - 1, b = hi - below - 1;  // 0-based in w
+  std::nth_element(w.begin(), w.begin() + a, w.end());
+  if (b > a) std::nth_element(w.begin() + a + 1, w.begin() + b, w.end());
+  std::sort(w.begin() + a, w.begin() + b + 1);
+  return std::vector<double>(w.begin() + a, w.begin() + b + 1);
+}
+
 // robust_scale()'s mean square (R/nonstationary.R): with q1, q2 the order
 // statistics k1 <= k2 (1-based) of r (those stats::quantile(type = 1)
 // returns), keep = r[r >= q1 & r <= q2] and mean((keep - mean(keep))^2),
@@ -384,14 +423,11 @@ double trimmed_mean_square(const Rcpp::NumericVector& r, R_xlen_t k1, R_xlen_t k
   const R_xlen_t n = r.size();
   if (n < 1 || k1 < 1 || k2 < k1 || k2 > n) return NA_REAL;
   const double* v = r.begin();
-  std::vector<double> w(v, v + n);
   for (R_xlen_t i = 0; i < n; i++)
     if (std::isnan(v[i])) return NA_REAL;
-  std::nth_element(w.begin(), w.begin() + (k2 - 1), w.end());
-  const double q2 = w[k2 - 1];
-  if (k1 < k2) std::nth_element(w.begin(), w.begin() + (k1 - 1), w.begin() + (k2 - 1));
-  const double q1 = w[k1 - 1];
-  // the kept values in their order (w is free again)
+  const double q1 = order_stats(v, n, k1, k1)[0], q2 = order_stats(v, n, k2, k2)[0];
+  std::vector<double> w(n);
+  // the kept values in their order
   R_xlen_t m = 0;
   for (R_xlen_t i = 0; i < n; i++)
     if (v[i] >= q1 && v[i] <= q2) w[m++] = v[i];
@@ -418,10 +454,8 @@ double abs_rank_band_mean(const Rcpp::NumericVector& z, R_xlen_t lo, R_xlen_t hi
     if (std::isnan(v[i])) return NA_REAL;
     a[i] = std::fabs(v[i]);
   }
-  std::nth_element(a.begin(), a.begin() + (lo - 1), a.end());
-  if (hi > lo) std::nth_element(a.begin() + lo, a.begin() + (hi - 1), a.end());
-  std::sort(a.begin() + (lo - 1), a.begin() + hi);
-  const double* b = a.data() + (lo - 1);
+  const std::vector<double> band = order_stats(a.data(), n, lo, hi);
+  const double* b = band.data();
   double mu;
   if (!r_mean(hi - lo + 1, [b](R_xlen_t i) { return b[i]; }, &mu)) return NA_REAL;
   return mu;
