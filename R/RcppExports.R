@@ -229,6 +229,10 @@ abs_rank_band_mean <- function(z, lo, hi) {
     .Call(`_allanvar_abs_rank_band_mean`, z, lo, hi)
 }
 
+steps_largest_difference <- function(cs, w, excluded) {
+    .Call(`_allanvar_steps_largest_difference`, cs, w, excluded)
+}
+
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }

@@ -121,13 +121,16 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     }
     best <- list(z = 0)
     for (j in seq_along(ws)) {
-      d <- allan_differences(r, ws[j], cr)
-      d[excluded[ws[j]:(nb - ws[j])]] <- 0
+      # the largest |Allan difference| at window ws[j] outside the excluded
+      # splits (src/series.cpp: allan_differences()' arithmetic, the first
+      # of equal ones as which.max(), without the vectors)
+      m <- steps_largest_difference(cr, ws[j], excluded)
+      i <- m[[1L]]
+      d <- m[[2L]]
       # a noiseless series (scale 0): any difference at all is a step, at
       # the largest difference
-      z <- if (scale[j] > 0) d / scale[j] else ifelse(d == 0, 0, sign(d) * Inf)
-      i <- which.max(abs(d))
-      if (abs(z[i]) > abs(best$z)) best <- list(z = z[i], d = d[i], i = i + ws[j] - 1L, j = j)
+      z <- if (scale[j] > 0) d / scale[j] else if (d == 0) 0 else sign(d) * Inf
+      if (abs(z) > abs(best$z)) best <- list(z = z, d = d, i = i + ws[j] - 1L, j = j)
     }
     if (abs(best$z) < zc) break
     w <- ws[best$j]

@@ -721,6 +721,18 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// steps_largest_difference
+Rcpp::NumericVector steps_largest_difference(const Rcpp::NumericVector& cs, int w, const Rcpp::LogicalVector& excluded);
+RcppExport SEXP _allanvar_steps_largest_difference(SEXP csSEXP, SEXP wSEXP, SEXP excludedSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type cs(csSEXP);
+    Rcpp::traits::input_parameter< int >::type w(wSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::LogicalVector& >::type excluded(excludedSEXP);
+    rcpp_result_gen = Rcpp::wrap(steps_largest_difference(cs, w, excluded));
+    return rcpp_result_gen;
+END_RCPP
+}
 // theo1_sums_cpp
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -890,6 +902,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_running_median_keep", (DL_FUNC) &_allanvar_running_median_keep, 2},
     {"_allanvar_trimmed_mean_square", (DL_FUNC) &_allanvar_trimmed_mean_square, 3},
     {"_allanvar_abs_rank_band_mean", (DL_FUNC) &_allanvar_abs_rank_band_mean, 3},
+    {"_allanvar_steps_largest_difference", (DL_FUNC) &_allanvar_steps_largest_difference, 3},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},

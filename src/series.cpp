@@ -480,3 +480,31 @@ double abs_rank_band_mean(const Rcpp::NumericVector& z, R_xlen_t lo, R_xlen_t hi
   if (!r_mean(hi - lo + 1, [b](R_xlen_t i) { return b[i]; }, &mu)) return NA_REAL;
   return mu;
 }
+
+// The step search's scan at one window (R/nonstationary.R, detect_steps()):
+// with cs = c(0, cumsum(r)) of nb block means, the Allan differences
+// d(i) = (cs[i + w + 1] - 2 * cs[i + 1] + cs[i - w + 1]) / w at the splits
+// i = w..nb - w (allan_differences()), 0 where excluded[i]; returns the
+// place (1-based among them) and value of the first largest |d|, as
+// which.max(abs(d)) finds it.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector steps_largest_difference(const Rcpp::NumericVector& cs, int w,
+                                             const Rcpp::LogicalVector& excluded) {
+  const R_xlen_t nb = cs.size() - 1;
+  const double* c = cs.begin();
+  const int* ex = excluded.begin();
+  const double wd = w;
+  R_xlen_t best = 0;
+  double bd = 0, ba = -1;
+  for (R_xlen_t i = w; i <= nb - w; i++) {
+    // cs[k] (1-based) is c[k - 1]
+    const double d = ex[i - 1] ? 0.0 : (c[i + w] - 2 * c[i] + c[i - w]) / wd;
+    const double a = std::fabs(d);
+    if (a > ba) {
+      ba = a;
+      bd = d;
+      best = i - w + 1;
+    }
+  }
+  return Rcpp::NumericVector::create(static_cast<double>(best), bd);
+}
