@@ -233,6 +233,10 @@ steps_largest_difference <- function(cs, w, excluded) {
     .Call(`_allanvar_steps_largest_difference`, cs, w, excluded)
 }
 
+which_abs_above <- function(z, zc) {
+    .Call(`_allanvar_which_abs_above`, z, zc)
+}
+
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }

@@ -19,7 +19,8 @@ block_avg <- function(x, b) {
   b <- as.integer(b)
   if (b <= 1L) return(x)
   nb <- length(x) %/% b
-  .colMeans(x[seq_len(nb * b)], b, nb)
+  # (x itself where the blocks cover it: the same values without a copy)
+  .colMeans(if (nb * b == length(x)) x else x[seq_len(nb * b)], b, nb)
 }
 
 # Allan differences of y at window w (blocks) for every split point i
@@ -677,7 +678,8 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
   if (is.null(z)) return(empty)
   zc <- max(min_z, stats::qnorm(1 - alpha / (2 * n)),
             spike_tail_level(z, alpha))
-  i <- spike_distinct(z, which(abs(z) > zc), zc, attr(z, "pi"))
+  big <- if (n < .Machine$integer.max) which_abs_above(z, zc) else which(abs(z) > zc)
+  i <- spike_distinct(z, big, zc, attr(z, "pi"))
   out <- data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
                     z = z[i])
   attr(out, "threshold") <- zc
@@ -783,7 +785,9 @@ spike_ao_z <- function(x, xw, p = 20L) {
   a <- ar_filter(e, pi, TRUE)
   a[is.na(a)] <- 0
   a[c(seq_len(2L * p), seq.int(max(1L, n - 2L * p + 1L), n))] <- 0
-  structure(a / (sqrt(sum(pi^2)) * se), pi = pi)
+  a <- a / (sqrt(sum(pi^2)) * se)
+  attr(a, "pi") <- pi                 # (structure() copied the 1e6 values)
+  a
 }
 
 # An outlier raises its neighbours' statistic too, by its own z times the

@@ -733,6 +733,17 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// which_abs_above
+Rcpp::IntegerVector which_abs_above(const Rcpp::NumericVector& z, double zc);
+RcppExport SEXP _allanvar_which_abs_above(SEXP zSEXP, SEXP zcSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    Rcpp::traits::input_parameter< double >::type zc(zcSEXP);
+    rcpp_result_gen = Rcpp::wrap(which_abs_above(z, zc));
+    return rcpp_result_gen;
+END_RCPP
+}
 // theo1_sums_cpp
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -903,6 +914,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_trimmed_mean_square", (DL_FUNC) &_allanvar_trimmed_mean_square, 3},
     {"_allanvar_abs_rank_band_mean", (DL_FUNC) &_allanvar_abs_rank_band_mean, 3},
     {"_allanvar_steps_largest_difference", (DL_FUNC) &_allanvar_steps_largest_difference, 3},
+    {"_allanvar_which_abs_above", (DL_FUNC) &_allanvar_which_abs_above, 2},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},

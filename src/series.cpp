@@ -508,3 +508,15 @@ Rcpp::NumericVector steps_largest_difference(const Rcpp::NumericVector& cs, int 
   }
   return Rcpp::NumericVector::create(static_cast<double>(best), bd);
 }
+
+// which(abs(z) > zc) without the two n-value temporaries (the spike
+// detector's candidates).
+// [[Rcpp::export(rng = false)]]
+Rcpp::IntegerVector which_abs_above(const Rcpp::NumericVector& z, double zc) {
+  const R_xlen_t n = z.size();
+  const double* v = z.begin();
+  std::vector<int> out;
+  for (R_xlen_t i = 0; i < n; i++)
+    if (std::fabs(v[i]) > zc) out.push_back(static_cast<int>(i + 1));
+  return Rcpp::IntegerVector(out.begin(), out.end());
+}
