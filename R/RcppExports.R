@@ -237,6 +237,10 @@ which_abs_above <- function(z, zc) {
     .Call(`_allanvar_which_abs_above`, z, zc)
 }
 
+median_of_squares <- function(d) {
+    .Call(`_allanvar_median_of_squares`, d)
+}
+
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }

@@ -33,7 +33,13 @@ allan_differences <- function(y, w, cs = c(0, cumsum(y))) {
 }
 
 # Robust scale of Allan differences: sqrt(median(D^2) / median(chi2_1)).
-robust_d_scale <- function(d) sqrt(stats::median(d^2) / stats::qchisq(0.5, 1))
+# (the median by selection in src/series.cpp; stats::median() where d has a
+# NaN or is empty)
+robust_d_scale <- function(d) {
+  m <- median_of_squares(d)
+  if (is.na(m)) m <- stats::median(d^2)
+  sqrt(m / stats::qchisq(0.5, 1))
+}
 
 #' Bias steps in a rate series (internal)
 #'

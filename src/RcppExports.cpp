@@ -744,6 +744,16 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// median_of_squares
+double median_of_squares(const Rcpp::NumericVector& d);
+RcppExport SEXP _allanvar_median_of_squares(SEXP dSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type d(dSEXP);
+    rcpp_result_gen = Rcpp::wrap(median_of_squares(d));
+    return rcpp_result_gen;
+END_RCPP
+}
 // theo1_sums_cpp
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -915,6 +925,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_abs_rank_band_mean", (DL_FUNC) &_allanvar_abs_rank_band_mean, 3},
     {"_allanvar_steps_largest_difference", (DL_FUNC) &_allanvar_steps_largest_difference, 3},
     {"_allanvar_which_abs_above", (DL_FUNC) &_allanvar_which_abs_above, 2},
+    {"_allanvar_median_of_squares", (DL_FUNC) &_allanvar_median_of_squares, 1},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},

@@ -9,6 +9,7 @@
 #include <Rcpp.h>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 #ifdef __SSE2__
 #include <emmintrin.h>
@@ -395,13 +396,13 @@ static bool r_mean(R_xlen_t n, Get get, double* out) {
 }
 
 // The order statistics lo..hi (1-based, lo <= hi <= n) of v[0..n), in
-// ascending order. A long v is first cut to the values between two of a
-// sorted sample's (every (n / 4096)th value) placed well outside the
-// ranks, whose count below is kept: a selection of a few percent of v
-// instead of all of it. Exact whatever the sample: where the cut misses
-// the ranks the whole of v is selected.
-static std::vector<double> order_stats(const double* v, R_xlen_t n, R_xlen_t lo,
-                                       R_xlen_t hi) {
+// ascending order, into `out`; false where v has a NaN. A long v is first
+// cut to the values between two of a sorted sample's (every (n / 4096)th
+// value) placed well outside the ranks, whose count below is kept: a
+// selection of a few percent of v instead of all of it. Exact whatever the
+// sample: where the cut misses the ranks the whole of v is selected.
+static bool order_stats(const double* v, R_xlen_t n, R_xlen_t lo, R_xlen_t hi,
+                        std::vector<double>& out) {
   std::vector<double> w;
   R_xlen_t below = 0;
   bool cut = false;
@@ -410,6 +411,8 @@ static std::vector<double> order_stats(const double* v, R_xlen_t n, R_xlen_t lo,
     std::vector<double> sm(m);
     const R_xlen_t stride = n / m;
     for (R_xlen_t i = 0; i < m; i++) sm[i] = v[i * stride];
+    for (R_xlen_t i = 0; i < m; i++)
+      if (std::isnan(sm[i])) return false;
     std::sort(sm.begin(), sm.end());
     const R_xlen_t ia = static_cast<R_xlen_t>(std::floor(double(lo - 1) / n * m)) - margin,
                    ib = static_cast<R_xlen_t>(std::ceil(double(hi) / n * m)) + margin;
@@ -419,10 +422,13 @@ static std::vector<double> order_stats(const double* v, R_xlen_t n, R_xlen_t lo,
       const double x = v[i];
       if (x < ta) below++;
       else if (x <= tb) w.push_back(x);
+      else if (std::isnan(x)) return false;  // (a NaN fails both tests)
     }
     cut = below < lo && below + R_xlen_t(w.size()) >= hi;
   }
   if (!cut) {
+    for (R_xlen_t i = 0; i < n; i++)
+      if (std::isnan(v[i])) return false;
     w.assign(v, v + n);
     below = 0;
   }
@@ -430,7 +436,8 @@ static std::vector<double> order_stats(const double* v, R_xlen_t n, R_xlen_t lo,
   std::nth_element(w.begin(), w.begin() + a, w.end());
   if (b > a) std::nth_element(w.begin() + a + 1, w.begin() + b, w.end());
   std::sort(w.begin() + a, w.begin() + b + 1);
-  return std::vector<double>(w.begin() + a, w.begin() + b + 1);
+  out.assign(w.begin() + a, w.begin() + b + 1);
+  return true;
 }
 
 // robust_scale()'s mean square (R/nonstationary.R): with q1, q2 the order
@@ -443,17 +450,33 @@ double trimmed_mean_square(const Rcpp::NumericVector& r, R_xlen_t k1, R_xlen_t k
   const R_xlen_t n = r.size();
   if (n < 1 || k1 < 1 || k2 < k1 || k2 > n) return NA_REAL;
   const double* v = r.begin();
-  for (R_xlen_t i = 0; i < n; i++)
-    if (std::isnan(v[i])) return NA_REAL;
-  const double q1 = order_stats(v, n, k1, k1)[0], q2 = order_stats(v, n, k2, k2)[0];
-  std::vector<double> w(n);
-  // the kept values in their order
+  std::vector<double> q;
+  if (!order_stats(v, n, k1, k1, q)) return NA_REAL;
+  const double q1 = q[0];
+  if (!order_stats(v, n, k2, k2, q)) return NA_REAL;
+  const double q2 = q[0];
+  // the kept values in their order, their sum on the way (r_mean()'s first
+  // pass)
+  std::unique_ptr<double[]> w(new double[n]);
   R_xlen_t m = 0;
-  for (R_xlen_t i = 0; i < n; i++)
-    if (v[i] >= q1 && v[i] <= q2) w[m++] = v[i];
-  const double* kp = w.data();
-  double mu, ms;
-  if (!r_mean(m, [kp](R_xlen_t i) { return kp[i]; }, &mu)) return NA_REAL;
+  long double s = 0;
+  for (R_xlen_t i = 0; i < n; i++) {
+    const double x = v[i];
+    if (x >= q1 && x <= q2) {
+      w[m++] = x;
+      s += x;
+    }
+  }
+  const double* kp = w.get();
+  if (!std::isfinite(static_cast<double>(s))) return NA_REAL;
+  s /= m;
+  if (std::isfinite(static_cast<double>(s))) {
+    long double t = 0;
+    for (R_xlen_t i = 0; i < m; i++) t += (kp[i] - s);
+    s += t / m;
+  }
+  const double mu = static_cast<double>(s);
+  double ms;
   // (keep - mu)^2 as R computes x^2: x * x in double
   if (!r_mean(m, [kp, mu](R_xlen_t i) { const double d = kp[i] - mu; return d * d; }, &ms))
     return NA_REAL;
@@ -468,13 +491,10 @@ double trimmed_mean_square(const Rcpp::NumericVector& r, R_xlen_t k1, R_xlen_t k
 double abs_rank_band_mean(const Rcpp::NumericVector& z, R_xlen_t lo, R_xlen_t hi) {
   const R_xlen_t n = z.size();
   if (lo < 1 || hi < lo || hi > n) return NA_REAL;
-  std::vector<double> a(n);
+  std::vector<double> a(n), band;
   const double* v = z.begin();
-  for (R_xlen_t i = 0; i < n; i++) {
-    if (std::isnan(v[i])) return NA_REAL;
-    a[i] = std::fabs(v[i]);
-  }
-  const std::vector<double> band = order_stats(a.data(), n, lo, hi);
+  for (R_xlen_t i = 0; i < n; i++) a[i] = std::fabs(v[i]);
+  if (!order_stats(a.data(), n, lo, hi, band)) return NA_REAL;
   const double* b = band.data();
   double mu;
   if (!r_mean(hi - lo + 1, [b](R_xlen_t i) { return b[i]; }, &mu)) return NA_REAL;
@@ -519,4 +539,28 @@ Rcpp::IntegerVector which_abs_above(const Rcpp::NumericVector& z, double zc) {
   for (R_xlen_t i = 0; i < n; i++)
     if (std::fabs(v[i]) > zc) out.push_back(static_cast<int>(i + 1));
   return Rcpp::IntegerVector(out.begin(), out.end());
+}
+
+// stats::median(d^2) of the step search's Allan differences
+// (robust_d_scale()): the middle order statistic of the squares (x * x, as
+// R's x^2), or R's mean() of the middle two. NA where d has a NaN or is
+// empty (the caller asks R then).
+// [[Rcpp::export(rng = false)]]
+double median_of_squares(const Rcpp::NumericVector& d) {
+  const R_xlen_t n = d.size();
+  if (n < 1) return NA_REAL;
+  std::vector<double> q(n);
+  const double* v = d.begin();
+  for (R_xlen_t i = 0; i < n; i++) {
+    if (std::isnan(v[i])) return NA_REAL;
+    q[i] = v[i] * v[i];
+  }
+  const R_xlen_t half = (n + 1) / 2;
+  std::nth_element(q.begin(), q.begin() + (half - 1), q.end());
+  if (n % 2 == 1) return q[half - 1];
+  const double a = q[half - 1], b = *std::min_element(q.begin() + half, q.end());
+  const double two[2] = {a, b};
+  double mu = NA_REAL;
+  if (!r_mean(2, [&two](R_xlen_t i) { return two[i]; }, &mu)) return NA_REAL;
+  return mu;
 }
