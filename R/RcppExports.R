@@ -217,6 +217,10 @@ ar_filter <- function(x, f, backward) {
     .Call(`_allanvar_ar_filter`, x, f, backward)
 }
 
+spike_ao_values <- function(x, sc, mu, pi, denom) {
+    .Call(`_allanvar_spike_ao_values`, x, sc, mu, pi, denom)
+}
+
 running_median_keep <- function(x, k) {
     .Call(`_allanvar_running_median_keep`, x, k)
 }

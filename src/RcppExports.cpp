@@ -686,6 +686,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// spike_ao_values
+Rcpp::NumericVector spike_ao_values(const Rcpp::NumericVector& x, double sc, double mu, const Rcpp::NumericVector& pi, double denom);
+RcppExport SEXP _allanvar_spike_ao_values(SEXP xSEXP, SEXP scSEXP, SEXP muSEXP, SEXP piSEXP, SEXP denomSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< double >::type sc(scSEXP);
+    Rcpp::traits::input_parameter< double >::type mu(muSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type pi(piSEXP);
+    Rcpp::traits::input_parameter< double >::type denom(denomSEXP);
+    rcpp_result_gen = Rcpp::wrap(spike_ao_values(x, sc, mu, pi, denom));
+    return rcpp_result_gen;
+END_RCPP
+}
 // running_median_keep
 Rcpp::NumericVector running_median_keep(const Rcpp::NumericVector& x, int k);
 RcppExport SEXP _allanvar_running_median_keep(SEXP xSEXP, SEXP kSEXP) {
@@ -920,6 +934,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_warmup_gains", (DL_FUNC) &_allanvar_warmup_gains, 6},
     {"_allanvar_spike_burg", (DL_FUNC) &_allanvar_spike_burg, 2},
     {"_allanvar_ar_filter", (DL_FUNC) &_allanvar_ar_filter, 3},
+    {"_allanvar_spike_ao_values", (DL_FUNC) &_allanvar_spike_ao_values, 5},
     {"_allanvar_running_median_keep", (DL_FUNC) &_allanvar_running_median_keep, 2},
     {"_allanvar_trimmed_mean_square", (DL_FUNC) &_allanvar_trimmed_mean_square, 3},
     {"_allanvar_abs_rank_band_mean", (DL_FUNC) &_allanvar_abs_rank_band_mean, 3},

@@ -236,17 +236,12 @@ Rcpp::NumericVector spike_burg(const Rcpp::NumericVector& x, int pmax) {
 // for the last length(f) - 1. Without the ts and its reversed copies; in
 // blocks of outputs, each output's sum still in the order of j (one
 // running sum per output: the compiler may then run outputs side by side).
-// [[Rcpp::export(rng = false)]]
-Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x,
-                              const Rcpp::NumericVector& f, bool backward) {
-  const R_xlen_t n = x.size(), nf = f.size();
-  Rcpp::NumericVector out(n, NA_REAL);
-  if (nf > n) return out;
-  const double* xp = x.begin();
-  const double* fp = f.begin();
-  double* op = out.begin();
+static void ar_filter_to(const double* xp, R_xlen_t n, const double* fp, R_xlen_t nf,
+                         bool backward, double* op) {
+  std::fill(op, op + n, NA_REAL);
+  if (nf > n) return;
   bool finite = true;
-  for (R_xlen_t i = 0; i < n && finite; i++) finite = !ISNAN(xp[i]);
+  for (R_xlen_t i = 0; i < n && finite; i++) finite = !std::isnan(xp[i]);
   // the outputs defined: i = lo .. hi - 1
   const R_xlen_t lo = backward ? 0 : nf - 1, hi = backward ? n - nf + 1 : n;
   if (!finite) {
@@ -255,7 +250,7 @@ Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x,
       bool ok = true;
       for (R_xlen_t j = 0; j < nf; j++) {
         const double tmp = backward ? xp[i + j] : xp[i - j];
-        if (ISNAN(tmp)) {
+        if (std::isnan(tmp)) {
           ok = false;
           break;
         }
@@ -263,7 +258,7 @@ Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x,
       }
       op[i] = ok ? z : NA_REAL;
     }
-    return out;
+    return;
   }
   R_xlen_t start = lo;
 #ifdef __SSE2__
@@ -297,6 +292,40 @@ Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x,
     }
     for (R_xlen_t k = 0; k < m; k++) op[b0 + k] = acc[k];
   }
+}
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector ar_filter(const Rcpp::NumericVector& x,
+                              const Rcpp::NumericVector& f, bool backward) {
+  Rcpp::NumericVector out(x.size());
+  ar_filter_to(x.begin(), x.size(), f.begin(), f.size(), backward, out.begin());
+  return out;
+}
+
+// The rest of spike_ao_z() (R/nonstationary.R) in one pass of buffers, the
+// R lines' operations in their order: xs = x / sc - mu; e = ar_filter(xs,
+// pi) with its first p values 0; a = ar_filter(e, pi, backward), NA as 0,
+// its first and last 2 p values 0; a / denom. For p >= 1 and n > 4 p.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector spike_ao_values(const Rcpp::NumericVector& x, double sc, double mu,
+                                    const Rcpp::NumericVector& pi, double denom) {
+  const R_xlen_t n = x.size(), nf = pi.size(), p = nf - 1;
+  Rcpp::NumericVector out(n);
+  if (p < 1 || n <= 4 * p) Rcpp::stop("spike_ao_values(): needs p >= 1 and n > 4 p");
+  const double* v = x.begin();
+  std::unique_ptr<double[]> xs(new double[n]), e(new double[n]);
+  for (R_xlen_t i = 0; i < n; i++) {
+    const double y = v[i] / sc;
+    xs[i] = y - mu;
+  }
+  ar_filter_to(xs.get(), n, pi.begin(), nf, false, e.get());
+  for (R_xlen_t i = 0; i < p; i++) e[i] = 0;
+  double* a = out.begin();
+  ar_filter_to(e.get(), n, pi.begin(), nf, true, a);
+  for (R_xlen_t i = 0; i < n; i++)
+    if (std::isnan(a[i])) a[i] = 0;
+  for (R_xlen_t i = 0; i < 2 * p; i++) a[i] = a[n - 1 - i] = 0;
+  for (R_xlen_t i = 0; i < n; i++) a[i] = a[i] / denom;
   return out;
 }
 
