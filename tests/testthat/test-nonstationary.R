@@ -348,3 +348,63 @@ test_that("the steps and the transients read one step search where no step was f
   # and outside a pass nothing is kept
   expect_null(series_pass_memo$steps)
 })
+
+test_that("the series pass's selection kernels give R's expressions to the bit", {
+  # the R expressions the C++ kernels replace (src/series.cpp)
+  scale_r <- function(r, trim = 0.005) {
+    q <- stats::quantile(r, c(trim, 1 - trim), names = FALSE, type = 1)
+    keep <- r[r >= q[1L] & r <= q[2L]]
+    zq <- stats::qnorm(1 - trim)
+    sqrt(mean((keep - mean(keep))^2) / (1 - 2 * zq * stats::dnorm(zq) / (1 - 2 * trim)))
+  }
+  band_r <- function(z, lo, hi) mean(sort(sort(abs(z), partial = c(lo, hi))[seq.int(lo, hi)]))
+  ao_r <- function(x, mu, pi, denom) {
+    n <- length(x)
+    p <- length(pi) - 1L
+    e <- ar_filter(x - mu, pi, FALSE)
+    e[seq_len(p)] <- 0
+    a <- ar_filter(e, pi, TRUE)
+    a[is.na(a)] <- 0
+    a[c(seq_len(2L * p), seq.int(max(1L, n - 2L * p + 1L), n))] <- 0
+    a / denom
+  }
+  set.seed(14)
+  # white, quantized (ties), heavy-tailed, sorted, and periodic in the
+  # selection's sample stride (its cut misses: the full selection)
+  for (k in 1:10) {
+    n <- c(37L, 1000L, 65535L, 65536L, 100003L)[(k - 1L) %% 5L + 1L]
+    x <- switch((k - 1L) %/% 2L + 1L, stats::rnorm(n), round(stats::rnorm(n) * 2) / 3,
+                stats::rt(n, 3) * 1e5 + 1e9, sort(stats::rnorm(n)),
+                rep_len(c(stats::rnorm(4095), 50), n))
+    expect_identical(robust_scale(x), scale_r(x))
+    expect_identical(spike_runmed(x, 7L),
+                     stats::runmed(x, 7L, endrule = "median", algorithm = "Turlach"))
+    expect_identical(spike_runmed(x, 9L),
+                     stats::runmed(x, 9L, endrule = "median", algorithm = "Turlach"))
+    lo <- ceiling(0.95 * n)
+    hi <- floor(0.99 * n)
+    if (hi > lo) expect_identical(abs_rank_band_mean(x, lo, hi), band_r(x, lo, hi))
+    d <- x[seq_len(n - k %% 2L)]                  # odd and even lengths
+    expect_identical(median_of_squares(d), stats::median(d^2))
+    zc <- stats::runif(1, 0, 2)
+    expect_identical(which_abs_above(x, zc), which(abs(x) > zc))
+    w <- c(1L, 3L, 17L)[k %% 3L + 1L]
+    cs <- c(0, cumsum(x))
+    ex <- stats::runif(n) < 0.1
+    dd <- allan_differences(x, w, cs)
+    dd[ex[w:(n - w)]] <- 0
+    i <- which.max(abs(dd))
+    expect_identical(steps_largest_difference(cs, w, ex), c(as.double(i), dd[i]))
+    if (n > 100L) {
+      pi <- c(1, stats::rnorm(k) / 4)
+      sc <- 2^stats::rpois(1, 3)
+      expect_identical(spike_ao_values(x * sc, sc, 0.25, pi, 1.5), ao_r(x, 0.25, pi, 1.5))
+    }
+  }
+  # a missing value: R's own path (its error) for the scale, runmed's for
+  # the median
+  y <- c(stats::rnorm(99), NA)
+  expect_error(robust_scale(y), "missing values")
+  expect_identical(spike_runmed(y, 7L),
+                   stats::runmed(y, 7L, endrule = "median", algorithm = "Turlach"))
+})
