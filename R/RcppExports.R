@@ -245,6 +245,10 @@ median_of_squares <- function(d) {
     .Call(`_allanvar_median_of_squares`, d)
 }
 
+drop_zeros <- function(z) {
+    .Call(`_allanvar_drop_zeros`, z)
+}
+
 theo1_sums_cpp <- function(v, rate, m, threads, method = 0L) {
     .Call(`_allanvar_theo1_sums_cpp`, v, rate, m, threads, method)
 }

@@ -721,7 +721,7 @@ spike_runmed <- function(x, k) {
 # and moves by at most 2. 0 where the body is Gaussian or the record short
 # (< 1e4 values).
 spike_tail_level <- function(z, alpha) {
-  z <- z[z != 0]
+  z <- drop_zeros(z)                 # z[z != 0] (src/series.cpp)
   n <- length(z)
   if (n < 1e4) return(0)
   S <- robust_scale(z)

@@ -768,6 +768,16 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// drop_zeros
+Rcpp::NumericVector drop_zeros(const Rcpp::NumericVector& z);
+RcppExport SEXP _allanvar_drop_zeros(SEXP zSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type z(zSEXP);
+    rcpp_result_gen = Rcpp::wrap(drop_zeros(z));
+    return rcpp_result_gen;
+END_RCPP
+}
 // theo1_sums_cpp
 Rcpp::NumericVector theo1_sums_cpp(const Rcpp::NumericVector& v, bool rate, const Rcpp::NumericVector& m, int threads, int method);
 RcppExport SEXP _allanvar_theo1_sums_cpp(SEXP vSEXP, SEXP rateSEXP, SEXP mSEXP, SEXP threadsSEXP, SEXP methodSEXP) {
@@ -941,6 +951,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_steps_largest_difference", (DL_FUNC) &_allanvar_steps_largest_difference, 3},
     {"_allanvar_which_abs_above", (DL_FUNC) &_allanvar_which_abs_above, 2},
     {"_allanvar_median_of_squares", (DL_FUNC) &_allanvar_median_of_squares, 1},
+    {"_allanvar_drop_zeros", (DL_FUNC) &_allanvar_drop_zeros, 1},
     {"_allanvar_theo1_sums_cpp", (DL_FUNC) &_allanvar_theo1_sums_cpp, 5},
     {"_allanvar_theo1_all_cpp", (DL_FUNC) &_allanvar_theo1_all_cpp, 4},
     {"_allanvar_theo1_incr_cpp", (DL_FUNC) &_allanvar_theo1_incr_cpp, 4},

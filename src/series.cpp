@@ -593,3 +593,18 @@ double median_of_squares(const Rcpp::NumericVector& d) {
   if (!r_mean(2, [&two](R_xlen_t i) { return two[i]; }, &mu)) return NA_REAL;
   return mu;
 }
+
+// z[z != 0] in one pass, without the logical index (spike_tail_level()); a
+// NaN gives NA there, as R's NA index does.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector drop_zeros(const Rcpp::NumericVector& z) {
+  const R_xlen_t n = z.size();
+  const double* v = z.begin();
+  R_xlen_t m = 0;
+  for (R_xlen_t i = 0; i < n; i++) m += v[i] != 0;
+  Rcpp::NumericVector out(m);
+  double* o = out.begin();
+  for (R_xlen_t i = 0, k = 0; i < n; i++)
+    if (v[i] != 0) o[k++] = std::isnan(v[i]) ? NA_REAL : v[i];
+  return out;
+}

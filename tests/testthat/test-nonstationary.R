@@ -388,6 +388,8 @@ test_that("the series pass's selection kernels give R's expressions to the bit",
     expect_identical(median_of_squares(d), stats::median(d^2))
     zc <- stats::runif(1, 0, 2)
     expect_identical(which_abs_above(x, zc), which(abs(x) > zc))
+    xz <- round(x)
+    expect_identical(drop_zeros(xz), xz[xz != 0])
     w <- c(1L, 3L, 17L)[k %% 3L + 1L]
     cs <- c(0, cumsum(x))
     ex <- stats::runif(n) < 0.1
@@ -405,6 +407,8 @@ test_that("the series pass's selection kernels give R's expressions to the bit",
   # the median
   y <- c(stats::rnorm(99), NA)
   expect_error(robust_scale(y), "missing values")
+  y0 <- c(0, NaN, NA, -0, 2)
+  expect_identical(drop_zeros(y0), y0[y0 != 0])
   expect_identical(spike_runmed(y, 7L),
                    stats::runmed(y, 7L, endrule = "median", algorithm = "Turlach"))
 })
