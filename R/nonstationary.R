@@ -692,8 +692,8 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
   out
 }
 
-# stats::runmed(x, k, endrule = "median"): the window medians by selection
-# in src/series.cpp (runmed's Turlach cost 0.04 s an axis), the ends by
+# stats::runmed(x, k, endrule = "median"): the window medians in
+# src/series.cpp (runmed's Turlach cost 0.04 s an axis), the ends by
 # runmed's own smoothEnds(); runmed itself where x has a NaN or is short.
 spike_runmed <- function(x, k) {
   k <- as.integer(k)
@@ -771,8 +771,6 @@ spike_ao_z <- function(x, xw, p = 20L) {
   top <- max(abs(xw))
   if (!is.finite(top) || !(top > 0)) return(NULL)
   sc <- 2^floor(log2(top))
-  x0 <- x
-  x <- x / sc
   xw <- xw / sc
   mu <- mean(xw)
   # Burg's AR(p) as ar.burg(aic = FALSE, demean = FALSE) gives it, numeric(0)
@@ -786,13 +784,13 @@ spike_ao_z <- function(x, xw, p = 20L) {
   se <- robust_scale(ew[-seq_len(p)])
   if (!isTRUE(se > 0)) return(NULL)
   # innovations e(t) = pi(B) x, then sum_j pi_j e(t + j) (the filter run
-  # backwards)
-  # (these lines in one C++ pass where the model has an order: the same
+  # backwards); where the model has an order, in one C++ pass (the same
   # operations without five n-value temporaries)
   denom <- sqrt(sum(pi^2)) * se
   if (p >= 1L && n > 4L * p) {
-    a <- spike_ao_values(x0, sc, mu, pi, denom)
+    a <- spike_ao_values(x, sc, mu, pi, denom)
   } else {
+    x <- x / sc
     e <- ar_filter(x - mu, pi, FALSE)
     e[seq_len(p)] <- 0
     a <- ar_filter(e, pi, TRUE)
