@@ -153,12 +153,24 @@ test_that("a measured reading with an unexplained run in its range is a bound or
   cv3$avar <- cv3$avar + 2 * log(2) / pi * 2e-4^2
   cv3$adev <- sqrt(cv3$avar)
   b <- reading_of(allanvar:::channel_readings(cv3, cf3, "gyro"), "flicker")
-  expect_identical(b$verdict, "measured")
-  b_u <- reading_of(allanvar:::channel_readings(
-    cv3, cf3, "gyro", unexplained = runs(b$tau_lo, b$tau_hi, "bump")), "flicker")
+  bump <- function(raise) {
+    cv <- cv3
+    inr <- cv$tau >= b$tau_lo & cv$tau <= b$tau_hi
+    cv$adev[inr] <- raise * cv$adev[inr]
+    cv
+  }
+  u_b <- runs(b$tau_lo, b$tau_hi, "bump")
+  expect_identical(reading_of(allanvar:::channel_readings(bump(1.05), cf3, "gyro"),
+                              "flicker")$verdict, "measured")
+  b_u <- reading_of(allanvar:::channel_readings(bump(1.05), cf3, "gyro", unexplained = u_b),
+                    "flicker")
   expect_identical(b_u$verdict, "not_determined")
   expect_match(b_u$why, "lies in its range (see $unexplained): other terms make most of the model there",
                fixed = TRUE)
+  # a run within 2% of the model (the verdicts' tolerance) does not count
+  b_small <- reading_of(allanvar:::channel_readings(bump(1.01), cf3, "gyro", unexplained = u_b),
+                        "flicker")
+  expect_identical(b_small$verdict, "measured")
 })
 
 test_that("an unexplained run outside a reading's range changes no reading", {
