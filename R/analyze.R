@@ -325,7 +325,8 @@ analyze_channel <- function(job, opts) {
   coef <- if (is.null(fit)) numeric() else fit$coefficients
   readings <- channel_readings(curve, coef, job$sensor, se = fit_se(fit),
                                fitted = if (!is.null(fit)) fit$data,
-                               series = if (!is.null(fit$series)) fit$series else series)
+                               series = if (!is.null(fit$series)) fit$series else series,
+                               unexplained = fit$unexplained)
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = failure$message, fit_condition = failure$condition,

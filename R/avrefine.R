@@ -46,8 +46,10 @@
 #'   to lines within the periodogram's resolution. Raw-data checks of the
 #'   other effects see the series with the significant lines removed.
 #' * What no catalogue effect explains is reported in `$unexplained`, not
-#'   papered over. When a run at the short-tau end stays unexplained, the
-#'   model is refitted from the first tau after it (a message says so and
+#'   papered over; a reading whose tau range meets such a run is not
+#'   "measured" (a bound or not determined, its `why` naming the run).
+#'   When a run at the short-tau end stays unexplained, the model is
+#'   refitted from the first tau after it (a message says so and
 #'   `$refine$tau_range` records it), so that points the model cannot
 #'   describe do not drive `N` to 0 or bend the long-tau terms.
 #' * Without raw data, `$refine$unconfirmed` lists the accepted effects that

@@ -208,7 +208,9 @@ effect_resonance <- function() {
     # sees the band only through the AV's sinc filter: it places fr poorly
     # and cannot tell a band 0.5 Hz wide from a tone, so a free tc runs
     # off), and free from there (a band that is not quite Lorentzian puts
-    # its AV-equivalent centre elsewhere). The criterion chooses; the
+    # its AV-equivalent centre elsewhere): searched from the band's values
+    # only (`local`), since the search over the whole range ends on a tone
+    # or a band the raw data do not hold. The criterion chooses; the
     # raw-data check still asks for the band within half its width of fr.
     propose = function(raw, tau, sig) {
       b <- diag_part(raw, "bands")
@@ -225,7 +227,7 @@ effect_resonance <- function() {
         one <- list(init = st, tau_from = 0.371 / st$fr / 2, tau_to = 2 / st$fr,
                     score = 2, note = note)
         out[[length(out) + 1L]] <- c(one, list(pin = list(fr = b$f_center[j], tc = b$tc[j])))
-        out[[length(out) + 1L]] <- one
+        out[[length(out) + 1L]] <- c(one, list(local = TRUE))
       }
       out
     },

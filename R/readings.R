@@ -23,9 +23,12 @@
 #'   `tau_hi` (the taus the reading rests on), `biased_by` (series effects
 #'   left in that change it), `bias_change`, `removed` (kinds taken out).
 #' `series`: the axis' series pass (detect_series_effects()) or NULL.
+#' `unexplained`: the runs the loop left unexplained (avrefine()'s
+#' `$unexplained`, taus as the curve's) or NULL; a reading resting on one is
+#' not measured (R/verdicts.R).
 #' @noRd
 channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL,
-                             series = NULL) {
+                             series = NULL, unexplained = NULL) {
   tau <- curve$tau
   adev <- curve$adev
   ok <- is.finite(adev) & adev > 0
@@ -43,7 +46,8 @@ channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL,
   })
   out <- do.call(rbind, rows)
   rownames(out) <- NULL
-  mark_series_bias(reading_verdicts(out, curve, lay, ok, rel), series)
+  mark_series_bias(reading_verdicts(out, curve, lay, ok, rel, unexplained),
+                   series)
 }
 
 # The readings of a dead axis: one row per reading, no value, `reason` as

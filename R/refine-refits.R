@@ -121,18 +121,13 @@ refit_call <- function(args) match.call(avfit, as.call(c(list(avfit), args)))
 # Refit the curve with one more term. avfit() profiles the nonlinear
 # parameters on its own grid; when the tracing gives a start value for the
 # new term's nonlinear parameters the refit is also tried from there, and
-# the better of the two is kept (`fit` NULL when both fail). Returns
-# list(fit, conditions) as try_refit() does.
+# the better of the two is kept (`fit` NULL when both fail); a `local`
+# trial is searched from its start only. Returns list(fit, conditions) as
+# try_refit() does.
 refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
-                       good_enough = NULL) {
+                       good_enough = NULL, local = FALSE) {
   one <- function(start, stage) {
     try_refit(refit_args(fit, terms, settings, start = start, hold = hold), stage)
-  }
-  first <- one(NULL, "screen")
-  best <- first$fit
-  conditions <- first$conditions
-  if (!is.null(best) && !is.null(good_enough) && good_enough(best)) {
-    return(list(fit = best, conditions = conditions))
   }
   lab <- new_label(fit$terms, effect)
   sp <- split_term(effect)
@@ -142,6 +137,19 @@ refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
     v <- init[[p]]
     is.numeric(v) && length(v) == 1L && is.finite(v) && v > 0
   }, logical(1))
+  # a trial searched from its start only (`local`) skips the search over
+  # the whole range, where it could only end far from what proposed it
+  local <- local && all(ok)
+  best <- NULL
+  conditions <- list()
+  if (!local) {
+    first <- one(NULL, "screen")
+    best <- first$fit
+    conditions <- first$conditions
+    if (!is.null(best) && !is.null(good_enough) && good_enough(best)) {
+      return(list(fit = best, conditions = conditions))
+    }
+  }
   if (any(ok)) {
     st <- unlist(init[nl[ok]])
     names(st) <- coef_names(e, lab)[match(nl[ok], e$params$name)]

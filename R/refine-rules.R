@@ -132,17 +132,18 @@ candidate_trials <- function(traced, present, candidates, sig) {
       r <- data.frame(
         effect = k, tau_from = strongest$tau_from, tau_to = strongest$tau_to,
         signature = paste0(strongest$description, " (no signature specific to ", k, ")"),
-        score = 0, traced = FALSE, stringsAsFactors = FALSE)
+        score = 0, local = FALSE, traced = FALSE, stringsAsFactors = FALSE)
       r$init <- list(list())
       r$pin <- list(NULL)
       r$after <- list(NULL)
       rows[[length(rows) + 1L]] <- r[, c("effect", "tau_from", "tau_to", "signature",
-                                         "score", "init", "pin", "after", "traced")]
+                                         "score", "local", "init", "pin", "after",
+                                         "traced")]
     }
   }
   if (!length(rows)) return(data.frame())
   do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
-                                                "signature", "score", "init",
+                                                "signature", "score", "local", "init",
                                                 "pin", "after", "traced")]))
 }
 

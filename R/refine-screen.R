@@ -32,7 +32,8 @@ screen_trial <- function(st, tr, nl_now) {
   settings$fixed <- relabel_values(settings$fixed, cur$terms, tm, keep_gone = TRUE)
   r <- refit_with(cur, c(tm), tr$effect,
                   tr$init[[1L]], settings, hold = c(hold_now, pin),
-                  good_enough = function(f) crit_s(f) < c0 - min_gain)
+                  good_enough = function(f) crit_s(f) < c0 - min_gain,
+                  local = isTRUE(tr$local))
   st$failures <- record_conditions(st$failures, r$conditions, st$step, tr$effect)
   new <- r$fit
   if (is.null(new)) return(list(st = st, cand = NULL))

@@ -38,12 +38,16 @@ verdict_phrase <- function(v) {
 
 # The verdict columns of readings `rd` (one row per reading) from `curve`
 # (tau, adev, lower, upper, edf, m) and the model's layout `lay`; `ok` the
-# usable points, `rel` the reliable ones (EDF >= 10).
-reading_verdicts <- function(rd, curve, lay, ok, rel) {
+# usable points, `rel` the reliable ones (EDF >= 10); `unexplained` the
+# fit's runs no catalogue effect explains (avrefine()'s $unexplained, in
+# the curve's taus) or NULL.
+reading_verdicts <- function(rd, curve, lay, ok, rel, unexplained = NULL) {
   ctx <- list(curve = curve, ok = ok, rel = rel,
               model = verdict_model(curve, lay),
               limits = !is.null(curve$lower) && !is.null(curve$upper))
-  v <- lapply(seq_len(nrow(rd)), function(i) judge_reading(rd[i, ], ctx))
+  v <- lapply(seq_len(nrow(rd)), function(i) {
+    judge_unexplained(rd[i, ], judge_reading(rd[i, ], ctx), unexplained, ctx)
+  })
   rd$verdict <- vapply(v, `[[`, "", "verdict")
   rd$why <- vapply(v, `[[`, "", "why")
   rd$tau_lo <- vapply(v, `[[`, 0, "lo")
@@ -123,6 +127,71 @@ judge_slope_reading <- function(r, flat, ctx) {
       "(EDF >= 10): the flat minimum is not reached"), tau[at], tau[at]))
   }
   verdict("measured", "", tau[at], tau[at])
+}
+
+# A measured reading whose range [lo, hi] overlaps a run the loop left
+# unexplained is not measured: the run test over consecutive points sees
+# structure the pointwise limits let pass. A run where the curve stays within
+# `verdict_tolerance` of the model (a significant 0.5% wiggle at short tau,
+# where the points' limits are finest) does not count, as in judge_span().
+# Where the reading's term makes most of the model over the overlap, the run
+# is attributed to it: the curve above the model there makes the reading a
+# lower bound (the data show more variance than the term gives), below it an
+# upper bound (every term adds variance, so the term is at most what the
+# model gives). Where other terms make most of the model, or the runs
+# disagree, it is not determined.
+judge_unexplained <- function(r, v, unexplained, ctx) {
+  if (v$verdict != "measured" || !NROW(unexplained) ||
+      !is.finite(v$lo) || !is.finite(v$hi)) return(v)
+  u <- unexplained[is.finite(unexplained$tau_from) & is.finite(unexplained$tau_to) &
+                     unexplained$tau_from <= v$hi & unexplained$tau_to >= v$lo, ,
+                   drop = FALSE]
+  side <- vapply(seq_len(nrow(u)), function(i) {
+    run_side(r, max(u$tau_from[i], v$lo), min(u$tau_to[i], v$hi), ctx)
+  }, 0)
+  u <- u[!is.na(side), , drop = FALSE]
+  side <- side[!is.na(side)]
+  if (!nrow(u)) return(v)
+  runs <- paste(ifelse(u$tau_from == u$tau_to, paste0(format_num(u$tau_from), " s"),
+                       sprintf("%s-%s s", format_num(u$tau_from), format_num(u$tau_to))),
+                collapse = ", ")
+  head <- sprintf("%s at tau %s %s in its range (see $unexplained)",
+                  if (nrow(u) > 1L) "unexplained runs" else "an unexplained run",
+                  runs, if (nrow(u) > 1L) "lie" else "lies")
+  term <- r$term
+  if (all(side == 1)) {
+    return(verdict("lower_bound", sprintf(paste0(
+      "%s: the curve lies above the model there, where %s makes most of it: ",
+      "%s is at least this"), head, term, term), v$lo, v$hi))
+  }
+  if (all(side == -1)) {
+    return(verdict("upper_bound", sprintf(paste0(
+      "%s: the curve lies below the model there, where %s makes most of it: ",
+      "%s is at most this"), head, term, term), v$lo, v$hi))
+  }
+  verdict("not_determined", paste0(head, if (any(side == 0))
+    ": other terms make most of the model there"
+    else ": the curve lies above the model at one and below it at another"),
+    v$lo, v$hi)
+}
+
+# Over the curve's points in [from, to]: NA when the curve stays within
+# `verdict_tolerance` of the model there; else +1 when it lies above the
+# model (on average, in log) and the reading's term makes at least half of
+# the model, -1 when below, 0 when the term does not make most of it (or
+# the points or the model are missing).
+run_side <- function(r, from, to, ctx) {
+  cv <- ctx$curve
+  w <- which(ctx$ok & cv$tau >= from & cv$tau <= to)
+  if (is.null(ctx$model) || !length(w)) return(0)
+  model <- ctx$model[w]
+  ratio <- cv$adev[w] / sqrt(model)
+  if (all(is.finite(ratio)) && max(abs(ratio - 1)) <= verdict_tolerance) return(NA_real_)
+  e <- reading_entry(r$role)
+  share <- r$value^2 * e$basis(cv$tau[w], NULL, NULL) / model
+  if (!all(is.finite(share)) || mean(share) < 0.5) return(0)
+  d <- mean(log(ratio))
+  if (!is.finite(d) || d == 0) 0 else sign(d)
 }
 
 # Model ADEV `m` against the curve's limits over the points in `span`. A

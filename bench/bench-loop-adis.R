@@ -5,8 +5,9 @@
 # - per axis (18 = 3 units x 6), one thread: the series pass, the curve and
 #   the first fit as analyze_imu() makes them, then the loop timed alone:
 #   avrefine(fit, data = x, series = <the series pass>) (CPU and elapsed);
-# - per unit: analyze_imu() of the 6-axis record with its default threads
-#   (elapsed and CPU), the reading (readRDS + imu_record()) timed apart.
+# - per unit: analyze_imu() of the 6-axis record with its defaults (elapsed
+#   and CPU, the forked workers' included), again with workers = 1
+#   (elapsed), the reading (readRDS + imu_record()) timed apart.
 # Builds alternate unit by unit so that the machine's load moves them
 # alike. Prints a per-axis table and the summary; CPU is the figure to
 # compare (elapsed follows the shared machine's load).
@@ -19,16 +20,24 @@ if (length(args) >= 2L && args[1L] == "--worker") {
   dir <- args[3L]
   out <- args[4L]
   suppressPackageStartupMessages(library(allanvar))
-  cpu <- function(t) t[[1L]] + t[[2L]]
+  # CPU of this process and of the children it waited for (forked workers)
+  cpu <- function(t) sum(t[c(1L, 2L, 4L, 5L)], na.rm = TRUE)
   t0 <- proc.time()
   m <- readRDS(file.path(dir, sprintf("adis16405_unit%d.rds", unit)))
   rec <- imu_record(m, freq = attr(m, "freq"), name = sprintf("unit%d", unit),
                     units = c(gyro = "deg/s", accel = "g"))
   t_read <- proc.time() - t0
-  # analyze_imu() as a user runs it (default threads, no future plan)
+  # analyze_imu() as a user runs it (default threads, no future plan: the
+  # axes in allanvar.threads forked workers where the build has `workers`),
+  # then with the axes one after another (workers = 1)
   t0 <- proc.time()
   a <- suppressWarnings(suppressMessages(analyze_imu(rec, progress = FALSE)))
   t_an <- proc.time() - t0
+  t_seq <- if ("workers" %in% names(formals(analyze_imu))) {
+    t0 <- proc.time()
+    a1 <- suppressWarnings(suppressMessages(analyze_imu(rec, progress = FALSE, workers = 1)))
+    proc.time() - t0
+  } else t_an
   # the loop alone per axis, one thread, prepared as analyze_channel() does
   options(allanvar.threads = 1L)
   rows <- list()
@@ -46,7 +55,8 @@ if (length(args) >= 2L && args[1L] == "--worker") {
   saveRDS(list(axes = do.call(rbind, rows),
                unit = data.frame(unit = unit, read_elapsed = t_read[["elapsed"]],
                                  analyze_elapsed = t_an[["elapsed"]],
-                                 analyze_cpu = cpu(t_an))), out)
+                                 analyze_cpu = cpu(t_an),
+                                 sequential_elapsed = t_seq[["elapsed"]])), out)
   quit(save = "no")
 }
 
@@ -84,15 +94,15 @@ wide <- reshape(axes[, c("build", "unit", "axis", "loop_cpu")], idvar = c("unit"
 names(wide) <- sub("^loop_cpu\\.", "cpu ", names(wide))
 print(wide, row.names = FALSE, digits = 3)
 cat("\nanalyze_imu() per 6-axis unit (default threads), seconds:\n")
-print(units[, c("build", "unit", "read_elapsed", "analyze_elapsed", "analyze_cpu")],
-      row.names = FALSE, digits = 3)
-cat("\n| build | loop CPU per axis, median (s) | max (s) | loop elapsed median (s) | analyze_imu() elapsed per unit, median (s) | its CPU median (s) | reading median (s) |\n|---|---|---|---|---|---|---|\n")
+print(units[, c("build", "unit", "read_elapsed", "analyze_elapsed", "analyze_cpu",
+               "sequential_elapsed")], row.names = FALSE, digits = 3)
+cat("\n| build | loop CPU per axis, median (s) | max (s) | loop elapsed median (s) | analyze_imu() elapsed per unit, median (s) | its CPU median (s) | with workers = 1, elapsed median (s) | reading median (s) |\n|---|---|---|---|---|---|---|---|\n")
 for (lb in labels) {
   a <- axes[axes$build == lb, ]
   v <- units[units$build == lb, ]
-  cat(sprintf("| %s | %.2f | %.2f | %.2f | %.1f | %.1f | %.2f |\n", lb,
+  cat(sprintf("| %s | %.2f | %.2f | %.2f | %.1f | %.1f | %.1f | %.2f |\n", lb,
               stats::median(a$loop_cpu), max(a$loop_cpu), stats::median(a$loop_elapsed),
               stats::median(v$analyze_elapsed), stats::median(v$analyze_cpu),
-              stats::median(v$read_elapsed)))
+              stats::median(v$sequential_elapsed), stats::median(v$read_elapsed)))
 }
 cat(sprintf("load average at end: %s\n", paste(readLines("/proc/loadavg", warn = FALSE), collapse = " ")))

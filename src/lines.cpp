@@ -54,29 +54,24 @@ Rcpp::NumericVector line_sums(const Rcpp::NumericVector& y, double f, double fre
   double ss[4] = {0, 0, 0, 0}, cc[4] = {0, 0, 0, 0}, sc[4] = {0, 0, 0, 0},
          sy[4] = {0, 0, 0, 0}, cy[4] = {0, 0, 0, 0};
   const double* v = y.begin();
+  // sample j + q in lane q
+  auto add = [&](int q, R_xlen_t j) {
+    const double s = ph.s[q], c = ph.c[q], x = v[j + q];
+    ss[q] += s * s;
+    cc[q] += c * c;
+    sc[q] += s * c;
+    sy[q] += s * x;
+    cy[q] += c * x;
+  };
   for (R_xlen_t j0 = 0; j0 < n; j0 += kBlock) {
     const R_xlen_t j1 = std::min(n, j0 + kBlock);
     ph.start(f, freq, j0);
     R_xlen_t j = j0;
     for (; j + 4 <= j1; j += 4) {
-      for (int q = 0; q < 4; ++q) {
-        const double s = ph.s[q], c = ph.c[q], x = v[j + q];
-        ss[q] += s * s;
-        cc[q] += c * c;
-        sc[q] += s * c;
-        sy[q] += s * x;
-        cy[q] += c * x;
-      }
+      for (int q = 0; q < 4; ++q) add(q, j);
       ph.advance();
     }
-    for (int q = 0; j + q < j1; ++q) {
-      const double s = ph.s[q], c = ph.c[q], x = v[j + q];
-      ss[q] += s * s;
-      cc[q] += c * c;
-      sc[q] += s * c;
-      sy[q] += s * x;
-      cy[q] += c * x;
-    }
+    for (int q = 0; j + q < j1; ++q) add(q, j);
     if ((j0 & 0xFFFFF) == 0) Rcpp::checkUserInterrupt();
   }
   auto total = [](const double* a) { return (a[0] + a[1]) + (a[2] + a[3]); };

@@ -49,7 +49,8 @@ test_that("forked workers give the run one after another; `workers` is checked",
   expect_true(inherits(future::plan(), "sequential"))
   expect_identical(getOption("allanvar.threads"), threads)
   # by default: forks only under the sequential plan, for a large record
-  expect_identical(axis_workers(NULL, 6L, 6e6), min(2L, as.integer(future::availableCores())))
+  expect_identical(axis_workers(NULL, 6L, 6e6),
+                   min(allanvar_threads(), as.integer(future::availableCores())))
   expect_identical(axis_workers(NULL, 2L, 4e4), 1L)
   expect_identical(axis_workers(NULL, 1L, 1e6), 1L)
   expect_identical(axis_workers(5, 3L, 10), 3L)
