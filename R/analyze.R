@@ -199,8 +199,13 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   }
   run <- function() {
     p <- progressr::progressor(steps = n_jobs)
+    # an axis's error comes back as a value, so that every axis's future
+    # is collected (none cancelled half-way, no worker left behind) before
+    # the first error is signalled again, as it was raised
     future.apply::future_lapply(jobs, function(job, opts) {
-      res <- analyze_channel(job, opts)
+      res <- tryCatch(analyze_channel(job, opts),
+                      error = function(e) structure(list(condition = e),
+                                                    class = "axis_failure"))
       p(job$label)
       res
     }, opts = opts, future.seed = TRUE, future.scheduling = Inf)
@@ -210,6 +215,8 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
   } else {
     run()
   }
+  failed <- Filter(function(r) inherits(r, "axis_failure"), results)
+  if (length(failed)) stop(failed[[1L]]$condition)
 
   out <- lapply(seq_along(records), function(i) {
     r <- records[[i]]
