@@ -406,7 +406,7 @@ test_that("the series pass's selection kernels give R's expressions to the bit",
   # a missing value: R's own path (its error) for the scale, runmed's for
   # the median
   y <- c(stats::rnorm(99), NA)
-  expect_error(robust_scale(y), "missing values")
+  expect_error(robust_scale(y), "missing values", class = "simpleError")
   y0 <- c(0, NaN, NA, -0, 2)
   expect_identical(drop_zeros(y0), y0[y0 != 0])
   expect_identical(spike_runmed(y, 7L),
