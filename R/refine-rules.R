@@ -136,12 +136,11 @@ candidate_trials <- function(traced, present, candidates, sig) {
       r$init <- list(list())
       r$pin <- list(NULL)
       r$after <- list(NULL)
-      rows[[length(rows) + 1L]] <- r[, c("effect", "tau_from", "tau_to", "signature",
-                                         "score", "local", "init", "pin", "after",
-                                         "traced")]
+      rows[[length(rows) + 1L]] <- r
     }
   }
   if (!length(rows)) return(data.frame())
+  # every row in one column order (the traced rows carry more columns)
   do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
                                                 "signature", "score", "local", "init",
                                                 "pin", "after", "traced")]))

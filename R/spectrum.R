@@ -677,15 +677,15 @@ remove_bands <- function(x, freq, bands) {
   X <- stats::fft(x - m)
   # bins 1..h hold 0..freq/2; bin j > h is bin n + 2 - j's mirror
   h <- n %/% 2L + 1L
-  fa <- (seq_len(h) - 1) * freq / n
+  fh <- (seq_len(h) - 1) * freq / n
   mir <- c(seq_len(h), if (n > h) (n + 2L - (h + 1L):n))
-  fa <- fa[mir]
+  fa <- fh[mir]
   # the bands' gains multiply; each band's background is read on the
   # series with the bands before it taken out
   G <- 1
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
-    M <- 2 * resonance_psd(fa[seq_len(h)], tau0, sqrt(b$power), b$f_center, b$tc)[mir]
+    M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)[mir]
     w <- max(b$width, b$f_to - b$f_from)
     d <- abs(fa - b$f_center)
     near <- which(d > 3 * w & d < 6 * w)

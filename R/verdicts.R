@@ -71,6 +71,11 @@ verdict <- function(v, why = "", lo = NA_real_, hi = NA_real_) {
   list(verdict = v, why = why, lo = lo, hi = hi)
 }
 
+# The share of the model `model` (AV at `tau`) that reading r's term makes.
+reading_share <- function(r, tau, model) {
+  r$value^2 * reading_entry(r$role)$basis(tau, NULL, NULL) / model
+}
+
 # One reading's verdict.
 judge_reading <- function(r, ctx) {
   e <- reading_entry(r$role)
@@ -103,7 +108,7 @@ judge_reading <- function(r, ctx) {
         "(EDF >= 10): the flat minimum is not reached"), min(tau[w]), max(tau[w])))
     }
   } else {
-    share <- r$value^2 * e$basis(tau, NULL, NULL) / model
+    share <- reading_share(r, tau, model)
     span <- ok & is.finite(share) & share >= 0.5
   }
   if (!any(span)) {
@@ -187,8 +192,7 @@ run_side <- function(r, from, to, ctx) {
   model <- ctx$model[w]
   ratio <- cv$adev[w] / sqrt(model)
   if (all(is.finite(ratio)) && max(abs(ratio - 1)) <= verdict_tolerance) return(NA_real_)
-  e <- reading_entry(r$role)
-  share <- r$value^2 * e$basis(cv$tau[w], NULL, NULL) / model
+  share <- reading_share(r, cv$tau[w], model)
   if (!all(is.finite(share)) || mean(share) < 0.5) return(0)
   d <- mean(log(ratio))
   if (!is.finite(d) || d == 0) 0 else sign(d)

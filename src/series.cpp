@@ -484,28 +484,16 @@ double trimmed_mean_square(const Rcpp::NumericVector& r, R_xlen_t k1, R_xlen_t k
   const double q1 = q[0];
   if (!order_stats(v, n, k2, k2, q)) return NA_REAL;
   const double q2 = q[0];
-  // the kept values in their order, their sum on the way (r_mean()'s first
-  // pass)
+  // the kept values in their order
   std::unique_ptr<double[]> w(new double[n]);
   R_xlen_t m = 0;
-  long double s = 0;
   for (R_xlen_t i = 0; i < n; i++) {
     const double x = v[i];
-    if (x >= q1 && x <= q2) {
-      w[m++] = x;
-      s += x;
-    }
+    if (x >= q1 && x <= q2) w[m++] = x;
   }
   const double* kp = w.get();
-  if (!std::isfinite(static_cast<double>(s))) return NA_REAL;
-  s /= m;
-  if (std::isfinite(static_cast<double>(s))) {
-    long double t = 0;
-    for (R_xlen_t i = 0; i < m; i++) t += (kp[i] - s);
-    s += t / m;
-  }
-  const double mu = static_cast<double>(s);
-  double ms;
+  double mu, ms;
+  if (!r_mean(m, [kp](R_xlen_t i) { return kp[i]; }, &mu)) return NA_REAL;
   // (keep - mu)^2 as R computes x^2: x * x in double
   if (!r_mean(m, [kp, mu](R_xlen_t i) { const double d = kp[i] - mu; return d * d; }, &ms))
     return NA_REAL;
