@@ -674,11 +674,15 @@ remove_bands <- function(x, freq, bands) {
   n <- length(x)
   m <- mean(x)
   tau0 <- 1 / freq
-  X <- stats::fft(x - m)
-  # bins 1..h hold 0..freq/2; bin j > h is bin n + 2 - j's mirror
-  h <- n %/% 2L + 1L
-  fh <- (seq_len(h) - 1) * freq / n
-  mir <- c(seq_len(h), if (n > h) (n + 2L - (h + 1L):n))
+  # zero-padded to a length with factors 2, 3, 5: R's fft() is quadratic
+  # in a large prime factor (a record of 1000003 samples would take an
+  # hour); the pad is filtered and dropped
+  np <- stats::nextn(n, c(2L, 3L, 5L))
+  X <- stats::fft(c(x - m, numeric(np - n)))
+  # bins 1..h hold 0..freq/2; bin j > h is bin np + 2 - j's mirror
+  h <- np %/% 2L + 1L
+  fh <- (seq_len(h) - 1) * freq / np
+  mir <- c(seq_len(h), if (np > h) (np + 2L - (h + 1L):np))
   fa <- fh[mir]
   # the bands' gains multiply; each band's background is read on the
   # series with the bands before it taken out
@@ -695,6 +699,6 @@ remove_bands <- function(x, freq, bands) {
     G <- G * sqrt(bg / (bg + M))
   }
   if (length(G) == 1L) return(x)
-  Re(stats::fft(X * G, inverse = TRUE)) / n + m
+  Re(stats::fft(X * G, inverse = TRUE))[seq_len(n)] / np + m
 }
 

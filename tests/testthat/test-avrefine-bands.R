@@ -39,6 +39,16 @@ test_that("remove_bands takes a resonance's excess out and keeps the white noise
   expect_equal(stats::var(y), stats::var(w), tolerance = 0.1)
   # no band: the series is returned unchanged
   expect_identical(remove_bands(w, freq, b[0, ]), w)
+  # a record of prime length (2^17 - 1) is transformed zero-padded: the
+  # same band comes out, the length is kept, and the last samples (beside
+  # the pad) are as white as the rest
+  p <- n - 1L
+  yp <- remove_bands(x[seq_len(p)], freq, b)
+  expect_length(yp, p)
+  expect_equal(nrow(find_bands(yp, freq)), 0L)
+  expect_lt(abs(r1(yp)), 0.03)
+  expect_equal(stats::var(yp[(p - 999L):p]), stats::var(w[(p - 999L):p]), tolerance = 0.15)
+  expect_equal(yp[1:1000], y[1:1000], tolerance = 0.02)
 })
 
 test_that("a filtered sensor with a resonance: the low-pass family, the band's centre, no slow sinusoid", {
