@@ -675,30 +675,35 @@ remove_bands <- function(x, freq, bands) {
   m <- mean(x)
   tau0 <- 1 / freq
   # zero-padded to a length with factors 2, 3, 5: R's fft() is quadratic
-  # in a large prime factor (a record of 1000003 samples would take an
+  # in a large prime factor (a record of 999983 samples would take half an
   # hour); the pad is filtered and dropped
   np <- stats::nextn(n, c(2L, 3L, 5L))
   X <- stats::fft(c(x - m, numeric(np - n)))
-  # bins 1..h hold 0..freq/2; bin j > h is bin np + 2 - j's mirror
+  # the gains are worked out on bins 1..h (0..freq/2); bin j > h is bin
+  # np + 2 - j's mirror, so each bin but DC (and Nyquist, np even) stands
+  # for two in the background's mean
   h <- np %/% 2L + 1L
   fh <- (seq_len(h) - 1) * freq / np
-  mir <- c(seq_len(h), if (np > h) (np + 2L - (h + 1L):np))
-  fa <- fh[mir]
+  wt <- rep(2, h)
+  wt[1L] <- 1
+  if (np %% 2L == 0L) wt[h] <- 1
+  Ph <- 2 * Mod(X[seq_len(h)])^2 / (n * freq)
   # the bands' gains multiply; each band's background is read on the
   # series with the bands before it taken out
   G <- 1
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
-    M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)[mir]
+    M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)
     w <- max(b$width, b$f_to - b$f_from)
-    d <- abs(fa - b$f_center)
+    d <- abs(fh - b$f_center)
     near <- which(d > 3 * w & d < 6 * w)
     Gn <- if (length(G) > 1L) G[near] else G
-    bg <- mean(2 * Mod(X[near])^2 * Gn^2 / (n * freq) - M[near])
+    bg <- sum(wt[near] * (Ph[near] * Gn^2 - M[near])) / sum(wt[near])
     if (!is.finite(bg) || bg <= 0) next
     G <- G * sqrt(bg / (bg + M))
   }
   if (length(G) == 1L) return(x)
+  G <- c(G, if (np > h) G[np + 2L - (h + 1L):np])
   Re(stats::fft(X * G, inverse = TRUE))[seq_len(n)] / np + m
 }
 
