@@ -122,18 +122,20 @@ test_that("a weak narrow band (below 2x its background): a resonance at the band
   expect_false(any(abs(cf[grepl("\\.f0$", names(cf))] - 10) < 1))
 })
 
-test_that("a band proposes its resonance pinned, and free from its values only", {
+test_that("a band proposes its resonance pinned, released from its values only", {
   set.seed(12)
   n <- 2^17
   freq <- 100
   x <- stats::rnorm(n) + ar2_resonance(n, 15, 0.3, 0.3, freq)
   fit <- avfit(allan(x, freq), terms = c("N", "K"))
   raw <- refine_diagnostics(x, freq)
+  b <- diag_part(raw, "bands")
+  expect_equal(nrow(b), 1L)
   p <- effect_entry("resonance")$propose(raw, fit$data$tau, NULL)
-  expect_length(p, 2L)
-  expect_true(length(p[[1]]$pin) == 2L && !isTRUE(p[[1]]$local))
-  expect_true(is.null(p[[2]]$pin) && isTRUE(p[[2]]$local))
-  # a local trial is the one search from its start; without `local` the
+  expect_length(p, 1L)
+  expect_identical(p[[1]]$pin, list(fr = b$f_center, tc = b$tc))
+  expect_true(isTRUE(p[[1]]$release))
+  # the release is one search from the pinned values; without `local` the
   # search over the whole range runs first
   log <- new.env()
   log$stages <- character()
@@ -142,11 +144,11 @@ test_that("a band proposes its resonance pinned, and free from its values only",
   on.exit(suppressMessages(untrace("try_refit", where = asNamespace("allanvar"))),
           add = TRUE)
   settings <- refit_settings(fit, list())
-  loc <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[2]]$init,
+  loc <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[1]]$pin,
                     settings, local = TRUE)
   expect_identical(log$stages, "screen from the traced start")
   log$stages <- character()
-  both <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[2]]$init, settings)
+  both <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[1]]$pin, settings)
   expect_identical(log$stages[1], "screen")
   # from the band's values the search finds the band
   expect_lt(abs(stats::coef(loc$fit)[["resonance1.fr"]] - 15), 0.3)
