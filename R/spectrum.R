@@ -397,21 +397,26 @@ remove_lines <- function(x, freq, f0) {
 # finest the data have. A Blackman-Harris (4-term) taper keeps a line's
 # power in its main lobe (+-4 bins) with side lobes 92 dB down, so however
 # strong a line is, its power does not leak into the bins around it.
-# Zero-padded to a length with factors 2, 3, 5 (R's fft() is slow on large
-# primes); `res` is the record's resolution freq / n, `df` the bin spacing.
+# Zero-padded to a power of two (record_fft_size()); `res` is the record's
+# resolution freq / n, `df` the bin spacing.
 record_periodogram <- function(x, freq) {
   n <- length(x)
   tp <- record_taper(n)
   w <- tp$w
-  np <- stats::nextn(n, c(2L, 3L, 5L))
-  y <- detrend_linear(x) * w
-  X <- stats::fft(c(y, numeric(np - n)))
-  half <- np %/% 2L + 1L
-  p <- Mod(X[seq_len(half)])^2 / (freq * tp$w2)
+  np <- record_fft_size(n)
+  X <- real_fft_cpp(detrend_linear(x) * w, np)
+  half <- length(X)
+  p <- Mod(X)^2 / (freq * tp$w2)
   p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
   list(f = (seq_len(half) - 1) * freq / np, psd = p, df = freq / np,
        res = freq / n, lobe = ceiling(4 * np / n) + 1L)
 }
+
+# The transforms of a whole record (record_periodogram(), remove_bands())
+# run on it zero-padded to a power of two, two samples per complex point,
+# by the package's FFT (src/real_fft.cpp: 1e6 points in about a tenth of
+# the time of R's fft(), which is also quadratic in a large prime factor).
+record_fft_size <- function(n) 2^max(2, ceiling(log2(n)))
 
 # The taper of record_periodogram() for n samples and its sum of squares.
 # Its cosines cost more than the record's FFT, and the loop reads records
@@ -674,20 +679,15 @@ remove_bands <- function(x, freq, bands) {
   n <- length(x)
   m <- mean(x)
   tau0 <- 1 / freq
-  # zero-padded to a length with factors 2, 3, 5: R's fft() is quadratic
-  # in a large prime factor (a record of 999983 samples would take half an
-  # hour); the pad is filtered and dropped
-  np <- stats::nextn(n, c(2L, 3L, 5L))
-  X <- stats::fft(c(x - m, numeric(np - n)))
-  # the gains are worked out on bins 1..h (0..freq/2); bin j > h is bin
-  # np + 2 - j's mirror, so each bin but DC (and Nyquist, np even) stands
-  # for two in the background's mean
-  h <- np %/% 2L + 1L
+  # zero-padded (record_fft_size()); the pad is filtered and dropped.
+  # Bins 0..freq/2: each but DC and Nyquist stands for its mirror too, so
+  # it weighs 2 in the background's mean
+  np <- record_fft_size(n)
+  X <- real_fft_cpp(x - m, np)
+  h <- length(X)
   fh <- (seq_len(h) - 1) * freq / np
-  wt <- rep(2, h)
-  wt[1L] <- 1
-  if (np %% 2L == 0L) wt[h] <- 1
-  Ph <- 2 * Mod(X[seq_len(h)])^2 / (n * freq)
+  wt <- c(1, rep(2, h - 2L), 1)
+  Ph <- 2 * Mod(X)^2 / (n * freq)
   # the bands' gains multiply; each band's background is read on the
   # series with the bands before it taken out
   G <- 1
@@ -703,7 +703,6 @@ remove_bands <- function(x, freq, bands) {
     G <- G * sqrt(bg / (bg + M))
   }
   if (length(G) == 1L) return(x)
-  G <- c(G, if (np > h) G[np + 2L - (h + 1L):np])
-  Re(stats::fft(X * G, inverse = TRUE))[seq_len(n)] / np + m
+  real_ifft_cpp(X * G, np, n) / np + m
 }
 
