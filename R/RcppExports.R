@@ -73,12 +73,8 @@ detrend_line <- function(x) {
     .Call(`_allanvar_detrend_line`, x)
 }
 
-welch_segments <- function(x, starts, win) {
-    .Call(`_allanvar_welch_segments`, x, starts, win)
-}
-
-welch_accumulate <- function(z, half, acc) {
-    .Call(`_allanvar_welch_accumulate`, z, half, acc)
+welch_sums <- function(x, starts, win) {
+    .Call(`_allanvar_welch_sums`, x, starts, win)
 }
 
 grid_stats <- function(x) {

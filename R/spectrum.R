@@ -9,15 +9,11 @@
 # ---- Welch periodogram --------------------------------------------------------
 
 # Welch periodogram (Hann, 50% overlap, segments demeaned), one-sided PSD
-# in u^2/Hz, in O(n log seg): the segments are the columns of one matrix
-# and mvfft transforms them together, two real segments per complex column
-# z = fft(a + i b), whose periodograms sum to (|z_k|^2 + |z_(seg-k)|^2) / 2.
-# The matrix is built and the squared moduli summed in C++
-# (src/evidence.cpp), one pass each, in chunks of columns that bound the
-# memory; the PSD is the R expression in the comments to rounding.
-# `detrend`: take the least-squares line out of x first (a linear trend
-# leaks into the lowest bins). Default `seg`: an eighth of the record, a
-# power of 2, at least 64.
+# in u^2/Hz, in O(n log seg): the segments' squared transforms summed in
+# C++ (welch_sums(), src/evidence.cpp: two real segments per complex
+# transform, one pair in memory at a time). `detrend`: take the
+# least-squares line out of x first (a linear trend leaks into the lowest
+# bins). Default `seg`: an eighth of the record, a power of 2, at least 64.
 welch_psd <- function(x, freq, seg = NULL, detrend = TRUE) {
   n <- length(x)
   if (is.null(seg)) seg <- 2^floor(log2(max(n / 8, 64)))
@@ -28,17 +24,7 @@ welch_psd <- function(x, freq, seg = NULL, detrend = TRUE) {
   win <- 0.5 - 0.5 * cos(2 * pi * (seq_len(seg) - 1) / seg)
   U <- sum(win^2)
   half <- seg %/% 2L + 1L
-  acc <- numeric(half)
-  # an even number of columns per chunk keeps the pairs of segments
-  chunk <- 2L * max(1L, (2^21) %/% seg)
-  for (c0 in seq.int(1L, length(starts), by = chunk)) {
-    st <- starts[c0:min(length(starts), c0 + chunk - 1L)]
-    # X <- matrix(x[outer(seq_len(seg) - 1L, st, `+`)], nrow = seg)
-    # X <- (X - rep(colMeans(X), each = seg)) * win
-    X <- welch_segments(x, st, win)
-    # acc + rowSums(Mod(stats::mvfft(X)[seq_len(half), , drop = FALSE])^2)
-    acc <- welch_accumulate(stats::mvfft(X), half, acc)
-  }
+  acc <- welch_sums(x, starts, win)
   k <- length(starts)
   p <- acc / k / (freq * U)
   p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]

@@ -243,27 +243,15 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// welch_segments
-Rcpp::ComplexMatrix welch_segments(const Rcpp::NumericVector& x, const Rcpp::IntegerVector& starts, const Rcpp::NumericVector& win);
-RcppExport SEXP _allanvar_welch_segments(SEXP xSEXP, SEXP startsSEXP, SEXP winSEXP) {
+// welch_sums
+Rcpp::NumericVector welch_sums(const Rcpp::NumericVector& x, const Rcpp::IntegerVector& starts, const Rcpp::NumericVector& win);
+RcppExport SEXP _allanvar_welch_sums(SEXP xSEXP, SEXP startsSEXP, SEXP winSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
     Rcpp::traits::input_parameter< const Rcpp::IntegerVector& >::type starts(startsSEXP);
     Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type win(winSEXP);
-    rcpp_result_gen = Rcpp::wrap(welch_segments(x, starts, win));
-    return rcpp_result_gen;
-END_RCPP
-}
-// welch_accumulate
-Rcpp::NumericVector welch_accumulate(const Rcpp::ComplexMatrix& z, int half, const Rcpp::NumericVector& acc);
-RcppExport SEXP _allanvar_welch_accumulate(SEXP zSEXP, SEXP halfSEXP, SEXP accSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::ComplexMatrix& >::type z(zSEXP);
-    Rcpp::traits::input_parameter< int >::type half(halfSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type acc(accSEXP);
-    rcpp_result_gen = Rcpp::wrap(welch_accumulate(z, half, acc));
+    rcpp_result_gen = Rcpp::wrap(welch_sums(x, starts, win));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -931,8 +919,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_terms_edf_cpp", (DL_FUNC) &_allanvar_terms_edf_cpp, 4},
     {"_allanvar_acf_sums", (DL_FUNC) &_allanvar_acf_sums, 2},
     {"_allanvar_detrend_line", (DL_FUNC) &_allanvar_detrend_line, 1},
-    {"_allanvar_welch_segments", (DL_FUNC) &_allanvar_welch_segments, 3},
-    {"_allanvar_welch_accumulate", (DL_FUNC) &_allanvar_welch_accumulate, 3},
+    {"_allanvar_welch_sums", (DL_FUNC) &_allanvar_welch_sums, 3},
     {"_allanvar_grid_stats", (DL_FUNC) &_allanvar_grid_stats, 1},
     {"_allanvar_gchisq_weights_cpp", (DL_FUNC) &_allanvar_gchisq_weights_cpp, 4},
     {"_allanvar_gchisq_cdf_cpp", (DL_FUNC) &_allanvar_gchisq_cdf_cpp, 2},

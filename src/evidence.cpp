@@ -3,6 +3,7 @@
 // an FFT of the whole record (O(n L) with L ~ 50 against two transforms of
 // n points) and exact to rounding.
 #include <Rcpp.h>
+#include "fft.h"
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -73,66 +74,53 @@ Rcpp::NumericVector detrend_line(const Rcpp::NumericVector& x) {
   return out;
 }
 
-// Welch periodogram (R/filter-noise.R, welch_psd_lin()) without R's many
-// passes over a seg x k index matrix: the segments x[s .. s + seg - 1]
-// (1-based starts), each minus its mean (a long double sum over seg, as R's
-// colMeans()) and times the window, in one pass. Two real segments go into
-// one complex column, a + i b (Press et al., Numerical Recipes, sec. 12.3,
-// "FFT of two real functions simultaneously"), so that half the transforms
-// are needed; an odd last segment has b = 0.
+// The Welch sums of welch_psd() (R/spectrum.R): over the segments
+// x[s .. s + seg - 1] (1-based starts), each minus its mean (a long double
+// sum over seg, as R's colMeans()) and times the window, the sum of
+// |A_f|^2 for f = 0..seg/2. Two real segments go into one complex
+// transform, z = a + i b (Press et al., Numerical Recipes, sec. 12.3, "FFT
+// of two real functions simultaneously"), by the package's FFT (src/fft.h;
+// `seg` a power of two), and |A_f|^2 + |B_f|^2 = (|Z_f|^2 + |Z_(seg-f)|^2)
+// / 2; an odd last segment has b = 0. One segment pair in memory at a time.
 // [[Rcpp::export(rng = false)]]
-Rcpp::ComplexMatrix welch_segments(const Rcpp::NumericVector& x,
-                                   const Rcpp::IntegerVector& starts,
-                                   const Rcpp::NumericVector& win) {
+Rcpp::NumericVector welch_sums(const Rcpp::NumericVector& x,
+                               const Rcpp::IntegerVector& starts,
+                               const Rcpp::NumericVector& win) {
   const R_xlen_t seg = win.size();
+  if (seg < 2 || (seg & (seg - 1)) != 0) Rcpp::stop("welch_sums: seg must be a power of two");
   const R_xlen_t k = starts.size();
-  const R_xlen_t cols = (k + 1) / 2;
-  Rcpp::ComplexMatrix out(seg, cols);
+  const R_xlen_t h = seg / 2 + 1;
   const double* v = x.begin();
   const double* w = win.begin();
-  Rcomplex* o = out.begin();
-  for (R_xlen_t j = 0; j < k; ++j) {
-    const double* s = v + (static_cast<R_xlen_t>(starts[j]) - 1);
-    long double sum = 0;
-    for (R_xlen_t i = 0; i < seg; ++i) sum += s[i];
-    sum /= static_cast<long double>(seg);
-    const double m = static_cast<double>(sum);
-    Rcomplex* col = o + (j / 2) * seg;
-    if (j % 2 == 0) {
-      for (R_xlen_t i = 0; i < seg; ++i) {
-        col[i].r = (s[i] - m) * w[i];
-        col[i].i = 0.0;
-      }
-    } else {
-      for (R_xlen_t i = 0; i < seg; ++i) col[i].i = (s[i] - m) * w[i];
-    }
-    if ((j & 0xFFF) == 0) Rcpp::checkUserInterrupt();
-  }
-  return out;
-}
-
-// acc + the sum over segments of |A_f|^2 for f = 0..half-1, from the
-// transforms Z = A + i B of the packed pairs: |A_f|^2 + |B_f|^2 =
-// (|Z_f|^2 + |Z_(seg-f)|^2) / 2 for real a, b.
-// [[Rcpp::export(rng = false)]]
-Rcpp::NumericVector welch_accumulate(const Rcpp::ComplexMatrix& z, int half,
-                                     const Rcpp::NumericVector& acc) {
-  const R_xlen_t seg = z.nrow();
-  const R_xlen_t k = z.ncol();
-  const R_xlen_t h = half;
+  const allanvar::FFTPlan plan(static_cast<size_t>(seg));
+  allanvar::cvec z(static_cast<size_t>(seg));
   std::vector<double> rs(h, 0.0);
-  const Rcomplex* p = z.begin();
-  for (R_xlen_t j = 0; j < k; ++j) {
-    const Rcomplex* col = p + j * seg;
-    for (R_xlen_t f = 0; f < h; ++f) {
-      const Rcomplex& a = col[f];
-      const Rcomplex& b = col[f == 0 ? 0 : seg - f];
-      rs[f] += 0.5 * ((a.r * a.r + a.i * a.i) + (b.r * b.r + b.i * b.i));
+  for (R_xlen_t j = 0; j < k; j += 2) {
+    for (int q = 0; q < 2; ++q) {
+      if (j + q >= k) {
+        for (R_xlen_t i = 0; i < seg; ++i) z[i].imag(0.0);
+        break;
+      }
+      const double* s = v + (static_cast<R_xlen_t>(starts[j + q]) - 1);
+      long double sum = 0;
+      for (R_xlen_t i = 0; i < seg; ++i) sum += s[i];
+      sum /= static_cast<long double>(seg);
+      const double m = static_cast<double>(sum);
+      if (q == 0) {
+        for (R_xlen_t i = 0; i < seg; ++i) z[i] = allanvar::cplx((s[i] - m) * w[i], 0.0);
+      } else {
+        for (R_xlen_t i = 0; i < seg; ++i) z[i].imag((s[i] - m) * w[i]);
+      }
     }
+    plan.run(z.data(), false);
+    for (R_xlen_t f = 0; f < h; ++f) {
+      const allanvar::cplx a = z[f];
+      const allanvar::cplx b = z[f == 0 ? 0 : seg - f];
+      rs[f] += 0.5 * (std::norm(a) + std::norm(b));
+    }
+    if ((j & 0xFFE) == 0) Rcpp::checkUserInterrupt();
   }
-  Rcpp::NumericVector out(h);
-  for (R_xlen_t f = 0; f < h; ++f) out[f] = acc[f] + rs[f];
-  return out;
+  return Rcpp::NumericVector(rs.begin(), rs.end());
 }
 
 // Median as R's median() computes it: the middle value, or for an even count

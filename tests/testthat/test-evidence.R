@@ -27,7 +27,7 @@ test_that("a periodogram line is found at f0 with its amplitude and significance
   expect_lte(sum(fa > 0), 1)
 })
 
-test_that("welch_psd()'s C++ segments give the all-R periodogram to rounding", {
+test_that("welch_psd()'s C++ sums give the all-R periodogram to rounding", {
   # The reference: the form welch_psd() had in R (each pair of detrended
   # segments demeaned, windowed and transformed as one complex vector).
   ref <- function(x, freq) {
