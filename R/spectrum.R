@@ -400,7 +400,7 @@ record_periodogram <- function(x, freq) {
 
 # The transforms of a whole record (record_periodogram(), remove_bands())
 # run on it zero-padded to a power of two, two samples per complex point,
-# by the package's FFT (src/real_fft.cpp: 1e6 points in about a tenth of
+# by the package's FFT (src/real_fft.cpp: 1e6 points in about half
 # the time of R's fft(), which is also quadratic in a large prime factor).
 record_fft_size <- function(n) 2^max(2, ceiling(log2(n)))
 
