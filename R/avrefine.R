@@ -101,7 +101,8 @@
 #'   ([av_terms()]); default all of them.
 #' @param max_steps Maximum number of effects to add. A further line of a
 #'   harmonic set already in the model is not counted (at most 10 of
-#'   those): it adds no new source.
+#'   those): it adds no new source; nor is a step that only chooses a
+#'   family's form again.
 #' @param criterion `"BIC"` (default) or `"AIC"`.
 #' @param min_gain Minimum decrease of the criterion for an effect to be
 #'   kept (10 is "very strong" evidence on the BIC scale; adjacent taus of

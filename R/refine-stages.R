@@ -50,7 +50,10 @@ stage_prepare <- function(st) {
 # no new source: it does not spend the `max_steps` budget (at most
 # `max_set_steps` such steps in a call). Once the budget is spent, steps go
 # on with those trials alone, so an axis's own effects cannot starve a set
-# of its harmonics.
+# of its harmonics. A step that only chooses a family's form again adds no
+# effect and spends no budget either (else an order that needed the
+# re-choice, e.g. a first-order low-pass taken first, stops one effect short
+# of an order that did not).
 max_set_steps <- 10L
 
 stage_steps <- function(st) {
@@ -59,9 +62,10 @@ stage_steps <- function(st) {
   if (budget < 1L) return(st)
   step <- 0L
   free <- 0L
+  rechosen <- 0L
   st$only_sets <- FALSE
   repeat {
-    if (step - free >= budget) {
+    if (step - free - rechosen >= budget) {
       if (free >= max_set_steps) break
       st$only_sets <- TRUE
     }
@@ -75,7 +79,10 @@ stage_steps <- function(st) {
     if (st$flow == "stop") break
     # a revisit that has reached the greedy run's terms ends as it did
     if (!is.null(st$until) && identical(sort(st$current$terms), st$until)) break
-    if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
+    # a family chosen again (settle) adds no effect: it spends no budget
+    if (st$flow == "next") {
+      rechosen <- rechosen + 1L
+    } else if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
       free <- free + 1L
     } else if (st$only_sets) {
       break
@@ -358,6 +365,8 @@ step_refit_winner <- function(st) {
     p2 <- instance_params(stats::coef(full), full$layout, best$label)
     ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)
     if (!isFALSE(ev2$support) &&
+        is.null(unconfirmed_marginal(effect, ev2, st$c0 - refine_crit(st, full),
+                                     st$args$min_gain, st$raw)) &&
         is.null(inadmissible(effect, p2, st$current$data$tau, st$args$freq)) &&
         earlier_hold(st, full)) {
       st$best$fit <- full
