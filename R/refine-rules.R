@@ -329,8 +329,8 @@ kind_excess <- function(adev_kinds, kinds, tau) {
 # curve's other end (a line fitted exactly at m = 1 freed the short-tau fit
 # and tipped a 118 s GM over min_gain). On the scale where raw support
 # counts as a gain of `min_gain`, such an effect must show the confirmed
-# one's total, 2 min_gain, from the curve. Effects with no raw-data check
-# (the power-law terms) are judged by the curve as before.
+# one's total, 2 min_gain, from the curve. Curve-only runs, and entries
+# with no raw-data check, are judged by the curve as before.
 unconfirmed_marginal <- function(effect, ev, gain, min_gain, raw) {
   if (is.null(raw) || !is.na(ev$support %||% NA)) return(NULL)
   e <- effect_entry(split_term(effect)$kind, split_term(effect)$variant)
