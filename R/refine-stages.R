@@ -50,10 +50,7 @@ stage_prepare <- function(st) {
 # no new source: it does not spend the `max_steps` budget (at most
 # `max_set_steps` such steps in a call). Once the budget is spent, steps go
 # on with those trials alone, so an axis's own effects cannot starve a set
-# of its harmonics. A step that only chooses a family's form again adds no
-# effect and spends no budget either (else an order that needed the
-# re-choice, e.g. a first-order low-pass taken first, stops one effect short
-# of an order that did not).
+# of its harmonics.
 max_set_steps <- 10L
 
 stage_steps <- function(st) {
@@ -62,10 +59,9 @@ stage_steps <- function(st) {
   if (budget < 1L) return(st)
   step <- 0L
   free <- 0L
-  rechosen <- 0L
   st$only_sets <- FALSE
   repeat {
-    if (step - free - rechosen >= budget) {
+    if (step - free >= budget) {
       if (free >= max_set_steps) break
       st$only_sets <- TRUE
     }
@@ -79,10 +75,7 @@ stage_steps <- function(st) {
     if (st$flow == "stop") break
     # a revisit that has reached the greedy run's terms ends as it did
     if (!is.null(st$until) && identical(sort(st$current$terms), st$until)) break
-    # a family chosen again (settle) adds no effect: it spends no budget
-    if (st$flow == "next") {
-      rechosen <- rechosen + 1L
-    } else if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
+    if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
       free <- free + 1L
     } else if (st$only_sets) {
       break
