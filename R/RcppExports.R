@@ -161,6 +161,14 @@ stamp_repeats <- function(t) {
     .Call(`_allanvar_stamp_repeats`, t)
 }
 
+real_fft_cpp <- function(x, n) {
+    .Call(`_allanvar_real_fft_cpp`, x, n)
+}
+
+real_ifft_cpp <- function(X, n, keep) {
+    .Call(`_allanvar_real_ifft_cpp`, X, n, keep)
+}
+
 resonance_psd_cpp <- function(f, tau0, sigma, fr, tc) {
     .Call(`_allanvar_resonance_psd_cpp`, f, tau0, sigma, fr, tc)
 }

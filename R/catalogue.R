@@ -45,8 +45,10 @@
 #   propose(raw, tau, sig)  candidates read from the raw-data diagnostics
 #                 (each may `pin` parameters the raw data measure better,
 #                 and name `after`: pinned values that must be in the model
-#                 first, the stronger lines of its harmonic set; `local`
-#                 TRUE: searched from its init only, not over the whole range)
+#                 first, the stronger lines of its harmonic set;
+#                 `release` TRUE: the pinned values are a start the curve
+#                 may refine: a pinned trial that passes is refitted with
+#                 them free, searched from there, and the better kept)
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
 #                 the raw series says about a fitted instance

@@ -58,17 +58,20 @@ band_acf <- function(h, tau0, f_lo, f_hi, s) {
 # Fourier frequency).
 sim_band <- function(n, tau0, scale, f_lo, f_hi, s) {
   freq <- 1 / tau0
-  k <- seq_len(n %/% 2L)
-  fk <- k * freq / n
+  # made at a length with factors 2, 3, 5 (R's fft() is quadratic in a
+  # large prime factor) and cut to n: a stretch of a stationary series
+  nf <- stats::nextn(n, c(2L, 3L, 5L))
+  k <- seq_len(nf %/% 2L)
+  fk <- k * freq / nf
   j <- findInterval(fk, band_edges(f_lo, f_hi, length(s)), rightmost.closed = TRUE)
   S1 <- numeric(length(fk))
   inside <- j >= 1L & j <= length(s)
   S1[inside] <- s[j[inside]]
-  sd <- sqrt(scale * S1 * freq / n)
-  c <- complex(n)
+  sd <- sqrt(scale * S1 * freq / nf)
+  c <- complex(nf)
   c[k + 1L] <- complex(real = stats::rnorm(length(k), sd = sd),
                        imaginary = -stats::rnorm(length(k), sd = sd))
-  Re(stats::fft(c, inverse = TRUE))
+  Re(stats::fft(c, inverse = TRUE))[seq_len(n)]
 }
 
 # The band's spectrum measured from the raw series: `b` a row of

@@ -194,13 +194,17 @@ acov_av <- function(m, g, sums = NULL) {
     S <- sums$S
     C <- sums$C
   }
-  vapply(m, function(mm) {
-    if (mm >= K) return(S / mm - 3 * C / mm^2)
+  # beyond the support the smooth form, for all m at once (a search asks
+  # for a hundred m at every value it visits); below it the sums
+  out <- S / m - 3 * C / m^2
+  for (j in which(m < K)) {
+    mm <- m[j]
     i <- seq_len(mm - 1L)
     s <- mm * (g[1L] - gz(mm))
     if (mm > 1L) s <- s + sum(i * (2 * gz(mm - i) - gz(i) - gz(2 * mm - i)))
-    s / mm^2
-  }, 0)
+    out[j] <- s / mm^2
+  }
+  out
 }
 
 # AV(m) of g(k) = A p^|k| (the AR(1) / Gauss-Markov form; p may be

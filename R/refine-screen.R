@@ -32,8 +32,7 @@ screen_trial <- function(st, tr, nl_now) {
   settings$fixed <- relabel_values(settings$fixed, cur$terms, tm, keep_gone = TRUE)
   r <- refit_with(cur, c(tm), tr$effect,
                   tr$init[[1L]], settings, hold = c(hold_now, pin),
-                  good_enough = function(f) crit_s(f) < c0 - min_gain,
-                  local = isTRUE(tr$local))
+                  good_enough = function(f) crit_s(f) < c0 - min_gain)
   st$failures <- record_conditions(st$failures, r$conditions, st$step, tr$effect)
   new <- r$fit
   if (is.null(new)) return(list(st = st, cand = NULL))
@@ -106,6 +105,27 @@ screen_trial <- function(st, tr, nl_now) {
         jd$dup))
     }
     return(list(st = st, cand = NULL))
+  }
+  # Pinned values the entry lets the curve refine (`release`): the
+  # instance that passed is refitted with them and the model's values free
+  # (held, a resonance released beside a filter at its one-term compromise
+  # runs off to a tone), searched from there only, and kept when its
+  # criterion is lower and it still passes (a band's centre read from the
+  # Welch spectrum 0.2% off costs the curve's criterion more than the
+  # raw-data check minds).
+  if (length(pin) && isTRUE(tr$release)) {
+    rel <- refit_with(cur, c(tm), tr$effect, tr$pin[[1L]], settings, local = TRUE)
+    st$failures <- record_conditions(st$failures, rel$conditions, st$step, tr$effect)
+    f <- rel$fit
+    if (!is.null(f) && is.finite(crit(f)) && crit(f) < c1 && max_share(f, lab) >= 0.02) {
+      jr <- judge_instance(st, f, tr$effect, lab, tau)
+      if (is.null(jr$why)) {
+        new <- f
+        c1 <- crit(f)
+        jd <- jr
+        pin <- NULL
+      }
+    }
   }
   why <- unconfirmed_marginal(tr$effect, jd$ev, c0 - c1, min_gain, st$raw)
   if (!is.null(why)) {

@@ -397,21 +397,26 @@ remove_lines <- function(x, freq, f0) {
 # finest the data have. A Blackman-Harris (4-term) taper keeps a line's
 # power in its main lobe (+-4 bins) with side lobes 92 dB down, so however
 # strong a line is, its power does not leak into the bins around it.
-# Zero-padded to a length with factors 2, 3, 5 (R's fft() is slow on large
-# primes); `res` is the record's resolution freq / n, `df` the bin spacing.
+# Zero-padded to a power of two (record_fft_size()); `res` is the record's
+# resolution freq / n, `df` the bin spacing.
 record_periodogram <- function(x, freq) {
   n <- length(x)
   tp <- record_taper(n)
   w <- tp$w
-  np <- stats::nextn(n, c(2L, 3L, 5L))
-  y <- detrend_linear(x) * w
-  X <- stats::fft(c(y, numeric(np - n)))
-  half <- np %/% 2L + 1L
-  p <- Mod(X[seq_len(half)])^2 / (freq * tp$w2)
+  np <- record_fft_size(n)
+  X <- real_fft_cpp(detrend_linear(x) * w, np)
+  half <- length(X)
+  p <- Mod(X)^2 / (freq * tp$w2)
   p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
   list(f = (seq_len(half) - 1) * freq / np, psd = p, df = freq / np,
        res = freq / n, lobe = ceiling(4 * np / n) + 1L)
 }
+
+# The transforms of a whole record (record_periodogram(), remove_bands())
+# run on it zero-padded to a power of two, two samples per complex point,
+# by the package's FFT (src/real_fft.cpp: 1e6 points in about a tenth of
+# the time of R's fft(), which is also quadratic in a large prime factor).
+record_fft_size <- function(n) 2^max(2, ceiling(log2(n)))
 
 # The taper of record_periodogram() for n samples and its sum of squares.
 # Its cosines cost more than the record's FFT, and the loop reads records
@@ -674,27 +679,30 @@ remove_bands <- function(x, freq, bands) {
   n <- length(x)
   m <- mean(x)
   tau0 <- 1 / freq
-  X <- stats::fft(x - m)
-  # bins 1..h hold 0..freq/2; bin j > h is bin n + 2 - j's mirror
-  h <- n %/% 2L + 1L
-  fh <- (seq_len(h) - 1) * freq / n
-  mir <- c(seq_len(h), if (n > h) (n + 2L - (h + 1L):n))
-  fa <- fh[mir]
+  # zero-padded (record_fft_size()); the pad is filtered and dropped.
+  # Bins 0..freq/2: each but DC and Nyquist stands for its mirror too, so
+  # it weighs 2 in the background's mean
+  np <- record_fft_size(n)
+  X <- real_fft_cpp(x - m, np)
+  h <- length(X)
+  fh <- (seq_len(h) - 1) * freq / np
+  wt <- c(1, rep(2, h - 2L), 1)
+  Ph <- 2 * Mod(X)^2 / (n * freq)
   # the bands' gains multiply; each band's background is read on the
   # series with the bands before it taken out
   G <- 1
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
-    M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)[mir]
+    M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)
     w <- max(b$width, b$f_to - b$f_from)
-    d <- abs(fa - b$f_center)
+    d <- abs(fh - b$f_center)
     near <- which(d > 3 * w & d < 6 * w)
     Gn <- if (length(G) > 1L) G[near] else G
-    bg <- mean(2 * Mod(X[near])^2 * Gn^2 / (n * freq) - M[near])
+    bg <- sum(wt[near] * (Ph[near] * Gn^2 - M[near])) / sum(wt[near])
     if (!is.finite(bg) || bg <= 0) next
     G <- G * sqrt(bg / (bg + M))
   }
   if (length(G) == 1L) return(x)
-  Re(stats::fft(X * G, inverse = TRUE)) / n + m
+  real_ifft_cpp(X * G, np, n) / np + m
 }
 

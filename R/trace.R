@@ -52,10 +52,10 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
   }, catalogue()[effect_kinds()])
   out <- list()
   one <- function(effect, from, to, init, signature, score, pin = NULL, after = NULL,
-                  local = FALSE) {
+                  release = FALSE) {
     list(effect = effect, tau_from = from, tau_to = to, init = init,
          signature = signature, score = score, pin = pin, after = after,
-         local = isTRUE(local))
+         release = isTRUE(release))
   }
   for (i in seq_len(nrow(sig))) {
     ctx <- trace_context(sig[i, ], tau, excess)
@@ -77,7 +77,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
         out[[length(out) + 1L]] <- one(
           p$effect %||% e$name, p$tau_from, p$tau_to, p$init,
           paste0(overlapping_signature(sig, p$tau_from, p$tau_to), "; ", p$note),
-          p$score, p$pin, p$after, p$local)
+          p$score, p$pin, p$after, p$release)
       }
     }
   }
@@ -91,7 +91,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
                    tau_to = vapply(out, `[[`, 0, "tau_to"),
                    signature = vapply(out, `[[`, "", "signature"),
                    score = vapply(out, `[[`, 0, "score"),
-                   local = vapply(out, `[[`, NA, "local"),
+                   release = vapply(out, `[[`, NA, "release"),
                    stringsAsFactors = FALSE)
   df$init <- lapply(out, `[[`, "init")
   df$pin <- lapply(out, function(o) o$pin)

@@ -507,6 +507,29 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// real_fft_cpp
+Rcpp::ComplexVector real_fft_cpp(const Rcpp::NumericVector& x, double n);
+RcppExport SEXP _allanvar_real_fft_cpp(SEXP xSEXP, SEXP nSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< double >::type n(nSEXP);
+    rcpp_result_gen = Rcpp::wrap(real_fft_cpp(x, n));
+    return rcpp_result_gen;
+END_RCPP
+}
+// real_ifft_cpp
+Rcpp::NumericVector real_ifft_cpp(const Rcpp::ComplexVector& X, double n, double keep);
+RcppExport SEXP _allanvar_real_ifft_cpp(SEXP XSEXP, SEXP nSEXP, SEXP keepSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::ComplexVector& >::type X(XSEXP);
+    Rcpp::traits::input_parameter< double >::type n(nSEXP);
+    Rcpp::traits::input_parameter< double >::type keep(keepSEXP);
+    rcpp_result_gen = Rcpp::wrap(real_ifft_cpp(X, n, keep));
+    return rcpp_result_gen;
+END_RCPP
+}
 // resonance_psd_cpp
 Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0, double sigma, double fr, double tc);
 RcppExport SEXP _allanvar_resonance_psd_cpp(SEXP fSEXP, SEXP tau0SEXP, SEXP sigmaSEXP, SEXP frSEXP, SEXP tcSEXP) {
@@ -930,6 +953,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_col_block_avar", (DL_FUNC) &_allanvar_col_block_avar, 3},
     {"_allanvar_stamp_steps", (DL_FUNC) &_allanvar_stamp_steps, 1},
     {"_allanvar_stamp_repeats", (DL_FUNC) &_allanvar_stamp_repeats, 1},
+    {"_allanvar_real_fft_cpp", (DL_FUNC) &_allanvar_real_fft_cpp, 2},
+    {"_allanvar_real_ifft_cpp", (DL_FUNC) &_allanvar_real_ifft_cpp, 3},
     {"_allanvar_resonance_psd_cpp", (DL_FUNC) &_allanvar_resonance_psd_cpp, 5},
     {"_allanvar_resonance_av_cpp", (DL_FUNC) &_allanvar_resonance_av_cpp, 5},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},

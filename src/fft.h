@@ -79,6 +79,8 @@ class FFTPlan {
       for (size_t j = 0; j < half; ++j) w_[half - 1 + j] = w[j * step];
     }
   }
+  // e^{-2 pi i j / n} for j < n / 2 (the last stage's twiddles).
+  const cplx* twiddles() const { return w_.data() + (n_ / 2 - 1); }
   // In place, natural order in and out; inverse without the 1/n factor.
   void run(cplx* a, bool inverse) const {
     const size_t n = n_;

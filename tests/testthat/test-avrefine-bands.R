@@ -39,6 +39,16 @@ test_that("remove_bands takes a resonance's excess out and keeps the white noise
   expect_equal(stats::var(y), stats::var(w), tolerance = 0.1)
   # no band: the series is returned unchanged
   expect_identical(remove_bands(w, freq, b[0, ]), w)
+  # a record of prime length (2^17 - 1) is transformed zero-padded: the
+  # same band comes out, the length is kept, and the last samples (beside
+  # the pad) are as white as the rest
+  p <- n - 1L
+  yp <- remove_bands(x[seq_len(p)], freq, b)
+  expect_length(yp, p)
+  expect_equal(nrow(find_bands(yp, freq)), 0L)
+  expect_lt(abs(r1(yp)), 0.03)
+  expect_equal(stats::var(yp[(p - 999L):p]), stats::var(w[(p - 999L):p]), tolerance = 0.15)
+  expect_equal(yp[1:1000], y[1:1000], tolerance = 0.02)
 })
 
 test_that("a filtered sensor with a resonance: the low-pass family, the band's centre, no slow sinusoid", {
@@ -112,18 +122,20 @@ test_that("a weak narrow band (below 2x its background): a resonance at the band
   expect_false(any(abs(cf[grepl("\\.f0$", names(cf))] - 10) < 1))
 })
 
-test_that("a band proposes its resonance pinned, and free from its values only", {
+test_that("a band proposes its resonance pinned, released from its values only", {
   set.seed(12)
   n <- 2^17
   freq <- 100
   x <- stats::rnorm(n) + ar2_resonance(n, 15, 0.3, 0.3, freq)
   fit <- avfit(allan(x, freq), terms = c("N", "K"))
   raw <- refine_diagnostics(x, freq)
+  b <- diag_part(raw, "bands")
+  expect_equal(nrow(b), 1L)
   p <- effect_entry("resonance")$propose(raw, fit$data$tau, NULL)
-  expect_length(p, 2L)
-  expect_true(length(p[[1]]$pin) == 2L && !isTRUE(p[[1]]$local))
-  expect_true(is.null(p[[2]]$pin) && isTRUE(p[[2]]$local))
-  # a local trial is the one search from its start; without `local` the
+  expect_length(p, 1L)
+  expect_identical(p[[1]]$pin, list(fr = b$f_center, tc = b$tc))
+  expect_true(isTRUE(p[[1]]$release))
+  # the release is one search from the pinned values; without `local` the
   # search over the whole range runs first
   log <- new.env()
   log$stages <- character()
@@ -132,11 +144,11 @@ test_that("a band proposes its resonance pinned, and free from its values only",
   on.exit(suppressMessages(untrace("try_refit", where = asNamespace("allanvar"))),
           add = TRUE)
   settings <- refit_settings(fit, list())
-  loc <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[2]]$init,
+  loc <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[1]]$pin,
                     settings, local = TRUE)
   expect_identical(log$stages, "screen from the traced start")
   log$stages <- character()
-  both <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[2]]$init, settings)
+  both <- refit_with(fit, c(fit$terms, "resonance"), "resonance", p[[1]]$pin, settings)
   expect_identical(log$stages[1], "screen")
   # from the band's values the search finds the band
   expect_lt(abs(stats::coef(loc$fit)[["resonance1.fr"]] - 15), 0.3)

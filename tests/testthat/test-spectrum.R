@@ -195,3 +195,26 @@ test_that("at the record's own resolution a line is a line and a band a band", {
   expect_false(is.na(match_line(12.21, l)))
 })
 
+
+test_that("the record's real transforms match R's fft() of the zero-padded series", {
+  set.seed(40)
+  for (len in c(5L, 8L, 1023L, 4096L, 10007L)) {
+    x <- stats::rnorm(len)
+    np <- allanvar:::record_fft_size(len)
+    expect_true(np >= len && log2(np) == round(log2(np)))
+    X <- allanvar:::real_fft_cpp(x, np)
+    ref <- stats::fft(c(x, numeric(np - len)))[seq_len(np / 2 + 1)]
+    expect_lt(max(Mod(X - ref)) / max(Mod(ref)), 1e-13)
+    # the inverse (unnormalised, as fft(inverse = TRUE)) gives the series back
+    y <- allanvar:::real_ifft_cpp(X, np, len) / np
+    expect_lt(max(abs(y - x)), 1e-13)
+    # a gain that is real and even filters as the full complex transform does
+    g <- exp(-seq_len(np / 2 + 1) / (np / 8))
+    full <- c(g, rev(g[2:(np / 2)]))
+    want <- Re(stats::fft(stats::fft(c(x, numeric(np - len))) * full, inverse = TRUE))[seq_len(len)]
+    expect_lt(max(abs(allanvar:::real_ifft_cpp(X * g, np, len) - want)), 1e-10 * np)
+  }
+  expect_error(allanvar:::real_fft_cpp(1:10 + 0, 12), "bad transform size")
+  expect_error(allanvar:::real_fft_cpp(1:10 + 0, 8), "bad transform size")
+  expect_error(allanvar:::real_ifft_cpp(complex(5), 8, 9), "bad transform size")
+})
