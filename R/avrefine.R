@@ -39,6 +39,11 @@
 #'   the band the curve can see, \eqn{1/\tau_{max}} to
 #'   \eqn{1/(2\tau_{min})}, or above Nyquist). Both are listed in
 #'   `$refine$rejected`.
+#' * An effect whose raw-data check neither confirms nor contradicts it (a
+#'   Gauss-Markov whose fitted \eqn{T_c} is 2-3 times the one the ACF of
+#'   block means reads) must lower the criterion by `2 * min_gain` on the
+#'   curve alone: a marginal gain there moves with whatever reshapes the
+#'   rest of the curve (listed in `$refine$rejected` otherwise).
 #' * An effect may replace a term (the catalogue's `replaces`): the filter
 #'   term replaces `N`, whose value it carries as its DC level.
 #' * A sinusoid proposed by a periodogram line keeps the line's frequency

@@ -322,3 +322,19 @@ kind_excess <- function(adev_kinds, kinds, tau) {
   }
   out
 }
+
+# An effect whose raw-data check could have confirmed it and did not (an
+# exponential ACF found, but at a Tc 2-3x from the fitted one) rests on the
+# curve alone; a marginal gain there moves with anything that reshapes the
+# curve's other end (a line fitted exactly at m = 1 freed the short-tau fit
+# and tipped a 118 s GM over min_gain). On the scale where raw support
+# counts as a gain of `min_gain`, such an effect must show the confirmed
+# one's total, 2 min_gain, from the curve. Curve-only runs, and entries
+# with no raw-data check, are judged by the curve as before.
+unconfirmed_marginal <- function(effect, ev, gain, min_gain, raw) {
+  if (is.null(raw) || !is.na(ev$support %||% NA)) return(NULL)
+  e <- effect_entry(split_term(effect)$kind, split_term(effect)$variant)
+  if (is.null(e$evidence) || gain >= 2 * min_gain) return(NULL)
+  sprintf(paste("the raw data do not confirm it (%s) and the curve alone gains",
+                "%s, less than 2 min_gain"), ev$text, format_num(gain))
+}

@@ -127,6 +127,11 @@ screen_trial <- function(st, tr, nl_now) {
       }
     }
   }
+  why <- unconfirmed_marginal(tr$effect, jd$ev, c0 - c1, min_gain, st$raw)
+  if (!is.null(why)) {
+    st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, why)
+    return(list(st = st, cand = NULL))
+  }
   # raw-data support counts as a gain of min_gain
   adj <- c1 - min_gain * isTRUE(jd$ev$support)
   list(st = st, cand = list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,

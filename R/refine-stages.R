@@ -358,6 +358,8 @@ step_refit_winner <- function(st) {
     p2 <- instance_params(stats::coef(full), full$layout, best$label)
     ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)
     if (!isFALSE(ev2$support) &&
+        is.null(unconfirmed_marginal(effect, ev2, st$c0 - refine_crit(st, full),
+                                     st$args$min_gain, st$raw)) &&
         is.null(inadmissible(effect, p2, st$current$data$tau, st$args$freq)) &&
         earlier_hold(st, full)) {
       st$best$fit <- full

@@ -184,3 +184,23 @@ test_that("remove is validated", {
   expect_error(avrefine(fit, remove = 1), class = "allanvar_error_argument")
   expect_error(avrefine(fit, remove = "steps"), class = "allanvar_error_argument")
 })
+
+test_that("an effect the raw data leave undecided must gain 2 min_gain on the curve", {
+  set.seed(2727)
+  freq <- 10
+  n <- 2e5
+  x <- gen_white(n, freq, 0.01) + gen_gm(n, freq, 0.02, 50)
+  raw <- refine_diagnostics(x, freq)
+  # a GM fitted at 2.5x the Tc the block-mean ACF reads: neither confirmed
+  # nor contradicted
+  ev <- raw_evidence("gm", list(sigma = 0.02, tc = 125), raw, diag_series(raw), freq)
+  expect_true(is.na(ev$support))
+  expect_match(unconfirmed_marginal("gm", ev, 15, 10, raw), "do not confirm")
+  expect_null(unconfirmed_marginal("gm", ev, 25, 10, raw))
+  # at the Tc the ACF reads it is confirmed: min_gain is enough
+  ev_ok <- raw_evidence("gm", list(sigma = 0.02, tc = 50), raw, diag_series(raw), freq)
+  expect_true(isTRUE(ev_ok$support))
+  expect_null(unconfirmed_marginal("gm", ev_ok, 12, 10, raw))
+  # a curve-only run has no raw data to ask: min_gain as before
+  expect_null(unconfirmed_marginal("gm", ev, 15, 10, NULL))
+})
