@@ -57,9 +57,10 @@ robust_d_scale <- function(d) {
 #' slow wander shrinks in proportion to the window, ratios 1/2 and 1/4, and
 #' is not a step; its location is set aside and the search goes on). The time is refined to the sample by the split
 #' maximising the difference of means over the window, the size is the
-#' difference of the means over the window on each side at the scale where
-#' the Allan variance is least (the most precise window the noise allows,
-#' kept within the neighbouring steps). The step is then removed and the
+#' difference of the means over the detecting window on each side (kept
+#' within the neighbouring steps; for a step that is where the Allan
+#' variance is least, and it does not move when an added continuous effect
+#' reshapes the Allan variance elsewhere). The step is then removed and the
 #' search repeated (binary segmentation).
 #'
 #' Two steps of opposite sign and similar size (ratio 1/3 to 3) less than
@@ -96,7 +97,6 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   cy <- c(0, cumsum(y))
   scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w, cy)), 0)
   v <- scale^2 / 2
-  wbest <- ws[which.min(v)] * b
   idx <- integer(0)
   zs <- numeric(0)
   sizes <- numeric(0)
@@ -104,14 +104,19 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   excluded <- logical(nb)
   rejected <- 0L
   # Each step found is removed by its local size (the difference of the
-  # means over the least-noisy window on each side), not by segment means:
+  # means over its detecting window on each side), not by segment means:
   # under red noise a segment's mean is far from the level next to the step.
+  # The detecting window, not the record's least-noisy one: for a step they
+  # agree (its z is largest where the Allan variance is least), but the
+  # least-noisy window moves when a continuous effect (a Gauss-Markov
+  # term) reshapes the Allan variance, and a short excursion read over a
+  # longer window is no longer the feature that was detected.
   # (lv: the steps' levels, step_levels(); only the 2 W samples read)
-  local_size <- function(lv, at, others) {
+  local_size <- function(lv, at, others, Wd) {
     bounds <- sort(c(1L, others, n + 1L))
     left <- max(bounds[bounds <= at - 1L])
     right <- min(bounds[bounds > at])
-    W <- max(1L, min(wbest, at - left, right - at))
+    W <- max(1L, min(Wd, at - left, right - at))
     xw <- steps_window(x, lv, at - W, at + W - 1L)
     c(size = mean(xw[W + seq_len(W)]) - mean(xw[seq_len(W)]), W = W)
   }
@@ -173,7 +178,7 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
       excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
       next
     }
-    sz <- local_size(lv, at, idx)
+    sz <- local_size(lv, at, idx, W)
     idx <- c(idx, at)
     zs <- c(zs, best$z)
     sizes <- c(sizes, sz[["size"]])
@@ -187,10 +192,11 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   idx <- idx[o]
   zs <- zs[o]
   sizes <- sizes[o]
+  wins <- wins[o]
   # final sizes, each with the other steps removed
   rows <- lapply(seq_along(idx), function(k) {
     lv <- step_levels(data.frame(index = idx[-k], size = sizes[-k]), n)
-    sz <- local_size(lv, idx[k], idx[-k])
+    sz <- local_size(lv, idx[k], idx[-k], wins[k])
     W <- sz[["W"]]
     # standard error: sqrt(2 AV) at the window used (interpolated in log)
     se <- sqrt(2 * exp(stats::approx(log(ws * b), log(v), log(W), rule = 2)$y))
@@ -212,37 +218,75 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     out <- rbind(out, ret)
     out <- out[order(out$index), , drop = FALSE]
   }
-  # opposite-sign pairs close together are transients
+  # Opposite-sign pairs close together are transients: first the pairs of
+  # two steps each found at the record-wide threshold, then a step no such
+  # pair took with a weak return (else a weak return beside a pulse takes
+  # one of its steps and leaves the other a lone step).
   pulse <- rep(FALSE, nrow(out))
   prow <- list()
-  k <- 1L
-  while (k < nrow(out)) {
-    a <- out[k, ]
-    c2 <- out[k + 1L, ]
-    ratio <- abs(c2$size / a$size)
-    # a weak partner found only near a strong step must bring the level
-    # back: the two sizes cancel within their errors (else a noise dip
-    # before a real step would turn the step into a transient)
-    cancels <- !(a$extra || c2$extra) ||
-      abs(a$size + c2$size) <= 3 * sqrt(a$se^2 + c2$se^2)
-    if (sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
-        !(a$extra && c2$extra) && cancels &&
-        ratio > 1 / 3 && ratio < 3) {
-      pulse[c(k, k + 1L)] <- TRUE
-      prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,
-                                              size = a$size)
-      k <- k + 2L
-    } else {
-      k <- k + 1L
+  for (weak in c(FALSE, TRUE)) {
+    free <- which(!pulse)
+    k <- 1L
+    while (k < length(free)) {
+      ia <- free[k]
+      ic <- free[k + 1L]
+      a <- out[ia, ]
+      c2 <- out[ic, ]
+      ratio <- abs(c2$size / a$size)
+      both <- !(a$extra || c2$extra)
+      ok <- sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
+        ratio > 1 / 3 && ratio < 3 && (both || (weak && !(a$extra && c2$extra)))
+      # a weak partner must bring the level back (else a noise dip before
+      # a real step would turn the step into a transient)
+      if (ok && !both) ok <- pulse_returns(x, out[-c(ia, ic), c("index", "size"), drop = FALSE],
+                                           a, c2, tau0)
+      if (ok) {
+        pulse[c(ia, ic)] <- TRUE
+        prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,
+                                                size = a$size)
+        k <- k + 2L
+      } else {
+        k <- k + 1L
+      }
     }
+  }
+  if (length(prow)) {
+    prow <- do.call(rbind, prow)
+    prow <- prow[order(prow$start), , drop = FALSE]
+    rownames(prow) <- NULL
   }
   # a return found below the record-wide threshold counts only as the end
   # of a transient
   steps <- out[!pulse & !out$extra, setdiff(names(out), "extra"), drop = FALSE]
   rownames(steps) <- NULL
-  attr(steps, "pulses") <- if (length(prow)) do.call(rbind, prow) else attr(empty, "pulses")
+  attr(steps, "pulses") <- if (length(prow)) prow else attr(empty, "pulses")
   attr(steps, "rejected") <- rejected
   steps
+}
+
+# Does the level come back across a pulse from step `a` to step `c2` (rows
+# of detect_steps()' table)? The level after the return less the level
+# before the onset (means over the shorter of their windows, the `others`
+# steps removed) against the same difference at that gap everywhere in
+# the record (robust scale: a few pulses do not move it). Across a gap the
+# difference carries the wander the series has at that lag (a random walk,
+# a Gauss-Markov term), which the steps' own errors (adjacent windows) do
+# not: the return of a pulse in such noise was refused as not cancelling.
+pulse_returns <- function(x, others, a, c2, tau0) {
+  n <- length(x)
+  i0 <- a$index
+  i1 <- c2$index
+  G <- i1 - i0
+  W <- as.integer(round(min(a$window, c2$window) / tau0))
+  W <- max(1L, min(W, i0 - 1L, n - i1 + 1L))
+  if (G < 1L || i0 - W < 1L || i1 + W - 1L > n) return(FALSE)
+  xs <- if (nrow(others)) remove_steps(x, others) else x
+  cs <- c(0, cumsum(xs))
+  net <- (cs[i1 + W] - cs[i1]) / W - (cs[i0] - cs[i0 - W]) / W
+  i <- seq.int(W + 1L, n - G - W + 1L)
+  if (length(i) < 64L) return(FALSE)
+  sc <- robust_d_scale((cs[i + G + W] - cs[i + G]) / W - (cs[i] - cs[i - W]) / W)
+  is.finite(sc) && abs(net) <= 3 * sc
 }
 
 # detect_steps() of a series within one series pass (detect_series()
