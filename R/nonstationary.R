@@ -57,10 +57,12 @@ robust_d_scale <- function(d) {
 #' slow wander shrinks in proportion to the window, ratios 1/2 and 1/4, and
 #' is not a step; its location is set aside and the search goes on). The time is refined to the sample by the split
 #' maximising the difference of means over the window, the size is the
-#' difference of the means over the detecting window on each side (kept
-#' within the neighbouring steps; for a step that is where the Allan
-#' variance is least, and it does not move when an added continuous effect
-#' reshapes the Allan variance elsewhere). The step is then removed and the
+#' difference of the means over the window on each side at the scale where
+#' the Allan variance is least (the most precise window the noise allows,
+#' kept within the neighbouring steps) when the level over it keeps the
+#' size read over the detecting window (within 2 combined standard errors),
+#' else over the detecting window (a short excursion is read at its own
+#' scale, which an added continuous effect does not move). The step is then removed and the
 #' search repeated (binary segmentation).
 #'
 #' Two steps of opposite sign and similar size (ratio 1/3 to 3) less than
@@ -97,6 +99,10 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   cy <- c(0, cumsum(y))
   scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w, cy)), 0)
   v <- scale^2 / 2
+  wbest <- ws[which.min(v)] * b
+  # standard error of a difference of means over W samples on each side:
+  # sqrt(2 AV) at W (interpolated in log)
+  se_at <- function(W) sqrt(2 * exp(stats::approx(log(ws * b), log(v), log(W), rule = 2)$y))
   idx <- integer(0)
   zs <- numeric(0)
   sizes <- numeric(0)
@@ -104,21 +110,32 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   excluded <- logical(nb)
   rejected <- 0L
   # Each step found is removed by its local size (the difference of the
-  # means over its detecting window on each side), not by segment means:
-  # under red noise a segment's mean is far from the level next to the step.
-  # The detecting window, not the record's least-noisy one: for a step they
-  # agree (its z is largest where the Allan variance is least), but the
-  # least-noisy window moves when a continuous effect (a Gauss-Markov
-  # term) reshapes the Allan variance, and a short excursion read over a
-  # longer window is no longer the feature that was detected.
+  # means over a window on each side), not by segment means: under red
+  # noise a segment's mean is far from the level next to the step. The
+  # window is the least-noisy one (the most precise read), kept within the
+  # neighbouring steps, when the level over it keeps the size read over the
+  # detecting window (the two reads agree within 2 combined standard
+  # errors); else the detecting one. A short excursion read over a longer
+  # window is no longer the feature that was detected (on the measured
+  # accelerometers excursions of 5-15 s read as steps of 1 standard error),
+  # and the least-noisy window moves when an added continuous effect (a
+  # Gauss-Markov term) reshapes the Allan variance: the read must not.
   # (lv: the steps' levels, step_levels(); only the 2 W samples read)
   local_size <- function(lv, at, others, Wd) {
     bounds <- sort(c(1L, others, n + 1L))
     left <- max(bounds[bounds <= at - 1L])
     right <- min(bounds[bounds > at])
-    W <- max(1L, min(Wd, at - left, right - at))
-    xw <- steps_window(x, lv, at - W, at + W - 1L)
-    c(size = mean(xw[W + seq_len(W)]) - mean(xw[seq_len(W)]), W = W)
+    read <- function(Wc) {
+      W <- max(1L, min(Wc, at - left, right - at))
+      xw <- steps_window(x, lv, at - W, at + W - 1L)
+      c(size = mean(xw[W + seq_len(W)]) - mean(xw[seq_len(W)]), W = W)
+    }
+    sd <- read(Wd)
+    sb <- read(wbest)
+    if (sb[["W"]] == sd[["W"]]) return(sb)
+    agree <- abs(sb[["size"]] - sd[["size"]]) <=
+      2 * sqrt(se_at(sb[["W"]])^2 + se_at(sd[["W"]])^2)
+    if (isTRUE(agree)) sb else sd
   }
   done <- -1L
   for (k in seq_len(max_steps + 20L)) {
@@ -198,8 +215,8 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     lv <- step_levels(data.frame(index = idx[-k], size = sizes[-k]), n)
     sz <- local_size(lv, idx[k], idx[-k], wins[k])
     W <- sz[["W"]]
-    # standard error: sqrt(2 AV) at the window used (interpolated in log)
-    se <- sqrt(2 * exp(stats::approx(log(ws * b), log(v), log(W), rule = 2)$y))
+    # standard error: sqrt(2 AV) at the window used
+    se <- se_at(W)
     data.frame(index = idx[k], time = (idx[k] - 1) * tau0, size = sz[["size"]],
                se = se, z = zs[k], window = W * tau0)
   })
@@ -225,7 +242,9 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   pulse <- rep(FALSE, nrow(out))
   prow <- list()
   for (weak in c(FALSE, TRUE)) {
-    free <- which(!pulse)
+    # (the first round sees the supported steps only: a weak return found
+    # between them must not keep them apart)
+    free <- which(!pulse & (weak | !out$extra))
     k <- 1L
     while (k < length(free)) {
       ia <- free[k]
@@ -267,8 +286,11 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
 # Does the level come back across a pulse from step `a` to step `c2` (rows
 # of detect_steps()' table)? The level after the return less the level
 # before the onset (means over the shorter of their windows, the `others`
-# steps removed) against the same difference at that gap everywhere in
-# the record (robust scale: a few pulses do not move it). Across a gap the
+# steps removed) must be within 3 of the same difference's standard
+# deviations at that gap everywhere in the record (robust scale: a few
+# pulses do not move it), and nearer the level before than the level
+# during the pulse (half the pulse's size, the mean of its two steps'):
+# else the level mostly stays and the first is a step. Across a gap the
 # difference carries the wander the series has at that lag (a random walk,
 # a Gauss-Markov term), which the steps' own errors (adjacent windows) do
 # not: the return of a pulse in such noise was refused as not cancelling.
@@ -286,7 +308,7 @@ pulse_returns <- function(x, others, a, c2, tau0) {
   i <- seq.int(W + 1L, n - G - W + 1L)
   if (length(i) < 64L) return(FALSE)
   sc <- robust_d_scale((cs[i + G + W] - cs[i + G]) / W - (cs[i] - cs[i - W]) / W)
-  is.finite(sc) && abs(net) <= 3 * sc
+  is.finite(sc) && abs(net) <= 3 * sc && abs(net) <= abs(a$size - c2$size) / 4
 }
 
 # detect_steps() of a series within one series pass (detect_series()
