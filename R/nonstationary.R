@@ -241,6 +241,7 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   # one of its steps and leaves the other a lone step).
   pulse <- rep(FALSE, nrow(out))
   prow <- list()
+  cs_all <- NULL
   for (weak in c(FALSE, TRUE)) {
     # (the first round sees the supported steps only: a weak return found
     # between them must not keep them apart)
@@ -257,8 +258,11 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
         ratio > 1 / 3 && ratio < 3 && (both || (weak && !(a$extra && c2$extra)))
       # a weak partner must bring the level back (else a noise dip before
       # a real step would turn the step into a transient)
-      if (ok && !both) ok <- pulse_returns(x, out[-c(ia, ic), c("index", "size"), drop = FALSE],
-                                           a, c2, tau0)
+      if (ok && !both) {
+        # c(0, cumsum()) of the series with every step found removed, once
+        if (is.null(cs_all)) cs_all <- c(0, cumsum(remove_steps(x, out[c("index", "size")])))
+        ok <- pulse_returns(cs_all, a, c2, tau0)
+      }
       if (ok) {
         pulse[c(ia, ic)] <- TRUE
         prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,
@@ -294,18 +298,20 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
 # difference carries the wander the series has at that lag (a random walk,
 # a Gauss-Markov term), which the steps' own errors (adjacent windows) do
 # not: the return of a pulse in such noise was refused as not cancelling.
-pulse_returns <- function(x, others, a, c2, tau0) {
-  n <- length(x)
+pulse_returns <- function(cs, a, c2, tau0) {
+  n <- length(cs) - 1L
   i0 <- a$index
   i1 <- c2$index
   G <- i1 - i0
   W <- as.integer(round(min(a$window, c2$window) / tau0))
   W <- max(1L, min(W, i0 - 1L, n - i1 + 1L))
   if (G < 1L || i0 - W < 1L || i1 + W - 1L > n) return(FALSE)
-  xs <- if (nrow(others)) remove_steps(x, others) else x
-  cs <- c(0, cumsum(xs))
-  net <- (cs[i1 + W] - cs[i1]) / W - (cs[i0] - cs[i0 - W]) / W
-  i <- seq.int(W + 1L, n - G - W + 1L)
+  # `cs` has every step removed, these two too: their sizes added back
+  # (removal is linear in the levels; the others stay removed)
+  net <- (cs[i1 + W] - cs[i1]) / W - (cs[i0] - cs[i0 - W]) / W + a$size + c2$size
+  # the record's difference at that gap, every W / 8 samples (neighbours
+  # closer than that share most of their samples)
+  i <- seq.int(W + 1L, n - G - W + 1L, by = max(1L, W %/% 8L))
   if (length(i) < 64L) return(FALSE)
   sc <- robust_d_scale((cs[i + G + W] - cs[i + G]) / W - (cs[i] - cs[i - W]) / W)
   is.finite(sc) && abs(net) <= 3 * sc && abs(net) <= abs(a$size - c2$size) / 4
