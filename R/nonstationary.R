@@ -62,13 +62,16 @@ robust_d_scale <- function(d) {
 #' kept within the neighbouring steps) when the level over it keeps the
 #' size read over the detecting window (within 2 combined standard errors),
 #' else over the detecting window (a short excursion is read at its own
-#' scale, which an added continuous effect does not move). The step is then removed and the
-#' search repeated (binary segmentation).
+#' scale, which an added continuous effect does not move). The step is
+#' then removed and the search repeated (binary segmentation).
 #'
 #' Two steps of opposite sign and similar size (ratio 1/3 to 3) less than
 #' `pulse_gap` seconds apart are a transient (a pulse or a shock that
 #' decays), not two bias steps: they are returned in attribute `pulses`
-#' (start, end, size) and left out of the steps.
+#' (start, end, size) and left out of the steps. Pairs of two steps found at
+#' the record-wide threshold are formed first; a step is then paired with
+#' a weaker return (step_return()) only when the level comes back
+#' (pulse_returns()).
 #' @return data.frame `index` (first sample after the step), `time` (s from
 #'   the first sample), `size` (rate unit), `se` (its standard error from
 #'   the Allan variance at the window used), `z` (detection statistic),
