@@ -59,13 +59,19 @@ robust_d_scale <- function(d) {
 #' maximising the difference of means over the window, the size is the
 #' difference of the means over the window on each side at the scale where
 #' the Allan variance is least (the most precise window the noise allows,
-#' kept within the neighbouring steps). The step is then removed and the
-#' search repeated (binary segmentation).
+#' kept within the neighbouring steps) when the level over it keeps the
+#' size read over the detecting window (within 2 combined standard errors),
+#' else over the detecting window (a short excursion is read at its own
+#' scale, which an added continuous effect does not move). The step is
+#' then removed and the search repeated (binary segmentation).
 #'
 #' Two steps of opposite sign and similar size (ratio 1/3 to 3) less than
 #' `pulse_gap` seconds apart are a transient (a pulse or a shock that
 #' decays), not two bias steps: they are returned in attribute `pulses`
-#' (start, end, size) and left out of the steps.
+#' (start, end, size) and left out of the steps. Pairs of two steps found at
+#' the record-wide threshold are formed first; a step is then paired with
+#' a weaker return (step_return()) only when the level comes back
+#' (pulse_returns()).
 #' @return data.frame `index` (first sample after the step), `time` (s from
 #'   the first sample), `size` (rate unit), `se` (its standard error from
 #'   the Allan variance at the window used), `z` (detection statistic),
@@ -97,6 +103,9 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   scale <- vapply(ws, function(w) robust_d_scale(allan_differences(y, w, cy)), 0)
   v <- scale^2 / 2
   wbest <- ws[which.min(v)] * b
+  # standard error of a difference of means over W samples on each side:
+  # sqrt(2 AV) at W (interpolated in log)
+  se_at <- function(W) sqrt(2 * exp(stats::approx(log(ws * b), log(v), log(W), rule = 2)$y))
   idx <- integer(0)
   zs <- numeric(0)
   sizes <- numeric(0)
@@ -104,16 +113,32 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   excluded <- logical(nb)
   rejected <- 0L
   # Each step found is removed by its local size (the difference of the
-  # means over the least-noisy window on each side), not by segment means:
-  # under red noise a segment's mean is far from the level next to the step.
+  # means over a window on each side), not by segment means: under red
+  # noise a segment's mean is far from the level next to the step. The
+  # window is the least-noisy one (the most precise read), kept within the
+  # neighbouring steps, when the level over it keeps the size read over the
+  # detecting window (the two reads agree within 2 combined standard
+  # errors); else the detecting one. A short excursion read over a longer
+  # window is no longer the feature that was detected (on the measured
+  # accelerometers excursions of 5-15 s read as steps of 1 standard error),
+  # and the least-noisy window moves when an added continuous effect (a
+  # Gauss-Markov term) reshapes the Allan variance: the read must not.
   # (lv: the steps' levels, step_levels(); only the 2 W samples read)
-  local_size <- function(lv, at, others) {
+  local_size <- function(lv, at, others, Wd) {
     bounds <- sort(c(1L, others, n + 1L))
     left <- max(bounds[bounds <= at - 1L])
     right <- min(bounds[bounds > at])
-    W <- max(1L, min(wbest, at - left, right - at))
-    xw <- steps_window(x, lv, at - W, at + W - 1L)
-    c(size = mean(xw[W + seq_len(W)]) - mean(xw[seq_len(W)]), W = W)
+    read <- function(Wc) {
+      W <- max(1L, min(Wc, at - left, right - at))
+      xw <- steps_window(x, lv, at - W, at + W - 1L)
+      c(size = mean(xw[W + seq_len(W)]) - mean(xw[seq_len(W)]), W = W)
+    }
+    sd <- read(Wd)
+    sb <- read(wbest)
+    if (sb[["W"]] == sd[["W"]]) return(sb)
+    agree <- abs(sb[["size"]] - sd[["size"]]) <=
+      2 * sqrt(se_at(sb[["W"]])^2 + se_at(sd[["W"]])^2)
+    if (isTRUE(agree)) sb else sd
   }
   done <- -1L
   for (k in seq_len(max_steps + 20L)) {
@@ -173,7 +198,7 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
       excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
       next
     }
-    sz <- local_size(lv, at, idx)
+    sz <- local_size(lv, at, idx, W)
     idx <- c(idx, at)
     zs <- c(zs, best$z)
     sizes <- c(sizes, sz[["size"]])
@@ -187,13 +212,14 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   idx <- idx[o]
   zs <- zs[o]
   sizes <- sizes[o]
+  wins <- wins[o]
   # final sizes, each with the other steps removed
   rows <- lapply(seq_along(idx), function(k) {
     lv <- step_levels(data.frame(index = idx[-k], size = sizes[-k]), n)
-    sz <- local_size(lv, idx[k], idx[-k])
+    sz <- local_size(lv, idx[k], idx[-k], wins[k])
     W <- sz[["W"]]
-    # standard error: sqrt(2 AV) at the window used (interpolated in log)
-    se <- sqrt(2 * exp(stats::approx(log(ws * b), log(v), log(W), rule = 2)$y))
+    # standard error: sqrt(2 AV) at the window used
+    se <- se_at(W)
     data.frame(index = idx[k], time = (idx[k] - 1) * tau0, size = sz[["size"]],
                se = se, z = zs[k], window = W * tau0)
   })
@@ -212,37 +238,86 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     out <- rbind(out, ret)
     out <- out[order(out$index), , drop = FALSE]
   }
-  # opposite-sign pairs close together are transients
+  # Opposite-sign pairs close together are transients: first the pairs of
+  # two steps each found at the record-wide threshold, then a step no such
+  # pair took with a weak return (else a weak return beside a pulse takes
+  # one of its steps and leaves the other a lone step).
   pulse <- rep(FALSE, nrow(out))
   prow <- list()
-  k <- 1L
-  while (k < nrow(out)) {
-    a <- out[k, ]
-    c2 <- out[k + 1L, ]
-    ratio <- abs(c2$size / a$size)
-    # a weak partner found only near a strong step must bring the level
-    # back: the two sizes cancel within their errors (else a noise dip
-    # before a real step would turn the step into a transient)
-    cancels <- !(a$extra || c2$extra) ||
-      abs(a$size + c2$size) <= 3 * sqrt(a$se^2 + c2$se^2)
-    if (sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
-        !(a$extra && c2$extra) && cancels &&
-        ratio > 1 / 3 && ratio < 3) {
-      pulse[c(k, k + 1L)] <- TRUE
-      prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,
-                                              size = a$size)
-      k <- k + 2L
-    } else {
-      k <- k + 1L
+  cs_all <- NULL
+  for (weak in c(FALSE, TRUE)) {
+    # (the first round sees the supported steps only: a weak return found
+    # between them must not keep them apart)
+    free <- which(!pulse & (weak | !out$extra))
+    k <- 1L
+    while (k < length(free)) {
+      ia <- free[k]
+      ic <- free[k + 1L]
+      a <- out[ia, ]
+      c2 <- out[ic, ]
+      ratio <- abs(c2$size / a$size)
+      both <- !(a$extra || c2$extra)
+      ok <- sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
+        ratio > 1 / 3 && ratio < 3 && (both || (weak && !(a$extra && c2$extra)))
+      # a weak partner must bring the level back (else a noise dip before
+      # a real step would turn the step into a transient)
+      if (ok && !both) {
+        # c(0, cumsum()) of the series with every step found removed, once
+        if (is.null(cs_all)) cs_all <- c(0, cumsum(remove_steps(x, out[c("index", "size")])))
+        ok <- pulse_returns(cs_all, a, c2, tau0)
+      }
+      if (ok) {
+        pulse[c(ia, ic)] <- TRUE
+        prow[[length(prow) + 1L]] <- data.frame(start = a$time, end = c2$time,
+                                                size = a$size)
+        k <- k + 2L
+      } else {
+        k <- k + 1L
+      }
     }
+  }
+  if (length(prow)) {
+    prow <- do.call(rbind, prow)
+    prow <- prow[order(prow$start), , drop = FALSE]
+    rownames(prow) <- NULL
   }
   # a return found below the record-wide threshold counts only as the end
   # of a transient
   steps <- out[!pulse & !out$extra, setdiff(names(out), "extra"), drop = FALSE]
   rownames(steps) <- NULL
-  attr(steps, "pulses") <- if (length(prow)) do.call(rbind, prow) else attr(empty, "pulses")
+  attr(steps, "pulses") <- if (length(prow)) prow else attr(empty, "pulses")
   attr(steps, "rejected") <- rejected
   steps
+}
+
+# Does the level come back across a pulse from step `a` to step `c2` (rows
+# of detect_steps()' table)? The level after the return less the level
+# before the onset (means over the shorter of their windows, the `others`
+# steps removed) must be within 3 of the same difference's standard
+# deviations at that gap everywhere in the record (robust scale: a few
+# pulses do not move it), and nearer the level before than the level
+# during the pulse (half the pulse's size, the mean of its two steps'):
+# else the level mostly stays and the first is a step. Across a gap the
+# difference carries the wander the series has at that lag (a random walk,
+# a Gauss-Markov term), which the steps' own errors (adjacent windows) do
+# not: the return of a pulse in such noise was refused as not cancelling.
+pulse_returns <- function(cs, a, c2, tau0) {
+  n <- length(cs) - 1L
+  i0 <- a$index
+  i1 <- c2$index
+  G <- i1 - i0
+  W <- as.integer(round(min(a$window, c2$window) / tau0))
+  W <- max(1L, min(W, i0 - 1L, n - i1 + 1L))
+  if (G < 1L || i0 - W < 1L || i1 + W - 1L > n) return(FALSE)
+  # `cs` has every step removed, these two too: their sizes added back
+  # (removal is linear in the levels; the others stay removed)
+  net <- (cs[i1 + W] - cs[i1]) / W - (cs[i0] - cs[i0 - W]) / W + a$size + c2$size
+  # the record's difference at that gap, every W / 8 samples (neighbours
+  # closer than that share most of their samples)
+  i <- seq.int(W + 1L, n - G - W + 1L, by = max(1L, W %/% 8L))
+  if (length(i) < 64L) return(FALSE)
+  sc <- robust_d_scale((cs[i + G + W] - cs[i + G]) / W - (cs[i] - cs[i - W]) / W)
+  is.finite(sc) && abs(net) <= 3 * sc && abs(net) <= abs(a$size - c2$size) / 4
 }
 
 # detect_steps() of a series within one series pass (detect_series()
