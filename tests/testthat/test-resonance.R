@@ -141,6 +141,15 @@ test_that("the raw data support a resonance where a band is, and contradict one 
   expect_true(resonance_raw_support(0.8, 20, 0.08, b)$support)
   expect_false(resonance_raw_support(0.8, 7, 0.08, b)$support)
   expect_false(resonance_raw_support(0.8, 20, 0.08, find_bands(rnorm(n), 100))$support)
+  # the curve's power against the band's measured one: within a factor 2
+  # it is the band; at 2.5x either way it stands for something else
+  p <- b$power[1]
+  for (k in c(0.6, 1.6)) expect_true(resonance_raw_support(sqrt(k * p), 20, 0.08, b)$support)
+  for (k in c(0.4, 2.5)) {
+    ev <- resonance_raw_support(sqrt(k * p), 20, 0.08, b)
+    expect_false(ev$support)
+    expect_match(ev$text, sprintf("power %.2g x", 1 / k), fixed = TRUE)
+  }
 })
 
 test_that("find_bands invents no band on smooth spectra (own generators, 10 seeds each)", {
