@@ -214,7 +214,10 @@ test_that("the record's real transforms match R's fft() of the zero-padded serie
     want <- Re(stats::fft(stats::fft(c(x, numeric(np - len))) * full, inverse = TRUE))[seq_len(len)]
     expect_lt(max(abs(allanvar:::real_ifft_cpp(X * g, np, len) - want)), 1e-10 * np)
   }
-  expect_error(allanvar:::real_fft_cpp(1:10 + 0, 12), "bad transform size")
-  expect_error(allanvar:::real_fft_cpp(1:10 + 0, 8), "bad transform size")
-  expect_error(allanvar:::real_ifft_cpp(complex(5), 8, 9), "bad transform size")
+  expect_error(allanvar:::real_fft_cpp(1:10 + 0, 12), "bad transform size",
+               class = "Rcpp::exception")
+  expect_error(allanvar:::real_fft_cpp(1:10 + 0, 8), "bad transform size",
+               class = "Rcpp::exception")
+  expect_error(allanvar:::real_ifft_cpp(complex(5), 8, 9), "bad transform size",
+               class = "Rcpp::exception")
 })
