@@ -97,10 +97,7 @@ Rcpp::NumericVector welch_sums(const Rcpp::NumericVector& x,
   std::vector<double> rs(h, 0.0);
   for (R_xlen_t j = 0; j < k; j += 2) {
     for (int q = 0; q < 2; ++q) {
-      if (j + q >= k) {
-        for (R_xlen_t i = 0; i < seg; ++i) z[i].imag(0.0);
-        break;
-      }
+      if (j + q >= k) break;  // an odd last segment: b = 0, set with a
       const double* s = v + (static_cast<R_xlen_t>(starts[j + q]) - 1);
       long double sum = 0;
       for (R_xlen_t i = 0; i < seg; ++i) sum += s[i];
