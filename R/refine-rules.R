@@ -333,7 +333,8 @@ kind_excess <- function(adev_kinds, kinds, tau) {
 # with no raw-data check, are judged by the curve as before.
 unconfirmed_marginal <- function(effect, ev, gain, min_gain, raw) {
   if (is.null(raw) || !is.na(ev$support %||% NA)) return(NULL)
-  e <- effect_entry(split_term(effect)$kind, split_term(effect)$variant)
+  sp <- split_term(effect)
+  e <- effect_entry(sp$kind, sp$variant)
   if (is.null(e$evidence) || gain >= 2 * min_gain) return(NULL)
   sprintf(paste("the raw data do not confirm it (%s) and the curve alone gains",
                 "%s, less than 2 min_gain"), ev$text, format_num(gain))
