@@ -438,7 +438,7 @@ test_that("a Gauss-Markov of tc 20 s is not read as steps; a step of 10 ADEV(10 
     st <- detect_steps(x, freq)
     j <- which.min(abs(st$index - at))
     # a step of 10 ADEV(10 s) sits near the threshold (z about 6-9): its
-    # size is within 25% about nine times in ten
+    # size is within 25% about seven times in ten (14 of 20 seeds)
     found <- found + (length(j) == 1L && abs(st$index[j] - at) <= 2 * freq &&
                         abs(st$size[j] / sz - 1) <= 0.25)
   }
