@@ -10,8 +10,11 @@
 # without the effect (within 5%), the effects added that the run without
 # it did not add (`extra`), and the seconds of the run with the effect.
 #
-#   R_LIBS=/tmp/lib Rscript bench/battery-loop.R [data dir] [cases regex]
-# (BATTERY_OUT=file.rds saves the table)
+#   R_LIBS=/tmp/lib Rscript bench/battery-loop.R [data dir] [cases regex] [set]
+# (BATTERY_OUT=file.rds saves the table). Set "a" (the default) is the
+# battery the loop was built against; set "b" has other frequencies, time
+# constants, amplitudes, axes and seeds, written once "a" passed, to see
+# whether what passes "a" generalises.
 #
 # The recordings stay in the shared data directory (never shipped).
 suppressPackageStartupMessages(library(allanvar))
@@ -21,6 +24,7 @@ dir <- if (length(args) >= 1L && nzchar(args[1L])) args[1L] else {
   if (dir.exists("../shared/data")) "../shared/data" else "/work/shared/data"
 }
 only <- if (length(args) >= 2L) args[2L] else "."
+set <- if (length(args) >= 3L) args[3L] else "a"
 freq <- 100
 
 # ---- generators --------------------------------------------------------------
@@ -34,6 +38,11 @@ g_gm <- function(n, sigma, tc) {
 }
 g_line <- function(n, amp, f0) amp * sin(2 * pi * f0 * seq_len(n) / freq + runif(1, 0, 2 * pi))
 g_square <- function(n, amp, f0) amp * sign(sin(2 * pi * f0 * seq_len(n) / freq + runif(1, 0, 2 * pi)))
+# a sawtooth: every harmonic k f0 at amplitude 1/k of the first
+g_saw <- function(n, amp, f0) {
+  ph <- (f0 * seq_len(n) / freq + runif(1)) %% 1
+  amp * (2 * ph - 1)
+}
 # a narrow band: white noise through a two-pole resonator (AR(2)) at f_r
 # with damping time tc (FWHM 1/(pi tc)), scaled to sd `sigma`
 g_band <- function(n, sigma, fr, tc) {
@@ -214,6 +223,84 @@ real <- list(
   list(u = 2, j = 4, what = "step", t0 = 4100),
   list(u = 3, j = 2, what = "step", t0 = 7300)
 )
+# ---- set "b" -------------------------------------------------------------------
+if (identical(set, "b")) {
+  cases <- list(
+    "sim: line 46.2 Hz, amp = 0.6 white sd" = function() {
+      b <- sim_base(); list(x = b + g_line(n_sim, 0.006, 46.2), base = b, expect = list(list("sinusoid", 46.2)))
+    },
+    "sim: line 38.5 Hz, amp = 0.3 white sd" = function() {
+      b <- sim_base(); list(x = b + g_line(n_sim, 0.003, 38.5), base = b, expect = list(list("sinusoid", 38.5)))
+    },
+    "sim: square wave 1.3 Hz" = function() {
+      b <- sim_base(); list(x = b + g_square(n_sim, 0.003, 1.3), base = b,
+        expect = list(list("sinusoid", 1.3), list("sinusoid", 3.9), list("sinusoid", 6.5)))
+    },
+    "sim: sawtooth 0.5 Hz" = function() {
+      b <- sim_base(); list(x = b + g_saw(n_sim, 0.006, 0.5), base = b,
+        expect = list(list("sinusoid", 0.5), list("sinusoid", 1.0), list("sinusoid", 1.5)))
+    },
+    "sim: GM tc 8 s" = function() {
+      b <- sim_base(); g <- g_gm(n_sim, 0.003, 8); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: GM tc 60 s" = function() {
+      b <- sim_base(); g <- g_gm(n_sim, 0.002, 60); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: GMs 1.5 s and 25 s" = function() {
+      b <- sim_base() + g_gm(n_sim, 0.004, 1.5); g <- g_gm(n_sim, 0.003, 25)
+      list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: band 7 Hz beside a resonance at 18 Hz" = function() {
+      b <- sim_base() + g_band(n_sim, 0.01, 18, 0.1)
+      list(x = b + g_band(n_sim, 0.006, 7, 0.3), base = b, expect = list(list("band", 7)))
+    },
+    "sim: band 30 Hz beside a resonance at 12 Hz" = function() {
+      b <- sim_base() + g_band(n_sim, 0.01, 12, 0.1)
+      list(x = b + g_band(n_sim, 0.006, 30, 0.3), base = b, expect = list(list("band", 30)))
+    },
+    "sim: warm-up tc 3% (150 s)" = function() {
+      b <- sim_base(); list(x = b + g_warmup(b, 150), base = b, expect = list(list("warmup", 150)))
+    },
+    "sim: warm-up tc 18% (900 s)" = function() {
+      b <- sim_base(); list(x = b + g_warmup(b, 900), base = b, expect = list(list("warmup", 900)))
+    },
+    "sim: GM 5 s + warm-up 200 s" = function() {
+      b <- sim_base() + g_gm(n_sim, 0.004, 5)
+      list(x = b + g_warmup(b, 200), base = b, expect = list(list("warmup", 200)))
+    },
+    "sim: step at 1234.5 s" = function() {
+      b <- sim_base(); sz <- g_step_size(b)
+      list(x = b + g_step(n_sim, 1234.5, sz), base = b, expect = list(list("steps", c(1234.5, sz))))
+    },
+    "control: N + K (seed 2)" = function() list(x = sim_base(), base = NULL),
+    "control: N + B + K strong B" = function() list(x = sim_base() + g_flicker(n_sim, 1e-3), base = NULL),
+    "control: Q + N + K coarse" = function() list(x = round(sim_base() / 0.04) * 0.04, base = NULL),
+    "control: N + K + R down" = function() {
+      t <- seq_len(n_sim) / freq; list(x = sim_base() - 4e-7 * t, base = NULL)
+    }
+  )
+
+  real <- list(
+    list(u = 2, j = 4, what = "line", f0 = 2.9),
+    list(u = 3, j = 5, what = "line", f0 = 0.9),
+    list(u = 1, j = 2, what = "line", f0 = 5.3),
+    list(u = 3, j = 3, what = "band", fr = 8),
+    list(u = 1, j = 1, what = "band", fr = 15),
+    list(u = 2, j = 1, what = "gm", tc = 8),
+    list(u = 3, j = 6, what = "gm", tc = 50),
+    list(u = 2, j = 5, what = "gm", tc = 20),
+    list(u = 1, j = 4, what = "nyquist", f0 = 46.5),
+    list(u = 3, j = 2, what = "nyquist", f0 = 49.0),
+    list(u = 2, j = 6, what = "square", f0 = 1.1),
+    list(u = 1, j = 1, what = "warmup", tc = 60),
+    list(u = 3, j = 3, what = "warmup", tc = 200),
+    list(u = 2, j = 2, what = "warmup", tc = 500),
+    list(u = 1, j = 6, what = "warmup", tc = 900),
+    list(u = 1, j = 3, what = "step", t0 = 2500),
+    list(u = 3, j = 5, what = "step", t0 = 8000)
+  )
+}
+
 for (rc in real) local({
   rc <- rc
   nm <- sprintf("real: unit %d col %d + %s", rc$u, rc$j,
@@ -273,7 +360,7 @@ cached_run <- function(x) {
 }
 rows <- list()
 for (nm in grep(only, names(cases), value = TRUE)) {
-  set.seed(2700 + match(nm, names(cases)))
+  set.seed((if (identical(set, "b")) 2900 else 2700) + match(nm, names(cases)))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
   if (is.null(cs$base)) {
