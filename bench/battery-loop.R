@@ -8,7 +8,8 @@
 # and prints one row: the effect named within tolerance (line f0 3%, GM tc
 # 25% of the realised one, band/resonance centre 5%), N against the run
 # without the effect (within 5%), the effects added that the run without
-# it did not add (`extra`), and the seconds of the run with the effect.
+# it did not add (`extra`), those it had that the run with the effect lost
+# (`lost`), and the seconds of the run with the effect.
 #
 #   R_LIBS=/tmp/lib Rscript bench/battery-loop.R [data dir] [cases regex] [set]
 # (BATTERY_OUT=file.rds saves the table). Set "a" (the default) is the
@@ -137,6 +138,9 @@ extra_kinds <- function(r, base, expect) {
   }
   if (length(out)) paste(out, collapse = "+") else ""
 }
+# the run without the effect's effects that the run with it lost (an added
+# effect must not replace or displace what the axis already has)
+lost_kinds <- function(r, base) extra_kinds(base, r, character())
 contradicted <- function(r) sum(r$steps$confirmed %in% FALSE)
 
 # ---- cases --------------------------------------------------------------------
@@ -367,7 +371,7 @@ for (nm in grep(only, names(cases), value = TRUE)) {
     r <- cached_run(cs$x)
     rows[[length(rows) + 1L]] <- data.frame(
       case = nm, named = NA, got = "", N_change = NA,
-      extra = paste(setdiff(kinds_all(r), c("N", "B", "K")), collapse = "+"),
+      extra = paste(setdiff(kinds_all(r), c("N", "B", "K")), collapse = "+"), lost = "",
       spikes = sprintf("%d", n_spikes(r)),
       contradicted = contradicted(r), chi2 = round(r$chi2, 2), seconds = round(r$seconds, 1))
   } else {
@@ -383,6 +387,7 @@ for (nm in grep(only, names(cases), value = TRUE)) {
       got = paste(got, collapse = "; "),
       N_change = round(100 * (n_of(r) / n_of(base) - 1), 1),
       extra = extra_kinds(r, base, vapply(cs$expect, `[[`, "", 1)),
+      lost = lost_kinds(r, base),
       spikes = sprintf("%d/%d", n_spikes(r), n_spikes(base)),
       contradicted = contradicted(r), chi2 = round(r$chi2, 2),
       seconds = round(r$seconds, 1))
