@@ -106,7 +106,9 @@
 #'   ([av_terms()]); default all of them.
 #' @param max_steps Maximum number of effects to add. A further line of a
 #'   harmonic set already in the model is not counted (at most 10 of
-#'   those): it adds no new source.
+#'   those): it adds no new source; nor is a step that only chooses a
+#'   family's form again (the filter's, at most 2 of those): it adds no
+#'   effect.
 #' @param criterion `"BIC"` (default) or `"AIC"`.
 #' @param min_gain Minimum decrease of the criterion for an effect to be
 #'   kept (10 is "very strong" evidence on the BIC scale; adjacent taus of
@@ -162,7 +164,7 @@
 #' ref <- avrefine(fit, candidates = c("gm", "K"), max_steps = 1)
 #' ref$steps[, c("effect", "params", "chi2_before", "chi2_after")]
 avrefine <- function(fit, data = NULL, candidates = effect_kinds(),
-                     max_steps = 5, criterion = "BIC", min_gain = 10,
+                     max_steps = 8, criterion = "BIC", min_gain = 10,
                      level = 3.5, remove = character(), series = NULL, ...) {
   check_present(missing(fit), "fit", "an avfit() result")
   args <- check_refine_args(fit, data, candidates, max_steps, criterion,

@@ -272,11 +272,20 @@ evidence_quantization <- function(par, raw, x, freq) {
   list(text = txt, support = z1 < -3)
 }
 
-# A ramp: a significant linear trend.
+# A ramp: a significant linear trend (read beyond the series effects left
+# in the data: stage_prepare()) of the size the curve asks for. A fitted R
+# beyond this multiple of the raw slope stands in for something else: on
+# white noise and a random walk with a 900 s warm-up left in, the curve's
+# long-tau rise took a ramp of 21x the slope left beside the warm-up.
+ramp_slope_factor <- 3
 evidence_trend <- function(par, raw, x, freq) {
   tr <- diag_value(raw, "trend")
-  list(text = sprintf("linear trend %s /s (t = %.1f)", format_num(tr$slope), tr$t),
-       support = tr$significant)
+  R <- abs(par[["R"]] %||% NA_real_)
+  big <- is.finite(R) && R > ramp_slope_factor * abs(tr$slope)
+  list(text = sprintf("linear trend %s /s (t = %.1f)%s", format_num(tr$slope), tr$t,
+                      if (big) sprintf(", %.1f x below the fitted R %s",
+                                       R / abs(tr$slope), format_num(R)) else ""),
+       support = tr$significant && !big)
 }
 
 # A power-law term of rate-PSD exponent `alpha`: the lag-1 noise

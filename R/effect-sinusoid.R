@@ -138,7 +138,6 @@ effect_sinusoid <- function() {
           pin = list(f0 = f0),
           note = sprintf("proposed by a periodogram line at %s Hz%s",
                          format_num(f0, 4), src))
-        if (length(out) >= 5L) break
       }
       out
     },

@@ -28,11 +28,19 @@ quantization_grid <- function(x) {
 
 # Linear trend of block means (100 blocks) against time: slope (u/s) and its
 # t value. Block means tame white noise; red noise still inflates t.
-linear_trend <- function(x, freq, blocks = 100L) {
+# `beside`: a function(m) giving columns of block means (of m samples) of
+# other shapes the series carries (series_shapes()), fitted with the line
+# so that the trend is the one beyond them.
+linear_trend <- function(x, freq, blocks = 100L, beside = NULL) {
   m <- max(1L, length(x) %/% blocks)
   b <- block_means(x, m)
   t <- (seq_along(b) - 0.5) * m / freq
-  fit <- summary(stats::lm(b ~ t))$coefficients
+  other <- if (!is.null(beside)) beside(m)
+  fit <- if (!is.null(other)) {
+    summary(stats::lm(b ~ t + other))$coefficients
+  } else {
+    summary(stats::lm(b ~ t))$coefficients
+  }
   slope <- fit[2L, 1L]
   tval <- fit[2L, 3L]
   list(slope = slope, t = tval, significant = is.finite(tval) && abs(tval) > 5)

@@ -159,6 +159,25 @@ ready_trials <- function(trials, fixed) {
   trials[ok, , drop = FALSE]
 }
 
+# Proposals that pin a value the model holds already (a periodogram line
+# in it) are dropped, and of the rest at most `max_pinned_trials` per entry
+# are kept, in the order the entry proposed them (strongest first): an
+# axis's own weaker line beyond the fifth strongest (below a square wave's
+# harmonics) is reached once the stronger ones are in the model, and a
+# step screens a bounded number of them.
+max_pinned_trials <- 5L
+fresh_pinned_trials <- function(trials, fixed) {
+  if (!nrow(trials) || is.null(trials$pin)) return(trials)
+  held <- vapply(trials$pin, function(p) {
+    v <- unlist(p)
+    length(v) > 0L && any(vapply(v, function(x) any(abs(fixed - x) <= 1e-9 * abs(x)), NA))
+  }, NA)
+  trials <- trials[!held, , drop = FALSE]
+  pinned <- lengths(trials$pin) > 0L
+  rank <- stats::ave(seq_len(nrow(trials)), trials$effect, pinned, FUN = seq_along)
+  trials[!pinned | rank <= max_pinned_trials, , drop = FALSE]
+}
+
 # The residual signature that matches an accepted term: the one whose tau
 # range holds (or lies nearest, within a factor 3) the term's characteristic
 # tau (the catalogue's peak_tau, otherwise the tau where the term's share of

@@ -12,6 +12,11 @@ screen_trial <- function(st, tr, nl_now) {
   hold_now <- st$hold
   c0 <- st$c0
   min_gain <- st$args$min_gain
+  # A further line of a harmonic set the model holds (its stronger lines,
+  # `after`, are in it) is no new source: the periodogram found it at the
+  # set's frequency, and the criterion need only prefer it
+  set_line <- continues_set(tr)
+  need <- if (set_line) 0 else min_gain
   pen <- refine_penalty(st)
   crit <- function(f) refine_crit(st, f)
   crit_s <- function(f) crit(f) + pen * length(hold_now)
@@ -37,12 +42,13 @@ screen_trial <- function(st, tr, nl_now) {
   new <- r$fit
   if (is.null(new)) return(list(st = st, cand = NULL))
   c1 <- crit_s(new)
-  pays <- is.finite(c1) && c1 < c0 - min_gain && new$chi2 < 0.9 * cur$chi2
+  pays <- is.finite(c1) && c1 < c0 - need &&
+    new$chi2 < (if (set_line) 1 else 0.9) * cur$chi2
   if (!pays) return(list(st = st, cand = NULL))
   lab <- new_label(cur$terms, tr$effect)
   # An added term that explains (almost) nothing anywhere is a refit
-  # artefact, not an effect.
-  if (max_share(new, lab) < 0.02) return(list(st = st, cand = NULL))
+  # artefact, not an effect (a set's further line is the periodogram's).
+  if (!set_line && max_share(new, lab) < 0.02) return(list(st = st, cand = NULL))
   tau <- cur$data$tau
   jd <- judge_instance(st, new, tr$effect, lab, tau)
   # A screened instance (others held) that fails is refitted once with

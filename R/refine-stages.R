@@ -42,6 +42,12 @@ stage_prepare <- function(st) {
     st$series <- a$series
   }
   st$raw <- refine_diagnostics(st$data, a$freq)
+  # a trend is a ramp only beyond what the series pass found and left in
+  # the data (a warm-up or a step projects onto a line)
+  beside <- series_shapes(st$series, length(st$data), a$freq)
+  if (!is.null(beside)) {
+    st$raw$base$trend <- linear_trend(st$data, a$freq, beside = beside)
+  }
   st
 }
 
@@ -52,6 +58,7 @@ stage_prepare <- function(st) {
 # on with those trials alone, so an axis's own effects cannot starve a set
 # of its harmonics.
 max_set_steps <- 10L
+max_rechosen <- 2L
 
 stage_steps <- function(st) {
   budget <- st$args$max_steps
@@ -59,9 +66,13 @@ stage_steps <- function(st) {
   if (budget < 1L) return(st)
   step <- 0L
   free <- 0L
+  # a step that only chose a family again (step_settle()) adds no effect:
+  # it leaves the budget alone (at most max_rechosen of them, each of which
+  # must lower the criterion by min_gain)
+  rechosen <- 0L
   st$only_sets <- FALSE
   repeat {
-    if (step - free >= budget) {
+    if (step - free - rechosen >= budget) {
       if (free >= max_set_steps) break
       st$only_sets <- TRUE
     }
@@ -75,7 +86,9 @@ stage_steps <- function(st) {
     if (st$flow == "stop") break
     # a revisit that has reached the greedy run's terms ends as it did
     if (!is.null(st$until) && identical(sort(st$current$terms), st$until)) break
-    if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
+    if (st$flow == "next" && rechosen < max_rechosen) {
+      rechosen <- rechosen + 1L
+    } else if (st$flow == "go" && free < max_set_steps && continues_set(st$best$trial)) {
       free <- free + 1L
     } else if (st$only_sets) {
       break
@@ -267,8 +280,10 @@ step_trace <- function(st) {
   traced <- trace_candidates(tau, cur$data$avar, cur$data$fitted, st$sig,
                              present = cur$terms, candidates = st$args$candidates,
                              raw = st$raw)
-  st$trials <- ready_trials(candidate_trials(traced, cur$terms, st$args$candidates,
-                                             st$sig), st$settings$fixed)
+  st$trials <- fresh_pinned_trials(
+    ready_trials(candidate_trials(traced, cur$terms, st$args$candidates, st$sig),
+                 st$settings$fixed),
+    st$settings$fixed)
   if (isTRUE(st$only_sets) && nrow(st$trials)) {
     keep <- vapply(seq_len(nrow(st$trials)), function(i) continues_set(st$trials[i, ]), NA)
     st$trials <- st$trials[keep, , drop = FALSE]

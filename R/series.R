@@ -165,6 +165,30 @@ remove_series <- function(x, freq, table) {
   x
 }
 
+# The shapes of the instances a series pass found and left in the data,
+# as block means of m samples, one column each (each entry's remove() on a
+# series of zeros): what a raw-data check fits beside its own regressor (a
+# ramp's trend is read beyond an unremoved warm-up or step, which a line
+# would otherwise take). An instance that moves no block mean by 1% of its
+# own largest sample (a spike) cannot bend such a check and is left out.
+# Returns function(m) for linear_trend()'s `beside`, or NULL.
+series_shapes <- function(series, n, freq) {
+  tab <- series$table
+  if (is.null(tab) || !NROW(tab)) return(NULL)
+  tab <- tab[!tab$removed, , drop = FALSE]
+  if (!nrow(tab)) return(NULL)
+  function(m) {
+    cols <- lapply(seq_len(nrow(tab)), function(i) {
+      shape <- -remove_series(numeric(n), freq, tab[i, , drop = FALSE])
+      b <- block_means(shape, m)
+      top <- max(abs(shape))
+      if (top > 0 && diff(range(b)) >= 0.01 * top) b
+    })
+    cols <- cols[!vapply(cols, is.null, NA)]
+    if (length(cols)) do.call(cbind, cols)
+  }
+}
+
 # What a result keeps of a series pass: everything but the cleaned series
 # `x` (a fit or an analysis must not carry a second copy of the data).
 series_kept <- function(s) {

@@ -182,7 +182,7 @@ growing_medians <- function(e) {
 #'   significance, concentration, kind ("line"/"band"), with attributes
 #'   `resolution` (Hz) and `nyquist`.
 #' @noRd
-spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 5L,
+spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 24L,
                            band_bins = 64L) {
   w <- welch_psd(x, freq, seg)
   p <- w$psd
@@ -279,14 +279,15 @@ match_line <- function(f0, lines, tol = 1, pick = c("nearest", "strongest")) {
 #'
 #' Lines whose frequencies are whole multiples of a fundamental (within the
 #' periodogram's resolution, widened with the harmonic number since the
-#' fundamental's error multiplies) are one source. The fundamental is the
+#' fundamental's error multiplies, up to 3 bins) are one source, up to
+#' the 50th harmonic (a square wave's reach the Nyquist frequency). The fundamental is the
 #' lowest line that explains the most others; a set of odd harmonics only
 #' (f, 3f, 5f) is the signature of a square or triangle wave.
 #' @return `lines` with columns `source` (integer id), `harmonic` (the
 #'   multiple of the source's fundamental, 1 for the fundamental itself)
 #'   and `pattern` ("single", "odd", "all") per source.
 #' @noRd
-harmonic_sets <- function(lines, max_harmonic = 15L) {
+harmonic_sets <- function(lines, max_harmonic = 50L) {
   n <- nrow(lines)
   lines$source <- integer(n)
   lines$harmonic <- integer(n)
@@ -302,7 +303,9 @@ harmonic_sets <- function(lines, max_harmonic = 15L) {
     f1 <- lines$f0[i]
     k <- lines$f0 / f1
     kr <- round(k)
-    tol <- res * (0.75 + 0.25 * kr)
+    # at most 3 bins: a square wave's 45th harmonic sits within 0.01 bin of
+    # 45 f1, and wider windows would take unrelated lines
+    tol <- res * pmin(0.75 + 0.25 * kr, 3)
     hit <- free & kr >= 1L & kr <= max_harmonic &
       abs(lines$f0 - kr * f1) <= tol
     hit[i] <- TRUE

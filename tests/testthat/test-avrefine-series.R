@@ -111,6 +111,42 @@ test_that("a long warm-up left in the data is not described again by a rate ramp
     expect_equal(nrow(wu), 1L)
     expect_lt(abs(wu$tc / 500 - 1), 0.25)
     expect_false("R" %in% ref$terms)
-    expect_true("R" %in% ref$refine$series_duplicates$effect)
+    # refused as the warm-up's duplicate, or (first) by the trend left
+    # beside the warm-up, a fraction of the ramp the curve asks for
+    rj <- ref$refine$rejected
+    expect_true("R" %in% ref$refine$series_duplicates$effect ||
+                  any(rj$effect == "R" & grepl("x below the fitted R", rj$reason)))
   }
+})
+
+test_that("a ramp must be backed by the trend left beside the series effects, at its size", {
+  # white + random walk + a 900 s warm-up (18% of the record): the trend of
+  # the block means is the warm-up's tail; fitted beside the warm-up's
+  # shape it is a fraction of the ramp the curve asks for
+  set.seed(2911)
+  n <- 5e5
+  t <- (seq_len(n) - 1) / 100
+  b <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-4 / 10))
+  x <- b - 0.08 * exp(-t / 900)
+  pass <- detect_series_effects(x, 100)
+  expect_true("warmup" %in% pass$table$kind)
+  plain <- linear_trend(x, 100)
+  beside <- linear_trend(x, 100, beside = series_shapes(pass, n, 100))
+  expect_true(plain$significant)
+  expect_lt(abs(beside$slope), abs(plain$slope) / 3)
+  # a fitted R beyond 3x the raw slope is not backed; one within it is
+  raw <- avdiagnose(x, 100)
+  raw$trend <- beside
+  ev_big <- evidence_trend(list(R = 5 * abs(beside$slope)), raw, x, 100)
+  expect_false(ev_big$support)
+  expect_match(ev_big$text, "x below the fitted R")
+  raw$trend$significant <- TRUE
+  expect_true(evidence_trend(list(R = 2 * abs(beside$slope)), raw, x, 100)$support)
+  # spikes move no block mean: they are not fitted beside the trend
+  sp <- list(table = data.frame(kind = "spikes", index = 10L, time = 0.09, size = 1,
+                                tc = NA, duration = NA, z = 9, removed = FALSE))
+  expect_null(series_shapes(sp, n, 100)(n %/% 100))
+  skip_on_cran()
+  ref <- suppressMessages(avrefine(avfit(allan(x, 100), terms = c("N", "B", "K")), data = x))
+  expect_false("R" %in% ref$terms)
 })

@@ -221,3 +221,24 @@ test_that("the record's real transforms match R's fft() of the zero-padded serie
   expect_error(allanvar:::real_ifft_cpp(complex(5), 8, 9), "bad transform size",
                class = "Rcpp::exception")
 })
+
+test_that("a square wave's harmonics above the 15th stay in its set; a weaker line of another source is still listed", {
+  # a strong 1.1 Hz square wave (odd harmonics up to Nyquist) and a 1.7 Hz
+  # line weaker than its first seven harmonics
+  set.seed(2914)
+  freq <- 100
+  n <- 5e5
+  t <- seq_len(n) / freq
+  x <- rnorm(n, sd = 0.01) + 0.01 * sign(sin(2 * pi * 1.1 * t + 0.4)) +
+    0.001 * sin(2 * pi * 1.7 * t + 1.1)
+  l <- harmonic_sets(spectral_lines(x, freq))
+  s <- l$source[match_line(1.1, l)]
+  hi <- l[l$source == s & l$harmonic > 15, , drop = FALSE]
+  expect_gt(nrow(hi), 0L)
+  expect_true(all(hi$harmonic %% 2 == 1))
+  expect_true(all(abs(hi$f0 - 1.1 * hi$harmonic) <= attr(l, "resolution")))
+  j <- match_line(1.7, l)
+  expect_false(is.na(j))
+  expect_false(l$source[j] == s)
+  expect_gt(sum(l$ratio > l$ratio[j]), 5L)
+})
