@@ -394,7 +394,7 @@ step_record <- function(st) {
     st$current, best$fit, st$c0, best$crit)
   st$pins[length(st$steps)] <- list(unlist(best$pin) %||% numeric(0))
   # the second instance of a split (split_trial()): its own row, at the
-  # values the final refit gave it
+  # values the final refit gave it (the step's gain is on the first row)
   if (!is.null(best$also)) {
     lab2 <- best$also$label
     par2 <- instance_params(stats::coef(best$fit), best$fit$layout, lab2)
@@ -405,7 +405,7 @@ step_record <- function(st) {
       best$trial$effect, lab2, loc2, par2,
       paste0(loc2$text, "; split from ", best$label, "'s one-term compromise",
              if (nzchar(ev2$text)) paste0("; raw data: ", ev2$text)),
-      ev2$support, st$current, best$fit, best$crit, best$crit)
+      ev2$support, best$fit, best$fit, best$crit, best$crit)
     st$pins[length(st$steps)] <- list(numeric(0))
   }
   st$current <- best$fit
