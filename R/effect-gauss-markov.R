@@ -78,12 +78,16 @@ evidence_gm <- function(par, raw, x, freq) {
   # avrefine()'s per-call store (NULL elsewhere)
   a <- acf_exponential(x, freq, tc, cache = diag_cache(raw))
   if (is.finite(a$tc) && a$z > 5) {
+    # within a factor 2: support; beyond 3: contradiction; between,
+    # undecided (a one-GM compromise over two processes sits there: the
+    # loop tries it as two GMs, one where the ACF reads Tc and one as far
+    # on the other side, the fitted Tc their geometric mean)
+    support <- if (a$tc > tc / 2 && a$tc < tc * 2) TRUE
+      else if (a$tc < tc / 3 || a$tc > tc * 3) FALSE else NA
     list(text = sprintf("exponential ACF of %s-sample means, Tc = %s s (z = %.1f)",
                         a$m, format_num(a$tc), a$z),
-         # within a factor 2: support; beyond 3: contradiction; between,
-         # undecided (a one-GM compromise over two processes sits there)
-         support = if (a$tc > tc / 2 && a$tc < tc * 2) TRUE
-           else if (a$tc < tc / 3 || a$tc > tc * 3) FALSE else NA)
+         support = support,
+         split = if (is.na(support)) list(list(tc = a$tc), list(tc = tc^2 / a$tc)))
   } else {
     list(text = sprintf("no exponential ACF near Tc = %s s (z = %.1f)",
                         format_num(tc), a$z), support = FALSE)

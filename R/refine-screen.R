@@ -133,6 +133,13 @@ screen_trial <- function(st, tr, nl_now) {
       }
     }
   }
+  sp <- split_trial(st, tr, tm, jd, lab, settings, pin, c1)
+  st <- sp$st
+  if (!is.null(sp$fit)) {
+    new <- sp$fit
+    c1 <- sp$crit
+    jd <- sp$jd
+  }
   why <- unconfirmed_marginal(tr$effect, jd$ev, c0 - c1, min_gain, st$raw)
   if (!is.null(why)) {
     st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, why)
@@ -142,7 +149,51 @@ screen_trial <- function(st, tr, nl_now) {
   adj <- c1 - min_gain * isTRUE(jd$ev$support)
   list(st = st, cand = list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
                             params = jd$par, ev = jd$ev, pin = pin,
-                            fixed = settings$fixed))
+                            fixed = settings$fixed, also = jd$also))
+}
+
+# One instance over two processes: the raw data read the instance's value
+# a factor 2-3 away (undecided; a 20 s GM beside an axis's own 170 s one
+# becomes one GM at 42 s, its block means' ACF reading 20 s). The entry's
+# evidence then says where the two would sit (`split`: start values of
+# two instances), and the pair is refitted with everything free. It
+# enters in this step, in place of the one, when it pays, each instance is
+# valid and confirmed by the raw data, and its criterion, with that
+# support counted as a gain of min_gain, is below the one's. Returns
+# list(st, fit, crit, jd); `fit` NULL when the one stays.
+split_trial <- function(st, tr, tm, jd, lab, settings, pin, c1) {
+  starts <- jd$ev$split
+  out <- list(st = st, fit = NULL)
+  if (length(starts) != 2L || !is.na(jd$ev$support %||% NA) ||
+      !isTRUE(effect_entry(split_term(tr$effect)$kind)$repeatable)) {
+    return(out)
+  }
+  cur <- st$current
+  tm2 <- c(tm, tr$effect)
+  lab2 <- new_label(tm, tr$effect)
+  sv <- c(pin_values(tm[-length(tm)], tr$effect, starts[[1L]]),
+          stats::setNames(unlist(starts[[2L]]),
+                          paste0(lab2, ".", names(starts[[2L]]))))
+  args <- refit_args(cur, tm2, settings, start = sv, hold = pin)
+  r <- state_refit(st, args, "split in two", tr$effect)
+  out$st <- r$st
+  f <- r$fit
+  crit <- refine_crit(st, f %||% cur)
+  if (is.null(f) || !is.finite(crit) || crit >= st$c0 - st$args$min_gain ||
+      f$chi2 >= 0.9 * cur$chi2 || crit - st$args$min_gain >= c1) {
+    return(out)
+  }
+  tau <- cur$data$tau
+  j1 <- judge_instance(out$st, f, tr$effect, lab, tau)
+  j2 <- judge_instance(out$st, f, tr$effect, lab2, tau)
+  if (!is.null(j1$why) || !is.null(j2$why) || !isTRUE(j1$ev$support) ||
+      !isTRUE(j2$ev$support) || min(max_share(f, lab), max_share(f, lab2)) < 0.02) {
+    return(out)
+  }
+  j1$ev$text <- sprintf("%s; split in two, %s with %s (%s): %s", j1$ev$text, lab, lab2,
+                        format_params(j2$par, tr$effect), j2$ev$text)
+  j1$also <- list(label = lab2, par = j2$par, ev = j2$ev)
+  list(st = out$st, fit = f, crit = crit, jd = j1)
 }
 
 # An instance that is not a valid instance of its effect on this curve (a

@@ -381,6 +381,9 @@ step_refit_winner <- function(st) {
       st$best$crit <- refine_crit(st, full)
       st$best$params <- p2
       st$best$ev <- ev2
+      if (!is.null(best$also)) {
+        st$best$ev$text <- paste0(ev2$text, "; split in two with ", best$also$label)
+      }
     }
   }
   st
@@ -405,6 +408,21 @@ step_record <- function(st) {
     best$trial$effect, best$label, loc, best$params, evidence, best$ev$support,
     st$current, best$fit, st$c0, best$crit)
   st$pins[length(st$steps)] <- list(unlist(best$pin) %||% numeric(0))
+  # the second instance of a split (split_trial()): its own row, at the
+  # values the final refit gave it (the step's gain is on the first row)
+  if (!is.null(best$also)) {
+    lab2 <- best$also$label
+    par2 <- instance_params(stats::coef(best$fit), best$fit$layout, lab2)
+    loc2 <- locate_signature(st$sig, best$fit, lab2)
+    ev2 <- raw_evidence(best$trial$effect, as.list(par2), st$raw,
+                        diag_series(st$raw), st$args$freq)
+    st$steps[[length(st$steps) + 1L]] <- step_row(
+      best$trial$effect, lab2, loc2, par2,
+      paste0(loc2$text, "; split from ", best$label, "'s one-term compromise",
+             if (nzchar(ev2$text)) paste0("; raw data: ", ev2$text)),
+      ev2$support, best$fit, best$fit, best$crit, best$crit)
+    st$pins[length(st$steps)] <- list(numeric(0))
+  }
   st$current <- best$fit
   st
 }

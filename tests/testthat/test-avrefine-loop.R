@@ -53,6 +53,30 @@ test_that("two Gauss-Markov processes a decade apart are both found (Tc within 3
   expect_false(any(ref$steps$confirmed %in% FALSE))
 })
 
+test_that("one GM over two processes an order apart is split in two in one step (Tc within 25%)", {
+  set.seed(4)
+  freq <- 1
+  n <- 6e4
+  g1 <- gen_gm(n, freq, 0.003, 20)
+  g2 <- gen_gm(n, freq, 0.003, 300)
+  x <- gen_white(n, freq, 0.01) + g1 + g2
+  # the realised Tc of each injected process: its own AR(1) coefficient
+  realised <- vapply(list(g1, g2), function(g) {
+    -1 / (freq * log(sum(g[-1] * g[-n]) / sum(g[-n]^2)))
+  }, 0)
+  # with one step the loop's single GM sits between the two (81 s, the
+  # block means' ACF reading 31 s: undecided); split, both are named
+  fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
+  ref <- suppressMessages(avrefine(fit, data = x, max_steps = 1))
+  cf <- coef(ref)
+  tc <- sort(unname(cf[grepl("^gm[0-9]+\\.tc$", names(cf))]))
+  expect_length(tc, 2)
+  expect_equal(tc, realised, tolerance = 0.25)
+  expect_equal(nrow(ref$steps), 2)
+  expect_true(all(ref$steps$confirmed %in% TRUE))
+  expect_match(ref$steps$evidence[2], "split from gm1")
+})
+
 test_that("a GM beside a sinusoid: both found and both confirmed by the raw data", {
   set.seed(303)
   freq <- 100
@@ -195,6 +219,10 @@ test_that("an effect the raw data leave undecided must gain 2 min_gain on the cu
   # nor contradicted
   ev <- raw_evidence("gm", list(sigma = 0.02, tc = 125), raw, diag_series(raw), freq)
   expect_true(is.na(ev$support))
+  # the loop tries it as two GMs: at the ACF's Tc and its mirror about 125 s
+  expect_length(ev$split, 2)
+  expect_equal(ev$split[[1]]$tc * ev$split[[2]]$tc, 125^2)
+  expect_lt(ev$split[[1]]$tc, 125 / 2)
   expect_match(unconfirmed_marginal("gm", ev, 15, 10, raw), "do not confirm")
   expect_null(unconfirmed_marginal("gm", ev, 25, 10, raw))
   # at the Tc the ACF reads it is confirmed: min_gain is enough
