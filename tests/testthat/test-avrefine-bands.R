@@ -154,3 +154,55 @@ test_that("a band proposes its resonance pinned, released from its values only",
   expect_lt(abs(stats::coef(loc$fit)[["resonance1.fr"]] - 15), 0.3)
   expect_lte(both$fit$objective, loc$fit$objective * (1 + 1e-8))
 })
+
+# A strong resonance's run of significant bins reaches far into its tails:
+# 3-6 run widths from its centre lie beyond Nyquist, where no background
+# can be read. It is still taken out of the series the other checks read
+# (else its oscillating ACF is read as a sensor filter's lag-1 excess).
+test_that("remove_bands takes out a resonance whose run is too wide for its background window", {
+  set.seed(21)
+  n <- 2^17
+  freq <- 100
+  z <- ar2_resonance(n, 18, 0.1, 1, freq)
+  x <- stats::rnorm(n) + z / stats::sd(z)
+  b <- find_bands(x, freq)
+  expect_equal(nrow(b), 1L)
+  # 3 run widths from the centre: below 0 Hz and above Nyquist
+  w <- b$f_to - b$f_from
+  expect_lt(b$f_center - 3 * w, 0)
+  expect_gt(b$f_center + 3 * w, freq / 2)
+  y <- remove_bands(x, freq, b)
+  r1 <- function(v) filter_evidence(v, freq)$r1
+  expect_gt(r1(x), 0.15)
+  expect_lt(abs(r1(y)), r1(x) / 3)
+})
+
+# The same resonance beside a weaker band (no sensor filter): the loop
+# describes the two bands, and no filter stands in for the resonance at
+# the first step (it did, moving N by +12%).
+test_that("a band beside a strong resonance: no filter taken first, both bands named", {
+  skip_on_cran()
+  set.seed(1)
+  n <- 2e5
+  freq <- 100
+  unit <- function(z) z / stats::sd(z)
+  b <- 0.01 * stats::rnorm(n) + cumsum(stats::rnorm(n, sd = 1e-5)) +
+    0.01 * unit(ar2_resonance(n, 18, 0.1, 1, freq))
+  x <- b + 0.006 * unit(ar2_resonance(n, 7, 0.3, 1, freq))
+  run <- function(v) {
+    f <- avfit(allan(v, freq), terms = c("N", "B", "K"))
+    suppressMessages(avrefine(f, data = v))
+  }
+  rx <- run(x)
+  rb <- run(b)
+  expect_false(grepl("^filter", rx$steps$effect[1L]))
+  cf <- stats::coef(rx)
+  fr <- cf[grepl("^resonance[0-9]*\\.fr$", names(cf))]
+  expect_length(fr, 2L)
+  expect_equal(sort(unname(fr)), c(7, 18), tolerance = 0.05)
+  white <- function(r) {
+    cf <- stats::coef(r)
+    unname(cf[grepl("^N$|^filter[^.]*\\.Nf$", names(cf))][1L])
+  }
+  expect_equal(white(rx), white(rb), tolerance = 0.05)
+})
