@@ -150,14 +150,8 @@ effect_filter <- function() {
     describe = function(values) "filter (the sensor's averaging)",
     # the short-lag ACF beyond the slow processes, of the series without
     # lines and bands (a resonance raises the short-lag ACF too)
-    diagnose = list(part = "filter", reads = "clean", needs = "bands",
-                    make = function(x, freq, dg) {
-                      fe <- filter_evidence(x, freq)
-                      fe$band_se <- band_removal_se(diag_part(dg, "bands"), x, freq)
-                      # an excess the band removal may have left proposes nothing
-                      fe$filtered <- fe$filtered && fe$r1 >= fe$band_se
-                      fe
-                    }),
+    diagnose = list(part = "filter", reads = "clean",
+                    make = function(x, freq, dg) filter_evidence(x, freq)),
     # the families describe one filter: the loop chooses among them again
     # on the final model, each started from the raw lag-1 excess
     family = list(variants = filter_family_variants,

@@ -487,8 +487,7 @@ filter_start_from_curve <- function(q, family, freq) {
 # one's filter part (filter_evidence(): the excess over the slow-process
 # level). Supported when the raw excess is significant (z > 5) and within a
 # factor 1.5 of the prediction; contradicted when the raw data show no
-# short-lag correlation (z < 2, or an excess below what the band removal
-# may have left, `fe$band_se`) or disagree by more than a factor 3;
+# short-lag correlation (z < 2) or disagree by more than a factor 3;
 # otherwise undecided.
 filter_raw_support <- function(spec, N, fe, var_x, freq) {
   tau0 <- 1 / freq
@@ -496,33 +495,13 @@ filter_raw_support <- function(spec, N, fe, var_x, freq) {
   obs <- fe$r1
   z <- fe$z1
   ratio <- obs / pred
-  # an excess no larger than what the band removal may have left
-  # (band_removal_se()) is not the sensor's filter
-  in_bands <- isTRUE(obs < fe$band_se)
-  support <- if (in_bands) FALSE
-    else if (is.finite(z) && z > 5 && is.finite(ratio) && ratio > 1 / 1.5 &&
-             ratio < 1.5) TRUE
+  support <- if (is.finite(z) && z > 5 && is.finite(ratio) && ratio > 1 / 1.5 &&
+                 ratio < 1.5) TRUE
     else if (!is.finite(z) || z < 2 || !is.finite(ratio) || ratio < 1 / 3 ||
              ratio > 3) FALSE
     else NA
-  list(text = paste0(sprintf(paste("raw lag-1 autocorrelation beyond the slow processes",
-                                   "%.3f (z = %.0f) against %.3f predicted by the filter"),
-                             obs, z, pred),
-                     if (in_bands) sprintf(", within the %.3f the band removal may leave",
-                                           fe$band_se)),
+  list(text = sprintf(paste("raw lag-1 autocorrelation beyond the slow processes",
+                            "%.3f (z = %.0f) against %.3f predicted by the filter"),
+                      obs, z, pred),
        support = support)
-}
-
-# The lag-1 autocorrelation the band removal (remove_bands()) may have left
-# in series `x` (the series without its bands): a fitted Lorentzian
-# describes a real resonator only approximately (AR(2) resonators of 7-30
-# Hz with damping times 0.1-0.3 s, as strong as the white noise, left 10-15%
-# of their lag-1 autocovariance); twice the largest, 30% of the bands'
-# lag-1 autocovariance sigma^2 exp(-tau0/tc) |cos(2 pi fr tau0)| over the
-# series' variance. 0 without bands.
-band_removal_se <- function(bands, x, freq) {
-  if (is.null(bands) || !nrow(bands)) return(0)
-  tau0 <- 1 / freq
-  g1 <- bands$power * exp(-tau0 / bands$tc) * abs(cos(2 * pi * bands$f_center * tau0))
-  0.3 * sum(g1) / stats::var(x)
 }

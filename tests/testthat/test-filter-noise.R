@@ -246,38 +246,3 @@ test_that("a moving average far longer than the curve's clusters needs only the 
   v <- filter_av(c(1, 10, 1000), filter_spec_of("ma", list(L = 1e9), tau0), tau0)
   expect_true(all(is.finite(v) & v > 0))
 })
-
-# What a band's removal leaves is not a filter: a fitted Lorentzian leaves
-# part of a real resonator's lag-1 autocorrelation (an AR(2) here), which a
-# short filter would match; a true sensor filter beside the same resonance
-# is still confirmed.
-test_that("the lag-1 excess a band's removal may leave does not confirm a filter", {
-  set.seed(31)
-  n <- 2^17
-  freq <- 100
-  ar2 <- function(fr, tc) {
-    r <- exp(-1 / (freq * tc))
-    z <- stats::filter(stats::rnorm(n + 2000L), c(2 * r * cos(2 * pi * fr / freq), -r^2),
-                       method = "recursive")
-    z <- as.numeric(z[-(1:2000)])
-    z / stats::sd(z)
-  }
-  check <- function(x, spec, N) {
-    dg <- refine_diagnostics(x, freq)
-    fe <- diag_part(dg, "filter")
-    list(fe = fe, s = filter_raw_support(spec, N, fe, diag_var(dg, dg$series), freq))
-  }
-  # white noise (N = 0.1) and a resonance, no filter: the excess left is
-  # within what the removal may leave; the filter it would ask for is not
-  # supported
-  x <- stats::rnorm(n) + ar2(18, 0.1)
-  a <- check(x, filter_spec("ma", L = 1 / (1 - 0.05)), 0.1)
-  expect_gt(a$fe$band_se, a$fe$r1)
-  expect_false(isTRUE(a$s$support))
-  # the same with the white noise through a 4-tap moving average: the
-  # filter is confirmed
-  w <- stats::rnorm(n + 3L, sd = 2)
-  y <- as.numeric(stats::filter(w, rep(0.25, 4), sides = 1))[-(1:3)] + 0.5 * ar2(18, 0.1)
-  b <- check(y, filter_spec("ma", L = 4), 2 * sqrt(1 / freq))
-  expect_true(b$s$support)
-})
