@@ -680,15 +680,9 @@ remove_bands <- function(x, freq, bands) {
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
     M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)
-    # 3-6 widths from the centre, the width the run of significant bins
-    # spans; a strong band's run reaches far into its tails, and when that
-    # window lies beyond Nyquist its fitted FWHM is the width (else the
-    # band would stay in the series the other checks read)
+    w <- max(b$width, b$f_to - b$f_from)
     d <- abs(fh - b$f_center)
-    for (w in unique(c(max(b$width, b$f_to - b$f_from), b$width))) {
-      near <- which(d > 3 * w & d < 6 * w)
-      if (length(near) >= 16L) break
-    }
+    near <- which(d > 3 * w & d < 6 * w)
     Gn <- if (length(G) > 1L) G[near] else G
     bg <- sum(wt[near] * (Ph[near] * Gn^2 - M[near])) / sum(wt[near])
     if (!is.finite(bg) || bg <= 0) next
