@@ -151,10 +151,8 @@ effect_sinusoid <- function() {
       make = function(x, freq, dg) {
         lines_outside_bands(diag_value(dg, "lines"), diag_part(dg, "bands"))
       },
-      # the strongest few only: a weak line moves the checks little, and
-      # each costs passes over the record (24 lines took 0.9 s an axis)
       clean = function(x, freq, lines) {
-        if (nrow(lines)) remove_lines(x, freq, utils::head(lines$f0, 5L)) else x
+        if (nrow(lines)) remove_lines(x, freq, lines$f0) else x
       }),
     peak_tau = function(par) sin_peak_ratio / par[["f0"]],
     describe = function(values) {
