@@ -102,8 +102,13 @@ continues_set <- function(trial) {
   !is.null(trial) && !is.null(trial$after) && length(unlist(trial$after)) > 0L
 }
 
-# The loop may have ended on a step that chose a family again.
-stage_rechoose <- function(st) rechoose_families(st)$st
+# The loop may have ended on a step that chose a family again. A loop that
+# ended because nothing paid has just chosen them on this same model
+# (step_settle()): that is not done twice.
+stage_rechoose <- function(st) {
+  if (identical(st$settled, st$current)) return(st)
+  rechoose_families(st)$st
+}
 
 # A greedy order can lock in the weaker explanation: an effect taken early
 # for a bump that a periodogram line explains (a GM of tc 0.025 s for a
@@ -348,6 +353,7 @@ step_settle <- function(st) {
   r <- rechoose_families(st)
   st <- r$st
   st$flow <- if (r$swapped) "next" else "stop"
+  if (!r$swapped) st$settled <- st$current
   st
 }
 
