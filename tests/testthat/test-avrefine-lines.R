@@ -170,9 +170,10 @@ test_that("a square wave added to a measured accelerometer: its 5th harmonic is 
 })
 
 test_that("an added line does not cost a measured axis its own Gauss-Markov term (a family chosen again is no effect)", {
-  # unit 3 accel_y: filter, 0.54 Hz line, resonance and a slow GM; a 0.9 Hz
-  # line added took the fifth step of the budget, and the step that only
-  # chose the filter's form again had spent the sixth
+  # unit 3 accel_y: filter, 0.54 Hz line, resonance and a slow GM; with a
+  # 0.9 Hz line added, the filter, both lines and the resonance took four
+  # steps of the old budget of five, and the step that only chose the
+  # filter's form again spent the fifth: the GM was never reached
   skip_if_no_shared()
   skip_on_cran()
   m <- readRDS(shared_file("adis16405_unit3.rds"))
