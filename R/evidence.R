@@ -36,11 +36,8 @@ linear_trend <- function(x, freq, blocks = 100L, beside = NULL) {
   b <- block_means(x, m)
   t <- (seq_along(b) - 0.5) * m / freq
   other <- if (!is.null(beside)) beside(m)
-  fit <- if (!is.null(other)) {
-    summary(stats::lm(b ~ t + other))$coefficients
-  } else {
-    summary(stats::lm(b ~ t))$coefficients
-  }
+  model <- if (is.null(other)) b ~ t else b ~ t + other
+  fit <- summary(stats::lm(model))$coefficients
   slope <- fit[2L, 1L]
   tval <- fit[2L, 3L]
   list(slope = slope, t = tval, significant = is.finite(tval) && abs(tval) > 5)

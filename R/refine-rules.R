@@ -152,10 +152,7 @@ candidate_trials <- function(traced, present, candidates, sig) {
 # a stronger one and left to absorb it on the curve.
 ready_trials <- function(trials, fixed) {
   if (!nrow(trials) || is.null(trials$after)) return(trials)
-  ok <- vapply(trials$after, function(a) {
-    v <- unlist(a)
-    !length(v) || all(vapply(v, function(x) any(abs(fixed - x) <= 1e-9 * abs(x)), NA))
-  }, NA)
+  ok <- vapply(trials$after, function(a) all(same_values(a, fixed)), NA)
   trials[ok, , drop = FALSE]
 }
 
@@ -168,10 +165,7 @@ ready_trials <- function(trials, fixed) {
 max_pinned_trials <- 5L
 fresh_pinned_trials <- function(trials, fixed) {
   if (!nrow(trials) || is.null(trials$pin)) return(trials)
-  held <- vapply(trials$pin, function(p) {
-    v <- unlist(p)
-    length(v) > 0L && any(vapply(v, function(x) any(abs(fixed - x) <= 1e-9 * abs(x)), NA))
-  }, NA)
+  held <- vapply(trials$pin, function(p) any(same_values(p, fixed)), NA)
   trials <- trials[!held, , drop = FALSE]
   pinned <- lengths(trials$pin) > 0L
   rank <- stats::ave(seq_len(nrow(trials)), trials$effect, pinned, FUN = seq_along)

@@ -21,13 +21,9 @@ screen_trial <- function(st, tr, nl_now) {
   crit <- function(f) refine_crit(st, f)
   crit_s <- function(f) crit(f) + pen * length(hold_now)
   # Parameters the raw data measure better than the curve (a line's
-  # frequency from the periodogram) are pinned there; a value already
-  # pinned in the model (that line is in it) is not proposed twice.
+  # frequency from the periodogram) are pinned there (a value the model
+  # already pins never reaches here: fresh_pinned_trials()).
   pin <- pin_values(cur$terms, tr$effect, tr$pin[[1L]])
-  if (length(pin) && any(vapply(pin, function(v) any(abs(st$settings$fixed - v) <=
-        1e-9 * abs(v)), logical(1)))) {
-    return(list(st = st, cand = NULL))
-  }
   # the instances the new one replaces leave; the held values of the
   # others follow their labels
   tm <- model_terms(cur$terms, tr$effect, c(tr$init[[1L]], tr$pin[[1L]]), cur)
