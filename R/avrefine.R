@@ -88,6 +88,16 @@
 #' contradict is not accepted (see `$refine$rejected`), so `confirmed` is
 #' never `FALSE` for a step of this loop.
 #'
+#' When nothing pays, the forms of a family (the sensor filter's) are
+#' chosen again on the current model; when none pays alone and the model is
+#' still far from the curve (\eqn{\chi^2} per degree of freedom above 4),
+#' each trial of that step the raw data refused at values it pins is
+#' refitted beside each other form, everything free, and the best such pair
+#' enters when it pays, the trial is confirmed and the new form is not
+#' contradicted (a first-order low-pass taken for the bump of a line can
+#' carry half a resonance, which the raw data then refuse at the power the
+#' curve gives it).
+#'
 #' The greedy order can lock in the weaker of two explanations (a short
 #' Gauss-Markov term taken at the first step for the bump of a line the
 #' periodogram shows plainly). When the loop ends far from the curve

@@ -280,6 +280,7 @@ stage_assemble <- function(st) {
 # leave no run reaching `level` for the second one).
 step_trace <- function(st) {
   cur <- st$current
+  st$refused <- list()
   tau <- cur$data$tau
   st$sig <- residual_signatures(tau, stats::residuals(cur), level = st$args$level)
   traced <- trace_candidates(tau, cur$data$avar, cur$data$fitted, st$sig,
@@ -347,11 +348,18 @@ screen_trials <- function(st) {
 }
 
 # Nothing paid: choose the families again on the current model; after a
-# change the loop goes on (the effects that pay may differ), else stops.
+# change the loop goes on (the effects that pay may differ); else a form
+# may pay beside a trial the raw data refused (family_pairs()), else the
+# loop stops.
 step_settle <- function(st) {
   if (!is.null(st$best)) return(st)
   r <- rechoose_families(st)
   st <- r$st
+  # no form pays alone: one may pay beside a trial the old form kept out
+  if (!r$swapped) {
+    st <- family_pairs(st)
+    if (!is.null(st$best)) return(st)
+  }
   st$flow <- if (r$swapped) "next" else "stop"
   if (!r$swapped) st$settled <- st$current
   st
@@ -388,7 +396,8 @@ step_refit_winner <- function(st) {
       st$best$params <- p2
       st$best$ev <- ev2
       if (!is.null(best$also)) {
-        st$best$ev$text <- paste0(ev2$text, "; split in two with ", best$also$label)
+        st$best$ev$text <- paste0(ev2$text, "; ", best$also$note %||%
+                                    paste("split in two with", best$also$label))
       }
     }
   }
@@ -418,13 +427,15 @@ step_record <- function(st) {
   # values the final refit gave it (the step's gain is on the first row)
   if (!is.null(best$also)) {
     lab2 <- best$also$label
+    effect2 <- best$also$effect %||% best$trial$effect
     par2 <- instance_params(stats::coef(best$fit), best$fit$layout, lab2)
     loc2 <- locate_signature(st$sig, best$fit, lab2)
-    ev2 <- raw_evidence(best$trial$effect, as.list(par2), st$raw,
+    ev2 <- raw_evidence(effect2, as.list(par2), st$raw,
                         diag_series(st$raw), st$args$freq)
     st$steps[[length(st$steps) + 1L]] <- step_row(
-      best$trial$effect, lab2, loc2, par2,
-      paste0(loc2$text, "; split from ", best$label, "'s one-term compromise",
+      effect2, lab2, loc2, par2,
+      paste0(loc2$text, "; ", best$also$note %||%
+               paste0("split from ", best$label, "'s one-term compromise"),
              if (nzchar(ev2$text)) paste0("; raw data: ", ev2$text)),
       ev2$support, best$fit, best$fit, best$crit, best$crit)
     st$pins[length(st$steps)] <- list(numeric(0))

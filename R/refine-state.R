@@ -33,6 +33,7 @@ new_refine_state <- function(fit, args, settings) {
     start = NULL,              # the model the steps started from
     pins = list(),             # per accepted step, the raw-data values it pinned
     blocked = list(),          # raw-data values of trials an earlier effect kept out
+    refused = list(),          # this step's trials the raw data refused (family_pairs())
     seeds = list(),            # pinned value sets a revisit takes first (stage_revisit())
     until = NULL,              # a revisit stops on reaching these terms (sorted)
     revisit = NULL,            # what the revisit compared, or NULL

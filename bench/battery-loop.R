@@ -97,9 +97,9 @@ named <- function(r, kind, value) {
   v <- switch(kind,
     sinusoid = cf[grepl("^sinusoid[0-9]*\\.f0$", names(cf))],
     gm = cf[grepl("^gm[0-9]*\\.tc$", names(cf))],
+    # a measured band's centre: its power centroid
     band = c(cf[grepl("^resonance[0-9]*\\.fr$", names(cf))],
-             (cf[grepl("^band[0-9]*\\.f_lo$", names(cf))] +
-                cf[grepl("^band[0-9]*\\.f_hi$", names(cf))]) / 2))
+             cf[grepl("^band[0-9]*\\.f_c$", names(cf))]))
   tol <- switch(kind, sinusoid = 0.03, gm = 0.25, band = 0.05)
   if (!length(v)) return(c(ok = FALSE, got = NA))
   j <- which.min(abs(log(v / value)))
