@@ -35,7 +35,10 @@ detrend_linear <- function(x) detrend_line(as.double(x))
 
 # Exponential ACF (a Gauss-Markov process) near a correlation time `tc` (s):
 # block-average so that white noise shrinks and the GM stays, detrend, and
-# fit log ACF on lag. Returns tc estimate, the lag-1 ACF and its z-score.
+# fit log ACF on lag. Returns tc estimate, the lag-1 ACF and its z-score,
+# and `shape`: the share of the ACF's variation about a line that the
+# exponential explains (near 1 for a GM; a resonance's oscillating residue
+# left by its removal reads as an exponential of a few samples at 0.3).
 # `cache`: NULL or an environment (avrefine()'s, one per call and series)
 # in which the ACF of the block means is kept by block size m, so that the
 # checks of many candidate Tc that share m read the series once.
@@ -72,5 +75,7 @@ acf_exponential <- function(x, freq, tc, cache = NULL) {
   X <- cbind(exp(-lag * m / (freq * grid[k])), 1, lag)
   a <- unname(stats::lm.fit(X, r)$coefficients[1L])
   est <- if (k > 1L && k < length(grid) && is.finite(a) && a > 0) grid[k] else NA_real_
-  list(tc = est, r1 = r[1L], amp = a, z = a * sqrt(nb), m = m)
+  rss_line <- sum(stats::lm.fit(X[, -1L, drop = FALSE], r)$residuals^2)
+  shape <- if (rss_line > 0) 1 - rss[k] / rss_line else NA_real_
+  list(tc = est, r1 = r[1L], amp = a, z = a * sqrt(nb), m = m, shape = shape)
 }

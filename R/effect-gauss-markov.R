@@ -77,7 +77,9 @@ evidence_gm <- function(par, raw, x, freq) {
   }
   # avrefine()'s per-call store (NULL elsewhere)
   a <- acf_exponential(x, freq, tc, cache = diag_cache(raw))
-  if (is.finite(a$tc) && a$z > 5) {
+  # an exponential that explains less than half of the ACF's variation
+  # about a line is not the ACF's shape (an oscillating residue)
+  if (is.finite(a$tc) && a$z > 5 && isTRUE(a$shape >= 0.5)) {
     # within a factor 2: support; beyond 3: contradiction; between,
     # undecided (a one-GM compromise over two processes sits there: the
     # loop tries it as two GMs, one where the ACF reads Tc and one as far
@@ -89,8 +91,12 @@ evidence_gm <- function(par, raw, x, freq) {
          support = support,
          split = if (is.na(support)) list(list(tc = a$tc), list(tc = tc^2 / a$tc)))
   } else {
-    list(text = sprintf("no exponential ACF near Tc = %s s (z = %.1f)",
-                        format_num(tc), a$z), support = FALSE)
+    list(text = sprintf("no exponential ACF near Tc = %s s (z = %.1f%s)",
+                        format_num(tc), a$z,
+                        if (is.finite(a$shape) && a$shape < 0.5)
+                          sprintf(", the exponential explains %.0f%% of its shape", 100 * a$shape)
+                        else ""),
+         support = FALSE)
   }
 }
 

@@ -57,6 +57,27 @@ test_that("a skewed band is measured from the raw series and its AV matches", {
   expect_equal(allan(y, freq, taus = a$tau)$avar, th, tolerance = 0.1)
 })
 
+test_that("a measured band's centre is its half-power centroid, not the middle of its skirted edges", {
+  # two-pole resonators (AR(2), stats::filter) at 7 and 18 Hz beside each
+  # other and white noise: each one's skirt widens the other's band edges
+  # unevenly, so the edges' midpoint and the whole band's centroid drift
+  set.seed(72)
+  freq <- 100
+  n <- 2^19
+  ar2 <- function(fr, tc) {
+    r <- exp(-1 / (freq * tc))
+    z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * fr / freq), -r^2),
+                                  method = "recursive"))[-(1:2000)]
+    z / stats::sd(z)
+  }
+  x <- 0.5 * ar2(7, 0.3) + ar2(18, 0.1) + rnorm(n, sd = 0.3)
+  bands <- allanvar:::find_bands(x, freq)
+  centre <- vapply(seq_len(nrow(bands)), function(j) {
+    allanvar:::measure_band(x, freq, bands[j, ], others = bands[-j, ])$f_c
+  }, 0)
+  for (fr in c(7, 18)) expect_lte(min(abs(centre / fr - 1)), 0.03)
+})
+
 test_that("the curve's scale must be the measured one", {
   e <- allanvar:::effect_entry("band")
   par <- list(amp = 1, f_lo = 17, f_hi = 26, u = 0.03)
