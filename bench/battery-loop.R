@@ -15,8 +15,9 @@
 # (BATTERY_OUT=file.rds saves the table). Set "a" (the default) is the
 # battery the loop was built against; set "b" has other frequencies, time
 # constants, amplitudes, axes and seeds, written once "a" passed, to see
-# whether what passes "a" generalises; set "c" was written before any run
-# on it, once "a" and "b" were in use.
+# whether what passes "a" generalises; sets "c" and "d" were each written
+# before any run on them, once the sets before were in use ("d" also has
+# simulated axes that carry a sensor's own filter, line and resonance).
 #
 # The recordings stay in the shared data directory (never shipped).
 suppressPackageStartupMessages(library(allanvar))
@@ -378,6 +379,72 @@ if (identical(set, "c")) {
   )
 }
 
+# ---- set "d" -------------------------------------------------------------------
+# Written before any run on it, once "a", "b" and "c" were in use. Its
+# simulated "sensor" axes carry what a measured accelerometer does: white
+# noise through a short moving average, a line, a two-pole resonance and a
+# random walk; the effect is added beside them.
+if (identical(set, "d")) {
+  sensor_base <- function(n = n_sim, fr = 9.85) {
+    w <- rnorm(n + 1L, sd = 0.01)
+    (w[-1L] + 0.25 * w[-(n + 1L)]) + g_band(n, 0.012, fr, 0.5) + g_line(n, 0.014, 0.54) + g_rw(n, 1.3e-4)
+  }
+  cases <- list(
+    "sim: line 48.6 Hz, amp = 0.7 white sd" = function() {
+      b <- sim_base(); list(x = b + g_line(n_sim, 0.007, 48.6), base = b, expect = list(list("sinusoid", 48.6)))
+    },
+    "sim: square wave 0.45 Hz" = function() {
+      b <- sim_base(); list(x = b + g_square(n_sim, 0.004, 0.45), base = b,
+        expect = list(list("sinusoid", 0.45), list("sinusoid", 1.35), list("sinusoid", 2.25)),
+        harmonics_of = 0.45)
+    },
+    "sim: GM tc 16 s" = function() {
+      b <- sim_base(); g <- g_gm(n_sim, 0.003, 16); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: GM tc 70 s" = function() {
+      b <- sim_base(); g <- g_gm(n_sim, 0.0015, 70); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: GMs 2 s and 30 s" = function() {
+      b <- sim_base() + g_gm(n_sim, 0.004, 2); g <- g_gm(n_sim, 0.003, 30)
+      list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: band 13 Hz beside a resonance at 27 Hz" = function() {
+      b <- sim_base() + g_band(n_sim, 0.01, 27, 0.15)
+      list(x = b + g_band(n_sim, 0.007, 13, 0.3), base = b, expect = list(list("band", 13)))
+    },
+    "sim: warm-up tc 6% (300 s)" = function() {
+      b <- sim_base(); list(x = b + g_warmup(b, 300), base = b, expect = list(list("warmup", 300)))
+    },
+    "sim sensor: line 3.7 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_line(n_sim, 0.004, 3.7), base = b, expect = list(list("sinusoid", 3.7)))
+    },
+    "sim sensor: line 2.2 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_line(n_sim, 0.003, 2.2), base = b, expect = list(list("sinusoid", 2.2)))
+    },
+    "sim sensor: GM tc 25 s" = function() {
+      b <- sensor_base(); g <- g_gm(n_sim, 0.003, 25); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim sensor: band 4 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_band(n_sim, 0.006, 4, 0.3), base = b, expect = list(list("band", 4)))
+    },
+    "control: sim sensor as it is" = function() list(x = sensor_base(), base = NULL),
+    "control: N + K (seed 4)" = function() list(x = sim_base(), base = NULL),
+    "control: N + B + K low B" = function() list(x = sim_base() + g_flicker(n_sim, 3e-4), base = NULL)
+  )
+  real <- list(
+    list(u = 1, j = 5, what = "line", f0 = 2.7),
+    list(u = 3, j = 4, what = "line", f0 = 5.6),
+    list(u = 2, j = 1, what = "band", fr = 9),
+    list(u = 3, j = 2, what = "gm", tc = 25),
+    list(u = 1, j = 6, what = "gm", tc = 12),
+    list(u = 2, j = 5, what = "nyquist", f0 = 46.8),
+    list(u = 1, j = 4, what = "square", f0 = 0.9),
+    list(u = 2, j = 5, what = "warmup", tc = 120),
+    list(u = 3, j = 3, what = "warmup", tc = 600),
+    list(u = 1, j = 2, what = "step", t0 = 3000)
+  )
+}
+
 for (rc in real) local({
   rc <- rc
   nm <- sprintf("real: unit %d col %d + %s", rc$u, rc$j,
@@ -438,7 +505,7 @@ cached_run <- function(x) {
 }
 rows <- list()
 for (nm in grep(only, names(cases), value = TRUE)) {
-  set.seed(c(a = 2700, b = 2900, c = 3100)[[set]] + match(nm, names(cases)))
+  set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300)[[set]] + match(nm, names(cases)))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
   if (is.null(cs$base)) {
