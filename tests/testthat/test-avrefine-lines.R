@@ -212,3 +212,28 @@ test_that("a line beside a measured axis's filter and resonance: the filter's fo
   expect_false(any(r$steps$confirmed %in% FALSE))
   expect_lt(r$chi2, 4)
 })
+
+test_that("a strong line beside a measured band enters: the band's measured scale is held, not broken", {
+  # a simulated sensor axis: white noise through a short moving average, a
+  # two-pole resonance at 9.85 Hz, a 0.54 Hz line of 1.4 x the white sd and
+  # a random walk. The first step took the band the raw spectrum measured;
+  # the line's refit moved the band's scale beyond its measured power, so
+  # the line was refused and the loop stopped at chi2/dof 6897 (N -54%).
+  set.seed(14)
+  freq <- 100
+  n <- 5e5
+  w <- rnorm(n + 1L, sd = 0.01)
+  r <- exp(-1 / (freq * 0.5))
+  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * 9.85 / freq), -r^2),
+                                method = "recursive"))[-(1:2000)]
+  t <- seq_len(n) / freq
+  x <- (w[-1L] + 0.25 * w[-(n + 1L)]) + 0.012 * z / stats::sd(z) +
+    0.014 * sin(2 * pi * 0.54 * t + runif(1, 0, 2 * pi)) + cumsum(rnorm(n, sd = 1.3e-4 / sqrt(freq)))
+  r <- loop(x, freq)
+  cf <- coef(r)
+  expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / 0.54 - 1)), 0.03)
+  expect_lt(r$chi2, 4)
+  # the white level at DC: 1.25 x 0.01 x sqrt(1 / freq)
+  expect_lte(abs(n_reading(r) / 1.25e-3 - 1), 0.15)
+  expect_false(any(r$steps$confirmed %in% FALSE))
+})
