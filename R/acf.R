@@ -39,11 +39,7 @@ detrend_linear <- function(x) detrend_line(as.double(x))
 # `cache`: NULL or an environment (avrefine()'s, one per call and series)
 # in which the ACF of the block means is kept by block size m, so that the
 # checks of many candidate Tc that share m read the series once.
-# `others`: correlation times (s) of further exponential parts the series
-# carries (the model's other GMs), fitted beside it with free amplitudes:
-# a 3 s GM's share of the 5 s block means' lag-1 ACF otherwise pulls a
-# 30 s GM's reading to 10-15 s.
-acf_exponential <- function(x, freq, tc, cache = NULL, others = numeric()) {
+acf_exponential <- function(x, freq, tc, cache = NULL) {
   m <- max(1L, floor(tc * freq / 8))
   key <- paste0("acf_exponential.", m)
   hit <- if (!is.null(cache)) cache[[key]]
@@ -63,22 +59,17 @@ acf_exponential <- function(x, freq, tc, cache = NULL, others = numeric()) {
   r <- hit$r
   max_lag <- length(r)
   lag <- seq_len(max_lag)
-  # an other part enters where its ACF neither vanishes by lag 1 nor stays
-  # flat over the lags (the constant and linear terms hold that)
-  others <- others[others * freq / m > 0.15 & others * freq / m < 2 * max_lag]
-  Xo <- vapply(others, function(t) exp(-lag * m / (freq * t)), numeric(max_lag))
-  Xo <- matrix(Xo, nrow = max_lag)
   # ACF = a exp(-lag m tau0 / Tc) + (c + d lag): the linear part absorbs the
   # slowly falling ACF of flicker and random walk over a few Tc. Tc is
   # profiled on a grid within a factor 5 of the hint; a minimum on the
   # grid's edge means Tc is not identified.
   grid <- tc * 10^seq(-0.7, 0.7, by = 0.02)
   rss <- vapply(grid, function(g) {
-    X <- cbind(exp(-lag * m / (freq * g)), Xo, 1, lag)
+    X <- cbind(exp(-lag * m / (freq * g)), 1, lag)
     sum(stats::lm.fit(X, r)$residuals^2)
   }, 0)
   k <- which.min(rss)
-  X <- cbind(exp(-lag * m / (freq * grid[k])), Xo, 1, lag)
+  X <- cbind(exp(-lag * m / (freq * grid[k])), 1, lag)
   a <- unname(stats::lm.fit(X, r)$coefficients[1L])
   est <- if (k > 1L && k < length(grid) && is.finite(a) && a > 0) grid[k] else NA_real_
   list(tc = est, r1 = r[1L], amp = a, z = a * sqrt(nb), m = m)

@@ -50,9 +50,8 @@
 #                 may refine: a pinned trial that passes is refitted with
 #                 them free, searched from there, and the better kept)
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
-#   evidence(par, raw, x, freq[, model])  list(text, support = TRUE/FALSE/NA): what
-#                 the raw series says about a fitted instance (`model`, when
-#                 the function takes it: the fit it sits in, or NULL)
+#   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
+#                 the raw series says about a fitted instance
 #   peak_tau(par)  characteristic tau of an instance (where its residual
 #                 signature sits), or NULL
 #   reading     NULL, or how the entry is read off a curve for a datasheet:

@@ -57,7 +57,7 @@ gm_discrete_rows <- function(term, sigma, tc, dt, unit, how) {
 
 # Raw-data evidence for a fitted GM: an exponential ACF of block means near
 # its Tc, or for Tc of a few samples the raw lag-1 autocorrelation.
-evidence_gm <- function(par, raw, x, freq, model = NULL) {
+evidence_gm <- function(par, raw, x, freq) {
   tc <- par[["tc"]] %||% NA_real_
   sigma <- par[["sigma"]] %||% NA_real_
   if (is.finite(tc) && tc * freq < 4) {
@@ -76,7 +76,7 @@ evidence_gm <- function(par, raw, x, freq, model = NULL) {
     return(list(text = "record too short for an ACF check", support = NA))
   }
   # avrefine()'s per-call store (NULL elsewhere)
-  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw), others = gm_others(model, tc))
+  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw))
   if (is.finite(a$tc) && a$z > 5) {
     # within a factor 2: support; beyond 3: contradiction; between,
     # undecided (a one-GM compromise over two processes sits there: the
@@ -92,17 +92,6 @@ evidence_gm <- function(par, raw, x, freq, model = NULL) {
     list(text = sprintf("no exponential ACF near Tc = %s s (z = %.1f)",
                         format_num(tc), a$z), support = FALSE)
   }
-}
-
-# The correlation times of the model's other GMs that the block-mean ACF
-# can tell from this one (more than a factor 2 away): it is read beside
-# them.
-gm_others <- function(model, tc) {
-  if (is.null(model)) return(numeric())
-  labs <- term_labels(model$terms)[split_term(model$terms)$kind == "gm"]
-  cf <- stats::coef(model)
-  v <- vapply(labs, function(l) instance_params(cf, model$layout, l)[["tc"]], 0)
-  unname(v[is.finite(v) & (v < tc / 2 | v > tc * 2)])
 }
 
 effect_gauss_markov <- function() {

@@ -181,17 +181,12 @@ print.avdiagnose <- function(x, ...) {
 
 # Evidence from the raw series for one fitted effect (`par`: its parameters
 # by name): a short string and whether the data support it (TRUE),
-# contradict it (FALSE) or cannot tell (NA). The entry's evidence() decides;
-# one with a `model` argument is also given the fit the instance sits in
-# (`model`, NULL when unknown), to read it beside the model's other terms.
-raw_evidence <- function(effect, par, raw, x, freq, model = NULL) {
+# contradict it (FALSE) or cannot tell (NA). The entry's evidence() decides.
+raw_evidence <- function(effect, par, raw, x, freq) {
   if (is.null(raw)) return(list(text = "", support = NA))
   e <- effect_entry(split_term(effect)$kind, split_term(effect)$variant)
   if (is.null(e$evidence)) {
     return(list(text = "no raw-data check for this effect", support = NA))
-  }
-  if ("model" %in% names(formals(e$evidence))) {
-    return(e$evidence(par, raw, x, freq, model = model))
   }
   e$evidence(par, raw, x, freq)
 }

@@ -40,22 +40,6 @@ screen_trial <- function(st, tr, nl_now) {
   c1 <- crit_s(new)
   pays <- is.finite(c1) && c1 < c0 - need &&
     new$chi2 < (if (set_line) 1 else 0.9) * cur$chi2
-  # A second instance screened beside its own kind held at the one-term
-  # compromise (a GM at 3.9 s over processes of 2.9 and 20 s) explains
-  # part of what is left but cannot pay for the holds: it is refitted once
-  # with everything free (without a residual signature no free pass runs).
-  if (!pays && is.finite(c1) && new$chi2 < 0.9 * cur$chi2 &&
-      holds_own_kind(cur, hold_now, tr$effect)) {
-    args <- refit_args(cur, new$terms, settings,
-                       start = stats::coef(new)[new$layout$role == "nonlinear"], hold = pin)
-    r <- state_refit(st, args, "free refit of a screen beside its own kind", tr$effect)
-    st <- r$st
-    if (!is.null(r$fit) && is.finite(crit(r$fit)) && crit(r$fit) < c1) {
-      new <- r$fit
-      c1 <- crit(new)
-      pays <- c1 < c0 - need && new$chi2 < 0.9 * cur$chi2
-    }
-  }
   if (!pays) return(list(st = st, cand = NULL))
   lab <- new_label(cur$terms, tr$effect)
   # An added term that explains (almost) nothing anywhere is a refit
@@ -218,7 +202,7 @@ judge_instance <- function(st, f, effect, label, tau) {
   par <- instance_params(stats::coef(f), f$layout, label)
   why <- inadmissible(effect, par, tau, freq)
   ev <- if (is.null(why)) raw_evidence(effect, as.list(par), st$raw,
-                                       diag_series(st$raw), freq, f)
+                                       diag_series(st$raw), freq)
   if (is.null(why) && isFALSE(ev$support)) {
     why <- paste("contradicted by the raw data:", ev$text)
   }
@@ -284,7 +268,7 @@ rechoose_families <- function(st) {
             st$args$min_gain) next
       par <- instance_params(stats::coef(g), g$layout, lab)
       if (!is.null(inadmissible(v, par, g$data$tau, st$args$freq))) next
-      ev <- raw_evidence(v, as.list(par), st$raw, diag_series(st$raw), st$args$freq, g)
+      ev <- raw_evidence(v, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
       if (isFALSE(ev$support) || !earlier_hold(st, g)) next
       swap <- list(fit = g, crit = refine_crit(st, g), effect = v, label = lab,
                    par = par, ev = ev)
@@ -303,13 +287,3 @@ rechoose_families <- function(st) {
   }
   list(st = st, swapped = FALSE)
 }
-
-# Whether the screen of `effect` held values (`hold`, named "label.param")
-# of an instance of the same kind in model `cur`.
-holds_own_kind <- function(cur, hold, effect) {
-  if (!length(hold)) return(FALSE)
-  kinds <- split_term(cur$terms)$kind
-  labs <- term_labels(cur$terms)[kinds == split_term(effect)$kind]
-  any(sub("\\.[^.]*$", "", names(hold)) %in% labs)
-}
-

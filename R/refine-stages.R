@@ -377,8 +377,7 @@ step_refit_winner <- function(st) {
   full <- r$fit
   if (!is.null(full) && refine_crit(st, full) <= best$crit + 1e-6) {
     p2 <- instance_params(stats::coef(full), full$layout, best$label)
-    ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq,
-                       full)
+    ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)
     if (!isFALSE(ev2$support) &&
         is.null(unconfirmed_marginal(effect, ev2, st$c0 - refine_crit(st, full),
                                      st$args$min_gain, st$raw)) &&
@@ -422,7 +421,7 @@ step_record <- function(st) {
     par2 <- instance_params(stats::coef(best$fit), best$fit$layout, lab2)
     loc2 <- locate_signature(st$sig, best$fit, lab2)
     ev2 <- raw_evidence(best$trial$effect, as.list(par2), st$raw,
-                        diag_series(st$raw), st$args$freq, best$fit)
+                        diag_series(st$raw), st$args$freq)
     st$steps[[length(st$steps) + 1L]] <- step_row(
       best$trial$effect, lab2, loc2, par2,
       paste0(loc2$text, "; split from ", best$label, "'s one-term compromise",

@@ -95,7 +95,7 @@ earlier_broken <- function(st, f) {
       out <- c(out, s$label)
       next
     }
-    ev <- raw_evidence(s$effect, as.list(par), st$raw, diag_series(st$raw), freq, f)
+    ev <- raw_evidence(s$effect, as.list(par), st$raw, diag_series(st$raw), freq)
     if (isFALSE(ev$support)) out <- c(out, s$label)
   }
   out
