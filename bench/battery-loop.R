@@ -12,7 +12,7 @@
 # (`lost`), and the seconds of the run with the effect.
 #
 #   R_LIBS=/tmp/lib Rscript bench/battery-loop.R [data dir] [cases regex] [set]
-# (BATTERY_OUT=file.rds saves the table). Set "a" (the default) is the
+# (BATTERY_OUT=file.rds saves the table; BATTERY_RUNS=dir each case's runs). Set "a" (the default) is the
 # battery the loop was built against; set "b" has other frequencies, time
 # constants, amplitudes, axes and seeds, written once "a" passed, to see
 # whether what passes "a" generalises; sets "c" and "d" were each written
@@ -532,6 +532,12 @@ for (nm in grep(only, names(cases), value = TRUE)) {
       spikes = sprintf("%d/%d", n_spikes(r), n_spikes(base)),
       contradicted = contradicted(r), chi2 = round(r$chi2, 2),
       seconds = round(r$seconds, 1))
+  }
+  # BATTERY_RUNS=dir keeps each case's series and runs (bench/gm-tc-raw.R reads them)
+  runs <- Sys.getenv("BATTERY_RUNS")
+  if (nzchar(runs) && !is.null(cs$base)) {
+    saveRDS(list(x = cs$x, base_x = cs$base, r = r, base = base, expect = cs$expect),
+            file.path(runs, paste0(set, "_", gsub("[^A-Za-z0-9.]+", "_", nm), ".rds")))
   }
   print(rows[[length(rows)]], row.names = FALSE)
 }
