@@ -2,7 +2,7 @@
 # the running-median backgrounds, spectral lines (significant bins, their
 # harmonic sets, the band an Allan deviation curve can see, matching within
 # the resolution, removal from the series) and broad bands (a resonance's
-# bump: detection, Lorentzian fit, removal). Periodic disturbances and
+# bump: detection, fit of the resonance's PSD, removal). Periodic disturbances and
 # narrow-band processes are read here for the catalogue's sinusoid,
 # resonance and band entries (R/effect-*.R).
 
@@ -490,7 +490,7 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
 #' lifts the median of its own window). Each band is then described by the
 #' resonance model fitted to the excess over the background by least
 #' squares (relative to the background): centre `f_center`, `tc` (its
-#' Lorentzian FWHM is 1/(pi tc), given as `width`), `power` (its variance,
+#' FWHM is about 1/(pi tc), given as `width`), `power` (its variance,
 #' sigma^2) and `share` of the series' variance.
 #' Cost O(n log seg).
 #' @noRd
@@ -577,7 +577,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     lo <- if (k > 1L) r2$to[k - 1L] + 1L else 2L
     hi <- if (k < length(r2$from)) r2$from[k + 1L] - 1L else nb
     reg <- max(2L, lo, r2$from[k] - 2L * wd):min(nb, hi, r2$to[k] + 2L * wd)
-    fit <- fit_lorentz(w$f[reg], p[reg] - bg[reg], bg[reg], tau0,
+    fit <- fit_resonance_psd(w$f[reg], p[reg] - bg[reg], bg[reg], tau0,
                        fc, sum(ex) * w$df, max(sdf, w$df))
     data.frame(f_center = fit$fr, f_from = w$f[j[1L]], f_to = w$f[j[length(j)]],
                width = 1 / (pi * fit$tc), tc = fit$tc, power = fit$sigma^2,
@@ -645,10 +645,10 @@ split_valleys <- function(r, p, bg, nu, min_bins) {
   r
 }
 
-# Least-squares fit of the resonance's one-sided PSD (2 x two-sided) to the
-# excess `ex` over a background `bg` at frequencies f, relative to the
-# background; starts from the band's moments.
-fit_lorentz <- function(f, ex, bg, tau0, fc, power, sdf) {
+# Least-squares fit of the resonance's one-sided PSD (2 x two-sided, the
+# AR(2) form of R/resonance.R) to the excess `ex` over a background `bg` at
+# frequencies f, relative to the background; starts from the band's moments.
+fit_resonance_psd <- function(f, ex, bg, tau0, fc, power, sdf) {
   model <- function(q) 2 * resonance_psd(f, tau0, exp(q[1L]), q[2L], exp(q[3L]))
   obj <- function(q) sum(((ex - model(q)) / bg)^2)
   q0 <- c(log(sqrt(power)), fc, log(1 / (2 * pi * sdf)))
@@ -658,12 +658,12 @@ fit_lorentz <- function(f, ex, bg, tau0, fc, power, sdf) {
 
 # The series with each broad band of find_bands() brought down to its
 # background: every FFT bin is scaled by sqrt(bg / (bg + M(f))), where M is
-# the band's fitted Lorentzian (one-sided PSD) and bg the background PSD
-# read 3-6 band widths away (M taken off), so that the expected power of
-# each bin becomes the background's. Phases are kept, so the white noise
-# and the filter's roll-off under the band stay; only the band's excess
-# goes. Used for the raw-data checks of the other effects (the filter's
-# short-lag ACF, a Gauss-Markov ACF), which a resonance disturbs.
+# the band's fitted resonance PSD (one-sided, the AR(2) form, skirt
+# included) and bg the background PSD (M taken off), so that the expected
+# power of each bin becomes the background's. Phases are kept, so the white
+# noise and the filter's roll-off under the band stay; only the band's
+# excess goes. Used for the raw-data checks of the other effects (the
+# filter's short-lag ACF, a Gauss-Markov ACF), which a resonance disturbs.
 remove_bands <- function(x, freq, bands) {
   if (is.null(bands) || !nrow(bands)) return(x)
   n <- length(x)
@@ -684,9 +684,12 @@ remove_bands <- function(x, freq, bands) {
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
     M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)
-    w <- max(b$width, b$f_to - b$f_from)
-    d <- abs(fh - b$f_center)
-    near <- which(d > 3 * w & d < 6 * w)
+    near <- band_background_bins(fh, bands, k)
+    if (!length(near)) {
+      warn("no background bins for the band at ", format(signif(b$f_center, 4)),
+           " Hz: left in the series", class = "band_kept")
+      next
+    }
     Gn <- if (length(G) > 1L) G[near] else G
     bg <- sum(wt[near] * (Ph[near] * Gn^2 - M[near])) / sum(wt[near])
     if (!is.finite(bg) || bg <= 0) next
@@ -696,3 +699,21 @@ remove_bands <- function(x, freq, bands) {
   real_ifft_cpp(X * G, np, n) / np + m
 }
 
+# The bins (indices into fh, 0..Nyquist) a band's background is read from:
+# 3-6 widths from its centre (the wider of its run and its fitted FWHM),
+# outside the other bands' runs. A wide run near 0 Hz or Nyquist has no
+# such bins (the ADIS z gyros' 20 Hz bands at 100 Hz): then 3-6 fitted
+# FWHM, then every bin outside all the runs.
+band_background_bins <- function(fh, bands, k) {
+  b <- bands[k, ]
+  d <- abs(fh - b$f_center)
+  other <- rep(FALSE, length(fh))
+  for (j in seq_len(nrow(bands))) {
+    other <- other | (fh >= bands$f_from[j] & fh <= bands$f_to[j])
+  }
+  w <- max(b$width, b$f_to - b$f_from)
+  near <- which(d > 3 * w & d < 6 * w & !other)
+  if (!length(near)) near <- which(d > 3 * b$width & d < 6 * b$width & !other)
+  if (!length(near)) near <- which(!other & d > b$width)
+  near
+}
