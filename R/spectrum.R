@@ -708,14 +708,11 @@ remove_bands <- function(x, freq, bands) {
   n <- length(x)
   m <- mean(x)
   tau0 <- 1 / freq
-  # zero-padded (record_fft_size()); the pad is filtered and dropped.
-  # Bins 0..freq/2: each but DC and Nyquist stands for its mirror too, so
-  # it weighs 2 in the background's mean
+  # zero-padded (record_fft_size()); the pad is filtered and dropped
   np <- record_fft_size(n)
   X <- real_fft_cpp(x - m, np)
   h <- length(X)
   fh <- (seq_len(h) - 1) * freq / np
-  wt <- c(1, rep(2, h - 2L), 1)
   Ph <- 2 * Mod(X)^2 / (n * freq)
   in_run <- rep(FALSE, h)
   for (j in seq_len(nrow(bands))) {
@@ -728,21 +725,19 @@ remove_bands <- function(x, freq, bands) {
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
     M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)
-    near <- band_background_bins(fh, b, in_run)
-    if (!length(near)) {
+    P <- Ph * G^2
+    # the power the spectrum shows, smoothed over the Welch resolution
+    # (freq / 512), and the band's fitted PSD no higher than its excess
+    # over the background B: a measured band that falls faster than the
+    # fitted form (the ADIS z gyros' below 20 Hz) loses no more than it has
+    S <- smooth(P)
+    B <- band_background(fh, b, in_run, S - pmin(M, S))
+    if (is.null(B)) {
       warn("no background bins for the band at ", format(signif(b$f_center, 4)),
            " Hz: left in the series", class = "band_kept")
       next
     }
-    P <- Ph * G^2
-    # Each bin keeps the power the spectrum shows (smoothed over the Welch
-    # resolution, freq / 512) less the band's: the background under the
-    # band as it is, sloped or not; no less than bg where the fitted form
-    # exceeds the measured band (the ADIS z gyros' falls faster below 20 Hz)
-    S <- smooth(P)
-    bg <- sum(wt[near] * (P[near] - pmin(M[near], S[near]))) / sum(wt[near])
-    if (!is.finite(bg) || bg <= 0) next
-    G <- G * sqrt(pmin(1, pmax(S - M, bg) / S))
+    G <- G * sqrt(B / (B + pmin(M, pmax(S - B, 0))))
   }
   if (length(G) == 1L) return(x)
   real_ifft_cpp(X * G, np, n) / np + m
@@ -761,17 +756,34 @@ bin_smoother <- function(n, k) {
   }
 }
 
-# The bins (indices into fh, 0..Nyquist) the background of band `b` (a row
-# of find_bands()) is read from: 3-6 widths from its centre (the wider of
-# its run and its fitted FWHM), outside every band's run (`other`, logical
-# over fh). A wide run near 0 Hz or Nyquist has no such bins (the ADIS z
-# gyros' 20 Hz bands at 100 Hz): then 3-6 fitted FWHM, then every bin
-# outside the runs.
-band_background_bins <- function(fh, b, other) {
-  d <- abs(fh - b$f_center)
-  w <- max(b$width, b$f_to - b$f_from)
-  near <- which(d > 3 * w & d < 6 * w & !other)
-  if (!length(near)) near <- which(d > 3 * b$width & d < 6 * b$width & !other)
-  if (!length(near)) near <- which(!other & d > b$width)
-  near
+# The background PSD under band `b` (a row of find_bands()) at every bin
+# fh (0..Nyquist), from `R`, the smoothed spectrum with the band's fitted
+# PSD taken off, outside every band's run (`other`, logical over fh): its
+# medians just below and just above the run (one run width, or 3 fitted
+# FWHM if wider, on each side; a median, as a window reaching 0 Hz holds
+# the random walk's few huge bins), linear in f between them, flat beyond;
+# from one side if the other has no bins (a run reaching 0 Hz or Nyquist,
+# the ADIS z gyros' 20 Hz bands at 100 Hz); else the median of all bins
+# outside the runs farther than one FWHM. A background that slopes under
+# the band (a filter's roll-off) is followed. NULL if no bin or a median <= 0.
+band_background <- function(fh, b, other, R) {
+  w <- max(b$f_to - b$f_from, 3 * b$width)
+  side <- function(sel) {
+    i <- which(sel & !other)
+    if (!length(i)) return(NULL)
+    v <- stats::median(R[i])
+    if (!is.finite(v) || v <= 0) return(NULL)
+    c(f = mean(fh[i]), v = v)
+  }
+  lo <- side(fh >= b$f_from - w & fh < b$f_from)
+  hi <- side(fh > b$f_to & fh <= b$f_to + w)
+  if (is.null(lo) && is.null(hi)) {
+    one <- side(abs(fh - b$f_center) > b$width)
+    if (is.null(one)) return(NULL)
+    return(rep(one[["v"]], length(fh)))
+  }
+  if (is.null(lo) || is.null(hi)) {
+    return(rep((if (is.null(lo)) hi else lo)[["v"]], length(fh)))
+  }
+  stats::approx(c(lo[["f"]], hi[["f"]]), c(lo[["v"]], hi[["v"]]), xout = fh, rule = 2)$y
 }
