@@ -212,8 +212,8 @@ effect_resonance <- function() {
     # off; the raw-data check still asks for the band within half its
     # width of fr. (A free trial beside the pinned one, screened whether or
     # not the pinned one passed, paid 0 of 68 times on the 18 ADIS16405
-    # axes for a quarter of the screening time.) A band that is not
-    # Lorentzian is the measured band's (entry "band").
+    # axes for a quarter of the screening time.) A band whose shape is not
+    # the AR(2)'s is the measured band's (entry "band").
     propose = function(raw, tau, sig) {
       b <- diag_part(raw, "bands")
       out <- list()

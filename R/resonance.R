@@ -84,9 +84,9 @@ resonance_start <- function(band) {
 # whose centre lies within half its width (or 2 resolution bins) of f_r is
 # support, with its power within a factor 2 of sigma^2; no band at all near
 # f_r contradicts it, as does a width 1/(pi tc) more than 3x off the band's.
-# The band's power is measured to a few percent; a band that is not quite
-# Lorentzian puts its AV-equivalent power off by tens of percent (the
-# accepted resonances of the 18 ADIS16405 axes: 0.93-1.5x). A resonance
+# The band's power is measured to a few percent; a band whose shape is not
+# quite the AR(2)'s puts its AV-equivalent power off by tens of percent
+# (the accepted resonances of the 18 ADIS16405 axes: 0.93-1.5x). A resonance
 # the curve wants at twice the band's power or more stands in for
 # something else that shapes the curve near 1/(2 f_r) (unit 3 accel_y with
 # a warm-up added took an 8.15 Hz resonance at 2.9x its band's power).
