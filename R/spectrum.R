@@ -696,9 +696,10 @@ fit_resonance_psd <- function(f, ex, bg, tau0, fc, power, sdf, start = NULL) {
 }
 
 # The series with each broad band of find_bands() brought down to its
-# background: every FFT bin is scaled by sqrt(bg / (bg + M(f))), where M is
+# background: every FFT bin is scaled by sqrt(B / (B + M(f))), where M is
 # the band's fitted resonance PSD (one-sided, the AR(2) form, skirt
-# included) and bg the background PSD (M taken off), so that the expected
+# included; no higher than the smoothed spectrum's excess over B) and B(f)
+# the background PSD under it (band_background()), so that the expected
 # power of each bin becomes the background's. Phases are kept, so the white
 # noise and the filter's roll-off under the band stay; only the band's
 # excess goes. Used for the raw-data checks of the other effects (the
