@@ -172,7 +172,7 @@ effect_resonance <- function() {
       effect_param("tc", "nonlinear", "s", "second (damping time; FWHM 1/(pi tc))",
                    profile = "smooth", print_unit = TRUE)),
     repeatable = TRUE, slope = NA_real_, psd_alpha = NA_real_,
-    formula = "Re of the AR(1) form with the complex pole exp(-tau0/tc + 2 pi i fr tau0)",
+    formula = "a real AR(2) (damped oscillator) with poles exp(-tau0/tc +- 2 pi i fr tau0)",
     signature = paste("a bump at tau ~ 0.37/fr with nulls like a sinusoid's but",
                       "damped; a broad periodogram band at fr of width 1/(pi tc)"),
     basis = function(tau, tau0, nl) {
@@ -212,8 +212,8 @@ effect_resonance <- function() {
     # off; the raw-data check still asks for the band within half its
     # width of fr. (A free trial beside the pinned one, screened whether or
     # not the pinned one passed, paid 0 of 68 times on the 18 ADIS16405
-    # axes for a quarter of the screening time.) A band that is not
-    # Lorentzian is the measured band's (entry "band").
+    # axes for a quarter of the screening time.) A band whose shape is not
+    # the AR(2)'s is the measured band's (entry "band").
     propose = function(raw, tau, sig) {
       b <- diag_part(raw, "bands")
       out <- list()

@@ -3,20 +3,35 @@
 # power is spread over a band of width ~1/(pi Tc) around f_r, so no
 # sinusoid describes it. Here: its math, simulator and raw-data evidence.
 #
-# Model: the real part of a complex AR(1), z_k = r e^{i w} z_{k-1} + e_k,
-# r = exp(-tau0 / Tc), w = 2 pi f_r tau0. Its autocovariance is
-#   g(h) = sigma^2 r^|h| cos(w h),
-# a Gauss-Markov process shifted to f_r (f_r = 0 gives the GM exactly);
-# its PSD is a pair of Lorentzians at +-f_r with half width 1/(2 pi Tc).
+# Model: a damped second-order system driven by white noise, sampled: the
+# real AR(2) x_k = 2 r cos(w) x_{k-1} - r^2 x_{k-2} + e_k with the poles
+# p = r e^{+-i w}, r = exp(-tau0 / Tc), w = 2 pi f_r tau0 (0 < f_r < Nyquist).
+# Its autocovariance is
+#   g(h) = sigma^2 r^|h| (cos(w h) + c sin(w |h|)),  c = (1 - r^2) / (1 + r^2) cot(w),
+# = Re(A p^|h|) with A = sigma^2 (1 - i c). The c term is the band's
+# low-frequency skirt (its PSD is 1 / |1 - p e^{-iw'}|^2 |1 - conj(p) e^{-iw'}|^2,
+# not a pair of Lorentzians); near f_r the two agree, FWHM ~ 1/(pi Tc).
+# sigma is the process's sd, whatever fr and tc.
+
+# c of the ACF's sine term
+resonance_c <- function(tau0, fr, tc) {
+  r <- exp(-tau0 / tc)
+  (1 - r^2) / (1 + r^2) / tan(2 * pi * fr * tau0)
+}
 
 resonance_acf <- function(h, tau0, sigma, fr, tc) {
   r <- exp(-tau0 / tc)
-  sigma^2 * r^abs(h) * cos(2 * pi * fr * tau0 * h)
+  w <- 2 * pi * fr * tau0
+  k <- abs(h)
+  # c sin(w k) = (1 - r^2) / (1 + r^2) cos(w) sin(w k) / sin(w), whose
+  # limit at sin(w) = 0 is k cos(w)^(k - 1)
+  ratio <- if (sin(w) == 0) k * cos(w)^(k - 1) else sin(w * k) / sin(w)
+  sigma^2 * r^k * (cos(w * k) + (1 - r^2) / (1 + r^2) * cos(w) * ratio)
 }
 
-# Exact discrete AV at cluster sizes m: g(h) = Re(sigma^2 p^|h|) with
-# p = r e^{iw}, so AV = Re(geometric_av(m, sigma^2, p)) (the AR(1) form,
-# noise-models.md section 1, with a complex pole).
+# Exact discrete AV at cluster sizes m: g(h) = Re(A p^|h|), and the AR(1)
+# form (noise-models.md section 1) is linear in A, so AV =
+# Re(geometric_av(m, A, p)) with a complex A and pole.
 # The searches evaluate it at every value they visit: in C++ (src/resonance.cpp,
 # the R expression's operations in R's complex arithmetic), the R expression
 # for anything but plain numbers.
@@ -30,39 +45,34 @@ resonance_av <- function(m, tau0, sigma, fr, tc) {
 
 resonance_av_r <- function(m, tau0, sigma, fr, tc) {
   p <- exp(-tau0 / tc) * exp(1i * 2 * pi * fr * tau0)
-  Re(geometric_av(m, sigma^2, p))
+  s2 <- sigma^2
+  A <- complex(real = s2, imaginary = -(s2 * resonance_c(tau0, fr, tc)))
+  Re(geometric_av(m, A, p))
 }
 
 is_plain_number <- function(v) is.double(v) && length(v) == 1L && !is.na(v)
 
-# Two-sided PSD (u^2/Hz) of the sampled process: tau0 sum_h g(h) e^{-i w' h}
-# = tau0 sigma^2 Re[(1 + q) / (1 - q)] summed over q = p e^{-iw'} and its
-# mirror, /2 each.
-# (src/resonance.cpp: r = exp(-tau0 / tc), w = 2 pi f tau0, w0 = 2 pi fr tau0,
-# one(d) = Re((1 + q) / (1 - q)) with q = r exp(1i d), and
-# tau0 sigma^2 0.5 (one(w0 - w) + one(-w0 - w)), in real arithmetic)
+# Two-sided PSD (u^2/Hz) of the sampled process:
+# tau0 s_e^2 / (|1 - p e^{-iw'}|^2 |1 - conj(p) e^{-iw'}|^2), w' = 2 pi f tau0,
+# with the innovation variance s_e^2 = sigma^2 (1 - r^2) |1 - p^2|^2 / (1 + r^2)
+# (src/resonance.cpp, in real arithmetic without cancellation near r = 1).
 resonance_psd <- function(f, tau0, sigma, fr, tc) {
   resonance_psd_cpp(as.double(f), tau0, sigma, fr, tc)
 }
 
-# n samples, started from the stationary law: x is the real part of z with
-# E|z|^2 = 2 sigma^2, so x has variance sigma^2.
+# n samples of the AR(2), started from the stationary law (two samples
+# with variance sigma^2 and lag-1 covariance g(1)).
 sim_resonance <- function(n, tau0, sigma, fr, tc) {
-  p <- exp(-tau0 / tc) * exp(1i * 2 * pi * fr * tau0)
-  s <- sigma * sqrt(1 - Mod(p)^2)
-  z <- complex(n)
-  z0 <- complex(real = stats::rnorm(1L, sd = sigma), imaginary = stats::rnorm(1L, sd = sigma))
-  e <- complex(real = stats::rnorm(n, sd = s), imaginary = stats::rnorm(n, sd = s))
-  # the real AR(2) form of Re z: x_k = 2 Re(p) x_{k-1} - |p|^2 x_{k-2} + u_k,
-  # u_k = Re(e_k - conj(p) e_{k-1}); started from two exact samples
-  u <- Re(e - Conj(p) * c(0, e[-n]))
-  z1 <- p * z0 + e[1L]
-  z2 <- p * z1 + e[2L]
-  if (n <= 2L) return(Re(c(z1, z2))[seq_len(n)])
-  u[1:2] <- 0
-  x <- stats::filter(u, c(2 * Re(p), -Mod(p)^2), method = "recursive",
-                     init = c(Re(z2), Re(z1)))
-  c(Re(z1), Re(z2), as.numeric(x[3:n]))
+  r <- exp(-tau0 / tc)
+  w <- 2 * pi * fr * tau0
+  rho <- resonance_acf(1, tau0, 1, fr, tc)
+  se <- sigma * sqrt((1 - r^2) * ((1 - r^2)^2 + 4 * r^2 * sin(w)^2) / (1 + r^2))
+  x1 <- stats::rnorm(1L, sd = sigma)
+  x2 <- rho * x1 + stats::rnorm(1L, sd = sigma * sqrt(max(1 - rho^2, 0)))
+  if (n <= 2L) return(c(x1, x2)[seq_len(n)])
+  x <- stats::filter(stats::rnorm(n - 2L, sd = se), c(2 * r * cos(w), -r^2),
+                     method = "recursive", init = c(x2, x1))
+  c(x1, x2, as.numeric(x))
 }
 
 # Start values of a resonance term from a band of find_bands().
@@ -74,9 +84,9 @@ resonance_start <- function(band) {
 # whose centre lies within half its width (or 2 resolution bins) of f_r is
 # support, with its power within a factor 2 of sigma^2; no band at all near
 # f_r contradicts it, as does a width 1/(pi tc) more than 3x off the band's.
-# The band's power is measured to a few percent; a band that is not quite
-# Lorentzian puts its AV-equivalent power off by tens of percent (the
-# accepted resonances of the 18 ADIS16405 axes: 0.93-1.5x). A resonance
+# The band's power is measured to a few percent; a band whose shape is not
+# quite the AR(2)'s puts its AV-equivalent power off by tens of percent
+# (the accepted resonances of the 18 ADIS16405 axes: 0.93-1.5x). A resonance
 # the curve wants at twice the band's power or more stands in for
 # something else that shapes the curve near 1/(2 f_r) (unit 3 accel_y with
 # a warm-up added took an 8.15 Hz resonance at 2.9x its band's power).

@@ -1,13 +1,15 @@
 # The battery's bands (bench/battery-loop.R, g_band: white noise through a
 # two-pole resonator, an AR(2)) against what the package describes them
-# with (the resonance entry: a Lorentzian pair, the real part of a complex
-# AR(1)) and against the band removal the filter's raw-data check reads
-# (remove_bands()). Prints, per band: the AV the band adds at 1 s and 10 s
-# in units of the white noise's (0.01 per sample, 100 Hz), the same for a
-# Lorentzian of equal variance, fr and tc; whether remove_bands() finds
-# background bins 3-6 run widths from the band's centre (else it leaves the
-# band in the series); and the filter check's lag-1 excess of the series
-# white + band before and after the removal (no filter in it: 0 is right).
+# with (the resonance entry: a real AR(2) since session 17; a Lorentzian
+# pair, the real part of a complex AR(1), before) and against the band
+# removal the filter's raw-data check reads (remove_bands()). Prints, per
+# band: the AV the band adds at 1 s and 10 s in units of the white noise's
+# (0.01 per sample, 100 Hz), the same for the resonance entry's exact AV
+# of equal variance, fr and tc (columns *_lorentz: the old form's name);
+# whether bins 3-6 run widths from the band's centre exist (main before
+# session 17 left the band in the series without them); and the filter
+# check's lag-1 excess of the series white + band before and after the
+# removal (no filter in it: 0 is right).
 #
 #   R_LIBS=/tmp/lib Rscript bench/band-shapes.R
 suppressPackageStartupMessages(library(allanvar))

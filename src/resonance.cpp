@@ -4,23 +4,27 @@
 #include <Rcpp.h>
 #include <complex>
 
-// tau0 * sigma^2 * 0.5 * (one(w0 - w) + one(-w0 - w)), w = 2 pi f tau0,
-// one(d) = Re((1 + q) / (1 - q)), q = r exp(1i * d), r = exp(-tau0 / tc),
-// which is (1 - r^2) / |1 - q|^2 with |1 - q|^2 = (1 - r)^2 + 4 r sin(d/2)^2:
-// no cancellation where r is near 1 and d near 0 (a long tc at its peak),
-// where 1 - r cos(d) would lose digits.
+// The real AR(2) with poles r exp(+-i w0), r = exp(-tau0 / tc),
+// w0 = 2 pi fr tau0, variance sigma^2:
+//   tau0 s_e^2 / (D(w0 - w) D(-w0 - w)),  w = 2 pi f tau0,
+//   D(d) = |1 - r exp(i d)|^2 = (1 - r)^2 + 4 r sin(d / 2)^2,
+//   s_e^2 = sigma^2 (1 - r^2) ((1 - r^2)^2 + 4 r^2 sin(w0)^2) / (1 + r^2)
+// (|1 - p^2|^2 written without cancellation), with 1 - r from expm1: no
+// digits lost where r is near 1 and d near 0 (a long tc at its peak).
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
                                       double sigma, double fr, double tc) {
   const double pi = 3.141592653589793238462643383279502884;
   const double a = -std::expm1(-tau0 / tc);  // 1 - r
   const double r = 1.0 - a;
-  const double num = a * (1.0 + r);
   const double a2 = a * a, r4 = 4.0 * r;
-  const double scale = tau0 * (sigma * sigma) * 0.5;
   // d / 2 = (+-w0 - w) / 2: both sines from one sine and cosine of w / 2
   const double h0 = pi * fr * tau0;
   const double sa = std::sin(h0), ca = std::cos(h0);
+  const double s0 = 2.0 * sa * ca;           // sin(w0)
+  const double q = a * (1.0 + r);            // 1 - r^2
+  const double se2 = q * (q * q + 4.0 * r * r * s0 * s0) / (1.0 + r * r);
+  const double scale = tau0 * (sigma * sigma) * se2;
   const R_xlen_t n = f.size();
   Rcpp::NumericVector out(n);
   for (R_xlen_t k = 0; k < n; k++) {
@@ -28,7 +32,7 @@ Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
     const double sb = std::sin(b), cb = std::cos(b);
     const double h1 = sa * cb - ca * sb;  // sin((w0 - w) / 2)
     const double h2 = sa * cb + ca * sb;  // -sin((-w0 - w) / 2)
-    out[k] = scale * (num / (a2 + r4 * h1 * h1) + num / (a2 + r4 * h2 * h2));
+    out[k] = scale / ((a2 + r4 * h1 * h1) * (a2 + r4 * h2 * h2));
     if ((k & 0xFFFFF) == 0) Rcpp::checkUserInterrupt();
   }
   return out;
@@ -62,8 +66,9 @@ static std::complex<double> r_cpow(std::complex<double> X, double yr) {
 }
 
 // A resonance's Allan variance at cluster sizes m (R/resonance.R,
-// resonance_av()): Re(geometric_av(m, sigma^2, p)), p = exp(-tau0 / tc) *
-// exp(1i * 2 * pi * fr * tau0), the R expressions' operations in their
+// resonance_av()): Re(geometric_av(m, A, p)), p = exp(-tau0 / tc) *
+// exp(1i * 2 * pi * fr * tau0), A = sigma^2 (1 - i c) with
+// c = (1 - r^2) / (1 + r^2) / tan(2 * pi * fr * tau0), the R expressions' operations in their
 // order and in R's complex arithmetic (each real promoted to complex before
 // a product or sum), so the values are R's; the loop's searches evaluate it
 // at every value they visit.
@@ -77,7 +82,11 @@ Rcpp::NumericVector resonance_av_cpp(const Rcpp::NumericVector& m, double tau0,
   w = w * cplx(fr, 0.0);
   w = w * cplx(tau0, 0.0);
   const cplx p = cplx(std::exp(-tau0 / tc), 0.0) * std::exp(w);
-  const cplx A(sigma * sigma, 0.0);
+  // resonance_c(): r^2 is r * r in R's arithmetic
+  const double r = std::exp(-tau0 / tc);
+  const double c = (1.0 - r * r) / (1.0 + r * r) / std::tan(2.0 * pi * fr * tau0);
+  const double s2 = sigma * sigma;
+  const cplx A(s2, -(s2 * c));
   const cplx p2 = r_cpow(p, 2.0);
   const cplx p3 = cplx(3.0, 0.0) * p;
   const cplx q2 = r_cpow(cplx(1.0, 0.0) - p, 2.0);
