@@ -255,23 +255,17 @@ judge_instance <- function(st, f, effect, label, tau) {
 rechoose_families <- function(st) {
   if (!length(st$steps)) return(list(st = st, swapped = FALSE))
   for (e in entries_with("family")) {
+    ff <- family_forms(st, e)
+    if (is.null(ff)) next
     cur <- st$current
-    variants <- e$family$variants
-    fi <- cur$terms[split_term(cur$terms)$kind == e$name]
-    if (length(fi) != 1L) next
-    rest <- cur$terms[cur$terms != fi]
-    old_lab <- term_labels(cur$terms)[cur$terms == fi]
-    nl_cur <- stats::coef(cur)[cur$layout$role == "nonlinear"]
+    fi <- ff$current
+    rest <- ff$rest
     stage <- paste(e$name, "family chosen again")
     swap <- NULL
-    for (j in seq_along(variants)) {
-      v <- family_term(e$name, variants, variants[j])
-      if (v == fi) next
-      lab <- new_label(rest, v)
-      s0 <- e$family$start(st$raw, variants[j])
-      start <- c(nl_cur[!startsWith(names(nl_cur), paste0(old_lab, "."))],
-                 if (length(s0)) stats::setNames(unlist(s0), paste0(lab, ".", names(s0))))
-      start <- start[names(start) %in% coef_layout(c(rest, v))$name]
+    for (fm in ff$forms) {
+      v <- fm$term
+      lab <- fm$label
+      start <- fm$start[names(fm$start) %in% coef_layout(c(rest, v))$name]
       args <- refit_args(cur, c(rest, v), st$settings, start = start)
       r <- state_refit(st, args, stage, v, length(st$steps) + 1L)
       st <- r$st
@@ -301,6 +295,30 @@ rechoose_families <- function(st) {
   list(st = st, swapped = FALSE)
 }
 
+# The other forms of family entry `e`'s one instance in the current model
+# (NULL when it holds none, or several): each form's term, label and the
+# start of its refit (the model's other nonlinear values, the form's own
+# read from the raw data).
+family_forms <- function(st, e) {
+  cur <- st$current
+  fi <- cur$terms[split_term(cur$terms)$kind == e$name]
+  if (length(fi) != 1L) return(NULL)
+  rest <- cur$terms[cur$terms != fi]
+  old_lab <- term_labels(cur$terms)[cur$terms == fi]
+  nl_cur <- stats::coef(cur)[cur$layout$role == "nonlinear"]
+  nl_rest <- nl_cur[!startsWith(names(nl_cur), paste0(old_lab, "."))]
+  variants <- e$family$variants
+  forms <- lapply(seq_along(variants), function(j) {
+    v <- family_term(e$name, variants, variants[j])
+    if (v == fi) return(NULL)
+    lab <- new_label(rest, v)
+    s0 <- e$family$start(st$raw, variants[j])
+    list(term = v, label = lab,
+         start = c(nl_rest, if (length(s0)) stats::setNames(unlist(s0), paste0(lab, ".", names(s0)))))
+  })
+  list(current = fi, rest = rest, forms = Filter(Negate(is.null), forms))
+}
+
 # The trials of this step refused as contradicted by the raw data at
 # values they pin, once each (a trial is screened held and free).
 add_refused <- function(refused, tr) {
@@ -327,20 +345,15 @@ family_pairs <- function(st) {
   min_gain <- st$args$min_gain
   tau <- cur$data$tau
   freq <- st$args$freq
-  nl_cur <- stats::coef(cur)[cur$layout$role == "nonlinear"]
   for (e in entries_with("family")) {
-    fi <- cur$terms[split_term(cur$terms)$kind == e$name]
-    if (length(fi) != 1L) next
-    rest <- cur$terms[cur$terms != fi]
-    old_lab <- term_labels(cur$terms)[cur$terms == fi]
-    variants <- e$family$variants
-    for (j in seq_along(variants)) {
-      v <- family_term(e$name, variants, variants[j])
-      if (v == fi) next
-      vlab <- new_label(rest, v)
-      s0 <- e$family$start(st$raw, variants[j])
-      sv <- c(nl_cur[!startsWith(names(nl_cur), paste0(old_lab, "."))],
-              if (length(s0)) stats::setNames(unlist(s0), paste0(vlab, ".", names(s0))))
+    ff <- family_forms(st, e)
+    if (is.null(ff)) next
+    fi <- ff$current
+    rest <- ff$rest
+    for (fm in ff$forms) {
+      v <- fm$term
+      vlab <- fm$label
+      sv <- fm$start
       for (tr in st$refused) {
         tm <- model_terms(c(rest, v), tr$effect, c(tr$init[[1L]], tr$pin[[1L]]), cur)
         before <- tm[-length(tm)]
