@@ -242,3 +242,26 @@ test_that("a square wave's harmonics above the 15th stay in its set; a weaker li
   expect_false(l$source[j] == s)
   expect_gt(sum(l$ratio > l$ratio[j]), 5L)
 })
+
+test_that("find_bands(): a band's fit does not slide onto a strong line beside it", {
+  # a 4 Hz two-pole band beside a 0.54 Hz line of 1.4 x the white sd and a
+  # 9.85 Hz resonance (stats::filter AR(2)s): the 4 Hz band's fit region
+  # reaches the line, and its resonance fit ran off to it (centre -0.52 Hz)
+  set.seed(2)
+  freq <- 100
+  n <- 5e5
+  ar2 <- function(fr, tc) {
+    r <- exp(-1 / (freq * tc))
+    z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * fr / freq), -r^2),
+                                  method = "recursive"))[-(1:2000)]
+    z / stats::sd(z)
+  }
+  t <- seq_len(n) / freq
+  x <- rnorm(n, sd = 0.01) + 0.006 * ar2(4, 0.3) + 0.014 * sin(2 * pi * 0.54 * t + 1) +
+    0.012 * ar2(9.85, 0.5)
+  b <- allanvar:::find_bands(x, freq)
+  expect_equal(nrow(b), 2L)
+  expect_lte(min(abs(b$f_center / 4 - 1)), 0.05)
+  expect_lte(min(abs(b$f_center / 9.85 - 1)), 0.02)
+  expect_true(all(b$f_center >= b$f_from & b$f_center <= b$f_to))
+})
