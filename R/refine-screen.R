@@ -273,12 +273,10 @@ rechoose_families <- function(st) {
       if (is.null(g) || !is.finite(refine_crit(st, g)) ||
           refine_crit(st, g) >= min(refine_crit(st, cur), swap$crit %||% Inf) -
             st$args$min_gain) next
-      par <- instance_params(stats::coef(g), g$layout, lab)
-      if (!is.null(inadmissible(v, par, g$data$tau, st$args$freq))) next
-      ev <- raw_evidence(v, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
-      if (isFALSE(ev$support) || !earlier_hold(st, g)) next
+      fj <- judge_form(st, g, v, lab)
+      if (is.null(fj)) next
       swap <- list(fit = g, crit = refine_crit(st, g), effect = v, label = lab,
-                   par = par, ev = ev)
+                   par = fj$par, ev = fj$ev)
     }
     if (!is.null(swap)) {
       loc <- locate_signature(st$sig, swap$fit, swap$label)
@@ -319,6 +317,17 @@ family_forms <- function(st, e) {
   list(current = fi, rest = rest, forms = Filter(Negate(is.null), forms))
 }
 
+# A family's form `v` (label `lab`) in refit `g`: valid on the curve, not
+# contradicted by the raw data, and the effects accepted earlier hold.
+# Returns list(par, ev), or NULL when it fails.
+judge_form <- function(st, g, v, lab) {
+  par <- instance_params(stats::coef(g), g$layout, lab)
+  if (!is.null(inadmissible(v, par, g$data$tau, st$args$freq))) return(NULL)
+  ev <- raw_evidence(v, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
+  if (isFALSE(ev$support) || !earlier_hold(st, g)) return(NULL)
+  list(par = par, ev = ev)
+}
+
 # The trials of this step refused as contradicted by the raw data at
 # values they pin, once each (a trial is screened held and free).
 add_refused <- function(refused, tr) {
@@ -344,7 +353,6 @@ family_pairs <- function(st) {
   c0 <- refine_crit(st, cur)
   min_gain <- st$args$min_gain
   tau <- cur$data$tau
-  freq <- st$args$freq
   for (e in entries_with("family")) {
     ff <- family_forms(st, e)
     if (is.null(ff)) next
@@ -375,16 +383,14 @@ family_pairs <- function(st) {
             c1 >= (st$best$crit %||% Inf) || max_share(f, lab) < 0.02) next
         jd <- judge_instance(st, f, tr$effect, lab, tau)
         if (!is.null(jd$why) || !isTRUE(jd$ev$support)) next
-        pv <- instance_params(stats::coef(f), f$layout, vlab)
-        if (!is.null(inadmissible(v, pv, tau, freq))) next
-        ev <- raw_evidence(v, as.list(pv), st$raw, diag_series(st$raw), freq)
-        if (isFALSE(ev$support) || !earlier_hold(st, f)) next
+        fj <- judge_form(st, f, v, vlab)
+        if (is.null(fj)) next
         jd$ev$text <- sprintf("%s; with the %s family chosen again (was %s)",
                               jd$ev$text, e$name, fi)
         st$best <- list(fit = f, crit = c1, adj = c1 - min_gain, trial = tr,
                         label = lab, params = jd$par, ev = jd$ev, pin = pin,
                         fixed = settings$fixed,
-                        also = list(effect = v, label = vlab, par = pv, ev = ev,
+                        also = list(effect = v, label = vlab, par = fj$par, ev = fj$ev,
                                     note = paste0("the ", e$name, " family chosen again (was ",
                                                   fi, ") beside ", lab)))
       }

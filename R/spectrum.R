@@ -575,16 +575,17 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     hi <- if (k < length(r2$from)) r2$from[k + 1L] - 1L else nb
     list(j = j, reg = max(2L, lo, r2$from[k] - 2L * wd):min(nb, hi, r2$to[k] + 2L * wd))
   })
+  # a fit whose centre leaves its run has slid onto a neighbour
+  in_run <- function(ft, g) ft$fr >= w$f[g$j[1L]] && ft$fr <= w$f[g$j[length(g$j)]]
   fits <- lapply(regs, function(g) {
     ex <- pmax(p[g$j] - bg[g$j], 0)
     fc <- sum(w$f[g$j] * ex) / sum(ex)
     sdf <- sqrt(sum((w$f[g$j] - fc)^2 * ex) / sum(ex))
     ft <- fit_resonance_psd(w$f[g$reg], p[g$reg] - bg[g$reg], bg[g$reg], tau0,
                             fc, sum(ex) * w$df, max(sdf, w$df))
-    # a fit whose centre leaves its run has slid onto a stronger neighbour
-    # in the fit region (a 4 Hz band's onto a 0.54 Hz line: centre 0.52
-    # Hz, tc 7600 s); the run's moments describe the band instead
-    if (ft$fr >= w$f[g$j[1L]] && ft$fr <= w$f[g$j[length(g$j)]]) ft else
+    # (a 4 Hz band's onto a 0.54 Hz line in the fit region: centre -0.52
+    # Hz); the run's moments describe the band instead
+    if (in_run(ft, g)) ft else
       list(sigma = sqrt(sum(ex) * w$df), fr = fc, tc = 1 / (2 * pi * max(sdf, w$df)))
   })
   # The background's running median still holds the bands' skirts (a
@@ -612,8 +613,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
       fits <- lapply(seq_along(regs), function(k) {
         g <- regs[[k]]
         ft <- fit_resonance_psd(w$f[g$reg], p[g$reg] - bg[g$reg], bg[g$reg], tau0, start = fits[[k]])
-        inside <- ft$fr >= w$f[g$j[1L]] && ft$fr <= w$f[g$j[length(g$j)]]
-        if (inside) ft else fits[[k]]
+        if (in_run(ft, g)) ft else fits[[k]]
       })
     }
   }
