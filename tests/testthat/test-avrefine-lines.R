@@ -9,6 +9,12 @@ loop <- function(x, freq) {
   fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
   suppressMessages(avrefine(fit, data = x))
 }
+# a measured ADIS16405 axis: the series, its rate and its white sd a sample
+measured_axis <- function(unit, axis) {
+  m <- readRDS(shared_file(sprintf("adis16405_unit%d.rds", unit)))
+  b <- as.numeric(m[, axis])
+  list(b = b, freq = attr(m, "freq"), s = stats::sd(diff(b)) / sqrt(2))
+}
 n_reading <- function(r) {
   cf <- coef(r)
   # N, or the white level a filter term of any form carries
@@ -100,10 +106,10 @@ test_that("a line beside a measured axis's own: the greedy order is revisited wi
   # stays where the run without it puts it, and the model fits.
   skip_if_no_shared()
   skip_on_cran()
-  m <- readRDS(shared_file("adis16405_unit2.rds"))
-  b <- as.numeric(m[, "accel_y"])
-  freq <- attr(m, "freq")
-  s <- stats::sd(diff(b)) / sqrt(2)
+  ax <- measured_axis(2, "accel_y")
+  b <- ax$b
+  freq <- ax$freq
+  s <- ax$s
   x <- b + 0.3 * s * sin(2 * pi * 1.7 * seq_along(b) / freq + 0.7)
   r <- loop(x, freq)
   cf <- coef(r)
@@ -157,10 +163,10 @@ test_that("a square wave added to a measured accelerometer: its 5th harmonic is 
   # below the square wave's harmonics and was never proposed.
   skip_if_no_shared()
   skip_on_cran()
-  m <- readRDS(shared_file("adis16405_unit2.rds"))
-  b <- as.numeric(m[, "accel_z"])
-  freq <- attr(m, "freq")
-  s <- stats::sd(diff(b)) / sqrt(2)
+  ax <- measured_axis(2, "accel_z")
+  b <- ax$b
+  freq <- ax$freq
+  s <- ax$s
   x <- b + 0.4 * s * sign(sin(2 * pi * 1.1 * seq_along(b) / freq + 2.1))
   r <- loop(x, freq)
   cf <- coef(r)
@@ -177,10 +183,10 @@ test_that("an added line does not cost a measured axis its own Gauss-Markov term
   # filter's form again spent the fifth: the GM was never reached
   skip_if_no_shared()
   skip_on_cran()
-  m <- readRDS(shared_file("adis16405_unit3.rds"))
-  b <- as.numeric(m[, "accel_y"])
-  freq <- attr(m, "freq")
-  s <- stats::sd(diff(b)) / sqrt(2)
+  ax <- measured_axis(3, "accel_y")
+  b <- ax$b
+  freq <- ax$freq
+  s <- ax$s
   x <- b + 0.3 * s * sin(2 * pi * 0.9 * seq_along(b) / freq + 0.4)
   r <- loop(x, freq)
   expect_true("gm" %in% split_term(r$terms)$kind)
@@ -197,10 +203,10 @@ test_that("a line beside a measured axis's filter and resonance: the filter's fo
   # at the power the curve gave it (chi2/dof 38, N +11%).
   skip_if_no_shared()
   skip_on_cran()
-  m <- readRDS(shared_file("adis16405_unit3.rds"))
-  b <- as.numeric(m[, "accel_x"])
-  freq <- attr(m, "freq")
-  s <- stats::sd(diff(b)) / sqrt(2)
+  ax <- measured_axis(3, "accel_x")
+  b <- ax$b
+  freq <- ax$freq
+  s <- ax$s
   x <- b + 0.3 * s * sin(2 * pi * 3.1 * seq_along(b) / freq + 1.3)
   r0 <- loop(b, freq)
   r <- loop(x, freq)
