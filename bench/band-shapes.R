@@ -1,4 +1,4 @@
-# The battery's bands (bench/battery-loop.R, g_band: white noise through a
+# The battery's bands (bench/battery-generators.R, g_band: white noise through a
 # two-pole resonator, an AR(2)) against what the package describes them
 # with (the resonance entry: a real AR(2) since session 17; a Lorentzian
 # pair, the real part of a complex AR(1), before) and against the band
@@ -11,19 +11,13 @@
 # check's lag-1 excess of the series white + band before and after the
 # removal (no filter in it: 0 is right).
 #
-#   R_LIBS=/tmp/lib Rscript bench/band-shapes.R
+#   R_LIBS=/tmp/lib Rscript bench/band-shapes.R   (from the repository root)
 suppressPackageStartupMessages(library(allanvar))
 options(allanvar.threads = 1L)
 ns <- asNamespace("allanvar")
 freq <- 100
 n <- 5e5
-g_band <- function(n, sigma, fr, tc) {
-  r <- exp(-1 / (freq * tc))
-  w0 <- 2 * pi * fr / freq
-  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(w0), -r^2),
-                                method = "recursive"))[-(1:2000)]
-  sigma * z / stats::sd(z)
-}
+source("bench/battery-generators.R")
 bands <- list(c(0.006, 7, 0.3), c(0.006, 12, 0.3), c(0.006, 30, 0.3),
               c(0.01, 12, 0.1), c(0.01, 18, 0.1), c(0.01, 21, 0.1))
 rows <- list()
