@@ -12,6 +12,7 @@
 # (`lost`), and the seconds of the run with the effect.
 #
 #   R_LIBS=/tmp/lib Rscript bench/battery-loop.R [data dir] [cases regex] [set]
+# (from the repository root: it sources bench/battery-generators.R)
 # (BATTERY_OUT=file.rds saves the table; BATTERY_RUNS=dir each case's runs). Set "a" (the default) is the
 # battery the loop was built against; set "b" has other frequencies, time
 # constants, amplitudes, axes and seeds, written once "a" passed, to see
