@@ -50,7 +50,11 @@ effect_quantization <- function() {
     # white phase: the structure function of the phase is 2 Q^2 / tau0^2 for l > 0
     exact_edf = function(amp, nl, tau0) list(list(shape = "step", coef = amp[[1L]]^2 / tau0^2)),
     trace = trace_edge("short", -1, "Q", basis),
-    evidence = evidence_quantization
+    evidence = evidence_quantization,
+    diagnose = list(part = "quantization", reads = "raw", needs = "lines",
+                    make = function(x, freq, dg) {
+                      quantization_lag1(x, freq, diag_part(dg, "lines"))
+                    })
   )
 }
 
@@ -260,16 +264,35 @@ discrete_row <- function(term, parameter, value, unit, continuous,
 # ---- raw-data evidence of the power-law terms --------------------------------
 
 # Quantization: the lag-1 ACF of differenced uniform noise is -1/2; an LSB
-# grid is reported when present.
+# grid is reported when present. The lag-1 ACF is read without the
+# periodogram's lines (quantization_lag1()): a line near Nyquist makes it
+# negative too (a 46.8 Hz line at 100 Hz: -0.10 on a sensor whose lag-1 ACF
+# without it is positive). (A bare avdiagnose(): its raw lag-1 ACF.)
 evidence_quantization <- function(par, raw, x, freq) {
   g <- diag_value(raw, "grid")
-  z1 <- diag_value(raw, "acf1_z")
-  txt <- sprintf("raw lag-1 ACF %.3f (z = %.0f)", diag_value(raw, "acf1"), z1)
+  q <- diag_part(raw, "quantization") %||%
+    list(r1 = diag_value(raw, "acf1"), z1 = diag_value(raw, "acf1_z"), lines = 0L)
+  txt <- sprintf("raw lag-1 ACF %.3f (z = %.0f)%s", q$r1, q$z1,
+                 if (q$lines > 0L) sprintf(" without its %d periodogram line%s", q$lines,
+                                           if (q$lines > 1L) "s" else "") else "")
   if (isTRUE(g$quantized)) {
     txt <- paste0(txt, sprintf("; LSB grid step %s (%.0f%% on grid)",
                                format_num(g$step), 100 * g$on_grid))
   }
-  list(text = txt, support = z1 < -3)
+  list(text = txt, support = q$z1 < -3)
+}
+
+# The raw lag-1 autocorrelation with the periodogram's lines taken out of
+# the autocovariances (a line of amplitude a at f adds a^2/2 to the
+# variance and a^2/2 cos(2 pi f tau0) at lag 1).
+quantization_lag1 <- function(x, freq, lines) {
+  n <- length(x)
+  a <- acf_sums(x - mean(x), 1L) / n
+  p <- lines$amp^2 / 2
+  c0 <- a[1L] - sum(p)
+  c1 <- a[2L] - sum(p * cos(2 * pi * lines$f0 / freq))
+  r1 <- if (c0 > 0) c1 / c0 else NA_real_
+  list(r1 = r1, z1 = r1 * sqrt(n), lines = nrow(lines))
 }
 
 # A ramp: a significant linear trend (read beyond the series effects left

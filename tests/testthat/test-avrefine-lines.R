@@ -40,6 +40,49 @@ test_that("a line at 49.3 Hz (100 Hz sampling, amplitude the white sd) is named;
   expect_lt(r$chi2, 2)
 })
 
+test_that("quantization's lag-1 evidence is read without the periodogram's lines", {
+  # own generator: white noise through a two-tap filter (lag-1 ACF +0.235)
+  # and a 46.8 Hz line of the white sd: the raw lag-1 ACF is -0.17, the
+  # filtered noise's own +0.235, which quantization cannot give
+  set.seed(2713)
+  freq <- 100
+  n <- 2e5
+  e <- rnorm(n + 1L)
+  x <- e[-1L] + 0.25 * e[-(n + 1L)] + sin(2 * pi * 46.8 * seq_len(n) / freq + 0.4)
+  d <- avdiagnose(x, freq)
+  expect_lt(d$acf1, -0.1)
+  q <- allanvar:::quantization_lag1(x, freq, d$lines)
+  expect_equal(q$r1, 0.25 / 1.0625, tolerance = 0.03)
+  dg <- allanvar:::refine_diagnostics(x, freq)
+  ev <- allanvar:::raw_evidence("Q", list(Q = 0.001), dg, allanvar:::diag_series(dg), freq)
+  expect_false(ev$support)
+  expect_match(ev$text, "without its 1 periodogram line")
+  # differenced uniform noise beside the same line: still quantization
+  u <- diff(runif(n + 1L, -1, 1)) * sqrt(3) / 2
+  y <- u + sin(2 * pi * 46.8 * seq_len(n) / freq + 0.4)
+  dg <- allanvar:::refine_diagnostics(y, freq)
+  expect_true(allanvar:::raw_evidence("Q", list(Q = 0.001), dg,
+                                      allanvar:::diag_series(dg), freq)$support)
+})
+
+test_that("a line at 46.8 Hz on a measured accelerometer: no quantization term beside it", {
+  # unit 2 accel_y carries the sensor's filter (positive short-lag ACF); a
+  # 46.8 Hz line of the white sd made its raw lag-1 ACF negative, and a Q
+  # term was taken as "confirmed" by it
+  skip_if_no_shared()
+  skip_on_cran()
+  ax <- measured_axis(2, "accel_y")
+  set.seed(2714)
+  x <- ax$b + ax$s * sin(2 * pi * 46.8 * seq_along(ax$b) / ax$freq + runif(1, 0, 2 * pi))
+  r <- loop(x, ax$freq)
+  cf <- coef(r)
+  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  expect_true(any(abs(f0 / 46.8 - 1) <= 0.03))
+  expect_false("Q" %in% r$terms)
+  expect_false(any(r$steps$confirmed %in% FALSE))
+  expect_equal(n_reading(r), n_reading(loop(ax$b, ax$freq)), tolerance = 0.05)
+})
+
 test_that("a 0.8 Hz square wave: its lines 0.8, 2.4 and 4.0 Hz are named, no band or resonance", {
   set.seed(2712)
   freq <- 100
