@@ -16,7 +16,7 @@
 # (BATTERY_OUT=file.rds saves the table; BATTERY_RUNS=dir each case's runs). Set "a" (the default) is the
 # battery the loop was built against; set "b" has other frequencies, time
 # constants, amplitudes, axes and seeds, written once "a" passed, to see
-# whether what passes "a" generalises; sets "c" and "d" were each written
+# whether what passes "a" generalises; sets "c", "d" and "e" were each written
 # before any run on them, once the sets before were in use ("d" also has
 # simulated axes that carry a sensor's own filter, line and resonance).
 #
@@ -401,6 +401,75 @@ if (identical(set, "d")) {
   )
 }
 
+# ---- set "e" -------------------------------------------------------------------
+# Written before any run on it, once "a" to "d" were in use (session 18):
+# other frequencies, time constants, axes and seeds; a sawtooth (every
+# harmonic); simulated sensor axes of another filter, line and resonance.
+if (identical(set, "e")) {
+  sensor_base <- function(n = n_sim) {
+    w <- rnorm(n + 1L, sd = 0.012)
+    (w[-1L] + 0.35 * w[-(n + 1L)]) + g_band(n, 0.01, 11.2, 0.4) + g_line(n, 0.011, 0.61) +
+      g_rw(n, 1e-4)
+  }
+  cases <- list(
+    "sim sensor: line 45.5 Hz, amp = 0.8 white sd" = function() {
+      b <- sensor_base(); list(x = b + g_line(n_sim, 0.0096, 45.5), base = b,
+                               expect = list(list("sinusoid", 45.5)))
+    },
+    "sim: sawtooth 1.1 Hz" = function() {
+      b <- sim_base(); list(x = b + g_saw(n_sim, 0.006, 1.1), base = b,
+        expect = list(list("sinusoid", 1.1), list("sinusoid", 2.2), list("sinusoid", 3.3)),
+        harmonics_of = 1.1)
+    },
+    "sim: GM tc 45 s" = function() {
+      b <- sim_base(); g <- g_gm(n_sim, 0.0025, 45); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: GMs 3 s and 50 s" = function() {
+      b <- sim_base() + g_gm(n_sim, 0.004, 3); g <- g_gm(n_sim, 0.0025, 50)
+      list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: band 7 Hz beside a resonance at 22 Hz" = function() {
+      b <- sim_base() + g_band(n_sim, 0.009, 22, 0.2)
+      list(x = b + g_band(n_sim, 0.006, 7, 0.4), base = b, expect = list(list("band", 7)))
+    },
+    "sim: warm-up tc 15% (750 s)" = function() {
+      b <- sim_base(); list(x = b + g_warmup(b, 750), base = b, expect = list(list("warmup", 750)))
+    },
+    "sim sensor: line 6.1 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_line(n_sim, 0.004, 6.1), base = b, expect = list(list("sinusoid", 6.1)))
+    },
+    "sim sensor: GM tc 10 s" = function() {
+      b <- sensor_base(); g <- g_gm(n_sim, 0.004, 10); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim sensor: band 17 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_band(n_sim, 0.007, 17, 0.3), base = b, expect = list(list("band", 17)))
+    },
+    "sim sensor: warm-up tc 200 s" = function() {
+      b <- sensor_base(); list(x = b + g_warmup(b, 200), base = b, expect = list(list("warmup", 200)))
+    },
+    "sim sensor: step at 2800 s" = function() {
+      b <- sensor_base(); sz <- g_step_size(b)
+      list(x = b + g_step(n_sim, 2800, sz), base = b, expect = list(list("steps", c(2800, sz))))
+    },
+    "control: sim sensor as it is" = function() list(x = sensor_base(), base = NULL),
+    "control: N + K (seed 5)" = function() list(x = sim_base(), base = NULL),
+    "control: N + B + K" = function() list(x = sim_base() + g_flicker(n_sim, 6e-4), base = NULL)
+  )
+  real <- list(
+    list(u = 3, j = 5, what = "line", f0 = 3.3),
+    list(u = 2, j = 4, what = "line", f0 = 0.3),
+    list(u = 1, j = 1, what = "nyquist", f0 = 44.1),
+    list(u = 2, j = 2, what = "band", fr = 15),
+    list(u = 1, j = 6, what = "band", fr = 6),
+    list(u = 2, j = 3, what = "gm", tc = 40),
+    list(u = 1, j = 5, what = "gm", tc = 6),
+    list(u = 3, j = 6, what = "square", f0 = 0.6),
+    list(u = 1, j = 3, what = "warmup", tc = 250),
+    list(u = 2, j = 6, what = "warmup", tc = 60),
+    list(u = 3, j = 1, what = "step", t0 = 5200)
+  )
+}
+
 for (rc in real) local({
   rc <- rc
   nm <- sprintf("real: unit %d col %d + %s", rc$u, rc$j,
@@ -461,7 +530,7 @@ cached_run <- function(x) {
 }
 rows <- list()
 for (nm in grep(only, names(cases), value = TRUE)) {
-  set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300)[[set]] + match(nm, names(cases)))
+  set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500)[[set]] + match(nm, names(cases)))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
   if (is.null(cs$base)) {
