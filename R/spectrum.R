@@ -433,13 +433,14 @@ record_taper <- function(n) {
 # significant (5 sd of a sum of bins whose taper correlates them over its
 # 2-bin noise bandwidth) and at least a tenth of the lines' excess (else it
 # is the lines' own shoulder or an error of the background). Returns
-# list(lines = frequencies, line_power, band = logical, band_power).
+# list(lines = frequencies, line_power, band = logical, band_power,
+# rest_ratio = the excess outside the lines' lobes over the background there).
 record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
   nb <- length(rp$psd)
   i_lo <- max(2L, floor(f_lo / rp$df) + 1L)
   i_hi <- min(nb - 1L, ceiling(f_hi / rp$df) + 1L)
   none <- list(lines = numeric(), line_power = numeric(), band = TRUE,
-               band_power = NA_real_)
+               band_power = NA_real_, rest_ratio = NA_real_)
   if (i_hi - i_lo < 4L) return(none)
   h <- 50L
   ext <- max(1L, i_lo - h):min(nb, i_hi + h)
@@ -474,7 +475,8 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
   band <- length(rest) > 0L && e_rest > 5 * sd_rest &&
     e_rest * rp$df > 0.1 * sum(lpow)
   list(lines = lines, line_power = lpow, band = band,
-       band_power = max(e_rest, 0) * rp$df)
+       band_power = max(e_rest, 0) * rp$df,
+       rest_ratio = if (length(rest)) e_rest / sum(b[rest]) else NA_real_)
 }
 
 # ---- bands ------------------------------------------------------------------------
@@ -550,7 +552,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
   # several bins: at the record's own resolution a line stays within the
   # taper's lobe and a band does not. Runs holding lines only are not
   # bands; the lines found on top of a band are kept as lines.
-  on_band <- numeric()
+  on_band <- list()
   if (length(r2$from)) {
     rp <- record_periodogram(x, freq)
     lbg <- log(bg)
@@ -560,7 +562,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
       sh <- record_peak_shape(rp, w$f[r2$from[k]] - w$df, w$f[r2$to[k]] + w$df,
                               bgf, alpha)
       keep[k] <- sh$band
-      if (sh$band) on_band <- c(on_band, sh$lines)
+      if (sh$band) on_band[[length(on_band) + 1L]] <- sh$lines
     }
     r2$from <- r2$from[keep]
     r2$to <- r2$to[keep]
@@ -617,6 +619,43 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
       })
     }
   }
+  # A run that holds lines beside a rest read as band power, cut at a
+  # valley from a neighbouring run, may hold no band of its own: its rest
+  # is the neighbour's skirt, which the running median left out (a 6.1 Hz
+  # line on the low skirt of an 11.2 Hz resonance was read as a band of
+  # FWHM 0.16 Hz carrying the line's power). It is judged again over the
+  # background plus the neighbours' fitted PSD, and must stand above it by
+  # more than that background's own error (a quarter: a skirt's slice
+  # stood 12-20% above the running median).
+  if (length(fits) > 1L) {
+    held <- vapply(on_band, length, 0L) > 0L
+    for (k in which(held)) {
+      nb_lo <- k > 1L && r2$from[k] - r2$to[k - 1L] <= 2L
+      nb_hi <- k < length(fits) && r2$from[k + 1L] - r2$to[k] <= 2L
+      if (!nb_lo && !nb_hi) {
+        held[k] <- FALSE
+        next
+      }
+      M <- bg
+      for (o in seq_along(fits)[-k]) {
+        M <- M + 2 * resonance_psd(w$f, tau0, fits[[o]]$sigma, fits[[o]]$fr, fits[[o]]$tc)
+      }
+      lm <- log(M)
+      sh <- record_peak_shape(rp, w$f[r2$from[k]] - w$df, w$f[r2$to[k]] + w$df,
+                              function(f) exp(stats::approx(w$f, lm, xout = f, rule = 2)$y),
+                              alpha)
+      held[k] <- !sh$band || !(sh$rest_ratio > 0.25)
+    }
+    if (any(held)) {
+      r2$from <- r2$from[!held]
+      r2$to <- r2$to[!held]
+      regs <- regs[!held]
+      fits <- fits[!held]
+      on_band <- on_band[!held]
+    }
+  }
+  on_band <- unlist(on_band)
+  if (is.null(on_band)) on_band <- numeric()
   rows <- lapply(seq_along(regs), function(k) {
     j <- regs[[k]]$j
     fit <- fits[[k]]

@@ -265,3 +265,25 @@ test_that("find_bands(): a band's fit does not slide onto a strong line beside i
   expect_lte(min(abs(b$f_center / 9.85 - 1)), 0.02)
   expect_true(all(b$f_center >= b$f_from & b$f_center <= b$f_to))
 })
+
+test_that("find_bands(): a line on a resonance's skirt is a line, not a band", {
+  # own generator: an MA(1) sensor filter, an 11.2 Hz two-pole resonance
+  # and a 6.1 Hz line (stats::filter AR(2), sin). Cut from the resonance at
+  # the valley, the line's run kept a slice of its skirt, read as band
+  # power: a band of FWHM 0.16 Hz at 6.13 Hz carrying the line's power
+  set.seed(3517)
+  freq <- 100
+  n <- 5e5
+  r <- exp(-1 / (freq * 0.4))
+  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * 11.2 / freq), -r^2),
+                                method = "recursive"))[-(1:2000)]
+  w <- rnorm(n + 1L, sd = 0.012)
+  t <- seq_len(n) / freq
+  x <- w[-1L] + 0.35 * w[-(n + 1L)] + 0.01 * z / stats::sd(z) + 0.004 * sin(2 * pi * 6.1 * t + 2)
+  b <- allanvar:::find_bands(x, freq)
+  expect_equal(nrow(b), 1L)
+  expect_equal(b$f_center, 11.2, tolerance = 0.02)
+  # the line is listed as a line beside the band, not as a band's
+  l <- allanvar:::lines_outside_bands(avdiagnose(x, freq)$lines, b)
+  expect_true(any(abs(l$f0 - 6.1) < 0.01))
+})
