@@ -243,7 +243,7 @@ effect_ramp <- function() {
     trace = trace_edge("long", 1, "R", basis),
     propose = function(raw, tau, sig) {
       tr <- diag_value(raw, "trend")
-      if (!isTRUE(tr$significant)) return(list())
+      if (!isTRUE(tr$significant) || isTRUE(tr$z <= 5)) return(list())
       list(list(init = list(R = abs(tr$slope)), tau_from = max(tau) / 10,
                 tau_to = max(tau), score = 1,
                 note = sprintf("proposed by a linear trend of %s /s",
@@ -305,10 +305,14 @@ evidence_trend <- function(par, raw, x, freq) {
   tr <- diag_value(raw, "trend")
   R <- abs(par[["R"]] %||% NA_real_)
   big <- is.finite(R) && R > ramp_slope_factor * abs(tr$slope)
-  list(text = sprintf("linear trend %s /s (t = %.1f)%s", format_num(tr$slope), tr$t,
+  # (a significant t that the likelihood beside the noise's own wander
+  # does not back, z <= 5, is a random walk's drift)
+  red <- is.finite(tr$z %||% NA_real_) && tr$z <= 5
+  list(text = sprintf("linear trend %s /s (t = %.1f%s)%s", format_num(tr$slope), tr$t,
+                      if (is.finite(tr$z %||% NA_real_)) sprintf(", likelihood z = %.1f", tr$z) else "",
                       if (big) sprintf(", %.1f x below the fitted R %s",
                                        R / abs(tr$slope), format_num(R)) else ""),
-       support = tr$significant && !big)
+       support = tr$significant && !big && !red)
 }
 
 # A power-law term of rate-PSD exponent `alpha`: the lag-1 noise

@@ -140,7 +140,9 @@ test_that("a ramp must be backed by the trend left beside the series effects, at
   ev_big <- evidence_trend(list(R = 5 * abs(beside$slope)), raw, x, 100)
   expect_false(ev_big$support)
   expect_match(ev_big$text, "x below the fitted R")
+  # (the size rule alone: the trend taken as significant by both tests)
   raw$trend$significant <- TRUE
+  raw$trend$z <- 10
   expect_true(evidence_trend(list(R = 2 * abs(beside$slope)), raw, x, 100)$support)
   # spikes move no block mean: they are not fitted beside the trend
   sp <- list(table = data.frame(kind = "spikes", index = 10L, time = 0.09, size = 1,

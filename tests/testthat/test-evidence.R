@@ -122,6 +122,35 @@ test_that("exponential ACF gives Tc; trend and lag-1 noise id are right", {
   expect_equal(round(lag1_noise_id(cumsum(rnorm(n)), 10)), -2)
 })
 
+test_that("a random walk's own drift is no ramp: the trend's likelihood beside the noise", {
+  # own generators: a random walk (with white noise) drifts over a record,
+  # and the t of a line through 100 block means reads that drift as
+  # significant; the likelihood ratio with each model fitting its own noise
+  # (white, random walk, AR(1)s) does not. A ramp on white noise passes both.
+  freq <- 100
+  n <- 5e5
+  t <- seq_len(n) / freq
+  zs <- ts <- numeric(0)
+  for (seed in 1:4) {
+    set.seed(seed)
+    x <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+    tr <- linear_trend(x, freq)
+    ts <- c(ts, abs(tr$t))
+    zs <- c(zs, tr$z)
+  }
+  expect_gt(max(ts), 5)
+  expect_length(zs, 4L)
+  expect_true(all(zs < 5))
+  set.seed(5)
+  y <- rnorm(n, sd = 0.01) + 2e-6 * t
+  ty <- linear_trend(y, freq)
+  expect_gt(ty$z, 5)
+  expect_true(ty$significant)
+  ev <- allanvar:::evidence_trend(list(R = 2e-6), structure(list(trend = ty), class = "avdiagnose"), y, freq)
+  expect_true(ev$support)
+  expect_match(ev$text, "likelihood z")
+})
+
 test_that("avdiagnose validates its arguments and prints", {
   expect_error(avdiagnose(), "`x` is missing",
     class = "allanvar_error_missing_argument")
