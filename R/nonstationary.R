@@ -69,9 +69,9 @@ robust_d_scale <- function(d) {
 #' `pulse_gap` seconds apart are a transient (a pulse or a shock that
 #' decays), not two bias steps: they are returned in attribute `pulses`
 #' (start, end, size) and left out of the steps. Pairs of two steps found at
-#' the record-wide threshold are formed first; a step is then paired with
-#' a weaker return (step_return()) only when the level comes back
-#' (pulse_returns()).
+#' the record-wide threshold are formed first (sizes unlike: only when the
+#' level comes back, pulse_returns()); a step is then paired with a weaker
+#' return (step_return()) of similar size only when the level comes back.
 #' @return data.frame `index` (first sample after the step), `time` (s from
 #'   the first sample), `size` (rate unit), `se` (its standard error from
 #'   the Allan variance at the window used), `z` (detection statistic),
