@@ -69,9 +69,9 @@ robust_d_scale <- function(d) {
 #' `pulse_gap` seconds apart are a transient (a pulse or a shock that
 #' decays), not two bias steps: they are returned in attribute `pulses`
 #' (start, end, size) and left out of the steps. Pairs of two steps found at
-#' the record-wide threshold are formed first; a step is then paired with
-#' a weaker return (step_return()) only when the level comes back
-#' (pulse_returns()).
+#' the record-wide threshold are formed first (sizes unlike: only when the
+#' level comes back, pulse_returns()); a step is then paired with a weaker
+#' return (step_return()) of similar size only when the level comes back.
 #' @return data.frame `index` (first sample after the step), `time` (s from
 #'   the first sample), `size` (rate unit), `se` (its standard error from
 #'   the Allan variance at the window used), `z` (detection statistic),
@@ -228,7 +228,7 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   # threshold: look for the opposite step within pulse_gap of each step,
   # at the Bonferroni level of that stretch alone.
   ret <- lapply(seq_len(nrow(out)), function(k) {
-    step_return(x, out, k, round(pulse_gap * freq), alpha, tau0)
+    step_return(x, out, k, round(pulse_gap * freq), alpha, tau0, ws[1L] * b, se_at)
   })
   ret <- do.call(rbind, ret)
   out$extra <- rep(FALSE, nrow(out))
@@ -257,11 +257,18 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
       c2 <- out[ic, ]
       ratio <- abs(c2$size / a$size)
       both <- !(a$extra || c2$extra)
-      ok <- sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
-        ratio > 1 / 3 && ratio < 3 && (both || (weak && !(a$extra && c2$extra)))
-      # a weak partner must bring the level back (else a noise dip before
-      # a real step would turn the step into a transient)
-      if (ok && !both) {
+      near <- sign(a$size) != sign(c2$size) && c2$time - a$time < pulse_gap &&
+        (both || (weak && !(a$extra && c2$extra)))
+      similar <- ratio > 1 / 3 && ratio < 3
+      # A weak partner must be of similar size and bring the level back
+      # (else a noise dip before a real step would turn the step into a
+      # transient). Two supported steps are a pulse when their sizes are
+      # similar or, where they are not, when the level comes back: each
+      # size is read over the least-noisy window between them, which can
+      # be short (an added Gauss-Markov term moves it), and a size ratio
+      # of 0.31 split a pulse whose level came back into two steps.
+      ok <- near && (similar || both)
+      if (ok && !(both && similar)) {
         # c(0, cumsum()) of the series with every step found removed, once
         if (is.null(cs_all)) cs_all <- c(0, cumsum(remove_steps(x, out[c("index", "size")])))
         ok <- pulse_returns(cs_all, a, c2, tau0)
@@ -344,18 +351,26 @@ pass_steps <- function(x, freq) {
 }
 
 # The step of opposite sign within `gap` samples after (or before) step k
-# of `steps`, the other steps removed: at windows from the step's own up to
-# gap / 4 (octaves), the split maximising the opposite difference of means
-# over the window on each side, never reaching across step k; kept when its
-# z (the step's standard error scaled as white noise to the window) exceeds
-# the Bonferroni threshold over that stretch and those windows (at least
-# 3). NULL when there is none.
-step_return <- function(x, steps, k, gap, alpha, tau0) {
+# of `steps`, the other steps removed: at windows (octaves) from half the
+# step's own (that window at most gap / 4, the search's least `W_min`
+# samples at least) up to gap / 4, the split maximising the
+# opposite difference of means over the window on each side, never
+# reaching across step k; kept when its z (over sqrt(2 AV) at the window,
+# `se_at()`) exceeds the Bonferroni threshold over that stretch and those
+# windows (at least 3). NULL when there is none. (From the step's own
+# window up, a return closer than it, or any return of a step whose size
+# was read over a window longer than the gap, had no window that could see
+# it: an added Gauss-Markov term that moved the windows turned a transient
+# into a lone step. From a quarter of it, noise returns of a bias step in
+# white noise made it a transient three times as often: 12 in 400, 4.)
+step_return <- function(x, steps, k, gap, alpha, tau0, W_min, se_at) {
   n <- length(x)
   at <- steps$index[k]
   if (!is.finite(steps$se[k]) || steps$se[k] <= 0) return(NULL)
-  W0 <- max(1L, as.integer(round(steps$window[k] / tau0)))
-  Ws <- unique(pmin(W0 * 2L^(0:8), max(W0, gap %/% 4L)))
+  W_top <- max(1L, gap %/% 4L)
+  W0 <- min(max(1L, as.integer(round(steps$window[k] / tau0))), W_top)
+  W1 <- max(as.integer(W_min), W0 %/% 2L, 1L)
+  Ws <- unique(pmin(W1 * 2L^(0:12), max(W1, W_top)))
   lv <- step_levels(steps[-k, c("index", "size"), drop = FALSE], n)
   # c(0, cumsum(xs)) only where the windows below read it (every
   # candidate lies within max(gap, W) of the step)
@@ -371,7 +386,7 @@ step_return <- function(x, steps, k, gap, alpha, tau0) {
     M <- M + length(cand) / W
     p <- cand - c0 + 1L
     d <- (cs[p + W] - 2 * cs[p] + cs[p - W]) / W
-    se <- steps$se[k] * sqrt(W0 / W)
+    se <- se_at(W)
     z <- -sign(steps$size[k]) * d / se
     j <- which.max(z)
     if (length(j) && is.finite(z[j]) && (is.null(best) || z[j] > best$zo)) {
