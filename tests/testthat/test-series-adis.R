@@ -82,23 +82,27 @@ test_that("ADIS16405 accelerometers: the spike count holds when white noise move
   }
 })
 
+# A Gauss-Markov series (own generator: an AR(1) by stats::filter) that
+# raises the ADEV of `b` by about 45% at tau = tc (issue 27's GM on measured
+# axes; its AV at tau = tc is about 0.42 sigma^2).
+gm_raising_adev <- function(b, freq, tc) {
+  a <- allan(b, freq, taus = "octave")
+  sigma <- sqrt(exp(stats::approx(log(a$tau), log(a$avar), log(tc))$y) * (1.45^2 - 1) / 0.42)
+  phi <- exp(-1 / (freq * tc))
+  w <- rnorm(length(b), sd = sigma * sqrt(1 - phi^2))
+  w[1L] <- rnorm(1L, sd = sigma)
+  as.numeric(stats::filter(w, phi, method = "recursive"))
+}
+
 test_that("ADIS16405 unit 1 accel_z: its transient at 2151 s stays a transient when a Gauss-Markov of tc 12 s is added", {
   skip_if_no_shared()
   m <- readRDS(shared_file("adis16405_unit1.rds"))
   freq <- attr(m, "freq")
   b <- as.numeric(m[, "accel_z"])
-  # the GM raises ADEV(12 s) by about 45% (issue 27's GM on measured axes);
-  # its AV at tau = tc is about 0.42 sigma^2
-  a <- allan(b, freq, taus = "octave")
-  tc <- 12
-  sigma <- sqrt(exp(stats::approx(log(a$tau), log(a$avar), log(tc))$y) * (1.45^2 - 1) / 0.42)
-  phi <- exp(-1 / (freq * tc))
   kept <- 0L
   for (seed in 1:6) {
     set.seed(seed)
-    w <- rnorm(length(b), sd = sigma * sqrt(1 - phi^2))
-    w[1L] <- rnorm(1L, sd = sigma)
-    x <- b + as.numeric(stats::filter(w, phi, method = "recursive"))
+    x <- b + gm_raising_adev(b, freq, 12)
     tab <- detect_series_effects(x, freq)$table
     near <- abs(tab$time - 2152) < 10
     kept <- kept + (any(near & tab$kind == "transients") && !any(near & tab$kind == "steps"))
@@ -120,14 +124,8 @@ test_that("ADIS16405 unit 3 accel_x: its pulse at 1844 s stays a transient when 
   # pulse pass the record-wide threshold, the least-noisy window between
   # them is 4 s and their sizes read there are 0.0031 and 0.0010 (ratio
   # 0.31); the level comes back, so they are a transient, not two steps
-  a <- allan(b, freq, taus = "octave")
   set.seed(3432)
-  tc <- exp(stats::runif(1, log(8), log(60)))
-  sigma <- sqrt(exp(stats::approx(log(a$tau), log(a$avar), log(tc))$y) * (1.45^2 - 1) / 0.42)
-  phi <- exp(-1 / (freq * tc))
-  w <- rnorm(length(b), sd = sigma * sqrt(1 - phi^2))
-  w[1L] <- rnorm(1L, sd = sigma)
-  x <- b + as.numeric(stats::filter(w, phi, method = "recursive"))
+  x <- b + gm_raising_adev(b, freq, exp(stats::runif(1, log(8), log(60))))
   tab <- detect_series_effects(x, freq)$table
   near <- abs(tab$time - 1850) < 25
   expect_true(any(near & tab$kind == "transients"))
