@@ -292,7 +292,7 @@ quantization_lag1 <- function(x, freq, lines) {
   c0 <- a[1L] - sum(p)
   c1 <- a[2L] - sum(p * cos(2 * pi * lines$f0 / freq))
   r1 <- if (c0 > 0) c1 / c0 else NA_real_
-  list(r1 = r1, z1 = r1 * sqrt(n), lines = nrow(lines))
+  list(r1 = r1, z1 = r1 * sqrt(n), lines = NROW(lines))
 }
 
 # A ramp: a significant linear trend (read beyond the series effects left

@@ -628,12 +628,12 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
   # more than that background's own error (a quarter: a skirt's slice
   # stood 12-20% above the running median).
   if (length(fits) > 1L) {
-    held <- vapply(on_band, length, 0L) > 0L
-    for (k in which(held)) {
+    skirt <- vapply(on_band, length, 0L) > 0L
+    for (k in which(skirt)) {
       nb_lo <- k > 1L && r2$from[k] - r2$to[k - 1L] <= 2L
       nb_hi <- k < length(fits) && r2$from[k + 1L] - r2$to[k] <= 2L
       if (!nb_lo && !nb_hi) {
-        held[k] <- FALSE
+        skirt[k] <- FALSE
         next
       }
       M <- bg
@@ -644,14 +644,14 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
       sh <- record_peak_shape(rp, w$f[r2$from[k]] - w$df, w$f[r2$to[k]] + w$df,
                               function(f) exp(stats::approx(w$f, lm, xout = f, rule = 2)$y),
                               alpha)
-      held[k] <- !sh$band || !(sh$rest_ratio > 0.25)
+      skirt[k] <- !isTRUE(sh$band) || !isTRUE(sh$rest_ratio > 0.25)
     }
-    if (any(held)) {
-      r2$from <- r2$from[!held]
-      r2$to <- r2$to[!held]
-      regs <- regs[!held]
-      fits <- fits[!held]
-      on_band <- on_band[!held]
+    if (any(skirt)) {
+      r2$from <- r2$from[!skirt]
+      r2$to <- r2$to[!skirt]
+      regs <- regs[!skirt]
+      fits <- fits[!skirt]
+      on_band <- on_band[!skirt]
     }
   }
   on_band <- unlist(on_band)
