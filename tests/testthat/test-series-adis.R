@@ -83,8 +83,8 @@ test_that("ADIS16405 accelerometers: the spike count holds when white noise move
 })
 
 # A Gauss-Markov series (own generator: an AR(1) by stats::filter) that
-# raises the ADEV of `b` by about 45% at tau = tc (issue 27's GM on measured
-# axes; its AV at tau = tc is about 0.42 sigma^2).
+# raises the ADEV of `b` by about 45% at tau = tc (as bench/battery-loop.R
+# sizes a GM on the measured axes; its AV at tau = tc is about 0.42 sigma^2).
 gm_raising_adev <- function(b, freq, tc) {
   a <- allan(b, freq, taus = "octave")
   sigma <- sqrt(exp(stats::approx(log(a$tau), log(a$avar), log(tc))$y) * (1.45^2 - 1) / 0.42)
