@@ -15,6 +15,7 @@ refine_stages <- function() {
 
 step_stages <- function() {
   list(trace = step_trace,           # signatures -> candidate trials
+       reform = step_reform,         # a family form chosen before a raw-data effect, again
        screen = step_screen,         # each trial refitted, judged, scored
        settle = step_settle,         # none paid: choose families again or stop
        refit = step_refit_winner,    # the winner with everything free
@@ -96,6 +97,11 @@ stage_steps <- function(st) {
   }
   st$only_sets <- FALSE
   st
+}
+
+# Does model `f` hold an instance of a family entry (forms chosen again)?
+holds_family <- function(f) {
+  any(split_term(f$terms)$kind %in% vapply(entries_with("family"), `[[`, "", "name"))
 }
 
 continues_set <- function(trial) {
@@ -302,6 +308,25 @@ step_trace <- function(st) {
   st
 }
 
+# A family's form chosen before an effect the raw data pinned and confirm
+# (a line's frequency) may have been chosen for that effect's bump (a
+# first-order low-pass taken for a 2.2 Hz line's bump beside a moving
+# average's own: N +24%); once the effect is in, the form is chosen again.
+# Not while a set that effect opened is incomplete (its further lines are
+# trials of this step): a form chosen again then takes their bumps in turn.
+step_reform <- function(st) {
+  if (!isTRUE(st$reform)) return(st)
+  if (nrow(st$trials) && any(vapply(seq_len(nrow(st$trials)),
+                                    function(i) continues_set(st$trials[i, ]), NA))) {
+    return(st)
+  }
+  st$reform <- FALSE
+  r <- rechoose_families(st)
+  st <- r$st
+  if (r$swapped) st$flow <- "next"
+  st
+}
+
 # Screening: the model's existing nonlinear parameters are held at their
 # current values while candidates are compared (one 1-D profile each); the
 # winner is then refitted with everything free. The criterion of a screened
@@ -423,6 +448,9 @@ step_record <- function(st) {
     best$trial$effect, best$label, loc, best$params, evidence, best$ev$support,
     st$current, best$fit, st$c0, best$crit)
   st$pins[length(st$steps)] <- list(unlist(best$pin) %||% numeric(0))
+  if (length(best$pin) && isTRUE(best$ev$support) && holds_family(st$current)) {
+    st$reform <- TRUE
+  }
   # the second instance of a split (split_trial()): its own row, at the
   # values the final refit gave it (the step's gain is on the first row)
   if (!is.null(best$also)) {
