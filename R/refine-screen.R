@@ -262,6 +262,8 @@ rechoose_families <- function(st) {
     rest <- ff$rest
     stage <- paste(e$name, "family chosen again")
     swap <- NULL
+    near <- list()
+    c_cur <- refine_crit(st, cur)
     for (fm in ff$forms) {
       v <- fm$term
       lab <- fm$label
@@ -270,18 +272,24 @@ rechoose_families <- function(st) {
       r <- state_refit(st, args, stage, v, length(st$steps) + 1L)
       st <- r$st
       g <- r$fit
-      if (is.null(g) || !is.finite(refine_crit(st, g)) ||
-          refine_crit(st, g) >= min(refine_crit(st, cur), swap$crit %||% Inf) -
-            st$args$min_gain) next
+      if (is.null(g) || !is.finite(refine_crit(st, g))) next
+      if (refine_crit(st, g) >= min(c_cur, swap$crit %||% Inf) - st$args$min_gain) {
+        # a form the curve cannot tell from the current one
+        if (refine_crit(st, g) < c_cur + st$args$min_gain) {
+          near[[length(near) + 1L]] <- list(fit = g, effect = v, label = lab)
+        }
+        next
+      }
       fj <- judge_form(st, g, v, lab)
       if (is.null(fj)) next
       swap <- list(fit = g, crit = refine_crit(st, g), effect = v, label = lab,
                    par = fj$par, ev = fj$ev)
     }
+    if (is.null(swap) && length(near)) swap <- acov_choice(st, cur, near)
     if (!is.null(swap)) {
       loc <- locate_signature(st$sig, swap$fit, swap$label)
       evidence <- paste0("the ", e$name, " family chosen again on the final model (was ",
-                         fi, "); ", loc$text)
+                         fi, "); ", loc$text, swap$note %||% "")
       if (nzchar(swap$ev$text)) evidence <- paste0(evidence, "; raw data: ", swap$ev$text)
       st$steps[[length(st$steps) + 1L]] <- step_row(
         swap$effect, swap$label, loc, swap$par, evidence, swap$ev$support,
@@ -291,6 +299,50 @@ rechoose_families <- function(st) {
     }
   }
   list(st = st, swapped = FALSE)
+}
+
+# Forms the curve cannot tell apart (criteria within min_gain: beside a
+# resonance a moving average and a first-order low-pass of the same lag-1
+# excess differ by about 1) are told apart by the raw series' short-lag
+# autocovariance steps (acov_steps()), which the whole model predicts
+# (model_acov()): when the current model's steps are off at the 0.1% level
+# of chi-square (3 dof) and a form's sum of squared z is lower by more than
+# that level, the form whose steps fit best is taken, if valid, not
+# contradicted and the earlier effects hold.
+# Returns the swap (as rechoose_families() keeps it) or NULL.
+acov_choice <- function(st, cur, near) {
+  level <- stats::qchisq(0.999, 3L)
+  m0 <- acov_misfit(st, cur)
+  if (!is.finite(m0) || m0 <= level) return(NULL)
+  best <- NULL
+  for (nf in near) {
+    m <- acov_misfit(st, nf$fit)
+    if (!is.finite(m) || m >= m0 - level || m >= (best$misfit %||% Inf)) next
+    fj <- judge_form(st, nf$fit, nf$effect, nf$label)
+    if (is.null(fj)) next
+    best <- list(fit = nf$fit, crit = refine_crit(st, nf$fit), effect = nf$effect,
+                 label = nf$label, par = fj$par, ev = fj$ev, misfit = m,
+                 note = sprintf(paste0("; the raw short-lag autocovariance steps (lags 1-3)",
+                                       " fit it, chi-square %s against %s"),
+                                format_num(m), format_num(m0)))
+  }
+  best
+}
+
+# Sum of squared z of the raw series' short-lag autocovariance steps against
+# those model `f` implies (NA without the raw series); the raw steps are
+# read once per call.
+acov_misfit <- function(st, f) {
+  if (is.null(st$data) || is.null(st$args$freq)) return(NA_real_)
+  cache <- diag_cache(st$raw)
+  raw <- if (!is.null(cache)) cache$acov_steps
+  if (is.null(raw)) {
+    raw <- acov_steps(st$data)
+    if (!is.null(cache)) cache$acov_steps <- raw
+  }
+  h <- seq_len(length(raw$d) + 1L)
+  md <- -diff(model_acov(f$layout, stats::coef(f), h, 1 / st$args$freq))
+  sum(((raw$d - md) / raw$se)^2)
 }
 
 # The other forms of family entry `e`'s one instance in the current model
