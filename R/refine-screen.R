@@ -345,6 +345,97 @@ acov_misfit <- function(st, f) {
   sum(((raw$d - md) / raw$se)^2)
 }
 
+# Two entries may describe one thing of the raw data (a band of the
+# spectrum as measured, or as a resonance whose AR(2) carries the skirt
+# beyond the band's run); the one screened first was chosen beside the
+# others held at values fitted without the rest (a measured band taken at
+# step 1, a first-order low-pass then fitted to its missing skirt: N +20%).
+# So each raw-data proposal that an instance of the model took the place
+# of (that instance's entry `replaces` the proposal's kind there) is
+# refitted in its place with everything free (values the entry releases are
+# a start, the others are held) and taken when it pays by min_gain, is
+# valid, not contradicted, and the earlier effects hold. Returns list(st,
+# swapped).
+rechoose_descriptions <- function(st) {
+  cur <- st$current
+  if (!length(st$steps) || is.null(st$raw)) return(list(st = st, swapped = FALSE))
+  c0 <- refine_crit(st, cur)
+  tau <- cur$data$tau
+  best <- NULL
+  for (e in entries_with("propose")) {
+    for (p in e$propose(st$raw, tau, st$sig)) {
+      eff <- p$effect %||% e$name
+      gone <- described_by(cur, e$name, c(p$init, p$pin))
+      if (!any(gone)) next
+      tm <- structure(c(cur$terms[!gone], eff), gone = gone)
+      before <- tm[-length(tm)]
+      lab <- new_label(before, eff)
+      hold <- if (!isTRUE(p$release)) pin_values(before, eff, p$pin)
+      start <- pin_values(before, eff, c(p$init[!names(p$init) %in% names(hold)],
+                                         if (isTRUE(p$release)) p$pin))
+      start <- start[!duplicated(names(start), fromLast = TRUE)]
+      settings <- st$settings
+      settings$fixed <- relabel_values(settings$fixed, cur$terms, tm, keep_gone = TRUE)
+      # as the model holds it, and beside each other form of its families
+      # (a form fitted to what the old description missed may be
+      # contradicted once the new one carries it)
+      sets <- list(list(terms = c(tm), start = NULL, form = NULL))
+      for (fe in entries_with("family")) {
+        ff <- family_forms(st, fe)
+        if (is.null(ff)) next
+        for (fm in ff$forms) {
+          sets[[length(sets) + 1L]] <- list(terms = replace(c(tm), c(tm) == ff$current, fm$term),
+                                            start = fm$start, form = fm)
+        }
+      }
+      for (ts in sets) {
+        sv <- c(start, ts$start)
+        sv <- sv[!duplicated(names(sv)) & names(sv) %in% coef_layout(ts$terms)$name]
+        args <- refit_args(cur, ts$terms, settings, start = sv, hold = hold)
+        r <- state_refit(st, args, "a description chosen again", eff, length(st$steps) + 1L)
+        st <- r$st
+        f <- r$fit
+        if (is.null(f) || !is.finite(refine_crit(st, f)) ||
+            refine_crit(st, f) >= min(c0, best$crit %||% Inf) - st$args$min_gain ||
+            f$chi2 >= cur$chi2 || max_share(f, lab) < 0.02) next
+        jd <- judge_instance(st, f, eff, lab, tau)
+        if (!is.null(jd$why)) next
+        if (!is.null(ts$form) && is.null(judge_form(st, f, ts$form$term, ts$form$label))) next
+        best <- list(fit = f, crit = refine_crit(st, f), effect = eff, label = lab,
+                     par = jd$par, ev = jd$ev, fixed = c(settings$fixed, hold),
+                     gone = cur$terms[attr(tm, "gone")], form = ts$form$term)
+      }
+    }
+  }
+  if (is.null(best)) return(list(st = st, swapped = FALSE))
+  loc <- locate_signature(st$sig, best$fit, best$label)
+  evidence <- paste0(best$label, " in place of the ", paste(best$gone, collapse = ", "),
+                     " (one thing of the raw data described again",
+                     if (!is.null(best$form)) paste0(", beside ", best$form), "); ", loc$text,
+                     if (nzchar(best$ev$text)) paste0("; raw data: ", best$ev$text))
+  st$steps[[length(st$steps) + 1L]] <- step_row(
+    best$effect, best$label, loc, best$par, evidence, best$ev$support,
+    cur, best$fit, c0, best$crit)
+  st$pins[length(st$steps)] <- list(numeric(0))
+  st$settings$fixed <- best$fixed
+  st$current <- best$fit
+  list(st = st, swapped = TRUE)
+}
+
+# The instances of model `cur` that took the place of an instance of kind
+# `kind` with values `par` (their entry `replaces` the kind, there).
+described_by <- function(cur, kind, par) {
+  labs <- term_labels(cur$terms)
+  kinds <- split_term(cur$terms)$kind
+  vapply(seq_along(cur$terms), function(i) {
+    ei <- effect_entry(kinds[i])
+    if (!kind %in% ei$replaces) return(FALSE)
+    if (is.null(ei$replaces_instance)) return(TRUE)
+    isTRUE(ei$replaces_instance(as.list(instance_params(stats::coef(cur), cur$layout, labs[i])),
+                                kind, as.list(par)))
+  }, NA)
+}
+
 # The other forms of family entry `e`'s one instance in the current model
 # (NULL when it holds none, or several): each form's term, label and the
 # start of its refit (the model's other nonlinear values, the form's own

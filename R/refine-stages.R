@@ -8,6 +8,7 @@ refine_stages <- function() {
        steps = stage_steps,          # add effects, one step at a time
        rechoose = stage_rechoose,    # families chosen again on the final model
        revisit = stage_revisit,      # raw-data values first, if the greedy order failed
+       redescribe = stage_redescribe, # one thing described by another entry
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
        assemble = stage_assemble)    # the refined avfit object
@@ -114,6 +115,16 @@ continues_set <- function(trial) {
 stage_rechoose <- function(st) {
   if (identical(st$settled, st$current)) return(st)
   rechoose_families(st)$st
+}
+
+# On the model the loop keeps (after a revisit: a greedy order that ended
+# far from the curve is first run again with the raw data's values first),
+# a thing of the raw data described by one entry may be described again by
+# another (rechoose_descriptions()), the family's form chosen beside it.
+stage_redescribe <- function(st) {
+  if (is.null(st$data) || !length(st$steps)) return(st)
+  r <- rechoose_descriptions(st)
+  if (r$swapped) rechoose_families(r$st)$st else r$st
 }
 
 # A greedy order can lock in the weaker explanation: an effect taken early
