@@ -19,6 +19,24 @@ acf_lags <- function(x, max_lag) {
   a / a[1L]
 }
 
+# Steps of the autocovariance at short lags, c(h) - c(h + 1) for h in
+# `lags`: a slow process (random walk, flicker, a long GM, a ramp) is flat
+# over a few lags and cancels; what is left is the short-memory part of
+# the series (the sensor's filter, a resonance, lines). Standard errors
+# from the spread over `blocks` consecutive blocks. Returns list(d, se).
+acov_steps <- function(x, lags = 1:3, blocks = 50L) {
+  K <- max(lags) + 1L
+  one <- function(y) {
+    a <- acf_sums(y - mean(y), K) / length(y)
+    a[lags + 1L] - a[lags + 2L]
+  }
+  m <- length(x) %/% blocks
+  per <- vapply(seq_len(blocks), function(b) one(x[(b - 1L) * m + seq_len(m)]),
+                numeric(length(lags)))
+  per <- matrix(per, nrow = length(lags))
+  list(d = one(x), se = apply(per, 1L, stats::sd) / sqrt(blocks))
+}
+
 # Means of consecutive blocks of m samples (the last partial block dropped).
 block_means <- function(x, m) {
   m <- as.integer(m)

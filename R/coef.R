@@ -327,6 +327,21 @@ model_alpha <- function(tau, tau0, lay, plan = model_plan(lay)) {
   out
 }
 
+# The autocovariance of the sampled rate at lags `h` (samples) that the
+# model with coefficients `values` (layout `lay`) implies: each term's
+# entry `acf` (per squared amplitude) times its amplitude squared. Terms
+# without one (the random walk, flicker, a ramp: not stationary) are left
+# out; over a few lags they are flat and cancel in differences.
+model_acov <- function(lay, values, h, tau0) {
+  out <- numeric(length(h))
+  for (p in model_plan(lay)) {
+    if (is.null(p$entry$acf) || length(p$amp) != 1L) next
+    nl <- if (length(p$nl)) as.list(stats::setNames(unname(values[p$nl]), p$nl_param))
+    out <- out + unname(values[[p$amp]])^2 * p$entry$acf(h, tau0, nl)
+  }
+  out
+}
+
 # The parameters of one instance as a named vector (names without the label
 # prefix: sigma, tc, or the kind for a bare coefficient).
 instance_params <- function(coef, lay, label) {

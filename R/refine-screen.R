@@ -262,6 +262,8 @@ rechoose_families <- function(st) {
     rest <- ff$rest
     stage <- paste(e$name, "family chosen again")
     swap <- NULL
+    near <- list()
+    c_cur <- refine_crit(st, cur)
     for (fm in ff$forms) {
       v <- fm$term
       lab <- fm$label
@@ -270,18 +272,24 @@ rechoose_families <- function(st) {
       r <- state_refit(st, args, stage, v, length(st$steps) + 1L)
       st <- r$st
       g <- r$fit
-      if (is.null(g) || !is.finite(refine_crit(st, g)) ||
-          refine_crit(st, g) >= min(refine_crit(st, cur), swap$crit %||% Inf) -
-            st$args$min_gain) next
+      if (is.null(g) || !is.finite(refine_crit(st, g))) next
+      if (refine_crit(st, g) >= min(c_cur, swap$crit %||% Inf) - st$args$min_gain) {
+        # a form the curve cannot tell from the current one
+        if (refine_crit(st, g) < c_cur + st$args$min_gain) {
+          near[[length(near) + 1L]] <- list(fit = g, effect = v, label = lab)
+        }
+        next
+      }
       fj <- judge_form(st, g, v, lab)
       if (is.null(fj)) next
       swap <- list(fit = g, crit = refine_crit(st, g), effect = v, label = lab,
                    par = fj$par, ev = fj$ev)
     }
+    if (is.null(swap) && length(near)) swap <- acov_choice(st, cur, near)
     if (!is.null(swap)) {
       loc <- locate_signature(st$sig, swap$fit, swap$label)
       evidence <- paste0("the ", e$name, " family chosen again on the final model (was ",
-                         fi, "); ", loc$text)
+                         fi, "); ", loc$text, swap$note %||% "")
       if (nzchar(swap$ev$text)) evidence <- paste0(evidence, "; raw data: ", swap$ev$text)
       st$steps[[length(st$steps) + 1L]] <- step_row(
         swap$effect, swap$label, loc, swap$par, evidence, swap$ev$support,
@@ -291,6 +299,141 @@ rechoose_families <- function(st) {
     }
   }
   list(st = st, swapped = FALSE)
+}
+
+# Forms the curve cannot tell apart (criteria within min_gain: beside a
+# resonance a moving average and a first-order low-pass of the same lag-1
+# excess differ by about 1) are told apart by the raw series' short-lag
+# autocovariance steps (acov_steps()), which the whole model predicts
+# (model_acov()): when the current model's steps are off at the 0.1% level
+# of chi-square (3 dof) and a form's sum of squared z is lower by more than
+# that level, the form whose steps fit best is taken, if valid, not
+# contradicted and the earlier effects hold.
+# Returns the swap (as rechoose_families() keeps it) or NULL.
+acov_choice <- function(st, cur, near) {
+  level <- stats::qchisq(0.999, 3L)
+  m0 <- acov_misfit(st, cur)
+  if (!is.finite(m0) || m0 <= level) return(NULL)
+  best <- NULL
+  for (nf in near) {
+    m <- acov_misfit(st, nf$fit)
+    if (!is.finite(m) || m >= m0 - level || m >= (best$misfit %||% Inf)) next
+    fj <- judge_form(st, nf$fit, nf$effect, nf$label)
+    if (is.null(fj)) next
+    best <- list(fit = nf$fit, crit = refine_crit(st, nf$fit), effect = nf$effect,
+                 label = nf$label, par = fj$par, ev = fj$ev, misfit = m,
+                 note = sprintf(paste0("; the raw short-lag autocovariance steps (lags 1-3)",
+                                       " fit it, chi-square %s against %s"),
+                                format_num(m), format_num(m0)))
+  }
+  best
+}
+
+# Sum of squared z of the raw series' short-lag autocovariance steps against
+# those model `f` implies (NA without the raw series); the raw steps are
+# read once per call.
+acov_misfit <- function(st, f) {
+  if (is.null(st$data) || is.null(st$args$freq)) return(NA_real_)
+  cache <- diag_cache(st$raw)
+  raw <- if (!is.null(cache)) cache$acov_steps
+  if (is.null(raw)) {
+    raw <- acov_steps(st$data)
+    if (!is.null(cache)) cache$acov_steps <- raw
+  }
+  h <- seq_len(length(raw$d) + 1L)
+  md <- -diff(model_acov(f$layout, stats::coef(f), h, 1 / st$args$freq))
+  sum(((raw$d - md) / raw$se)^2)
+}
+
+# Two entries may describe one thing of the raw data (a band of the
+# spectrum as measured, or as a resonance whose AR(2) carries the skirt
+# beyond the band's run); the one screened first was chosen beside the
+# others held at values fitted without the rest (a measured band taken at
+# step 1, a first-order low-pass then fitted to its missing skirt: N +20%).
+# So each raw-data proposal that an instance of the model took the place
+# of (that instance's entry `replaces` the proposal's kind there) is
+# refitted in its place with everything free (values the entry releases are
+# a start, the others are held) and taken when it pays by min_gain, is
+# valid, not contradicted, and the earlier effects hold. Returns list(st,
+# swapped).
+rechoose_descriptions <- function(st) {
+  cur <- st$current
+  if (!length(st$steps) || is.null(st$raw)) return(list(st = st, swapped = FALSE))
+  c0 <- refine_crit(st, cur)
+  tau <- cur$data$tau
+  best <- NULL
+  for (e in entries_with("propose")) {
+    for (p in e$propose(st$raw, tau, st$sig)) {
+      eff <- p$effect %||% e$name
+      gone <- described_by(cur, e$name, c(p$init, p$pin))
+      if (!any(gone)) next
+      tm <- structure(c(cur$terms[!gone], eff), gone = gone)
+      before <- tm[-length(tm)]
+      lab <- new_label(before, eff)
+      hold <- if (!isTRUE(p$release)) pin_values(before, eff, p$pin)
+      start <- pin_values(before, eff, c(p$init[!names(p$init) %in% names(hold)],
+                                         if (isTRUE(p$release)) p$pin))
+      start <- start[!duplicated(names(start), fromLast = TRUE)]
+      settings <- st$settings
+      settings$fixed <- relabel_values(settings$fixed, cur$terms, tm, keep_gone = TRUE)
+      # as the model holds it, and beside each other form of its families
+      # (a form fitted to what the old description missed may be
+      # contradicted once the new one carries it)
+      sets <- list(list(terms = c(tm), start = NULL, form = NULL))
+      for (fe in entries_with("family")) {
+        ff <- family_forms(st, fe)
+        if (is.null(ff)) next
+        for (fm in ff$forms) {
+          sets[[length(sets) + 1L]] <- list(terms = replace(c(tm), c(tm) == ff$current, fm$term),
+                                            start = fm$start, form = fm)
+        }
+      }
+      for (ts in sets) {
+        sv <- c(start, ts$start)
+        sv <- sv[!duplicated(names(sv)) & names(sv) %in% coef_layout(ts$terms)$name]
+        args <- refit_args(cur, ts$terms, settings, start = sv, hold = hold)
+        r <- state_refit(st, args, "a description chosen again", eff, length(st$steps) + 1L)
+        st <- r$st
+        f <- r$fit
+        if (is.null(f) || !is.finite(refine_crit(st, f)) ||
+            refine_crit(st, f) >= min(c0, best$crit %||% Inf) - st$args$min_gain ||
+            f$chi2 >= cur$chi2 || max_share(f, lab) < 0.02) next
+        jd <- judge_instance(st, f, eff, lab, tau)
+        if (!is.null(jd$why)) next
+        if (!is.null(ts$form) && is.null(judge_form(st, f, ts$form$term, ts$form$label))) next
+        best <- list(fit = f, crit = refine_crit(st, f), effect = eff, label = lab,
+                     par = jd$par, ev = jd$ev, fixed = c(settings$fixed, hold),
+                     gone = cur$terms[attr(tm, "gone")], form = ts$form$term)
+      }
+    }
+  }
+  if (is.null(best)) return(list(st = st, swapped = FALSE))
+  loc <- locate_signature(st$sig, best$fit, best$label)
+  evidence <- paste0(best$label, " in place of the ", paste(best$gone, collapse = ", "),
+                     " (one thing of the raw data described again",
+                     if (!is.null(best$form)) paste0(", beside ", best$form), "); ", loc$text,
+                     if (nzchar(best$ev$text)) paste0("; raw data: ", best$ev$text))
+  st$steps[[length(st$steps) + 1L]] <- step_row(
+    best$effect, best$label, loc, best$par, evidence, best$ev$support,
+    cur, best$fit, c0, best$crit)
+  st$pins[length(st$steps)] <- list(numeric(0))
+  st$settings$fixed <- best$fixed
+  st$current <- best$fit
+  list(st = st, swapped = TRUE)
+}
+
+# The instances of model `cur` that took the place of an instance of kind
+# `kind` with values `par` (their entry `replaces` the kind, there).
+described_by <- function(cur, kind, par) {
+  labs <- term_labels(cur$terms)
+  kinds <- split_term(cur$terms)$kind
+  vapply(seq_along(cur$terms), function(i) {
+    ei <- effect_entry(kinds[i])
+    if (!kind %in% ei$replaces) return(FALSE)
+    if (is.null(ei$replaces_instance)) return(TRUE)
+    isTRUE(ei$replaces_instance(as.list(instance_params(stats::coef(cur), cur$layout, labs[i])),
+                                kind, as.list(par)))
+  }, NA)
 }
 
 # The other forms of family entry `e`'s one instance in the current model

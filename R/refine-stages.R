@@ -8,6 +8,7 @@ refine_stages <- function() {
        steps = stage_steps,          # add effects, one step at a time
        rechoose = stage_rechoose,    # families chosen again on the final model
        revisit = stage_revisit,      # raw-data values first, if the greedy order failed
+       redescribe = stage_redescribe, # one thing described by another entry
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
        assemble = stage_assemble)    # the refined avfit object
@@ -15,6 +16,7 @@ refine_stages <- function() {
 
 step_stages <- function() {
   list(trace = step_trace,           # signatures -> candidate trials
+       reform = step_reform,         # a family form chosen before a raw-data effect, again
        screen = step_screen,         # each trial refitted, judged, scored
        settle = step_settle,         # none paid: choose families again or stop
        refit = step_refit_winner,    # the winner with everything free
@@ -98,6 +100,11 @@ stage_steps <- function(st) {
   st
 }
 
+# Does model `f` hold an instance of a family entry (forms chosen again)?
+holds_family <- function(f) {
+  any(split_term(f$terms)$kind %in% vapply(entries_with("family"), `[[`, "", "name"))
+}
+
 continues_set <- function(trial) {
   !is.null(trial) && !is.null(trial$after) && length(unlist(trial$after)) > 0L
 }
@@ -108,6 +115,16 @@ continues_set <- function(trial) {
 stage_rechoose <- function(st) {
   if (identical(st$settled, st$current)) return(st)
   rechoose_families(st)$st
+}
+
+# On the model the loop keeps (after a revisit: a greedy order that ended
+# far from the curve is first run again with the raw data's values first),
+# a thing of the raw data described by one entry may be described again by
+# another (rechoose_descriptions()), the family's form chosen beside it.
+stage_redescribe <- function(st) {
+  if (is.null(st$data) || !length(st$steps)) return(st)
+  r <- rechoose_descriptions(st)
+  if (r$swapped) rechoose_families(r$st)$st else r$st
 }
 
 # A greedy order can lock in the weaker explanation: an effect taken early
@@ -302,6 +319,25 @@ step_trace <- function(st) {
   st
 }
 
+# A family's form chosen before an effect the raw data pinned and confirm
+# (a line's frequency) may have been chosen for that effect's bump (a
+# first-order low-pass taken for a 2.2 Hz line's bump beside a moving
+# average's own: N +24%); once the effect is in, the form is chosen again.
+# Not while a set that effect opened is incomplete (its further lines are
+# trials of this step): a form chosen again then takes their bumps in turn.
+step_reform <- function(st) {
+  if (!isTRUE(st$reform)) return(st)
+  if (nrow(st$trials) && any(vapply(seq_len(nrow(st$trials)),
+                                    function(i) continues_set(st$trials[i, ]), NA))) {
+    return(st)
+  }
+  st$reform <- FALSE
+  r <- rechoose_families(st)
+  st <- r$st
+  if (r$swapped) st$flow <- "next"
+  st
+}
+
 # Screening: the model's existing nonlinear parameters are held at their
 # current values while candidates are compared (one 1-D profile each); the
 # winner is then refitted with everything free. The criterion of a screened
@@ -423,6 +459,9 @@ step_record <- function(st) {
     best$trial$effect, best$label, loc, best$params, evidence, best$ev$support,
     st$current, best$fit, st$c0, best$crit)
   st$pins[length(st$steps)] <- list(unlist(best$pin) %||% numeric(0))
+  if (length(best$pin) && isTRUE(best$ev$support) && holds_family(st$current)) {
+    st$reform <- TRUE
+  }
   # the second instance of a split (split_trial()): its own row, at the
   # values the final refit gave it (the step's gain is on the first row)
   if (!is.null(best$also)) {

@@ -29,6 +29,7 @@ new_refine_state <- function(fit, args, settings) {
     c0 = NA_real_,             # the criterion before the step
     flow = "go",               # "go", "next" (on to the next step), "stop"
     settled = NULL,            # the model the families were last chosen on, unchanged
+    reform = FALSE,            # a family form predates an effect the raw data pinned and confirmed
     only_sets = FALSE,         # budget spent: only further lines of held harmonic sets
     start = NULL,              # the model the steps started from
     pins = list(),             # per accepted step, the raw-data values it pinned

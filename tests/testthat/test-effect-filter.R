@@ -85,3 +85,25 @@ test_that("a resonance term fits a narrow-band process", {
   # sine part the entry's cos form lacks: a slightly larger chi2
   expect_lt(f$chi2, 5)
 })
+
+test_that("short-lag autocovariance steps: a random walk cancels, the moving average's form fits them, a first-order low-pass does not", {
+  # white noise through a 2-tap average (weights 1, 0.25) plus a random
+  # walk: the steps c(h) - c(h + 1) are the filter's alone (lag 1 only);
+  # a first-order low-pass of the same lag-1 correlation puts a fifth of
+  # it at lag 2
+  set.seed(52)
+  freq <- 100
+  n <- 4e5
+  w <- rnorm(n + 1L, sd = 0.01)
+  x <- (w[-1L] + 0.25 * w[-(n + 1L)]) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+  raw <- acov_steps(x)
+  # the filter's lag-1 autocovariance 0.25 x 0.01^2, nothing beyond
+  expect_lt(max(abs(raw$d - c(0.25e-4, 0, 0)) / raw$se), 4)
+  a <- allan(x, freq)
+  z <- function(f) (raw$d - -diff(model_acov(f$layout, coef(f), 1:4, 1 / freq))) / raw$se
+  z_ma <- z(avfit(a, terms = c("filter", "K")))
+  z_lp1 <- z(avfit(a, terms = c("filter:lp1", "K")))
+  expect_lt(max(abs(z_ma)), 4)
+  # what acov_choice() asks: lower by more than the 0.1% point of chi-square
+  expect_gt(sum(z_lp1^2) - sum(z_ma^2), stats::qchisq(0.999, 3))
+})
