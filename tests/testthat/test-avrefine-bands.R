@@ -217,13 +217,7 @@ test_that("a sensor's resonance taken first as a measured band is described agai
   set.seed(1)
   freq <- 100
   n <- 5e5
-  w <- rnorm(n + 1L, sd = 0.01)
-  r <- exp(-1 / (freq * 0.5))
-  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * 9.85 / freq), -r^2),
-                                method = "recursive"))[-(1:2000)]
-  t <- seq_len(n) / freq
-  x <- (w[-1L] + 0.25 * w[-(n + 1L)]) + 0.012 * z / stats::sd(z) +
-    0.014 * sin(2 * pi * 0.54 * t + runif(1, 0, 2 * pi)) + cumsum(rnorm(n, sd = 1.3e-4 / sqrt(freq)))
+  x <- sim_sensor_axis(n, freq)
   fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
   res <- suppressMessages(avrefine(fit, data = x))
   cf <- coef(res)

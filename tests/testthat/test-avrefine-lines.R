@@ -272,13 +272,7 @@ test_that("a strong line beside a measured band enters: the band's measured scal
   set.seed(14)
   freq <- 100
   n <- 5e5
-  w <- rnorm(n + 1L, sd = 0.01)
-  r <- exp(-1 / (freq * 0.5))
-  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * 9.85 / freq), -r^2),
-                                method = "recursive"))[-(1:2000)]
-  t <- seq_len(n) / freq
-  x <- (w[-1L] + 0.25 * w[-(n + 1L)]) + 0.012 * z / stats::sd(z) +
-    0.014 * sin(2 * pi * 0.54 * t + runif(1, 0, 2 * pi)) + cumsum(rnorm(n, sd = 1.3e-4 / sqrt(freq)))
+  x <- sim_sensor_axis(n, freq)
   r <- loop(x, freq)
   cf <- coef(r)
   expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / 0.54 - 1)), 0.03)
@@ -299,13 +293,8 @@ test_that("a filter form taken for a line's bump is chosen again once the line i
   set.seed(6)
   freq <- 100
   n <- 5e5
-  w <- rnorm(n + 1L, sd = 0.01)
-  r <- exp(-1 / (freq * 0.5))
-  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * 9.85 / freq), -r^2),
-                                method = "recursive"))[-(1:2000)]
+  b <- sim_sensor_axis(n, freq)
   t <- seq_len(n) / freq
-  b <- (w[-1L] + 0.25 * w[-(n + 1L)]) + 0.012 * z / stats::sd(z) +
-    0.014 * sin(2 * pi * 0.54 * t + runif(1, 0, 2 * pi)) + cumsum(rnorm(n, sd = 1.3e-4 / sqrt(freq)))
   x <- b + 0.003 * sin(2 * pi * 2.2 * t + runif(1, 0, 2 * pi))
   r0 <- loop(b, freq)
   r <- loop(x, freq)
