@@ -11,6 +11,10 @@ sin_peak_adev <- 0.7246       # ... where ADEV = 0.7246 A
 # accelerometers' own 1.6-1.7 Hz lines are fitted at 2.0-2.5x the amp read
 # there, the curve's misplaced sinusoids at 5-9x.
 sin_amp_factor <- 3
+# A line's frequency is read to this many Welch bins over the square root
+# of its peak's ratio to the background (at most 1.5 bins): 0.11 bins for
+# a line 2192 x its background, the full 1.5 for one 11 x.
+sin_f0_bins <- 5
 
 # Raw-data evidence: a periodogram line near f0.
 evidence_sinusoid <- function(par, raw, x, freq) {
@@ -28,12 +32,22 @@ evidence_sinusoid <- function(par, raw, x, freq) {
       # 1/7 its amplitude while the added line was 0.1 Hz away)
       amp <- abs(par[["amp"]] %||% NA_real_)
       big <- is.finite(amp) && l$amp[j] > 0 && amp > sin_amp_factor * l$amp[j]
-      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)%s",
+      # the line's frequency is measured to a fraction of a bin that shrinks
+      # as it stands out (the log peak's interpolation): a fitted f0 beyond
+      # that is the curve's own, not the line's (a curve far from its model
+      # took 0.6123 Hz for a line the periodogram reads at 0.60997 Hz, 2192 x
+      # its background, and the line's AV oscillation at 5-20 s went wrong)
+      off <- abs(f0 - l$f0[j])
+      prec <- res * min(1.5, sin_f0_bins / sqrt(max(l$ratio[j], 1)))
+      away <- off > prec
+      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)%s%s",
                                  format_num(l$f0[j], 4), format_num(l$amp[j]),
                                  l$p_value[j],
                                  if (big) sprintf(", %.1f x weaker than the fitted amp %s",
-                                                  amp / l$amp[j], format_num(amp)) else ""),
-                  support = !big))
+                                                  amp / l$amp[j], format_num(amp)) else "",
+                                 if (away) sprintf(", %s Hz from the fitted f0 (it reads f0 to %s Hz)",
+                                                   format_num(off, 2), format_num(prec, 2)) else ""),
+                  support = !big && !away))
     }
   }
   if (is.finite(f0) && f0 < 4 * res) {
