@@ -114,6 +114,31 @@ test_that("a sinusoid sized for a strong line is not backed by a weak line besid
   expect_true(ev(list(amp = 0.06, f0 = 1.59), raw, x, freq)$support)
 })
 
+test_that("a sinusoid's f0 must lie within its periodogram line's own precision", {
+  # own generator: white noise, a strong line at 0.61 Hz (2000 x its
+  # background) and a weak one at 2.3 Hz. The curve took 0.6123 Hz for
+  # such a line (0.77 Welch bins off) and its AV oscillation at long taus
+  # went wrong; a weak line's frequency is read only to about a bin.
+  set.seed(2715)
+  freq <- 100
+  t <- seq_len(5e5) / freq
+  x <- rnorm(length(t)) + sin(2 * pi * 0.61 * t + 1) + 0.03 * sin(2 * pi * 2.3 * t + 2)
+  raw <- avdiagnose(x, freq)
+  l <- raw$lines
+  res <- attr(l, "resolution")
+  strong <- l[which.min(abs(l$f0 - 0.61)), ]
+  weak <- l[which.min(abs(l$f0 - 2.3)), ]
+  expect_gt(strong$ratio, 500)
+  expect_lt(weak$ratio, 50)
+  ev <- allanvar:::evidence_sinusoid
+  expect_true(ev(list(amp = 1, f0 = strong$f0), raw, x, freq)$support)
+  off <- ev(list(amp = 1, f0 = strong$f0 + 0.77 * res), raw, x, freq)
+  expect_false(off$support)
+  expect_match(off$text, "from the fitted f0")
+  # the weak line: half a bin off is within what it can tell
+  expect_true(ev(list(amp = 0.03, f0 = weak$f0 + 0.5 * res), raw, x, freq)$support)
+})
+
 test_that("a harmonic set's further lines do not spend the step budget", {
   # the square wave above with room for one effect only: its fundamental
   # spends the budget, 2.4 and 4.0 Hz follow as lines of the same source
