@@ -11,10 +11,15 @@ test_that("a periodogram line is found at f0 with its amplitude and significance
   expect_equal(d$lines$f0[1], 0.5, tolerance = 0.01)
   expect_equal(d$lines$amp[1], 0.02, tolerance = 0.1)
   expect_lt(d$lines$p_value[1], 1e-10)
-  # matched within the periodogram's resolution, not a fixed 25%
+  # matched within the line's own precision (a fraction of the Welch bin
+  # that shrinks as the line stands out: 5 / sqrt(its peak ratio) bins, at
+  # most 1.5), not a fixed 25%
   res <- attr(d$lines, "resolution")
-  ev <- raw_evidence("sinusoid", list(f0 = 0.5 + res), d, x, 100)
+  prec <- res * min(1.5, 5 / sqrt(d$lines$ratio[1]))
+  ev <- raw_evidence("sinusoid", list(f0 = d$lines$f0[1] + 0.9 * prec), d, x, 100)
   expect_true(ev$support)
+  ev <- raw_evidence("sinusoid", list(f0 = d$lines$f0[1] + 1.1 * prec), d, x, 100)
+  expect_false(ev$support)
   ev <- raw_evidence("sinusoid", list(f0 = 0.52), d, x, 100)
   expect_false(ev$support)
   ev <- raw_evidence("sinusoid", list(f0 = 2), d, x, 100)
