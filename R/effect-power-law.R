@@ -307,9 +307,10 @@ evidence_trend <- function(par, raw, x, freq) {
   big <- is.finite(R) && R > ramp_slope_factor * abs(tr$slope)
   # (a significant t that the likelihood beside the noise's own wander
   # does not back, z <= 5, is a random walk's drift)
-  red <- is.finite(tr$z %||% NA_real_) && tr$z <= 5
+  z <- tr$z %||% NA_real_
+  red <- is.finite(z) && z <= 5
   list(text = sprintf("linear trend %s /s (t = %.1f%s)%s", format_num(tr$slope), tr$t,
-                      if (is.finite(tr$z %||% NA_real_)) sprintf(", likelihood z = %.1f", tr$z) else "",
+                      if (is.finite(z)) sprintf(", likelihood z = %.1f", z) else "",
                       if (big) sprintf(", %.1f x below the fitted R %s",
                                        R / abs(tr$slope), format_num(R)) else ""),
        support = tr$significant && !big && !red)

@@ -579,6 +579,12 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
   })
   # a fit whose centre leaves its run has slid onto a neighbour
   in_run <- function(ft, g) ft$fr >= w$f[g$j[1L]] && ft$fr <= w$f[g$j[length(g$j)]]
+  # the one-sided PSD of fitted bands on the Welch grid
+  fitted_psd <- function(fs) {
+    M <- 0
+    for (ft in fs) M <- M + 2 * resonance_psd(w$f, tau0, ft$sigma, ft$fr, ft$tc)
+    M
+  }
   fits <- lapply(regs, function(g) {
     ex <- pmax(p[g$j] - bg[g$j], 0)
     fc <- sum(w$f[g$j] * ex) / sum(ex)
@@ -605,8 +611,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     for (k in seq_along(r2$from)) mask[r2$from[k]:r2$to[k]] <- TRUE
     keep <- which(!mask)
     for (it in seq_len(if (length(keep) > 10L) 2L else 0L)) {
-      M <- 0
-      for (ft in fits) M <- M + 2 * resonance_psd(w$f, tau0, ft$sigma, ft$fr, ft$tc)
+      M <- fitted_psd(fits)
       lq <- log(pmax(p - M, .Machine$double.xmin))
       bg2 <- exp(running_median(lq[keep], octave(seq_along(keep)), exact = FALSE) - corr)
       bg <- exp(stats::approx(keep, log(bg2), xout = seq_len(nb), rule = 2)$y)
@@ -636,11 +641,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
         skirt[k] <- FALSE
         next
       }
-      M <- bg
-      for (o in seq_along(fits)[-k]) {
-        M <- M + 2 * resonance_psd(w$f, tau0, fits[[o]]$sigma, fits[[o]]$fr, fits[[o]]$tc)
-      }
-      lm <- log(M)
+      lm <- log(bg + fitted_psd(fits[-k]))
       sh <- record_peak_shape(rp, w$f[r2$from[k]] - w$df, w$f[r2$to[k]] + w$df,
                               function(f) exp(stats::approx(w$f, lm, xout = f, rule = 2)$y),
                               alpha)
