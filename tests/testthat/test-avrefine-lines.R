@@ -15,6 +15,11 @@ measured_axis <- function(unit, axis) {
   b <- as.numeric(m[, axis])
   list(b = b, freq = attr(m, "freq"), s = stats::sd(diff(b)) / sqrt(2))
 }
+# the axis with a periodic wave (a line; `wave`: its shape) of `amp` x its
+# white sd at f0 Hz added
+with_wave <- function(ax, amp, f0, phase, wave = sin) {
+  ax$b + amp * ax$s * wave(2 * pi * f0 * seq_along(ax$b) / ax$freq + phase)
+}
 n_reading <- function(r) {
   cf <- coef(r)
   # N, or the white level a filter term of any form carries
@@ -73,7 +78,7 @@ test_that("a line at 46.8 Hz on a measured accelerometer: no quantization term b
   skip_on_cran()
   ax <- measured_axis(2, "accel_y")
   set.seed(2714)
-  x <- ax$b + ax$s * sin(2 * pi * 46.8 * seq_along(ax$b) / ax$freq + runif(1, 0, 2 * pi))
+  x <- with_wave(ax, 1, 46.8, runif(1, 0, 2 * pi))
   r <- loop(x, ax$freq)
   cf <- coef(r)
   f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
@@ -177,8 +182,7 @@ test_that("a line beside a measured axis's own: the greedy order is revisited wi
   ax <- measured_axis(2, "accel_y")
   b <- ax$b
   freq <- ax$freq
-  s <- ax$s
-  x <- b + 0.3 * s * sin(2 * pi * 1.7 * seq_along(b) / freq + 0.7)
+  x <- with_wave(ax, 0.3, 1.7, 0.7)
   r <- loop(x, freq)
   cf <- coef(r)
   f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
@@ -234,8 +238,7 @@ test_that("a square wave added to a measured accelerometer: its 5th harmonic is 
   ax <- measured_axis(2, "accel_z")
   b <- ax$b
   freq <- ax$freq
-  s <- ax$s
-  x <- b + 0.4 * s * sign(sin(2 * pi * 1.1 * seq_along(b) / freq + 2.1))
+  x <- with_wave(ax, 0.4, 1.1, 2.1, function(u) sign(sin(u)))
   r <- loop(x, freq)
   cf <- coef(r)
   f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
@@ -254,8 +257,7 @@ test_that("an added line does not cost a measured axis its own Gauss-Markov term
   ax <- measured_axis(3, "accel_y")
   b <- ax$b
   freq <- ax$freq
-  s <- ax$s
-  x <- b + 0.3 * s * sin(2 * pi * 0.9 * seq_along(b) / freq + 0.4)
+  x <- with_wave(ax, 0.3, 0.9, 0.4)
   r <- loop(x, freq)
   expect_true("gm" %in% split_term(r$terms)$kind)
   cf <- coef(r)
@@ -274,8 +276,7 @@ test_that("a line beside a measured axis's filter and resonance: the filter's fo
   ax <- measured_axis(3, "accel_x")
   b <- ax$b
   freq <- ax$freq
-  s <- ax$s
-  x <- b + 0.3 * s * sin(2 * pi * 3.1 * seq_along(b) / freq + 1.3)
+  x <- with_wave(ax, 0.3, 3.1, 1.3)
   r0 <- loop(b, freq)
   r <- loop(x, freq)
   expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
@@ -342,7 +343,7 @@ test_that("a filter form the curve cannot tell from the moving average is told b
   skip_if_no_shared()
   skip_on_cran()
   ax <- measured_axis(3, "accel_x")
-  x <- ax$b + 0.35 * ax$s * sin(2 * pi * 4.3 * seq_along(ax$b) / ax$freq + 1.3)
+  x <- with_wave(ax, 0.35, 4.3, 1.3)
   r0 <- loop(ax$b, ax$freq)
   r <- loop(x, ax$freq)
   expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
