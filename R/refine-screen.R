@@ -40,7 +40,12 @@ screen_trial <- function(st, tr, nl_now) {
   c1 <- crit_s(new)
   pays <- is.finite(c1) && c1 < c0 - need &&
     new$chi2 < (if (set_line) 1 else 0.9) * cur$chi2
-  if (!pays) return(list(st = st, cand = NULL))
+  if (!pays) {
+    # raw-data values that do not pay alone may pay beside a family form
+    # the raw data refused alone (family_pairs())
+    if (length(pin)) st$unpaid <- add_refused(st$unpaid, tr)
+    return(list(st = st, cand = NULL))
+  }
   lab <- new_label(cur$terms, tr$effect)
   # An added term that explains (almost) nothing anywhere is a refit
   # artefact, not an effect (a set's further line is the periodogram's).
@@ -111,6 +116,13 @@ screen_trial <- function(st, tr, nl_now) {
     # raw-data values the raw data then contradict: family_pairs() may try
     # them beside another form of the model's family
     if (length(pin) && isFALSE(jd$ev$support)) st$refused <- add_refused(st$refused, tr)
+    # a form of a family the model lacks, fitted alone to what another
+    # effect also shapes: family_pairs() may add it beside that effect
+    kind <- split_term(tr$effect)$kind
+    if (!length(pin) && isFALSE(jd$ev$support) && !is.null(effect_entry(kind)$family) &&
+        !kind %in% split_term(cur$terms)$kind) {
+      st$refused_forms <- union(st$refused_forms, kind)
+    }
     # raw-data values an earlier effect keeps out: a revisit takes them first
     if (isTRUE(jd$moved) && length(pin)) st$blocked[[length(st$blocked) + 1L]] <- unlist(pin)
     if (!is.null(jd$dup)) {
@@ -439,25 +451,34 @@ described_by <- function(cur, kind, par) {
 # The other forms of family entry `e`'s one instance in the current model
 # (NULL when it holds none, or several): each form's term, label and the
 # start of its refit (the model's other nonlinear values, the form's own
-# read from the raw data).
-family_forms <- function(st, e) {
+# read from the raw data). With `absent = TRUE`, a model holding no
+# instance gets every form, to add (`current` NULL).
+family_forms <- function(st, e, absent = FALSE) {
   cur <- st$current
   fi <- cur$terms[split_term(cur$terms)$kind == e$name]
-  if (length(fi) != 1L) return(NULL)
-  rest <- cur$terms[cur$terms != fi]
-  old_lab <- term_labels(cur$terms)[cur$terms == fi]
-  nl_cur <- stats::coef(cur)[cur$layout$role == "nonlinear"]
-  nl_rest <- nl_cur[!startsWith(names(nl_cur), paste0(old_lab, "."))]
+  if (length(fi) > 1L || (length(fi) == 0L && !absent) || (length(fi) == 1L && absent)) {
+    return(NULL)
+  }
   variants <- e$family$variants
+  # the instances a form leaves (the form's old instance; an added one
+  # takes the place of what its entry replaces: a filter, of N)
+  out <- if (length(fi)) cur$terms == fi else
+    attr(model_terms(cur$terms, family_term(e$name, variants, variants[1L])), "gone")
+  rest <- cur$terms[!out]
+  nl_cur <- stats::coef(cur)[cur$layout$role == "nonlinear"]
+  for (lab in term_labels(cur$terms)[out]) {
+    nl_cur <- nl_cur[!startsWith(names(nl_cur), paste0(lab, "."))]
+  }
+  nl_rest <- nl_cur
   forms <- lapply(seq_along(variants), function(j) {
     v <- family_term(e$name, variants, variants[j])
-    if (v == fi) return(NULL)
+    if (length(fi) && v == fi) return(NULL)
     lab <- new_label(rest, v)
     s0 <- e$family$start(st$raw, variants[j])
     list(term = v, label = lab,
          start = c(nl_rest, if (length(s0)) stats::setNames(unlist(s0), paste0(lab, ".", names(s0)))))
   })
-  list(current = fi, rest = rest, forms = Filter(Negate(is.null), forms))
+  list(current = if (length(fi)) fi, rest = rest, forms = Filter(Negate(is.null), forms))
 }
 
 # A family's form `v` (label `lab`) in refit `g`: valid on the curve, not
@@ -486,26 +507,37 @@ add_refused <- function(refused, tr) {
 # it). When nothing paid, no other form pays alone and the model is still
 # far from the curve (chi2/dof above revisit_chi2), each trial refused
 # this step at raw-data values is refitted beside each other form of the
-# family, everything free. The best pair enters as this step's winner
-# when it pays, the trial is confirmed by the raw data, the new form is
-# valid and not contradicted, and the effects accepted earlier hold.
-# Returns st, with st$best set when a pair won.
+# family, everything free. The converse: a family the model lacks, whose
+# forms the raw data refused alone (a moving average fitted without a
+# 45.5 Hz line, whose bump at tau0 hides the average's dip, predicts too
+# little lag-1 autocorrelation), and raw-data values that did not pay
+# alone (that line: its bump sits where the missing filter's dip is) are
+# refitted together, each form of the family beside each such trial. The
+# best pair enters as this step's winner when it pays, the trial is
+# confirmed by the raw data, the new form is valid and not contradicted,
+# and the effects accepted earlier hold. Returns st, with st$best set when
+# a pair won.
 family_pairs <- function(st) {
   cur <- st$current
-  if (!length(st$refused) || !(cur$chi2 > revisit_chi2)) return(st)
+  if (!(cur$chi2 > revisit_chi2)) return(st)
   c0 <- refine_crit(st, cur)
   min_gain <- st$args$min_gain
   tau <- cur$data$tau
   for (e in entries_with("family")) {
     ff <- family_forms(st, e)
-    if (is.null(ff)) next
+    trials <- st$refused
+    if (is.null(ff) && e$name %in% st$refused_forms) {
+      ff <- family_forms(st, e, absent = TRUE)
+      trials <- c(st$refused, st$unpaid)
+    }
+    if (is.null(ff) || !length(trials)) next
     fi <- ff$current
     rest <- ff$rest
     for (fm in ff$forms) {
       v <- fm$term
       vlab <- fm$label
       sv <- fm$start
-      for (tr in st$refused) {
+      for (tr in trials) {
         tm <- model_terms(c(rest, v), tr$effect, c(tr$init[[1L]], tr$pin[[1L]]), cur)
         before <- tm[-length(tm)]
         lab <- new_label(before, tr$effect)
@@ -516,7 +548,8 @@ family_pairs <- function(st) {
         settings <- st$settings
         settings$fixed <- relabel_values(settings$fixed, c(rest, v), tm, keep_gone = TRUE)
         args <- refit_args(cur, c(tm), settings, start = start, hold = pin)
-        r <- state_refit(st, args, paste(e$name, "family chosen again beside a trial"),
+        r <- state_refit(st, args, paste(e$name, if (is.null(fi)) "family added" else
+                                           "family chosen again", "beside a trial"),
                          tr$effect)
         st <- r$st
         f <- r$fit
@@ -528,14 +561,22 @@ family_pairs <- function(st) {
         if (!is.null(jd$why) || !isTRUE(jd$ev$support)) next
         fj <- judge_form(st, f, v, vlab)
         if (is.null(fj)) next
-        jd$ev$text <- sprintf("%s; with the %s family chosen again (was %s)",
-                              jd$ev$text, e$name, fi)
+        how <- if (is.null(fi)) {
+          sprintf("the %s family added beside it (neither paid alone)", e$name)
+        } else {
+          sprintf("the %s family chosen again (was %s)", e$name, fi)
+        }
+        jd$ev$text <- sprintf("%s; with %s", jd$ev$text, how)
         st$best <- list(fit = f, crit = c1, adj = c1 - min_gain, trial = tr,
                         label = lab, params = jd$par, ev = jd$ev, pin = pin,
                         fixed = settings$fixed,
                         also = list(effect = v, label = vlab, par = fj$par, ev = fj$ev,
-                                    note = paste0("the ", e$name, " family chosen again (was ",
-                                                  fi, ") beside ", lab)))
+                                    note = if (is.null(fi)) {
+                                      paste0("the ", e$name, " family added beside ", lab)
+                                    } else {
+                                      paste0("the ", e$name, " family chosen again (was ",
+                                             fi, ") beside ", lab)
+                                    }))
       }
     }
   }

@@ -298,6 +298,8 @@ stage_assemble <- function(st) {
 step_trace <- function(st) {
   cur <- st$current
   st$refused <- list()
+  st$unpaid <- list()
+  st$refused_forms <- character()
   tau <- cur$data$tau
   st$sig <- residual_signatures(tau, stats::residuals(cur), level = st$args$level)
   traced <- trace_candidates(tau, cur$data$avar, cur$data$fitted, st$sig,

@@ -35,6 +35,8 @@ new_refine_state <- function(fit, args, settings) {
     pins = list(),             # per accepted step, the raw-data values it pinned
     blocked = list(),          # raw-data values of trials an earlier effect kept out
     refused = list(),          # this step's trials the raw data refused (family_pairs())
+    unpaid = list(),           # this step's raw-pinned trials that did not pay alone
+    refused_forms = character(), # family kinds absent from the model whose forms the raw data refused this step
     seeds = list(),            # pinned value sets a revisit takes first (stage_revisit())
     until = NULL,              # a revisit stops on reaching these terms (sorted)
     revisit = NULL,            # what the revisit compared, or NULL

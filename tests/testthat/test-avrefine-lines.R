@@ -333,6 +333,35 @@ test_that("a filter form taken for a line's bump is chosen again once the line i
   expect_lt(r$chi2, 4)
 })
 
+test_that("a line near Nyquist and the filter it hides enter together", {
+  # white noise through a moving average (0.35), a resonance at 13.3 Hz, a
+  # 0.73 Hz line and a random walk, with a line near Nyquist of 0.8 x the
+  # white sd added. The line's AV sits at tau0, where the moving average's
+  # dip is: the line alone did not pay, and the filter alone was refused
+  # (fitted without the line it predicted too little lag-1
+  # autocorrelation). On main 96019cc the line was not named, N -2.5%.
+  set.seed(1)
+  freq <- 100
+  n <- 5e5
+  t <- seq_len(n) / freq
+  w <- rnorm(n + 1L, sd = 0.01)
+  a <- exp(-1 / (freq * 0.6))
+  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * a * cos(2 * pi * 13.3 / freq), -a^2),
+                                method = "recursive"))[-(1:2000)]
+  b <- (w[-1L] + 0.35 * w[-(n + 1L)]) + 0.009 * z / stats::sd(z) +
+    0.01 * sin(2 * pi * 0.73 * t + 1) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+  f0 <- runif(1, 44, 48.5)
+  x <- b + 0.008 * sin(2 * pi * f0 * t + runif(1, 0, 2 * pi))
+  r0 <- loop(b, freq)
+  r <- loop(x, freq)
+  cf <- coef(r)
+  expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / f0 - 1)), 0.03)
+  expect_identical(sum(startsWith(r$terms, "filter")), 1L)
+  expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
+  expect_false(any(r$steps$confirmed %in% FALSE))
+  expect_lt(r$chi2, 4)
+})
+
 test_that("a filter form the curve cannot tell from the moving average is told by the raw short-lag autocovariance", {
   # unit 3 accel_x (a moving-average filter, a 0.54 Hz line, a 9.8 Hz
   # resonance) with a 4.3 Hz line of 0.35 x the white sd: the first step
