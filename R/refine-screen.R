@@ -506,8 +506,10 @@ add_refused <- function(refused, tr) {
 # resonance for less power than its band holds, and the raw data refuse
 # it). When nothing paid, no other form pays alone and the model is still
 # far from the curve (chi2/dof above revisit_chi2), each trial refused
-# this step at raw-data values is refitted beside each other form of the
-# family, everything free. The converse: a family the model lacks, whose
+# this step at raw-data values, or that did not pay alone at them (a
+# square wave's harmonic beside a first-order low-pass that took the bumps
+# of the harmonics not yet in, and the axis's resonance), is refitted beside each other form of the family, everything free. The
+# converse: a family the model lacks, whose
 # forms the raw data refused alone (a moving average fitted without a
 # 45.5 Hz line, whose bump at tau0 hides the average's dip, predicts too
 # little lag-1 autocorrelation), and raw-data values that did not pay
@@ -525,11 +527,8 @@ family_pairs <- function(st) {
   tau <- cur$data$tau
   for (e in entries_with("family")) {
     ff <- family_forms(st, e)
-    trials <- st$refused
-    if (is.null(ff) && e$name %in% st$refused_forms) {
-      ff <- family_forms(st, e, absent = TRUE)
-      trials <- c(st$refused, st$unpaid)
-    }
+    if (is.null(ff) && e$name %in% st$refused_forms) ff <- family_forms(st, e, absent = TRUE)
+    trials <- c(st$refused, st$unpaid)
     if (is.null(ff) || !length(trials)) next
     fi <- ff$current
     rest <- ff$rest
