@@ -16,7 +16,7 @@
 # (BATTERY_OUT=file.rds saves the table; BATTERY_RUNS=dir each case's runs). Set "a" (the default) is the
 # battery the loop was built against; set "b" has other frequencies, time
 # constants, amplitudes, axes and seeds, written once "a" passed, to see
-# whether what passes "a" generalises; sets "c", "d" and "e" were each written
+# whether what passes "a" generalises; sets "c" to "f" were each written
 # before any run on them, once the sets before were in use ("d" also has
 # simulated axes that carry a sensor's own filter, line and resonance).
 #
@@ -470,6 +470,91 @@ if (identical(set, "e")) {
   )
 }
 
+# ---- set "f" -------------------------------------------------------------------
+# Written before any run on it, once "a" to "e" were in use (session 19):
+# other frequencies, time constants, axes and seeds; simulated sensor axes
+# whose filter is a first-order low-pass (an AR(1)) instead of a moving
+# average; a sawtooth on a measured axis.
+if (identical(set, "f")) {
+  sensor_base <- function(n = n_sim) {
+    w <- as.numeric(stats::filter(rnorm(n, sd = 0.009), 0.3, method = "recursive"))
+    w + g_band(n, 0.008, 15.5, 0.35) + g_line(n, 0.009, 0.48) + g_rw(n, 1.2e-4)
+  }
+  cases <- list(
+    "sim: line 47.2 Hz, amp = 0.6 white sd" = function() {
+      b <- sim_base(); list(x = b + g_line(n_sim, 0.006, 47.2), base = b, expect = list(list("sinusoid", 47.2)))
+    },
+    "sim lp sensor: line 46.1 Hz, amp = 0.9 white sd" = function() {
+      b <- sensor_base(); list(x = b + g_line(n_sim, 0.0081, 46.1), base = b,
+                               expect = list(list("sinusoid", 46.1)))
+    },
+    "sim: square wave 1.3 Hz" = function() {
+      b <- sim_base(); list(x = b + g_square(n_sim, 0.005, 1.3), base = b,
+        expect = list(list("sinusoid", 1.3), list("sinusoid", 3.9), list("sinusoid", 6.5)),
+        harmonics_of = 1.3)
+    },
+    "sim lp sensor: square wave 0.9 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_square(n_sim, 0.004, 0.9), base = b,
+        expect = list(list("sinusoid", 0.9), list("sinusoid", 2.7), list("sinusoid", 4.5)),
+        harmonics_of = 0.9)
+    },
+    "sim: GM tc 28 s" = function() {
+      b <- sim_base(); g <- g_gm(n_sim, 0.003, 28); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: GMs 1.2 s and 15 s" = function() {
+      b <- sim_base() + g_gm(n_sim, 0.005, 1.2); g <- g_gm(n_sim, 0.003, 15)
+      list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim: band 16 Hz beside a resonance at 32 Hz" = function() {
+      b <- sim_base() + g_band(n_sim, 0.009, 32, 0.2)
+      list(x = b + g_band(n_sim, 0.006, 16, 0.3), base = b, expect = list(list("band", 16)))
+    },
+    "sim: warm-up tc 4% (200 s)" = function() {
+      b <- sim_base(); list(x = b + g_warmup(b, 200), base = b, expect = list(list("warmup", 200)))
+    },
+    "sim: warm-up tc 20% (1000 s)" = function() {
+      b <- sim_base(); list(x = b + g_warmup(b, 1000), base = b, expect = list(list("warmup", 1000)))
+    },
+    "sim lp sensor: line 7.3 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_line(n_sim, 0.0035, 7.3), base = b, expect = list(list("sinusoid", 7.3)))
+    },
+    "sim lp sensor: GM tc 14 s" = function() {
+      b <- sensor_base(); g <- g_gm(n_sim, 0.004, 14); list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    },
+    "sim lp sensor: band 24 Hz" = function() {
+      b <- sensor_base(); list(x = b + g_band(n_sim, 0.006, 24, 0.3), base = b, expect = list(list("band", 24)))
+    },
+    "sim lp sensor: warm-up tc 400 s" = function() {
+      b <- sensor_base(); list(x = b + g_warmup(b, 400), base = b, expect = list(list("warmup", 400)))
+    },
+    "sim lp sensor: step at 1700 s" = function() {
+      b <- sensor_base(); sz <- g_step_size(b)
+      list(x = b + g_step(n_sim, 1700, sz), base = b, expect = list(list("steps", c(1700, sz))))
+    },
+    "control: sim lp sensor as it is" = function() list(x = sensor_base(), base = NULL),
+    "control: N + K + R (seed 6)" = function() {
+      t <- seq_len(n_sim) / freq
+      list(x = sim_base() + 3e-7 * t, base = NULL)
+    },
+    "control: Q + N + K (seed 6)" = function() list(x = round(sim_base() / 0.015) * 0.015, base = NULL)
+  )
+  real <- list(
+    list(u = 2, j = 6, what = "line", f0 = 2.6),
+    list(u = 3, j = 4, what = "line", f0 = 0.75),
+    list(u = 1, j = 2, what = "line", f0 = 4.4),
+    list(u = 3, j = 2, what = "nyquist", f0 = 47.7),
+    list(u = 1, j = 3, what = "band", fr = 17),
+    list(u = 3, j = 5, what = "band", fr = 13.5),
+    list(u = 2, j = 1, what = "gm", tc = 15),
+    list(u = 3, j = 6, what = "gm", tc = 8),
+    list(u = 2, j = 5, what = "square", f0 = 0.35),
+    list(u = 1, j = 4, what = "saw", f0 = 1.4),
+    list(u = 3, j = 2, what = "warmup", tc = 200),
+    list(u = 1, j = 5, what = "warmup", tc = 500),
+    list(u = 2, j = 3, what = "step", t0 = 2200)
+  )
+}
+
 for (rc in real) local({
   rc <- rc
   nm <- sprintf("real: unit %d col %d + %s", rc$u, rc$j,
@@ -478,6 +563,7 @@ for (rc in real) local({
                        gm = sprintf("GM tc %s s", rc$tc),
                        nyquist = sprintf("line %s Hz", rc$f0),
                        square = sprintf("square wave %s Hz", rc$f0),
+                       saw = sprintf("sawtooth %s Hz", rc$f0),
                        warmup = sprintf("warm-up tc %s s", rc$tc),
                        step = sprintf("step at %s s", rc$t0)))
   cases[[nm]] <<- function() {
@@ -494,6 +580,10 @@ for (rc in real) local({
                     expect = list(list("sinusoid", rc$f0), list("sinusoid", 3 * rc$f0),
                                   list("sinusoid", 5 * rc$f0)),
                     harmonics_of = rc$f0),
+      saw = list(x = b + g_saw(n, 0.5 * s, rc$f0), base = b,
+                 expect = list(list("sinusoid", rc$f0), list("sinusoid", 2 * rc$f0),
+                               list("sinusoid", 3 * rc$f0)),
+                 harmonics_of = rc$f0),
       warmup = list(x = b + g_warmup(b, rc$tc), base = b,
                     expect = list(list("warmup", rc$tc))),
       step = {
@@ -530,7 +620,7 @@ cached_run <- function(x) {
 }
 rows <- list()
 for (nm in grep(only, names(cases), value = TRUE)) {
-  set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500)[[set]] + match(nm, names(cases)))
+  set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500, f = 3700)[[set]] + match(nm, names(cases)))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
   if (is.null(cs$base)) {

@@ -194,6 +194,12 @@ test_that("the raw data support a fitted filter, and contradict one on white noi
   wrong <- filter_raw_support(filter_spec("ma", L = 4), N,
                               filter_evidence(rnorm(n, sd = 0.05), 100), 0.05^2, 100)
   expect_false(wrong$support)
+  # a filter sized for more than the raw data hold: 2.5 x the raw lag-1
+  # excess is contradicted, 1.8 x undecided, 1.3 x supported
+  for (k in c(2.5, 1.8, 1.3)) {
+    s <- filter_raw_support(filter_spec("ma", L = 4), N * sqrt(k), fe, var(x), 100)$support
+    if (k > 2) expect_false(s) else if (k > 1.5) expect_true(is.na(s)) else expect_true(s)
+  }
 })
 
 test_that("the C++ Welch periodogram is R's matrix expression to rounding", {
