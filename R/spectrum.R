@@ -568,7 +568,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     r2$to <- r2$to[keep]
   }
   total <- stats::var(x)
-  regs <- lapply(seq_along(r2$from), function(k) {
+  make_regs <- function(r2) lapply(seq_along(r2$from), function(k) {
     j <- r2$from[k]:r2$to[k]
     wd <- length(j)
     # the fit region stops short of the neighbouring bands (else a weak
@@ -577,6 +577,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     hi <- if (k < length(r2$from)) r2$from[k + 1L] - 1L else nb
     list(j = j, reg = max(2L, lo, r2$from[k] - 2L * wd):min(nb, hi, r2$to[k] + 2L * wd))
   })
+  regs <- make_regs(r2)
   # a fit whose centre leaves its run has slid onto a neighbour
   in_run <- function(ft, g) ft$fr >= w$f[g$j[1L]] && ft$fr <= w$f[g$j[length(g$j)]]
   # the one-sided PSD of fitted bands on the Welch grid
@@ -596,6 +597,47 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     if (in_run(ft, g)) ft else
       list(sigma = sqrt(sum(ex) * w$df), fr = fc, tc = 1 / (2 * pi * max(sdf, w$df)))
   })
+  # Two bands whose flanks meet with no valley split_valleys() could cut
+  # (a 10 Hz resonance of 0.85 x the background on the skirt of a 7.1 Hz
+  # band of 4.5 x: one run of 1.8-10.7 Hz, one band fitted at 7.1 Hz, the
+  # resonance lost) are two when two resonances fit the run's excess
+  # better than one beyond the false-alarm level and are distinct: further
+  # apart than the sum of their widths (closer, they make one bump on the
+  # Allan curve, which a measured band of the whole run describes; a 22 Hz
+  # band split from a z gyro's own 20 Hz one left two pieces the loop
+  # could not add one by one), each wider than a Welch bin (the measured
+  # axes' own bands, not of the AR(2) shape, fit two overlapping resonances
+  # better too) and each side's peak a quarter above the background plus
+  # the other's fitted PSD (as the skirt check below: the background under
+  # a broad run is read to 10-20%; a strong band added to a measured gyro
+  # left a second "resonance" on its flank standing 10-19% above). The run
+  # is cut where the upper one takes over.
+  k <- 1L
+  while (k <= length(regs)) {
+    g <- regs[[k]]
+    pf <- if (length(g$j) >= 2L * min_bins + 1L) {
+      band_pair_fit(g$j, g$reg, fits[[k]], w$f, p, bg, tau0, w$nu)
+    }
+    ok <- !is.null(pf) && !is.na(pf$cut) && pf$stand > 0.25 &&
+      pf$chi2_one - pf$chi2_two > stats::qchisq(1 - alpha, 3L) &&
+      all(vapply(pf$fits, function(ft) 1 / (pi * ft$tc), 0) >= w$df) &&
+      pf$cut > min_bins && length(g$j) - pf$cut + 1L >= min_bins
+    if (!ok) {
+      k <- k + 1L
+      next
+    }
+    at <- g$j[pf$cut]
+    r2$from <- append(r2$from, at, after = k)
+    r2$to <- append(r2$to, r2$to[k], after = k)
+    r2$to[k] <- at - 1L
+    fits <- append(fits, pf$fits[2L], after = k)
+    fits[[k]] <- pf$fits[[1L]]
+    ln <- on_band[[k]] %||% numeric()
+    on_band <- append(on_band, list(ln[ln >= w$f[at]]), after = k)
+    on_band[[k]] <- ln[ln < w$f[at]]
+    regs <- make_regs(r2)
+    k <- k + 2L
+  }
   # The background's running median still holds the bands' skirts (a
   # resonance's PSD falls as f^-4 away from f_r and lifts the whole
   # spectrum by a few percent), and where pass 2's mask reaches 0 Hz it is
@@ -738,6 +780,62 @@ fit_resonance_psd <- function(f, ex, bg, tau0, fc, power, sdf, start = NULL) {
     c(log(start$sigma), start$fr, log(start$tc))
   o <- stats::optim(q0, obj, control = list(maxit = 500L, reltol = 1e-10))
   list(sigma = exp(o$par[1L]), fr = o$par[2L], tc = exp(o$par[3L]))
+}
+
+# Two bands whose flanks meet with no valley deep enough for
+# split_valleys() (a weak resonance on a strong band's skirt) are told
+# apart by their shape: the excess over the background in region `reg`
+# (Welch bins; run `j` within it) is fitted by one resonance (`fit1`) and
+# by two, the second started at the largest excess the first leaves in
+# the run. The chi-square of each (the bins' scatter (bg + M)^2 / nu,
+# inflated 1.5^2 for the overlapping segments) is returned with the two
+# fits, the bin of `j` where the second takes over from the first (NA
+# unless both centres are in the run, further apart than the sum of their
+# widths)
+# and `stand`: how far the weaker side's peak stands above the background
+# plus the other's fitted PSD, relative to them.
+band_pair_fit <- function(j, reg, fit1, f, p, bg, tau0, nu) {
+  one <- function(ft, ff) 2 * resonance_psd(ff, tau0, ft$sigma, ft$fr, ft$tc)
+  chi2 <- function(M) sum(((p[reg] - bg[reg] - M) / (bg[reg] + M))^2) * nu / 1.5^2
+  M1 <- one(fit1, f[reg])
+  out <- list(chi2_one = chi2(M1), chi2_two = NA_real_, cut = NA_integer_)
+  res <- p[j] - bg[j] - one(fit1, f[j])
+  hw1 <- 1 / (2 * pi * fit1$tc)
+  far <- abs(f[j] - fit1$fr) > hw1
+  if (!any(far & res > 0)) return(out)
+  i2 <- which(far)[which.max(res[far])]
+  near <- abs(f[j] - f[j[i2]]) <= hw1
+  pow2 <- sum(pmax(res[near], 0)) * (f[2L] - f[1L])
+  if (!(pow2 > 0)) return(out)
+  ex <- p[reg] - bg[reg]
+  model <- function(q) {
+    2 * resonance_psd(f[reg], tau0, exp(q[1L]), q[2L], exp(q[3L])) +
+      2 * resonance_psd(f[reg], tau0, exp(q[4L]), q[5L], exp(q[6L]))
+  }
+  obj <- function(q) sum(((ex - model(q)) / bg[reg])^2)
+  q0 <- c(log(fit1$sigma), fit1$fr, log(fit1$tc), log(sqrt(pow2)), f[j[i2]], log(fit1$tc))
+  o <- stats::optim(q0, obj, control = list(maxit = 2000L, reltol = 1e-10))
+  a <- list(sigma = exp(o$par[1L]), fr = o$par[2L], tc = exp(o$par[3L]))
+  b <- list(sigma = exp(o$par[4L]), fr = o$par[5L], tc = exp(o$par[6L]))
+  if (a$fr > b$fr) { t <- a; a <- b; b <- t }
+  out$chi2_two <- chi2(model(o$par))
+  out$fits <- list(a, b)
+  apart <- 1 / (pi * a$tc) + 1 / (pi * b$tc)
+  inside <- function(ft) ft$fr >= f[j[1L]] && ft$fr <= f[j[length(j)]]
+  if (!inside(a) || !inside(b) || b$fr - a$fr <= apart) return(out)
+  # where the upper one takes over, between the centres
+  between <- which(f[j] > a$fr & f[j] < b$fr)
+  if (!length(between)) return(out)
+  over <- between[one(b, f[j[between]]) >= one(a, f[j[between]])]
+  if (!length(over)) return(out)
+  out$cut <- over[1L]
+  # how far each side's peak stands above the background plus the other's
+  # fitted PSD (relative)
+  lo <- j[seq_len(out$cut - 1L)]
+  hi <- j[out$cut:length(j)]
+  stand <- function(i, other) max((p[i] - bg[i] - one(other, f[i])) / (bg[i] + one(other, f[i])))
+  out$stand <- min(stand(lo, b), stand(hi, a))
+  out
 }
 
 # The series with each broad band of find_bands() brought down to its

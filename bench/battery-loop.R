@@ -555,6 +555,21 @@ if (identical(set, "f")) {
   )
 }
 
+# ---- set "g" -------------------------------------------------------------------
+# Every measured axis with a line and with a band added (session 19), the
+# frequencies drawn once from a fixed seed (lines 1-8 Hz, bands 5-25 Hz,
+# away from each axis's own 0.55 Hz line and its harmonics by the draw
+# alone): effects beside whatever each axis carries.
+if (identical(set, "g")) {
+  cases <- list()
+  set.seed(4100)
+  real <- list()
+  for (u in 1:3) for (j in 1:6) {
+    real[[length(real) + 1L]] <- list(u = u, j = j, what = "line", f0 = round(runif(1, 1, 8), 2))
+    real[[length(real) + 1L]] <- list(u = u, j = j, what = "band", fr = round(runif(1, 5, 25), 1))
+  }
+}
+
 for (rc in real) local({
   rc <- rc
   nm <- sprintf("real: unit %d col %d + %s", rc$u, rc$j,
@@ -620,7 +635,7 @@ cached_run <- function(x) {
 }
 rows <- list()
 for (nm in grep(only, names(cases), value = TRUE)) {
-  set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500, f = 3700)[[set]] + match(nm, names(cases)))
+  set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500, f = 3700, g = 3900)[[set]] + match(nm, names(cases)))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
   if (is.null(cs$base)) {
