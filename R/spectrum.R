@@ -610,6 +610,36 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     if (in_run(ft, g)) ft else
       list(sigma = sqrt(sum(ex) * w$df), fr = fc, tc = 1 / (2 * pi * max(sdf, w$df)))
   })
+  # The background's running median still holds the bands' skirts (a
+  # resonance's PSD falls as f^-4 away from f_r and lifts the whole
+  # spectrum by a few percent), and where pass 2's mask reaches 0 Hz it is
+  # extended flat from above the band (under a falling spectrum, too low):
+  # the fits took part of each band for background, or background for
+  # band (power 6-16% low on the battery's simulated bands, 27% high on a
+  # band added to unit 1 gyro_x). Twice: the background re-read from the
+  # spectrum with the fitted bands taken off, masking only the runs
+  # themselves (the flanks and skirts are in the fitted PSD), and the bands
+  # refitted on it from their fits.
+  reread <- function() {
+    if (!length(fits)) return()
+    mask <- rep(FALSE, nb)
+    for (k in seq_along(r2$from)) mask[r2$from[k]:r2$to[k]] <- TRUE
+    keep <- which(!mask)
+    for (it in seq_len(if (length(keep) > 10L) 2L else 0L)) {
+      M <- fitted_psd(fits)
+      lq <- log(pmax(p - M, .Machine$double.xmin))
+      bg2 <- exp(running_median(lq[keep], octave(seq_along(keep)), exact = FALSE) - corr)
+      bg <<- exp(stats::approx(keep, log(bg2), xout = seq_len(nb), rule = 2)$y)
+      # a refit whose centre leaves its run (a weak run beside a strong
+      # band sliding onto the other's flank) keeps its fit
+      fits <<- lapply(seq_along(regs), function(k) {
+        g <- regs[[k]]
+        ft <- fit_resonance_psd(w$f[g$reg], p[g$reg] - bg[g$reg], bg[g$reg], tau0, start = fits[[k]])
+        if (in_run(ft, g)) ft else fits[[k]]
+      })
+    }
+  }
+  reread()
   # Two bands whose flanks meet with no valley split_valleys() could cut
   # (a 10 Hz resonance of 0.85 x the background on the skirt of a 7.1 Hz
   # band of 4.5 x: one run of 1.8-10.7 Hz, one band fitted at 7.1 Hz, the
@@ -623,15 +653,25 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
   # better too) and each side's peak a quarter above the background plus
   # the other's fitted PSD (as the skirt check below: the background under
   # a broad run is read to 10-20%; a strong band added to a measured gyro
-  # left a second "resonance" on its flank standing 10-19% above). The run
-  # is cut where the upper one takes over.
+  # left a second "resonance" on its flank standing 10-19% above), the
+  # weaker no more than twice as wide as the stronger (a broad excess beside
+  # a band is the background's curvature under the run, read by a median
+  # interpolated across it: a second-order low-pass's roll-off left one of
+  # FWHM 4.7 Hz beside a 15 Hz resonance of 1.2 Hz). The run is cut where
+  # the upper one takes over. Judged on the background re-read beside the
+  # fits (the first, read with a run and its flanks masked, leaves a strong
+  # band's skirts as excess), which is read again beside the split bands.
+  n_runs <- length(regs)
   k <- 1L
   while (k <= length(regs)) {
     g <- regs[[k]]
     pf <- if (length(g$j) >= 2L * min_bins + 1L) {
       band_pair_fit(g$j, g$reg, fits[[k]], w$f, p, bg, tau0, w$nu)
     }
+    wd <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) 1 / (pi * ft$tc), 0)
+    pw <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) ft$sigma^2, 0)
     ok <- !is.null(pf) && !is.na(pf$cut) && pf$stand > 0.25 &&
+      wd[which.min(pw)] <= 2 * wd[which.max(pw)] &&
       pf$chi2_one - pf$chi2_two > stats::qchisq(1 - alpha, 3L) &&
       all(vapply(pf$fits, function(ft) 1 / (pi * ft$tc), 0) >= w$df) &&
       pf$cut > min_bins && length(g$j) - pf$cut + 1L >= min_bins
@@ -651,34 +691,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     regs <- make_regs(r2)
     k <- k + 2L
   }
-  # The background's running median still holds the bands' skirts (a
-  # resonance's PSD falls as f^-4 away from f_r and lifts the whole
-  # spectrum by a few percent), and where pass 2's mask reaches 0 Hz it is
-  # extended flat from above the band (under a falling spectrum, too low):
-  # the fits took part of each band for background, or background for
-  # band (power 6-16% low on the battery's simulated bands, 27% high on a
-  # band added to unit 1 gyro_x). Twice: the background re-read from the
-  # spectrum with the fitted bands taken off, masking only the runs
-  # themselves (the flanks and skirts are in the fitted PSD), and the bands
-  # refitted on it from their fits.
-  if (length(fits)) {
-    mask <- rep(FALSE, nb)
-    for (k in seq_along(r2$from)) mask[r2$from[k]:r2$to[k]] <- TRUE
-    keep <- which(!mask)
-    for (it in seq_len(if (length(keep) > 10L) 2L else 0L)) {
-      M <- fitted_psd(fits)
-      lq <- log(pmax(p - M, .Machine$double.xmin))
-      bg2 <- exp(running_median(lq[keep], octave(seq_along(keep)), exact = FALSE) - corr)
-      bg <- exp(stats::approx(keep, log(bg2), xout = seq_len(nb), rule = 2)$y)
-      # a refit whose centre leaves its run (a weak run beside a strong
-      # band sliding onto the other's flank) keeps its fit
-      fits <- lapply(seq_along(regs), function(k) {
-        g <- regs[[k]]
-        ft <- fit_resonance_psd(w$f[g$reg], p[g$reg] - bg[g$reg], bg[g$reg], tau0, start = fits[[k]])
-        if (in_run(ft, g)) ft else fits[[k]]
-      })
-    }
-  }
+  if (length(regs) > n_runs) reread()
   # A run that holds lines beside a rest read as band power, cut at a
   # valley from a neighbouring run, may hold no band of its own: its rest
   # is the neighbour's skirt, which the running median left out (a 6.1 Hz

@@ -175,6 +175,8 @@ test_that("the raw data support a resonance where a band is, and contradict one 
   expect_true(resonance_raw_support(0.8, 20, 0.08, b)$support)
   expect_false(resonance_raw_support(0.8, 7, 0.08, b)$support)
   expect_false(resonance_raw_support(0.8, 20, 0.08, find_bands(rnorm(n), 100))$support)
+  # a resonance far narrower than the Welch bin is a tone, not this band
+  expect_false(resonance_raw_support(0.8, 20, 100, b)$support)
   # the curve's power against the band's measured one: within a factor 2
   # it is the band; at 2.5x either way it stands for something else
   p <- b$power[1]
