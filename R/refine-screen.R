@@ -536,7 +536,13 @@ family_pairs <- function(st) {
       v <- fm$term
       vlab <- fm$label
       sv <- fm$start
-      for (tr in trials) {
+      for (ti in seq_along(trials)) {
+        tr <- trials[[ti]]
+        # beside a trial that did not pay alone, the form must be confirmed
+        # by the raw data, not merely left undecided (a second-order
+        # low-pass at 45 Hz, nearly white, entered beside a weak line of 2.6
+        # x its periodogram amplitude: N -10%)
+        unpaid <- ti > length(st$refused)
         tm <- model_terms(c(rest, v), tr$effect, c(tr$init[[1L]], tr$pin[[1L]]), cur)
         before <- tm[-length(tm)]
         lab <- new_label(before, tr$effect)
@@ -559,7 +565,7 @@ family_pairs <- function(st) {
         jd <- judge_instance(st, f, tr$effect, lab, tau)
         if (!is.null(jd$why) || !isTRUE(jd$ev$support)) next
         fj <- judge_form(st, f, v, vlab)
-        if (is.null(fj)) next
+        if (is.null(fj) || (unpaid && !isTRUE(fj$ev$support))) next
         how <- if (is.null(fi)) {
           sprintf("the %s family added beside it (neither paid alone)", e$name)
         } else {
