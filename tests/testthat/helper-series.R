@@ -6,6 +6,16 @@ gen_white_walk <- function(n, white = 0.1, rw = 5e-5, seed) {
   rnorm(n, sd = white) + cumsum(rnorm(n, sd = rw))
 }
 
+# n samples of a two-pole resonance (white noise through stats::filter's
+# AR(2) with poles exp(-1 / (freq tc) +- 2 pi i fr / freq), its first
+# `burn` samples dropped), scaled to unit sd.
+ar2_unit <- function(n, fr, tc, freq, burn = 2000L) {
+  r <- exp(-1 / (freq * tc))
+  z <- as.numeric(stats::filter(rnorm(n + burn), c(2 * r * cos(2 * pi * fr / freq), -r^2),
+                                method = "recursive"))[-seq_len(burn)]
+  z / stats::sd(z)
+}
+
 # A simulated sensor axis (own generator: stats::filter, sin, cumsum; not
 # the package's simulator): white noise through a short moving average
 # (weights 1, 0.25), a two-pole resonance at 9.85 Hz (tc 0.5 s), a 0.54 Hz

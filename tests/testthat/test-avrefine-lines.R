@@ -366,10 +366,8 @@ test_that("a line near Nyquist and the filter it hides enter together", {
   n <- 5e5
   t <- seq_len(n) / freq
   w <- rnorm(n + 1L, sd = 0.01)
-  a <- exp(-1 / (freq * 0.6))
-  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * a * cos(2 * pi * 13.3 / freq), -a^2),
-                                method = "recursive"))[-(1:2000)]
-  b <- (w[-1L] + 0.35 * w[-(n + 1L)]) + 0.009 * z / stats::sd(z) +
+  z <- ar2_unit(n, 13.3, 0.6, freq)
+  b <- (w[-1L] + 0.35 * w[-(n + 1L)]) + 0.009 * z +
     0.01 * sin(2 * pi * 0.73 * t + 1) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
   f0 <- runif(1, 44, 48.5)
   x <- b + 0.008 * sin(2 * pi * f0 * t + runif(1, 0, 2 * pi))
@@ -394,11 +392,9 @@ test_that("a square wave beside a first-order low-pass sensor: no low-pass sized
   freq <- 100
   n <- 5e5
   t <- seq_len(n) / freq
-  a <- exp(-1 / (freq * 0.35))
-  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * a * cos(2 * pi * 15.5 / freq), -a^2),
-                                method = "recursive"))[-(1:2000)]
+  z <- ar2_unit(n, 15.5, 0.35, freq)
   b <- as.numeric(stats::filter(rnorm(n, sd = 0.009), 0.3, method = "recursive")) +
-    0.008 * z / stats::sd(z) + 0.009 * sin(2 * pi * 0.48 * t + 2) +
+    0.008 * z + 0.009 * sin(2 * pi * 0.48 * t + 2) +
     cumsum(rnorm(n, sd = 1.2e-4 / sqrt(freq)))
   f0 <- runif(1, 0.7, 1.2)
   x <- b + 0.004 * sign(sin(2 * pi * f0 * t + runif(1, 0, 2 * pi)))

@@ -250,12 +250,7 @@ test_that("find_bands(): a band's fit does not slide onto a strong line beside i
   set.seed(2)
   freq <- 100
   n <- 5e5
-  ar2 <- function(fr, tc) {
-    r <- exp(-1 / (freq * tc))
-    z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * fr / freq), -r^2),
-                                  method = "recursive"))[-(1:2000)]
-    z / stats::sd(z)
-  }
+  ar2 <- function(fr, tc) ar2_unit(n, fr, tc, freq)
   t <- seq_len(n) / freq
   x <- rnorm(n, sd = 0.01) + 0.006 * ar2(4, 0.3) + 0.014 * sin(2 * pi * 0.54 * t + 1) +
     0.012 * ar2(9.85, 0.5)
@@ -274,12 +269,10 @@ test_that("find_bands(): a line on a resonance's skirt is a line, not a band", {
   set.seed(3517)
   freq <- 100
   n <- 5e5
-  r <- exp(-1 / (freq * 0.4))
-  z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * 11.2 / freq), -r^2),
-                                method = "recursive"))[-(1:2000)]
+  z <- ar2_unit(n, 11.2, 0.4, freq)
   w <- rnorm(n + 1L, sd = 0.012)
   t <- seq_len(n) / freq
-  x <- w[-1L] + 0.35 * w[-(n + 1L)] + 0.01 * z / stats::sd(z) + 0.004 * sin(2 * pi * 6.1 * t + 2)
+  x <- w[-1L] + 0.35 * w[-(n + 1L)] + 0.01 * z + 0.004 * sin(2 * pi * 6.1 * t + 2)
   b <- allanvar:::find_bands(x, freq)
   expect_equal(nrow(b), 1L)
   expect_equal(b$f_center, 11.2, tolerance = 0.02)
@@ -295,12 +288,7 @@ test_that("find_bands(): a weak resonance on a strong band's skirt is a second b
   # 96019cc), the 10.2 Hz resonance lost.
   freq <- 100
   n <- 5e5
-  ar2 <- function(fr, tc) {
-    r <- exp(-1 / (freq * tc))
-    z <- as.numeric(stats::filter(rnorm(n + 2000), c(2 * r * cos(2 * pi * fr / freq), -r^2),
-                                  method = "recursive"))[-(1:2000)]
-    z / stats::sd(z)
-  }
+  ar2 <- function(fr, tc) ar2_unit(n, fr, tc, freq)
   set.seed(1)
   w <- rnorm(n + 1L, sd = 0.01)
   x <- w[-1L] + 0.2 * w[-(n + 1L)] + 0.0045 * ar2(7.1, 0.27) + 0.0018 * ar2(10.2, 0.25)
@@ -325,11 +313,9 @@ test_that("find_bands(): a band with a line on top is measured without the line"
   set.seed(1)
   freq <- 100
   n <- 1e6
-  r <- exp(-1 / (freq * 0.5))
-  z <- as.numeric(stats::filter(rnorm(n + 5000), c(2 * r * cos(2 * pi * 8.2 / freq), -r^2),
-                                method = "recursive"))[-(1:5000)]
+  z <- ar2_unit(n, 8.2, 0.5, freq, burn = 5000L)
   w <- rnorm(n + 1L, sd = 0.01)
-  x <- w[-1L] + 0.2 * w[-(n + 1L)] + 0.001 * z / stats::sd(z) +
+  x <- w[-1L] + 0.2 * w[-(n + 1L)] + 0.001 * z +
     0.003 * sin(2 * pi * 7.6 * seq_len(n) / freq + 2)
   b <- allanvar:::find_bands(x, freq)
   expect_equal(nrow(b), 1L)
