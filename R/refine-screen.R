@@ -505,20 +505,19 @@ add_refused <- function(refused, tr) {
 # carries half of the axis's 9.8 Hz resonance: the curve asks the
 # resonance for less power than its band holds, and the raw data refuse
 # it). When nothing paid, no other form pays alone and the model is still
-# far from the curve (chi2/dof above revisit_chi2), each trial refused
-# this step at raw-data values, or that did not pay alone at them (a
-# square wave's harmonic beside a first-order low-pass that took the bumps
-# of the harmonics not yet in, and the axis's resonance), is refitted beside each other form of the family, everything free. The
-# converse: a family the model lacks, whose
-# forms the raw data refused alone (a moving average fitted without a
-# 45.5 Hz line, whose bump at tau0 hides the average's dip, predicts too
-# little lag-1 autocorrelation), and raw-data values that did not pay
-# alone (that line: its bump sits where the missing filter's dip is) are
-# refitted together, each form of the family beside each such trial. The
-# best pair enters as this step's winner when it pays, the trial is
-# confirmed by the raw data, the new form is valid and not contradicted,
-# and the effects accepted earlier hold. Returns st, with st$best set when
-# a pair won.
+# far from the curve (chi2/dof above revisit_chi2), each trial refused this
+# step at raw-data values, or that did not pay alone at them (a square
+# wave's harmonic beside a first-order low-pass that took the bumps of the
+# harmonics not yet in, and the axis's resonance), is refitted beside each
+# other form of the family, everything free. Conversely, the forms of a
+# family the model lacks, which the raw data refused alone (a moving
+# average fitted without a 45.5 Hz line, whose bump at tau0 hides the
+# average's dip, predicts too little lag-1 autocorrelation), are each
+# refitted beside such trials (that line). The best pair enters as this
+# step's winner when it pays, the trial is confirmed by the raw data, the
+# new form is valid and not contradicted (confirmed, beside a trial that
+# did not pay alone), and the effects accepted earlier hold. Returns st,
+# with st$best set when a pair won.
 family_pairs <- function(st) {
   cur <- st$current
   if (!(cur$chi2 > revisit_chi2)) return(st)

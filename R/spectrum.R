@@ -673,7 +673,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     ok <- !is.null(pf) && !is.na(pf$cut) && pf$stand > 0.25 &&
       wd[which.min(pw)] <= 2 * wd[which.max(pw)] &&
       pf$chi2_one - pf$chi2_two > stats::qchisq(1 - alpha, 3L) &&
-      all(vapply(pf$fits, function(ft) 1 / (pi * ft$tc), 0) >= w$df) &&
+      all(wd >= w$df) &&
       pf$cut > min_bins && length(g$j) - pf$cut + 1L >= min_bins
     if (!ok) {
       k <- k + 1L
@@ -817,9 +817,8 @@ fit_resonance_psd <- function(f, ex, bg, tau0, fc, power, sdf, start = NULL) {
 # inflated 1.5^2 for the overlapping segments) is returned with the two
 # fits, the bin of `j` where the second takes over from the first (NA
 # unless both centres are in the run, further apart than the sum of their
-# widths)
-# and `stand`: how far the weaker side's peak stands above the background
-# plus the other's fitted PSD, relative to them.
+# widths) and `stand`: how far the weaker side's peak stands above the
+# background plus the other's fitted PSD, relative to them.
 band_pair_fit <- function(j, reg, fit1, f, p, bg, tau0, nu) {
   one <- function(ft, ff) 2 * resonance_psd(ff, tau0, ft$sigma, ft$fr, ft$tc)
   chi2 <- function(M) sum(((p[reg] - bg[reg] - M) / (bg[reg] + M))^2) * nu / 1.5^2
