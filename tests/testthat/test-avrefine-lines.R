@@ -20,6 +20,11 @@ measured_axis <- function(unit, axis) {
 with_wave <- function(ax, amp, f0, phase, wave = sin) {
   ax$b + amp * ax$s * wave(2 * pi * f0 * seq_along(ax$b) / ax$freq + phase)
 }
+# the sinusoids' fitted frequencies, named by coefficient
+fitted_f0 <- function(r) {
+  cf <- coef(r)
+  cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+}
 n_reading <- function(r) {
   cf <- coef(r)
   # N, or the white level a filter term of any form carries
@@ -34,7 +39,7 @@ test_that("a line at 49.3 Hz (100 Hz sampling, amplitude the white sd) is named;
   x <- b + 0.01 * sin(2 * pi * 49.3 * seq_len(n) / freq + 0.7)
   r <- loop(x, freq)
   cf <- coef(r)
-  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  f0 <- fitted_f0(r)
   expect_length(f0, 1L)
   expect_equal(unname(f0), 49.3, tolerance = 0.03 / 49.3)
   expect_equal(cf[[sub("f0", "amp", names(f0))]], 0.01, tolerance = 0.1)
@@ -80,8 +85,7 @@ test_that("a line at 46.8 Hz on a measured accelerometer: no quantization term b
   set.seed(2714)
   x <- with_wave(ax, 1, 46.8, runif(1, 0, 2 * pi))
   r <- loop(x, ax$freq)
-  cf <- coef(r)
-  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  f0 <- fitted_f0(r)
   expect_true(any(abs(f0 / 46.8 - 1) <= 0.03))
   expect_false("Q" %in% r$terms)
   expect_false(any(r$steps$confirmed %in% FALSE))
@@ -94,8 +98,7 @@ test_that("a 0.8 Hz square wave: its lines 0.8, 2.4 and 4.0 Hz are named, no ban
   n <- 5e5
   x <- gen_base(n, freq) + 0.004 * sign(sin(2 * pi * 0.8 * seq_len(n) / freq + 0.3))
   r <- loop(x, freq)
-  cf <- coef(r)
-  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  f0 <- fitted_f0(r)
   for (h in c(1, 3, 5)) expect_lte(min(abs(f0 / (0.8 * h) - 1)), 0.03)
   # only odd harmonics: the set's pattern
   expect_true(all(abs(f0 / 0.8 - round(f0 / 0.8)) < 0.01 & round(f0 / 0.8) %% 2 == 1))
@@ -156,7 +159,7 @@ test_that("a harmonic set's further lines do not spend the step budget", {
   f0s <- function(x) {
     fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
     r <- suppressMessages(avrefine(fit, data = x, max_steps = 1))
-    coef(r)[grepl("^sinusoid[0-9]+\\.f0$", names(coef(r)))]
+    fitted_f0(r)
   }
   f0 <- f0s(b + sq)
   # (a further odd harmonic the periodogram finds may follow too: a set's
@@ -184,8 +187,7 @@ test_that("a line beside a measured axis's own: the greedy order is revisited wi
   freq <- ax$freq
   x <- with_wave(ax, 0.3, 1.7, 0.7)
   r <- loop(x, freq)
-  cf <- coef(r)
-  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  f0 <- fitted_f0(r)
   expect_true(any(abs(f0 / 1.7 - 1) <= 0.03))
   expect_false(any(r$steps$confirmed %in% FALSE))
   expect_lt(r$chi2, 4)
@@ -240,8 +242,7 @@ test_that("a square wave added to a measured accelerometer: its 5th harmonic is 
   freq <- ax$freq
   x <- with_wave(ax, 0.4, 1.1, 2.1, function(u) sign(sin(u)))
   r <- loop(x, freq)
-  cf <- coef(r)
-  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  f0 <- fitted_f0(r)
   for (h in c(1, 3, 5)) expect_lte(min(abs(f0 / (1.1 * h) - 1)), 0.03)
   expect_lte(min(abs(f0 / 0.566 - 1)), 0.03)
   expect_false(any(r$steps$confirmed %in% FALSE))
@@ -260,8 +261,7 @@ test_that("a square wave on a measured accelerometer: a low-pass taken for its h
   x <- with_wave(ax, 0.4, 0.66, 0.4, function(u) sign(sin(u)))
   r0 <- loop(ax$b, ax$freq)
   r <- loop(x, ax$freq)
-  cf <- coef(r)
-  f0 <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  f0 <- fitted_f0(r)
   for (h in c(1, 3)) expect_lte(min(abs(f0 / (0.66 * h) - 1)), 0.03)
   expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
   expect_true(any(split_term(r$terms)$kind %in% c("resonance", "band")))
@@ -281,8 +281,7 @@ test_that("an added line does not cost a measured axis its own Gauss-Markov term
   x <- with_wave(ax, 0.3, 0.9, 0.4)
   r <- loop(x, freq)
   expect_true("gm" %in% split_term(r$terms)$kind)
-  cf <- coef(r)
-  expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / 0.9 - 1)), 0.03)
+  expect_lte(min(abs(fitted_f0(r) / 0.9 - 1)), 0.03)
   expect_lt(r$chi2, 4)
 })
 
@@ -302,7 +301,7 @@ test_that("a line beside a measured axis's filter and resonance: the filter's fo
   r <- loop(x, freq)
   expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
   cf <- coef(r)
-  expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / 3.1 - 1)), 0.03)
+  expect_lte(min(abs(fitted_f0(r) / 3.1 - 1)), 0.03)
   centre <- cf[grepl("^resonance[0-9]+\\.fr$|^band[0-9]+\\.f_c$", names(cf))]
   expect_lte(min(abs(centre / 9.84 - 1)), 0.05)
   expect_true(any(grepl("chosen again (was filter:lp1) beside", r$steps$evidence, fixed = TRUE)))
@@ -321,8 +320,7 @@ test_that("a strong line beside a measured band enters: the band's measured scal
   n <- 5e5
   x <- sim_sensor_axis(n, freq)
   r <- loop(x, freq)
-  cf <- coef(r)
-  expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / 0.54 - 1)), 0.03)
+  expect_lte(min(abs(fitted_f0(r) / 0.54 - 1)), 0.03)
   expect_lt(r$chi2, 4)
   # the white level at DC: 1.25 x 0.01 x sqrt(1 / freq)
   expect_lte(abs(n_reading(r) / 1.25e-3 - 1), 0.15)
@@ -345,8 +343,7 @@ test_that("a filter form taken for a line's bump is chosen again once the line i
   x <- b + 0.003 * sin(2 * pi * 2.2 * t + runif(1, 0, 2 * pi))
   r0 <- loop(b, freq)
   r <- loop(x, freq)
-  cf <- coef(r)
-  expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / 2.2 - 1)), 0.03)
+  expect_lte(min(abs(fitted_f0(r) / 2.2 - 1)), 0.03)
   expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
   expect_identical(sort(r$terms[startsWith(r$terms, "filter")]),
                    sort(r0$terms[startsWith(r0$terms, "filter")]))
@@ -373,8 +370,7 @@ test_that("a line near Nyquist and the filter it hides enter together", {
   x <- b + 0.008 * sin(2 * pi * f0 * t + runif(1, 0, 2 * pi))
   r0 <- loop(b, freq)
   r <- loop(x, freq)
-  cf <- coef(r)
-  expect_lte(min(abs(cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))] / f0 - 1)), 0.03)
+  expect_lte(min(abs(fitted_f0(r) / f0 - 1)), 0.03)
   expect_identical(sum(startsWith(r$terms, "filter")), 1L)
   expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
   expect_false(any(r$steps$confirmed %in% FALSE))
@@ -400,8 +396,7 @@ test_that("a square wave beside a first-order low-pass sensor: no low-pass sized
   x <- b + 0.004 * sign(sin(2 * pi * f0 * t + runif(1, 0, 2 * pi)))
   r0 <- loop(b, freq)
   r <- loop(x, freq)
-  cf <- coef(r)
-  f <- cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))]
+  f <- fitted_f0(r)
   for (h in c(1, 3)) expect_lte(min(abs(f / (f0 * h) - 1)), 0.03)
   expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
   expect_true(any(split_term(r$terms)$kind %in% c("resonance", "band")))
