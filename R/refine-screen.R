@@ -465,11 +465,10 @@ family_forms <- function(st, e, absent = FALSE) {
   out <- if (length(fi)) cur$terms == fi else
     attr(model_terms(cur$terms, family_term(e$name, variants, variants[1L])), "gone")
   rest <- cur$terms[!out]
-  nl_cur <- stats::coef(cur)[cur$layout$role == "nonlinear"]
+  nl_rest <- stats::coef(cur)[cur$layout$role == "nonlinear"]
   for (lab in term_labels(cur$terms)[out]) {
-    nl_cur <- nl_cur[!startsWith(names(nl_cur), paste0(lab, "."))]
+    nl_rest <- nl_rest[!startsWith(names(nl_rest), paste0(lab, "."))]
   }
-  nl_rest <- nl_cur
   forms <- lapply(seq_along(variants), function(j) {
     v <- family_term(e$name, variants, variants[j])
     if (length(fi) && v == fi) return(NULL)
@@ -565,22 +564,15 @@ family_pairs <- function(st) {
         if (!is.null(jd$why) || !isTRUE(jd$ev$support)) next
         fj <- judge_form(st, f, v, vlab)
         if (is.null(fj) || (unpaid && !isTRUE(fj$ev$support))) next
-        how <- if (is.null(fi)) {
-          sprintf("the %s family added beside it (neither paid alone)", e$name)
-        } else {
+        how <- if (is.null(fi)) sprintf("the %s family added", e$name) else
           sprintf("the %s family chosen again (was %s)", e$name, fi)
-        }
-        jd$ev$text <- sprintf("%s; with %s", jd$ev$text, how)
+        jd$ev$text <- paste0(jd$ev$text, "; with ", how,
+                             if (is.null(fi)) " beside it (neither paid alone)")
         st$best <- list(fit = f, crit = c1, adj = c1 - min_gain, trial = tr,
                         label = lab, params = jd$par, ev = jd$ev, pin = pin,
                         fixed = settings$fixed,
                         also = list(effect = v, label = vlab, par = fj$par, ev = fj$ev,
-                                    note = if (is.null(fi)) {
-                                      paste0("the ", e$name, " family added beside ", lab)
-                                    } else {
-                                      paste0("the ", e$name, " family chosen again (was ",
-                                             fi, ") beside ", lab)
-                                    }))
+                                    note = paste(how, "beside", lab)))
       }
     }
   }

@@ -106,8 +106,8 @@ resonance_raw_support <- function(sigma, fr, tc, bands) {
   # narrower than a tenth of the resolution the band was measured at (a
   # resonance of tc 2620 s took a 2.05 Hz line's place beside a band of
   # FWHM 0.22 Hz, one Welch bin: floored there, the widths agreed)
-  wr <- max(bands$width[j], res) / max(1 / (pi * tc), res)
-  if (1 / (pi * tc) < res / 10) wr <- max(bands$width[j], res) * pi * tc
+  fw <- 1 / (pi * tc)
+  wr <- max(bands$width[j], res) / (if (fw < res / 10) fw else max(fw, res))
   txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x and width %.2g x the fitted)",
                  format(signif(bands$f_center[j], 4)), format(signif(bands$width[j], 2)),
                  100 * bands$share[j], pr, wr)
