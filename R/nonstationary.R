@@ -745,7 +745,9 @@ robust_scale <- function(r, trim = 0.005) {
 #' innovations' robust scale), is compared with the Gaussian Bonferroni
 #' level over the record (at least `min_z`), or beyond what the series'
 #' own heavy-tailed noise reaches over the record where its body is not
-#' Gaussian (spike_tail_level()); a neighbour of an outlier is
+#' Gaussian (spike_tail_level()), moved clear of the candidates' own |z|
+#' (stable_level(): a scale moved 2% by an added effect must not move the
+#' count); a neighbour of an outlier is
 #' a spike only beyond what the outlier lends it (spike_distinct()).
 #' Judged on the running median's residual instead, a line near Nyquist of
 #' the white noise's amplitude raised the scale 20% and took 85% of the
@@ -758,7 +760,8 @@ robust_scale <- function(r, trim = 0.005) {
 #'   (its excess over the running median of `k` samples), `z`; attribute
 #'   `threshold` (in robust sd).
 #' @noRd
-detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
+detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L,
+                          level_margin = 0.03) {
   n <- length(x)
   med <- spike_runmed(x, k)
   r <- x - med
@@ -774,7 +777,13 @@ detect_spikes <- function(x, freq, alpha = 0.01, k = 7L, min_z = 6, p = 20L) {
   if (is.null(z)) return(empty)
   zc <- max(min_z, stats::qnorm(1 - alpha / (2 * n)),
             spike_tail_level(z, alpha))
-  big <- if (n < .Machine$integer.max) which_abs_above(z, zc) else which(abs(z) > zc)
+  # the level moved clear of the candidates (stable_level()), which are
+  # looked for down to the least level it can choose
+  lo <- zc / (1 + level_margin)
+  big <- if (n < .Machine$integer.max) which_abs_above(z, lo) else which(abs(z) > lo)
+  zc <- stable_level(z[spike_distinct(z, big, lo, attr(z, "pi"))], zc,
+                     margin = level_margin)
+  big <- big[abs(z[big]) > zc]
   i <- spike_distinct(z, big, zc, attr(z, "pi"))
   out <- data.frame(index = i, time = (i - 1) / freq, value = x[i], size = r[i],
                     z = z[i])

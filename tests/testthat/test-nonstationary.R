@@ -204,6 +204,35 @@ test_that("the spike count does not flip when the scale moves 2%; no spikes in c
   expect_lte(hits, 1L)
 })
 
+test_that("a few spikes, one within 1% of the level: the count does not move when the scale moves 2%", {
+  n <- 2e5
+  freq <- 100
+  # Gaussian noise and four outliers; one is sized (its statistic read at a
+  # low level, twice) to sit 1% above the level of 6 (the Bonferroni level
+  # here is 5.45), where a 2% larger scale takes it below
+  set.seed(808)
+  x <- rnorm(n)
+  at <- c(30011L, 81234L, 120555L, 170001L)
+  y <- x
+  y[at] <- y[at] + c(12, 9, 20, -10)
+  for (k in 1:2) {
+    z <- detect_spikes(y, freq, min_z = 3, level_margin = 0)
+    z <- z$z[match(at[2L], z$index)]
+    y[at[2L]] <- x[at[2L]] + (y[at[2L]] - x[at[2L]]) * 6.06 / abs(z)
+  }
+  # the same outliers in noise 2% larger (an added effect's share)
+  bigger <- y + 0.02 * x
+  counts <- c(nrow(detect_spikes(y, freq)), nrow(detect_spikes(bigger, freq)))
+  expect_equal(counts[1L], counts[2L])
+  # the three clear ones are found either way
+  expect_true(all(at[-2L] %in% detect_spikes(y, freq)$index))
+  expect_true(all(at[-2L] %in% detect_spikes(bigger, freq)$index))
+  # a level that stays at 6 counts the near one in one series only
+  plain <- c(nrow(detect_spikes(y, freq, level_margin = 0)),
+             nrow(detect_spikes(bigger, freq, level_margin = 0)))
+  expect_equal(plain, c(4L, 3L))
+})
+
 test_that("heavy-tailed noise is the noise, not spikes: gross outliers beyond its tail are", {
   skip_on_cran()
   n <- 5e5
