@@ -415,28 +415,52 @@ step_refit_winner <- function(st) {
   }
   if (!length(st$hold)) return(st)
   lay <- best$fit$layout
-  args <- refit_args(st$current, best$fit$terms, st$settings,
-                     start = stats::coef(best$fit)[lay$role == "nonlinear"])
+  start <- stats::coef(best$fit)[lay$role == "nonlinear"]
   effect <- best$trial$effect
-  r <- state_refit(st, args, "refit of the winner", effect)
-  st <- r$st
-  full <- r$fit
-  if (!is.null(full) && refine_crit(st, full) <= best$crit + 1e-6) {
+  # a refit taken when it is no worse than the screened one, its evidence
+  # read again, and leaves every earlier effect as the raw data had it
+  taken <- function(st, full) {
+    if (is.null(full) || refine_crit(st, full) > best$crit + 1e-6) return(NULL)
     p2 <- instance_params(stats::coef(full), full$layout, best$label)
     ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)
-    if (!isFALSE(ev2$support) &&
-        is.null(unconfirmed_marginal(effect, ev2, st$c0 - refine_crit(st, full),
-                                     st$args$min_gain, st$raw)) &&
-        is.null(inadmissible(effect, p2, st$current$data$tau, st$args$freq)) &&
-        earlier_hold(st, full)) {
-      st$best$fit <- full
-      st$best$crit <- refine_crit(st, full)
-      st$best$params <- p2
-      st$best$ev <- ev2
-      if (!is.null(best$also)) {
-        st$best$ev$text <- paste0(ev2$text, "; ", best$also$note %||%
-                                    paste("split in two with", best$also$label))
+    ok <- !isFALSE(ev2$support) &&
+      is.null(unconfirmed_marginal(effect, ev2, st$c0 - refine_crit(st, full),
+                                   st$args$min_gain, st$raw)) &&
+      is.null(inadmissible(effect, p2, st$current$data$tau, st$args$freq)) &&
+      earlier_hold(st, full)
+    if (ok) list(fit = full, params = p2, ev = ev2)
+  }
+  args <- refit_args(st$current, best$fit$terms, st$settings, start = start)
+  r <- state_refit(st, args, "refit of the winner", effect)
+  st <- r$st
+  won <- taken(st, r$fit)
+  # Everything free may trade two earlier terms against each other (a
+  # filter's shape against a measured band's power at the short taus,
+  # which the raw data then refuse) where one held value alone was left
+  # behind (a GM's tc, entered before a line the curve still carried):
+  # then each earlier term's values are freed alone, the best taken.
+  if (is.null(won)) {
+    owners <- sub("[.][^.]*$", "", names(st$hold))
+    for (k in unique(owners)) {
+      args <- refit_args(st$current, best$fit$terms, st$settings, start = start,
+                         hold = st$hold[owners != k])
+      r <- state_refit(st, args, "refit of the winner, one term freed", effect)
+      st <- r$st
+      one <- taken(st, r$fit)
+      if (!is.null(one) && (is.null(won) ||
+                            refine_crit(st, one$fit) < refine_crit(st, won$fit))) {
+        won <- one
       }
+    }
+  }
+  if (!is.null(won)) {
+    st$best$fit <- won$fit
+    st$best$crit <- refine_crit(st, won$fit)
+    st$best$params <- won$params
+    st$best$ev <- won$ev
+    if (!is.null(best$also)) {
+      st$best$ev$text <- paste0(won$ev$text, "; ", best$also$note %||%
+                                  paste("split in two with", best$also$label))
     }
   }
   st
