@@ -417,18 +417,21 @@ step_refit_winner <- function(st) {
   lay <- best$fit$layout
   start <- stats::coef(best$fit)[lay$role == "nonlinear"]
   effect <- best$trial$effect
-  # a refit taken when it is no worse than the screened one, its evidence
-  # read again, and leaves every earlier effect as the raw data had it
-  taken <- function(st, full) {
-    if (is.null(full) || refine_crit(st, full) > best$crit + 1e-6) return(NULL)
+  # a refit taken when it is no worse than the screened one (both on the
+  # all-free scale: each value still held charged as screening charges
+  # them), its evidence read again, and leaves every earlier effect as the
+  # raw data had it
+  taken <- function(st, full, held = 0L) {
+    if (is.null(full)) return(NULL)
+    crit <- refine_crit(st, full) + refine_penalty(st) * held
+    if (crit > best$crit + 1e-6) return(NULL)
     p2 <- instance_params(stats::coef(full), full$layout, best$label)
     ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)
     ok <- !isFALSE(ev2$support) &&
-      is.null(unconfirmed_marginal(effect, ev2, st$c0 - refine_crit(st, full),
-                                   st$args$min_gain, st$raw)) &&
+      is.null(unconfirmed_marginal(effect, ev2, st$c0 - crit, st$args$min_gain, st$raw)) &&
       is.null(inadmissible(effect, p2, st$current$data$tau, st$args$freq)) &&
       earlier_hold(st, full)
-    if (ok) list(fit = full, params = p2, ev = ev2)
+    if (ok) list(fit = full, crit = crit, params = p2, ev = ev2)
   }
   args <- refit_args(st$current, best$fit$terms, st$settings, start = start)
   r <- state_refit(st, args, "refit of the winner", effect)
@@ -446,16 +449,13 @@ step_refit_winner <- function(st) {
                          hold = st$hold[owners != k])
       r <- state_refit(st, args, "refit of the winner, one term freed", effect)
       st <- r$st
-      one <- taken(st, r$fit)
-      if (!is.null(one) && (is.null(won) ||
-                            refine_crit(st, one$fit) < refine_crit(st, won$fit))) {
-        won <- one
-      }
+      one <- taken(st, r$fit, sum(owners != k))
+      if (!is.null(one) && (is.null(won) || one$crit < won$crit)) won <- one
     }
   }
   if (!is.null(won)) {
     st$best$fit <- won$fit
-    st$best$crit <- refine_crit(st, won$fit)
+    st$best$crit <- won$crit
     st$best$params <- won$params
     st$best$ev <- won$ev
     if (!is.null(best$also)) {

@@ -232,3 +232,32 @@ test_that("an effect the raw data leave undecided must gain 2 min_gain on the cu
   # a curve-only run has no raw data to ask: min_gain as before
   expect_null(unconfirmed_marginal("gm", ev, 15, 10, NULL))
 })
+
+test_that("a value held in screening is freed alone where freeing all breaks an earlier effect (unit 2 accel_z + GM 10 s)", {
+  skip_on_cran()
+  skip_if_no_shared()
+  m <- readRDS(shared_file("adis16405_unit2.rds"))
+  freq <- attr(m, "freq")
+  b <- as.numeric(m[, "accel_z"])
+  # a GM raising the axis's ADEV by about 45% at 10 s (its AV at tau = tc
+  # is 0.42 sigma^2)
+  a <- allan(b, freq, taus = "octave")
+  sigma <- sqrt(exp(stats::approx(log(a$tau), log(a$avar), log(10))$y) * (1.45^2 - 1) / 0.42)
+  for (seed in 3:4) {
+    set.seed(seed)
+    x <- b + gen_gm(length(b), freq, sigma, 10)
+    ref <- suppressWarnings(suppressMessages(
+      avrefine(avfit(allan(x, freq), terms = c("N", "B", "K")), data = x)))
+    cf <- coef(ref)
+    is_tc <- grepl("^gm[0-9]+\\.tc$", names(cf))
+    expect_equal(sum(is_tc), 1L)
+    # a later step held the GM's tc (at 50.7 and 27.9 s on these seeds)
+    # and the refit with everything freed broke an earlier effect, so the
+    # tc stayed held in the final model. Freed alone, the curve places it
+    # at 19-20 s (the realised tc is about 10 s: the curve trades the rest
+    # against the axis's flicker and random walk)
+    expect_false(ref$layout$fixed[ref$layout$name == names(cf)[is_tc]])
+    expect_lt(cf[is_tc], 25)
+    expect_true(all(ref$steps$confirmed %in% c(TRUE, NA)))
+  }
+})
