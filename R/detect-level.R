@@ -4,7 +4,7 @@
 # quantile, at least min_z, or the series' own tail). The statistics share a
 # scale estimated from the record, and an effect added to the series moves
 # that scale, so every statistic, by about 2%: a candidate within that of
-# the level falls in or out (spike counts of measured axes flipped in 29 of
+# the level falls in or out (spike counts of measured axes flipped in 26 of
 # 188 battery cases with a line, band, square wave or GM added). The level
 # is raised from `zc` to the least value with no candidate within a factor
 # 1 + `margin` on either side (where the candidates above are many, fewer
