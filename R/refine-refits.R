@@ -161,3 +161,34 @@ refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
   }
   list(fit = best, conditions = conditions)
 }
+
+# Refits of `terms` on the current model with the held values `hold` free
+# (from `start`): all of them first; where `judge(st, fit, still)` refuses
+# that (`still`: how many values the refit left held), each term's held
+# values alone, the best `judge` takes (its `crit`). Everything free may
+# trade two earlier terms against each other (a filter's shape against a
+# measured band's power at the short taus, which the raw data refuse)
+# where one held value alone was left behind (a GM's tc held at 48.5 s
+# while the curve asks for 20-25 s). Returns list(st, won): `won` NULL or
+# what `judge` returned.
+free_held <- function(st, terms, start, hold, judge, stage, effect,
+                      step = st$step, tau_range = NULL) {
+  refit <- function(st, keep) {
+    args <- refit_args(st$current, terms, st$settings, start = start, hold = keep)
+    if (!is.null(tau_range)) args$tau_range <- tau_range
+    state_refit(st, args, stage, effect, step)
+  }
+  r <- refit(st, NULL)
+  st <- r$st
+  won <- judge(st, r$fit, 0L)
+  owners <- sub("[.][^.]*$", "", names(hold))
+  if (is.null(won) && length(unique(owners)) > 1L) {
+    for (k in unique(owners)) {
+      r <- refit(st, hold[owners != k])
+      st <- r$st
+      one <- judge(st, r$fit, sum(owners != k))
+      if (!is.null(one) && (is.null(won) || one$crit < won$crit)) won <- one
+    }
+  }
+  list(st = st, won = won)
+}

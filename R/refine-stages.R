@@ -11,6 +11,7 @@ refine_stages <- function() {
        redescribe = stage_redescribe, # one thing described by another entry
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
+       release = stage_release,      # values the last screening held, freed
        assemble = stage_assemble)    # the refined avfit object
 }
 
@@ -266,6 +267,34 @@ stage_trim <- function(st) {
   st
 }
 
+# A step screens its candidates with the model's nonlinear values held and
+# keeps them held when its free refit breaks an earlier effect; the last
+# step's stay so in the model returned (a GM's tc held at 48.5 s, its
+# interval of zero width). They are freed in one last refit, taken where
+# it is no worse on the all-free scale and leaves every effect as the raw
+# data had it; else they stay held, and the report says so. Values the
+# raw data pinned (a line's frequency) stay pinned.
+stage_release <- function(st) {
+  cur <- st$current
+  lay <- cur$layout
+  held <- lay$name[lay$fixed & lay$role == "nonlinear" &
+                     !lay$name %in% names(st$settings$fixed)]
+  if (!length(held)) return(st)
+  nl <- stats::coef(cur)[lay$role == "nonlinear"]
+  limit <- refine_crit(st, cur) + refine_penalty(st) * length(held) + 1e-6
+  taken <- function(st, f, still) {
+    if (is.null(f)) return(NULL)
+    crit <- refine_crit(st, f) + refine_penalty(st) * still
+    if (crit <= limit && earlier_hold(st, f)) list(fit = f, crit = crit)
+  }
+  r <- free_held(st, cur$terms, nl, nl[held], taken, "refit with the held values free",
+                 "release", length(st$steps) + 1L,
+                 tau_range = if (!is.null(st$tau_range)) c(st$tau_range[1L], Inf))
+  st <- r$st
+  if (!is.null(r$won)) st$current <- r$won$fit
+  st
+}
+
 stage_assemble <- function(st) {
   fit <- st$fit
   out <- complete_covariance(st$current)
@@ -433,26 +462,14 @@ step_refit_winner <- function(st) {
       earlier_hold(st, full)
     if (ok) list(fit = full, crit = crit, params = p2, ev = ev2)
   }
-  args <- refit_args(st$current, best$fit$terms, st$settings, start = start)
-  r <- state_refit(st, args, "refit of the winner", effect)
+  # the values the screened fit held, under its labels (a replaced term
+  # renumbers the others: those whose values it carries unchanged)
+  hold <- start[names(start) %in% names(st$hold)]
+  hold <- hold[hold == st$hold[names(hold)]]
+  r <- free_held(st, best$fit$terms, start, hold, taken,
+                 "refit of the winner", effect)
   st <- r$st
-  won <- taken(st, r$fit)
-  # Everything free may trade two earlier terms against each other (a
-  # filter's shape against a measured band's power at the short taus,
-  # which the raw data then refuse) where one held value alone was left
-  # behind (a GM's tc, entered before a line the curve still carried):
-  # then each earlier term's values are freed alone, the best taken.
-  if (is.null(won)) {
-    owners <- sub("[.][^.]*$", "", names(st$hold))
-    for (k in unique(owners)) {
-      args <- refit_args(st$current, best$fit$terms, st$settings, start = start,
-                         hold = st$hold[owners != k])
-      r <- state_refit(st, args, "refit of the winner, one term freed", effect)
-      st <- r$st
-      one <- taken(st, r$fit, sum(owners != k))
-      if (!is.null(one) && (is.null(won) || one$crit < won$crit)) won <- one
-    }
-  }
+  won <- r$won
   if (!is.null(won)) {
     st$best$fit <- won$fit
     st$best$crit <- won$crit

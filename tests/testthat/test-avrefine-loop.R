@@ -233,7 +233,7 @@ test_that("an effect the raw data leave undecided must gain 2 min_gain on the cu
   expect_null(unconfirmed_marginal("gm", ev, 15, 10, NULL))
 })
 
-test_that("a value held in screening is freed alone where freeing all breaks an earlier effect (unit 2 accel_z + GM 10 s)", {
+test_that("values held in screening are freed alone where freeing all breaks an earlier effect, also at the end (unit 2 accel_z + GM 10 s)", {
   skip_on_cran()
   skip_if_no_shared()
   m <- readRDS(shared_file("adis16405_unit2.rds"))
@@ -260,4 +260,14 @@ test_that("a value held in screening is freed alone where freeing all breaks an 
     expect_lt(cf[is_tc], 25)
     expect_true(all(ref$steps$confirmed %in% c(TRUE, NA)))
   }
+  # seed 1 ends with a second, slow GM whose tc the last step held (at
+  # 1220 s, an interval of zero width); the release stage frees both
+  set.seed(1)
+  x <- b + gen_gm(length(b), freq, sigma, 10)
+  ref <- suppressWarnings(suppressMessages(
+    avrefine(avfit(allan(x, freq), terms = c("N", "B", "K")), data = x)))
+  tcs <- ref$layout$name[grepl("^gm[0-9]+\\.tc$", ref$layout$name)]
+  expect_length(tcs, 2L)
+  expect_false(any(ref$layout$fixed[ref$layout$name %in% tcs]))
+  expect_true(all(ref$se[tcs] > 0))
 })
