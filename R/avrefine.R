@@ -66,8 +66,12 @@
 #'
 #' For speed, candidates are first screened with the nonlinear parameters
 #' already in the model (`tc`, `f0`) held at their current values, and the
-#' winner is refitted with all of them free; only when screening finds
-#' nothing are the candidates tried again with everything free. Every refit
+#' winner is refitted with all of them free (where that refit breaks an
+#' effect accepted earlier, with each earlier term's values freed alone,
+#' the best taken; the values the last step held are freed so in one last
+#' refit, and those that stay held are marked "held" in the report); only
+#' when screening finds nothing are the candidates tried again with
+#' everything free. Every refit
 #' starts from the current model's nonlinear estimates and uses its
 #' settings (`bias_correct`, `correlation`, `control`, and its EDF), given
 #' to [avfit()] explicitly; arguments in `...` override them.
