@@ -162,6 +162,14 @@ refit_with <- function(fit, terms, effect, init, settings, hold = NULL,
   list(fit = best, conditions = conditions)
 }
 
+# The nonlinear values fit `f` holds that `settings` did not pin (the raw
+# data's values): those screening held, named as `f` names them.
+held_values <- function(f, settings) {
+  lay <- f$layout
+  held <- lay$fixed & lay$role == "nonlinear" & !lay$name %in% names(settings$fixed)
+  stats::coef(f)[lay$name[held]]
+}
+
 # Refits of `terms` on the current model with the held values `hold` free
 # (from `start`): all of them first; where `judge(st, fit, still)` refuses
 # that (`still`: how many values the refit left held), each term's held

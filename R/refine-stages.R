@@ -276,18 +276,16 @@ stage_trim <- function(st) {
 # raw data pinned (a line's frequency) stay pinned.
 stage_release <- function(st) {
   cur <- st$current
-  lay <- cur$layout
-  held <- lay$name[lay$fixed & lay$role == "nonlinear" &
-                     !lay$name %in% names(st$settings$fixed)]
+  held <- held_values(cur, st$settings)
   if (!length(held)) return(st)
-  nl <- stats::coef(cur)[lay$role == "nonlinear"]
+  nl <- stats::coef(cur)[cur$layout$role == "nonlinear"]
   limit <- refine_crit(st, cur) + refine_penalty(st) * length(held) + 1e-6
   taken <- function(st, f, still) {
     if (is.null(f)) return(NULL)
     crit <- refine_crit(st, f) + refine_penalty(st) * still
     if (crit <= limit && earlier_hold(st, f)) list(fit = f, crit = crit)
   }
-  r <- free_held(st, cur$terms, nl, nl[held], taken, "refit with the held values free",
+  r <- free_held(st, cur$terms, nl, held, taken, "refit with the held values free",
                  "release", length(st$steps) + 1L,
                  tau_range = if (!is.null(st$tau_range)) c(st$tau_range[1L], Inf))
   st <- r$st
@@ -462,11 +460,7 @@ step_refit_winner <- function(st) {
       earlier_hold(st, full)
     if (ok) list(fit = full, crit = crit, params = p2, ev = ev2)
   }
-  # the values the screened fit held, under its labels (a replaced term
-  # renumbers the others: those whose values it carries unchanged)
-  hold <- start[names(start) %in% names(st$hold)]
-  hold <- hold[hold == st$hold[names(hold)]]
-  r <- free_held(st, best$fit$terms, start, hold, taken,
+  r <- free_held(st, best$fit$terms, start, held_values(best$fit, st$settings), taken,
                  "refit of the winner", effect)
   st <- r$st
   won <- r$won
