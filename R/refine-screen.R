@@ -17,9 +17,8 @@ screen_trial <- function(st, tr, nl_now) {
   # set's frequency, and the criterion need only prefer it
   set_line <- continues_set(tr)
   need <- if (set_line) 0 else min_gain
-  pen <- refine_penalty(st)
   crit <- function(f) refine_crit(st, f)
-  crit_s <- function(f) crit(f) + pen * length(hold_now)
+  crit_s <- function(f) refine_crit_held(st, f, length(hold_now))
   # Parameters the raw data measure better than the curve (a line's
   # frequency from the periodogram) are pinned there (a value the model
   # already pins never reaches here: fresh_pinned_trials()).
@@ -99,7 +98,7 @@ screen_trial <- function(st, tr, nl_now) {
       r <- state_refit(st, args, "refit with earlier effects held", tr$effect)
       st <- r$st
       held <- r$fit
-      c_held <- if (is.null(held)) Inf else crit(held) + pen * length(keep)
+      c_held <- if (is.null(held)) Inf else refine_crit_held(st, held, length(keep))
       if (is.finite(c_held) && c_held < c0 - min_gain &&
           held$chi2 < 0.9 * cur$chi2 && max_share(held, lab) >= 0.02) {
         jh <- judge_instance(st, held, tr$effect, lab, tau)

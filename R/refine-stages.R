@@ -279,10 +279,10 @@ stage_release <- function(st) {
   held <- held_values(cur, st$settings)
   if (!length(held)) return(st)
   nl <- stats::coef(cur)[cur$layout$role == "nonlinear"]
-  limit <- refine_crit(st, cur) + refine_penalty(st) * length(held) + 1e-6
+  limit <- refine_crit_held(st, cur, length(held)) + 1e-6
   taken <- function(st, f, still) {
     if (is.null(f)) return(NULL)
-    crit <- refine_crit(st, f) + refine_penalty(st) * still
+    crit <- refine_crit_held(st, f, still)
     if (crit <= limit && earlier_hold(st, f)) list(fit = f, crit = crit)
   }
   r <- free_held(st, cur$terms, nl, held, taken, "refit with the held values free",
@@ -450,7 +450,7 @@ step_refit_winner <- function(st) {
   # raw data had it
   taken <- function(st, full, held = 0L) {
     if (is.null(full)) return(NULL)
-    crit <- refine_crit(st, full) + refine_penalty(st) * held
+    crit <- refine_crit_held(st, full, held)
     if (crit > best$crit + 1e-6) return(NULL)
     p2 <- instance_params(stats::coef(full), full$layout, best$label)
     ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)

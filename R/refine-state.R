@@ -77,6 +77,11 @@ refine_crit <- function(st, f) {
 refine_penalty <- function(st) {
   if (st$args$criterion == "BIC") log(st$current$nobs) else 2
 }
+# The criterion of a fit that holds `held` of the model's values, on the
+# all-free scale: each held value charged one parameter's penalty.
+refine_crit_held <- function(st, f, held) {
+  refine_crit(st, f) + refine_penalty(st) * held
+}
 
 # A refit for the state: the conditions it raised are recorded as failures
 # of (`step`, `effect`). Returns list(st, fit).
