@@ -821,6 +821,8 @@ fit_resonance_psd <- function(f, ex, bg, tau0, fc, power, sdf, start = NULL) {
 # background plus the other's fitted PSD, relative to them.
 band_pair_fit <- function(j, reg, fit1, f, p, bg, tau0, nu) {
   one <- function(ft, ff) 2 * resonance_psd(ff, tau0, ft$sigma, ft$fr, ft$tc)
+  # a resonance from its log sigma, fr and log tc
+  unpack <- function(q) list(sigma = exp(q[1L]), fr = q[2L], tc = exp(q[3L]))
   chi2 <- function(M) sum(((p[reg] - bg[reg] - M) / (bg[reg] + M))^2) * nu / 1.5^2
   M1 <- one(fit1, f[reg])
   out <- list(chi2_one = chi2(M1), chi2_two = NA_real_, cut = NA_integer_)
@@ -833,15 +835,12 @@ band_pair_fit <- function(j, reg, fit1, f, p, bg, tau0, nu) {
   pow2 <- sum(pmax(res[near], 0)) * (f[2L] - f[1L])
   if (!(pow2 > 0)) return(out)
   ex <- p[reg] - bg[reg]
-  model <- function(q) {
-    2 * resonance_psd(f[reg], tau0, exp(q[1L]), q[2L], exp(q[3L])) +
-      2 * resonance_psd(f[reg], tau0, exp(q[4L]), q[5L], exp(q[6L]))
-  }
+  model <- function(q) one(unpack(q[1:3]), f[reg]) + one(unpack(q[4:6]), f[reg])
   obj <- function(q) sum(((ex - model(q)) / bg[reg])^2)
   q0 <- c(log(fit1$sigma), fit1$fr, log(fit1$tc), log(sqrt(pow2)), f[j[i2]], log(fit1$tc))
   o <- stats::optim(q0, obj, control = list(maxit = 2000L, reltol = 1e-10))
-  a <- list(sigma = exp(o$par[1L]), fr = o$par[2L], tc = exp(o$par[3L]))
-  b <- list(sigma = exp(o$par[4L]), fr = o$par[5L], tc = exp(o$par[6L]))
+  a <- unpack(o$par[1:3])
+  b <- unpack(o$par[4:6])
   if (a$fr > b$fr) { t <- a; a <- b; b <- t }
   out$chi2_two <- chi2(model(o$par))
   out$fits <- list(a, b)
