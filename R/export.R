@@ -228,8 +228,11 @@ write_kalibr_yaml <- function(x, file = "imu.yaml", axis = "max",
 #'   comes from), `continuous_unit`, `dt` and `convention`; rows in the
 #'   catalogue's order of the terms (N, B, K, then the Gauss-Markov terms).
 #'   For an analysis also `verdict` and `why` (of the reading N, B or K the
-#'   row comes from, see [analyze_imu()]; "" for other model terms) and
-#'   `warning` (failed unit checks of the axis).
+#'   row comes from, see [analyze_imu()]; for a Gauss-Markov term,
+#'   "measured" when the fit determines its sigma and Tc within a factor 2
+#'   at 95% and held neither, else "not determined" with the widest
+#'   interval: a record of a few thousand seconds often cannot tell a slow
+#'   term's Tc better) and `warning` (failed unit checks of the axis).
 #' @export
 #' @examples
 #' kalman_params(c(N = 1e-3, K = 1e-5, gm1.sigma = 2e-4, gm1.tc = 50), dt = 0.01)
@@ -268,10 +271,16 @@ kalman_params <- function(x, dt = NULL, bias_instability = NULL,
       d <- discrete_rows(cf, dt, ch$channel, ch$sensor, bias_instability,
                          tau_B %||% if (nrow(flat)) flat$tau else NA_real_,
                          bounds = rd$term[rd$is_bound])
-      # each parameter carries the verdict of the reading it comes from
+      # each parameter carries the verdict of the reading it comes from;
+      # a term that is no reading (a Gauss-Markov term), how well the fit
+      # determines its values
       i <- match(d$term, rd$term)
-      d$verdict <- ifelse(is.na(i), "", rd$verdict[i])
-      d$why <- ifelse(is.na(i), "", rd$why[i])
+      tv <- lapply(unique(d$term[is.na(i)]), function(l) term_verdict(ch$fit, l))
+      names(tv) <- unique(d$term[is.na(i)])
+      d$verdict <- ifelse(is.na(i), vapply(d$term, function(l) tv[[l]]$verdict %||% "", ""),
+                          rd$verdict[i])
+      d$why <- ifelse(is.na(i), vapply(d$term, function(l) tv[[l]]$why %||% "", ""),
+                      rd$why[i])
       d$warning <- rep(channel_unit_warning(uw, ch$channel), nrow(d))
       d
     })

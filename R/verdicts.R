@@ -332,3 +332,40 @@ verdict_note <- function(verdict, why = "", biased_by = "", bias_change = NA_rea
   }
   out
 }
+
+# A model term that is no reading (a Gauss-Markov term a filter takes from
+# kalman_params()) is measured when the fit determines each of its values
+# within a factor `term_factor` at 95% (1.96 standard errors of its log)
+# and held none of them; otherwise not determined, with the widest
+# interval. A record of a few thousand seconds often cannot tell a slow
+# term's time constant to better than that (bench/gm-tc-information.R:
+# the Cramer-Rao bound of log tc is 0.1-0.5 on the battery's GM cases).
+term_factor <- 2
+term_verdict <- function(fit, label) {
+  lay <- if (is.null(fit)) NULL else fit$layout
+  lay <- lay[lay$label == label, , drop = FALSE]
+  if (!NROW(lay)) return(verdict("not_determined", "the term is not in the fit"))
+  value <- unname(fit$coefficients[lay$name])
+  se <- fit_se(fit)
+  se <- if (is.null(se)) rep(NA_real_, nrow(lay)) else unname(se[lay$name])
+  # seconds are the one unit a term's own values name (an amplitude is in
+  # the curve's rate unit, which the fit does not carry)
+  unit <- ifelse(lay$unit == "s", " s", "")
+  held <- lay$fixed %in% TRUE | !is.finite(se) | se <= 0
+  if (any(held)) {
+    return(verdict("not_determined", sprintf(
+      "%s held in the final fit: no standard error", paste(lay$param[held], collapse = ", "))))
+  }
+  if (any(!is.finite(value) | value <= 0)) {
+    return(verdict("not_determined", sprintf("%s at 0 in the fit", lay$param[value <= 0][1L])))
+  }
+  half <- stats::qnorm(0.975) * se / value         # half-width of the log interval
+  k <- which.max(half)
+  lo <- value[k] * exp(-half[k])
+  hi <- value[k] * exp(half[k])
+  if (half[k] <= log(term_factor)) return(verdict("measured", "", lo, hi))
+  verdict("not_determined", sprintf(
+    "%s's 95%% interval %s-%s%s is wider than a factor %s either way of %s%s",
+    lay$param[k], format_num(lo), format_num(hi), unit[k], format_num(term_factor),
+    format_num(value[k]), unit[k]), lo, hi)
+}

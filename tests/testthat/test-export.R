@@ -268,3 +268,45 @@ test_that("write_kalibr_yaml() refuses a sensor with a value it could not read",
                class = "allanvar_error_argument")
   expect_false(file.exists(f))
 })
+
+test_that("a Gauss-Markov term's rows say how well the record determines it", {
+  # own generator: white + walk + an AR(1) of tc 10 s over 4000 s; the
+  # exact Fisher information of that model puts log tc's SD at 0.096
+  # (av_information()), so a factor-2 95% interval is within reach
+  set.seed(11)
+  n <- 4e5
+  phi <- exp(-1 / (100 * 10))
+  g <- as.numeric(stats::filter(rnorm(n, sd = 0.003 * sqrt(1 - phi^2)), phi, "recursive"))
+  x <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-5)) + g
+  bound <- av_information(c(N = 1e-3, K = 1e-4, gm1.sigma = 0.003, gm1.tc = 10),
+                          n = n, freq = 100)$bound
+  expect_lt(bound$rel_se[bound$parameter == "gm1.tc"], log(2) / 1.96 / 2)
+  a <- suppressWarnings(analyze_imu(imu_record(cbind(gyro_x = x), freq = 100, unit = "rad/s")))
+  kp <- kalman_params(a)
+  gm <- kp[grepl("^gm", kp$term), , drop = FALSE]
+  expect_identical(nrow(gm), 2L)
+  expect_identical(unique(gm$verdict), "measured")
+  tc <- -0.01 / log(gm$value[gm$parameter == "phi"])
+  expect_lt(abs(log(tc / 10)), 1.96 * 0.096 + 0.05)
+
+  # the rule itself, on a fit's layout: 1.96 standard errors of the log
+  # within log 2 is measured; wider, or a value held, is not
+  lay <- data.frame(name = c("gm1.sigma", "gm1.tc"), label = "gm1", kind = "gm",
+                    variant = "", param = c("sigma", "tc"), role = c("amp", "nonlinear"),
+                    unit = c("u", "s"), hidden = FALSE, fixed = FALSE)
+  fit <- function(se_tc, fixed = c(FALSE, FALSE)) {
+    lay$fixed <- fixed
+    list(layout = lay, coefficients = c(gm1.sigma = 0.002, gm1.tc = 50),
+         se = c(gm1.sigma = 1e-4, gm1.tc = se_tc))
+  }
+  ns <- asNamespace("allanvar")
+  v <- ns$term_verdict(fit(50 * 0.3), "gm1")
+  expect_identical(v$verdict, "measured")
+  expect_equal(c(v$lo, v$hi), 50 * exp(c(-1, 1) * 1.96 * 0.3), tolerance = 1e-3)
+  v <- ns$term_verdict(fit(50 * 0.4), "gm1")
+  expect_identical(v$verdict, "not_determined")
+  expect_match(v$why, "tc's 95% interval 22.8-110 s is wider than a factor 2", fixed = TRUE)
+  v <- ns$term_verdict(fit(0, fixed = c(FALSE, TRUE)), "gm1")
+  expect_identical(v$verdict, "not_determined")
+  expect_match(v$why, "tc held in the final fit", fixed = TRUE)
+})
