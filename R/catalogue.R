@@ -48,7 +48,9 @@
 #                 first, the stronger lines of its harmonic set;
 #                 `release` TRUE: the pinned values are a start the curve
 #                 may refine: a pinned trial that passes is refitted with
-#                 them free, searched from there, and the better kept)
+#                 them free, searched from there, and the better kept;
+#                 `late` TRUE: they stay pinned until the loop ends and
+#                 are freed then, beside the rest, by stage_release())
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
 #                 the raw series says about a fitted instance

@@ -232,6 +232,12 @@ effect_band <- function() {
       make = function(x, freq, dg) {
         bands <- diag_part(dg, "bands")
         Filter(Negate(is.null), lapply(seq_len(nrow(bands)), function(j) {
+          # a run with two peaks is two resonances (the resonance entry
+          # proposes both, each measured), not one measured band: measured
+          # as one, it took a sensor filter's form with it (unit 3 accel_x
+          # + an 8.1 Hz band beside its 9.86 Hz resonance: a first-order
+          # low-pass in place of its moving average, N +9%)
+          if (isTRUE(!is.na(bands$pair_fr1[j]))) return(NULL)
           measure_band(x, freq, bands[j, ], welch = raw_welch(dg), others = bands[-j, ])
         }))
       }),

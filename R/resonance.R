@@ -80,6 +80,33 @@ resonance_start <- function(band) {
   list(sigma = sqrt(band$power), fr = band$f_center, tc = band$tc)
 }
 
+# The resonances the raw data measure in the bands of find_bands(): a band
+# that two resonances fit better (closer than the sum of their widths, so
+# one run) gives the two, the stronger first, else the band's own fit;
+# rows as find_bands()' (f_center, width, tc, power, share) and `paired`
+# (one of two).
+band_resonances <- function(bands) {
+  if (!nrow(bands)) return(cbind(bands, paired = logical()))
+  cols <- c("f_center", "f_from", "f_to", "width", "tc", "power", "share")
+  rows <- lapply(seq_len(nrow(bands)), function(i) {
+    b <- bands[i, cols, drop = FALSE]
+    b$paired <- FALSE
+    if (is.null(bands$pair_fr1) || is.na(bands$pair_fr1[i])) return(b)
+    two <- b[c(1L, 1L), , drop = FALSE]
+    two$paired <- TRUE
+    two$f_center <- c(bands$pair_fr1[i], bands$pair_fr2[i])
+    two$tc <- c(bands$pair_tc1[i], bands$pair_tc2[i])
+    two$width <- 1 / (pi * two$tc)
+    two$power <- c(bands$pair_power1[i], bands$pair_power2[i])
+    two$share <- b$share * two$power / b$power
+    two[order(-two$power), , drop = FALSE]
+  })
+  out <- do.call(rbind, rows)
+  rownames(out) <- NULL
+  attr(out, "resolution") <- attr(bands, "resolution")
+  out
+}
+
 # What the raw data say about a fitted resonance: a band of find_bands()
 # whose centre lies within half its width (or 2 resolution bins) of f_r is
 # support, with its power within a factor 2 of sigma^2; no band at all near
@@ -91,6 +118,14 @@ resonance_start <- function(band) {
 # something else that shapes the curve near 1/(2 f_r) (unit 3 accel_y with
 # a warm-up added took an 8.15 Hz resonance at 2.9x its band's power).
 resonance_raw_support <- function(sigma, fr, tc, bands) {
+  # a band's own fit and, where two resonances fit it better, each of them
+  if (nrow(bands) && !is.null(bands$pair_fr1) && any(!is.na(bands$pair_fr1))) {
+    res <- attr(bands, "resolution")
+    cols <- c("f_center", "width", "power", "share")
+    bands <- rbind(bands[, cols, drop = FALSE],
+                   band_resonances(bands[!is.na(bands$pair_fr1), , drop = FALSE])[, cols, drop = FALSE])
+    attr(bands, "resolution") <- res
+  }
   if (!nrow(bands)) {
     return(list(text = sprintf("no spectral band near %s Hz", format(signif(fr, 3))),
                 support = FALSE))

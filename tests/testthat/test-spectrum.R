@@ -325,3 +325,28 @@ test_that("find_bands(): a band with a line on top is measured without the line"
   expect_lt(b$share, 0.02)
   expect_true(any(abs(attr(b, "lines") - 7.6) < 0.01))
 })
+
+test_that("find_bands(): two resolved resonances in one run are kept as a pair; one resonance has none", {
+  # own generator: white noise, a 9.86 Hz two-pole resonance (tc 0.47 s,
+  # FWHM 0.68 Hz) and an 8.1 Hz one (tc 0.3 s, FWHM 1.06 Hz) added: 1.76
+  # Hz apart, closer than the sum of their widths, so one run; their
+  # half-power bands do not overlap
+  freq <- 100
+  n <- 5e5
+  set.seed(1)
+  base <- rnorm(n, sd = 0.01) + 0.002 * ar2_unit(n, 9.86, 0.47, freq)
+  b <- allanvar:::find_bands(base + 0.005 * ar2_unit(n, 8.1, 0.3, freq), freq)
+  expect_equal(nrow(b), 1L)
+  expect_equal(c(b$pair_fr1, b$pair_fr2), c(8.1, 9.86), tolerance = 0.02)
+  expect_equal(1 / (pi * c(b$pair_tc1, b$pair_tc2)), 1 / (pi * c(0.3, 0.47)), tolerance = 0.25)
+  # each measured resonance is a candidate of its own, the stronger first
+  r <- allanvar:::band_resonances(b)
+  expect_equal(r$f_center, c(8.1, 9.86), tolerance = 0.02)
+  expect_true(all(r$paired))
+  expect_gt(r$power[1L], r$power[2L])
+  # the axis alone: one band, no pair
+  b0 <- allanvar:::find_bands(base, freq)
+  expect_equal(nrow(b0), 1L)
+  expect_true(is.na(b0$pair_fr1))
+  expect_false(allanvar:::band_resonances(b0)$paired)
+})
