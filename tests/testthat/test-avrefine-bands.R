@@ -12,6 +12,11 @@ butter2 <- function(e, fc, freq) {
   as.numeric(stats::filter(u, -a, method = "recursive"))
 }
 
+# The loop as analyze_imu() runs it on an axis: N, B, K, then the raw series.
+loop_raw <- function(v, freq) {
+  suppressMessages(avrefine(avfit(allan(v, freq), terms = c("N", "B", "K")), data = v))
+}
+
 # AR(2) resonance at fr with damping time tc (innovation sd s).
 ar2_resonance <- function(n, fr, tc, s, freq) {
   r <- exp(-1 / (freq * tc))
@@ -187,18 +192,11 @@ test_that("a band beside a resonance: no filter term, N within 5% of the run wit
   set.seed(1)
   n <- 2e5
   freq <- 100
-  unit_ar2 <- function(fr, tc) {
-    z <- ar2_resonance(n, fr, tc, 1, freq)
-    z / stats::sd(z)
-  }
   base <- stats::rnorm(n, sd = 0.01) + cumsum(stats::rnorm(n, sd = 1e-5)) +
-    0.01 * unit_ar2(18, 0.1)
-  x <- base + 0.006 * unit_ar2(7, 0.3)
-  run <- function(v) {
-    suppressMessages(avrefine(avfit(allan(v, freq), terms = c("N", "B", "K")), data = v))
-  }
-  r0 <- run(base)
-  r1 <- run(x)
+    0.01 * ar2_unit(n, 18, 0.1, freq)
+  x <- base + 0.006 * ar2_unit(n, 7, 0.3, freq)
+  r0 <- loop_raw(base, freq)
+  r1 <- loop_raw(x, freq)
   expect_false(any(grepl("^filter", r1$terms)))
   expect_true("N" %in% r0$terms && "N" %in% r1$terms)
   expect_equal(unname(coef(r1)[["N"]]), unname(coef(r0)[["N"]]), tolerance = 0.05)
@@ -240,18 +238,11 @@ test_that("a band added beside a sensor's resonance in one run: two resonances, 
   set.seed(1)
   freq <- 100
   n <- 5e5
-  unit_ar2 <- function(fr, tc) {
-    z <- ar2_resonance(n, fr, tc, 1, freq)
-    z / stats::sd(z)
-  }
   base <- stats::rnorm(n, sd = 0.01) + cumsum(stats::rnorm(n, sd = 1e-5)) +
-    0.002 * unit_ar2(9.86, 0.47)
-  x <- base + 0.005 * unit_ar2(8.1, 0.3)
-  run <- function(v) {
-    suppressMessages(avrefine(avfit(allan(v, freq), terms = c("N", "B", "K")), data = v))
-  }
-  r0 <- run(base)
-  r1 <- run(x)
+    0.002 * ar2_unit(n, 9.86, 0.47, freq)
+  x <- base + 0.005 * ar2_unit(n, 8.1, 0.3, freq)
+  r0 <- loop_raw(base, freq)
+  r1 <- loop_raw(x, freq)
   fr <- coef(r1)[grepl("^resonance[0-9]*\\.fr$", names(coef(r1)))]
   expect_length(fr, 2L)
   expect_equal(sort(unname(fr)), c(8.1, 9.86), tolerance = 0.03)
@@ -273,13 +264,9 @@ test_that("a band added beside a measured accelerometer's own resonance: both na
   freq <- attr(m, "freq")
   set.seed(5)
   n <- length(b)
-  z <- ar2_resonance(n, 8.1, 0.3, 1, freq)
-  x <- b + 0.5 * stats::sd(diff(b)) / sqrt(2) * z / stats::sd(z)
-  run <- function(v) {
-    suppressMessages(avrefine(avfit(allan(v, freq), terms = c("N", "B", "K")), data = v))
-  }
-  r0 <- run(b)
-  r1 <- run(x)
+  x <- b + 0.5 * stats::sd(diff(b)) / sqrt(2) * ar2_unit(n, 8.1, 0.3, freq)
+  r0 <- loop_raw(b, freq)
+  r1 <- loop_raw(x, freq)
   fr <- coef(r1)[grepl("^resonance[0-9]*\\.fr$", names(coef(r1)))]
   expect_true(any(abs(fr / 8.1 - 1) < 0.05))
   expect_true(any(abs(fr / 9.86 - 1) < 0.05))
