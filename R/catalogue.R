@@ -49,7 +49,7 @@
 #                 `release` TRUE: the pinned values are a start the curve
 #                 may refine: a pinned trial that passes is refitted with
 #                 them free, searched from there, and the better kept;
-#                 `late` TRUE: they stay pinned until the loop ends and
+#                 `release_late` TRUE: they stay pinned until the loop ends and
 #                 are freed then, beside the rest, by stage_release())
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what

@@ -232,13 +232,13 @@ effect_resonance <- function() {
         one <- list(init = st, tau_from = 0.371 / st$fr / 2, tau_to = 2 / st$fr,
                     score = 2, note = note)
         # One of two resonances the run resolves stays where the raw data
-        # measure it until the loop ends (`late`): released at once, the
+        # measure it until the loop ends (`release_late`): released at once, the
         # first one in spread over its neighbour (a 9.86 Hz resonance beside
         # an added 8.1 Hz band: one resonance at 8.25 Hz); freed beside the
         # other, the curve refines a shape that is not quite the AR(2)'s (a
         # z gyro's own 20 Hz band beside an added 22.1 Hz one)
         out[[length(out) + 1L]] <- c(one, list(pin = list(fr = b$f_center[j], tc = b$tc[j]),
-                                               release = !b$paired[j], late = b$paired[j]))
+                                               release = !b$paired[j], release_late = b$paired[j]))
       }
       out
     },

@@ -132,7 +132,7 @@ candidate_trials <- function(traced, present, candidates, sig) {
       r <- data.frame(
         effect = k, tau_from = strongest$tau_from, tau_to = strongest$tau_to,
         signature = paste0(strongest$description, " (no signature specific to ", k, ")"),
-        score = 0, release = FALSE, late = FALSE, traced = FALSE, stringsAsFactors = FALSE)
+        score = 0, release = FALSE, release_late = FALSE, traced = FALSE, stringsAsFactors = FALSE)
       r$init <- list(list())
       r$pin <- list(NULL)
       r$after <- list(NULL)
@@ -142,7 +142,7 @@ candidate_trials <- function(traced, present, candidates, sig) {
   if (!length(rows)) return(data.frame())
   # every row in one column order (the traced rows carry more columns)
   do.call(rbind, lapply(rows, function(r) r[, c("effect", "tau_from", "tau_to",
-                                                "signature", "score", "release", "late",
+                                                "signature", "score", "release", "release_late",
                                                 "init", "pin", "after", "traced")]))
 }
 

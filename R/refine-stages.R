@@ -274,19 +274,19 @@ stage_trim <- function(st) {
 # it is no worse on the all-free scale and leaves every effect as the raw
 # data had it; else they stay held, and the report says so. Values the
 # raw data pinned (a line's frequency) stay pinned, but for those an entry
-# frees only now (`late`: two resonances of one run), freed with them at
-# the cost of their parameters.
+# frees only now (`release_late`: two resonances of one run), freed with
+# them at the cost of their parameters.
 stage_release <- function(st) {
   cur <- st$current
   held <- held_values(cur, st$settings)
   pinned <- st$settings$fixed
-  late <- intersect(intersect(st$late, names(pinned)), cur$layout$name)
-  if (!length(held) && !length(late)) return(st)
+  to_free <- intersect(intersect(st$release_late, names(pinned)), cur$layout$name)
+  if (!length(held) && !length(to_free)) return(st)
   nl <- stats::coef(cur)[cur$layout$role == "nonlinear"]
   limit <- refine_crit_held(st, cur, length(held)) + 1e-6
-  st$settings$fixed <- pinned[!names(pinned) %in% late]
-  held <- c(held, stats::coef(cur)[late])
-  # a refit's values still held, less the late ones it left pinned (never
+  st$settings$fixed <- pinned[!names(pinned) %in% to_free]
+  held <- c(held, stats::coef(cur)[to_free])
+  # a refit's values still held, less the pinned ones it left pinned (never
   # charged: the raw data measure them)
   charged <- function(f) {
     lay <- f$layout
@@ -301,10 +301,10 @@ stage_release <- function(st) {
                  "release", length(st$steps) + 1L,
                  tau_range = if (!is.null(st$tau_range)) c(st$tau_range[1L], Inf))
   st <- r$st
-  # the late values the refit taken left held (or all of them, when none
-  # was taken) stay pinned
-  kept <- if (is.null(r$won)) late else
-    intersect(late, r$won$fit$layout$name[r$won$fit$layout$fixed])
+  # the values freed here that the refit taken left held (all of them, when
+  # none was taken) stay pinned
+  kept <- if (is.null(r$won)) to_free else
+    intersect(to_free, r$won$fit$layout$name[r$won$fit$layout$fixed])
   st$settings$fixed <- c(st$settings$fixed, pinned[kept])
   if (!is.null(r$won)) st$current <- r$won$fit
   st
@@ -514,7 +514,7 @@ step_record <- function(st) {
     st$current, best$fit, st$c0, best$crit)
   st$pins[length(st$steps)] <- list(unlist(best$pin) %||% numeric(0))
   # pinned values the entry frees only once the loop ends (stage_release())
-  if (isTRUE(best$trial$late)) st$late <- c(st$late, names(unlist(best$pin)))
+  if (isTRUE(best$trial$release_late)) st$release_late <- c(st$release_late, names(unlist(best$pin)))
   if (length(best$pin) && isTRUE(best$ev$support) && holds_family(st$current)) {
     st$reform <- TRUE
   }

@@ -33,7 +33,7 @@ new_refine_state <- function(fit, args, settings) {
     only_sets = FALSE,         # budget spent: only further lines of held harmonic sets
     start = NULL,              # the model the steps started from
     pins = list(),             # per accepted step, the raw-data values it pinned
-    late = character(),        # pinned values an entry frees at the end (stage_release())
+    release_late = character(), # pinned values an entry frees at the end (stage_release())
     blocked = list(),          # raw-data values of trials an earlier effect kept out
     refused = list(),          # this step's trials the raw data refused (family_pairs())
     unpaid = list(),           # this step's raw-pinned trials that did not pay alone

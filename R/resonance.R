@@ -80,9 +80,10 @@ resonance_start <- function(band) {
   list(sigma = sqrt(band$power), fr = band$f_center, tc = band$tc)
 }
 
-# The resonances the raw data measure in the bands of find_bands(): a band
-# that two resonances fit better (closer than the sum of their widths, so
-# one run) gives the two, the stronger first, else the band's own fit;
+# The resonances the raw data measure in the bands of find_bands(): a run
+# with two peaks (its pair: closer than the sum of their widths, so one
+# run, but the excess dips between them) gives the two, the stronger
+# first, else the band's own fit;
 # rows as find_bands()' (f_center, width, tc, power, share) and `paired`
 # (one of two).
 band_resonances <- function(bands) {

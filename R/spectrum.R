@@ -495,7 +495,7 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
 #' FWHM is about 1/(pi tc), given as `width`), `power` (its variance,
 #' sigma^2) and `share` of the series' variance; a run that two resonances
 #' fit better but that stays one (their centres closer than the sum of
-#' their widths) also carries the two (`pair_fr1`, `pair_tc1`,
+#' their widths) with the excess dipping between them also carries the two (`pair_fr1`, `pair_tc1`,
 #' `pair_power1`, `pair_fr2`, ...; NA otherwise).
 #' Cost O(n log seg).
 #' @noRd

@@ -52,10 +52,10 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
   }, catalogue()[effect_kinds()])
   out <- list()
   one <- function(effect, from, to, init, signature, score, pin = NULL, after = NULL,
-                  release = FALSE, late = FALSE) {
+                  release = FALSE, release_late = FALSE) {
     list(effect = effect, tau_from = from, tau_to = to, init = init,
          signature = signature, score = score, pin = pin, after = after,
-         release = isTRUE(release), late = isTRUE(late))
+         release = isTRUE(release), release_late = isTRUE(release_late))
   }
   for (i in seq_len(nrow(sig))) {
     ctx <- trace_context(sig[i, ], tau, excess)
@@ -77,7 +77,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
         out[[length(out) + 1L]] <- one(
           p$effect %||% e$name, p$tau_from, p$tau_to, p$init,
           paste0(overlapping_signature(sig, p$tau_from, p$tau_to), "; ", p$note),
-          p$score, p$pin, p$after, p$release, p$late)
+          p$score, p$pin, p$after, p$release, p$release_late)
       }
     }
   }
@@ -92,7 +92,7 @@ trace_candidates <- function(tau, avar, fitted, sig, present,
                    signature = vapply(out, `[[`, "", "signature"),
                    score = vapply(out, `[[`, 0, "score"),
                    release = vapply(out, `[[`, NA, "release"),
-                   late = vapply(out, `[[`, NA, "late"),
+                   release_late = vapply(out, `[[`, NA, "release_late"),
                    stringsAsFactors = FALSE)
   df$init <- lapply(out, `[[`, "init")
   df$pin <- lapply(out, function(o) o$pin)
