@@ -356,8 +356,9 @@ term_verdict <- function(fit, label) {
     return(verdict("not_determined", sprintf(
       "%s held in the final fit: no standard error", paste(lay$param[held], collapse = ", "))))
   }
-  if (any(!is.finite(value) | value <= 0)) {
-    return(verdict("not_determined", sprintf("%s at 0 in the fit", lay$param[value <= 0][1L])))
+  zero <- !(is.finite(value) & value > 0)
+  if (any(zero)) {
+    return(verdict("not_determined", sprintf("%s at 0 in the fit", lay$param[zero][1L])))
   }
   half <- stats::qnorm(0.975) * se / value         # half-width of the log interval
   k <- which.max(half)
