@@ -270,12 +270,15 @@ series_duplicate <- function(series, fit, label, share = 1) {
 # tau it weighs most, the model with and without the term are refitted on
 # the curve with those kinds' excess (ADEV^2 with minus without each, from
 # the series pass) taken out; if the term no longer pays by the criterion
-# there, it describes the series effect. Kinds a noise term's own
+# there (by `gain`: twice min_gain for a term the raw data did not
+# confirm, as unconfirmed_marginal() asks of the whole curve), it
+# describes the series effect. Kinds a noise term's own
 # excursions can produce (the entry's `noise_lookalike`: transients) are
 # not taken out: a measured accelerometer's 20 s GM is also six transients
 # to the series pass. Returns NULL or a one-row data
 # frame like series_duplicate()'s (`ratio` the kinds' share at that tau).
-series_pays_without <- function(st, new, label, min_share = 0.1) {
+series_pays_without <- function(st, new, label, gain = st$args$min_gain,
+                                min_share = 0.1) {
   series <- st$series
   if (is.null(series) || !NROW(series$table) || !NROW(series$adev_kinds)) return(NULL)
   left <- unique(series$table$kind[!series$table$removed])
@@ -305,7 +308,7 @@ series_pays_without <- function(st, new, label, min_share = 0.1) {
   f_out <- refit_on(st$current)
   f_in <- refit_on(new)
   if (is.null(f_out) || is.null(f_in)) return(NULL)
-  if (refine_crit(st, f_in) < refine_crit(st, f_out) - st$args$min_gain) return(NULL)
+  if (refine_crit(st, f_in) < refine_crit(st, f_out) - gain) return(NULL)
   data.frame(series_kind = colnames(at)[which.max(at[1L, ])], ratio = sum(at) / own,
              tau = new$data$tau[j], how = "refit", stringsAsFactors = FALSE)
 }
@@ -336,6 +339,14 @@ kind_excess <- function(adev_kinds, kinds, tau) {
   out
 }
 
+# Could the raw data have confirmed this instance (its entry has a check,
+# the loop has the series) and did not decide (`ev$support` NA)?
+rests_on_curve <- function(effect, ev, raw) {
+  if (is.null(raw) || !is.na(ev$support %||% NA)) return(FALSE)
+  sp <- split_term(effect)
+  !is.null(effect_entry(sp$kind, sp$variant)$evidence)
+}
+
 # An effect whose raw-data check could have confirmed it and did not (an
 # exponential ACF found, but at a Tc 2-3x from the fitted one) rests on the
 # curve alone; a marginal gain there moves with anything that reshapes the
@@ -345,10 +356,7 @@ kind_excess <- function(adev_kinds, kinds, tau) {
 # one's total, 2 min_gain, from the curve. Curve-only runs, and entries
 # with no raw-data check, are judged by the curve as before.
 unconfirmed_marginal <- function(effect, ev, gain, min_gain, raw) {
-  if (is.null(raw) || !is.na(ev$support %||% NA)) return(NULL)
-  sp <- split_term(effect)
-  e <- effect_entry(sp$kind, sp$variant)
-  if (is.null(e$evidence) || gain >= 2 * min_gain) return(NULL)
+  if (!rests_on_curve(effect, ev, raw) || gain >= 2 * min_gain) return(NULL)
   sprintf(paste("the raw data do not confirm it (%s) and the curve alone gains",
                 "%s, less than 2 min_gain"), ev$text, format_num(gain))
 }

@@ -233,7 +233,10 @@ judge_instance <- function(st, f, effect, label, tau) {
   # a term standing in for a series effect this run found and left in the
   # data describes one thing twice (remove it in the series instead)
   dup <- if (is.null(why)) series_duplicate(st$series, f, label)
-  if (is.null(why) && is.null(dup)) dup <- series_pays_without(st, f, label)
+  if (is.null(why) && is.null(dup)) {
+    need <- st$args$min_gain * (1 + rests_on_curve(effect, ev, st$raw))
+    dup <- series_pays_without(st, f, label, gain = need)
+  }
   if (!is.null(dup)) {
     why <- if (dup$how == "share") {
       sprintf(paste("describes the %s found in the series (not removed): it adds",
