@@ -275,8 +275,7 @@ kalman_params <- function(x, dt = NULL, bias_instability = NULL,
       # a term that is no reading (a Gauss-Markov term), how well the fit
       # determines its values
       i <- match(d$term, rd$term)
-      own <- unique(d$term[is.na(i)])
-      tv <- lapply(stats::setNames(own, own), function(l) term_verdict(ch$fit, l))
+      tv <- own_term_verdicts(ch$fit, ch$coef, rd)
       d$verdict <- ifelse(is.na(i), vapply(tv, `[[`, "", "verdict")[d$term], rd$verdict[i])
       d$why <- ifelse(is.na(i), vapply(tv, `[[`, "", "why")[d$term], rd$why[i])
       d$warning <- rep(channel_unit_warning(uw, ch$channel), nrow(d))

@@ -23,8 +23,12 @@
 #'   `tau_B <= tau_rel / 3`; otherwise the curve may still fall and B is an
 #'   upper bound; a record at least `T * 3 tau_B / tau_rel` long is needed.
 #' * **N**: a -1/2 region (or a fitted N) must exist.
-#' * **any fitted term** whose relative standard error (from the fit's
-#'   `vcov`) exceeds 50% is reported as not resolvable.
+#' * **any fitted term that is no reading** (a Gauss-Markov term, a line, a
+#'   band) is reported when the fit does not determine each of its values
+#'   within a factor 2 at 95% (1.96 standard errors of the log): the rule
+#'   of the `verdict` column of [kalman_params()], over the values the fit
+#'   estimated (a line's frequency held at the periodogram's is not judged
+#'   here; there a held value makes the term not determined).
 #' * **non-stationary effects** of the raw series (spikes/outliers, bias
 #'   steps, warm-up, transients; [detect_series_effects()], run by [avrefine()]
 #'   when it has the data, so by [analyze_imu()] with `refine = TRUE` or
@@ -160,17 +164,14 @@ channel_guidance <- function(ch) {
                  nzchar(rd$why) & !rd$term %in% said, , drop = FALSE]
   msg <- c(msg, sprintf("%s = %.3g %s is %s: %s.", judged$term, judged$value,
                         judged$unit, verdict_phrase(judged$verdict), judged$why))
-  fit <- ch$fit
-  if (!is.null(fit) && !is.null(fit$vcov) && length(fit$coefficients)) {
-    cf <- fit$coefficients
-    se <- suppressWarnings(sqrt(pmax(diag(as.matrix(fit$vcov)), 0)))
-    if (length(se) == length(cf)) {
-      names(se) <- names(cf)
-      bad <- names(cf)[is.finite(se) & cf != 0 & se / abs(cf) > 0.5]
-      for (b in bad) {
-        msg <- c(msg, sprintf("term %s is not resolvable from this record (relative standard error %.0f%%).",
-                              b, 100 * se[[b]] / abs(cf[[b]])))
-      }
+  # Every fitted term that is no reading, by the rule of kalman_params()'
+  # verdicts (its values within a factor 2 at 95%) over the values the fit
+  # estimated: a value held at the raw data's reading is no want of record.
+  tv <- own_term_verdicts(ch$fit, ch$coef, rd, free_only = TRUE)
+  for (l in names(tv)) {
+    if (tv[[l]]$verdict != "measured") {
+      msg <- c(msg, sprintf("term %s is %s from this record: %s.", l,
+                            verdict_phrase(tv[[l]]$verdict), tv[[l]]$why))
     }
   }
   msg <- c(msg, series_guidance(if (!is.null(ch$series)) ch$series else ch$fit$series,

@@ -340,8 +340,11 @@ verdict_note <- function(verdict, why = "", biased_by = "", bias_change = NA_rea
 # interval. A record of a few thousand seconds often cannot tell a slow
 # term's time constant to better than that (bench/gm-tc-information.R:
 # the Cramer-Rao bound of log tc is 0.1-0.5 on the battery's GM cases).
+# `free_only`: judge the values the fit estimated and pass over the held
+# ones (a line's frequency or a band's shape read from the periodogram:
+# held, but not for want of record); NULL when every value is held.
 term_factor <- 2
-term_verdict <- function(fit, label) {
+term_verdict <- function(fit, label, free_only = FALSE) {
   lay <- if (is.null(fit)) NULL else fit$layout
   lay <- lay[lay$label == label, , drop = FALSE]
   if (!NROW(lay)) return(verdict("not_determined", "the term is not in the fit"))
@@ -352,6 +355,14 @@ term_verdict <- function(fit, label) {
   # the curve's rate unit, which the fit does not carry)
   unit <- ifelse(lay$unit == "s", " s", "")
   held <- lay$fixed %in% TRUE | !is.finite(se) | se <= 0
+  if (free_only) {
+    if (all(held)) return(NULL)
+    lay <- lay[!held, , drop = FALSE]
+    value <- value[!held]
+    se <- se[!held]
+    unit <- unit[!held]
+    held <- held[!held]
+  }
   if (any(held)) {
     return(verdict("not_determined", sprintf(
       "%s held in the final fit: no standard error", paste(lay$param[held], collapse = ", "))))
@@ -369,4 +380,22 @@ term_verdict <- function(fit, label) {
     "%s's 95%% interval %s-%s%s is wider than a factor %s either way of %s%s",
     lay$param[k], format_num(lo), format_num(hi), unit[k], format_num(term_factor),
     format_num(value[k]), unit[k]), lo, hi)
+}
+
+# The verdicts (term_verdict()) of a channel's fitted instances that are no
+# reading: neither a reading's term nor folded into one. Named by their
+# labels as unfolded_coef() numbers them, the names kalman_params() prints
+# (a folded fast GM before a slow one makes the slow one "gm1" there,
+# while the fit knows it as "gm2"). `free_only`: as term_verdict()'s (a
+# term with every value held is left out).
+own_term_verdicts <- function(fit, coef, rd, free_only = FALSE) {
+  if (is.null(fit) || !length(coef)) return(list())
+  folded <- unlist(strsplit(rd$folded[nzchar(rd$folded)], ",", fixed = TRUE))
+  lay <- check_coef(coef)
+  kept <- unique(lay$label[!lay$label %in% folded])
+  shown <- unique(check_coef(unfolded_coef(coef, folded = folded))$label)
+  own <- !shown %in% rd$term
+  out <- lapply(kept[own], function(l) term_verdict(fit, l, free_only = free_only))
+  names(out) <- shown[own]
+  out[!vapply(out, is.null, NA)]
 }

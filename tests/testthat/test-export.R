@@ -309,4 +309,33 @@ test_that("a Gauss-Markov term's rows say how well the record determines it", {
   v <- ns$term_verdict(fit(0, fixed = c(FALSE, TRUE)), "gm1")
   expect_identical(v$verdict, "not_determined")
   expect_match(v$why, "tc held in the final fit", fixed = TRUE)
+  # the guidance's reading judges the estimated values only
+  expect_identical(ns$term_verdict(fit(50 * 0.3, fixed = c(FALSE, TRUE)), "gm1",
+                                   free_only = TRUE)$verdict, "measured")
+  expect_null(ns$term_verdict(fit(0, fixed = c(TRUE, TRUE)), "gm1", free_only = TRUE))
+})
+
+test_that("a term's verdict follows it when a fast GM before it is folded into N", {
+  # gm1 (tc 0.05 s) folds into the white noise; kalman_params() and the
+  # guidance then call the 50 s GM "gm1", and its verdict is its own (on
+  # b66a8d2 the row took the folded GM's: held, not determined)
+  lay <- data.frame(name = c("N", "gm1.sigma", "gm1.tc", "gm2.sigma", "gm2.tc"),
+                    label = c("N", "gm1", "gm1", "gm2", "gm2"), kind = c("N", "gm", "gm", "gm", "gm"),
+                    variant = "", param = c("N", "sigma", "tc", "sigma", "tc"),
+                    role = c("amp", "amp", "nonlinear", "amp", "nonlinear"),
+                    unit = c("u", "u", "s", "u", "s"), hidden = FALSE,
+                    fixed = c(FALSE, FALSE, TRUE, FALSE, FALSE))
+  cf <- c(N = 1e-3, gm1.sigma = 0.01, gm1.tc = 0.05, gm2.sigma = 0.002, gm2.tc = 50)
+  fit <- list(layout = lay, coefficients = cf,
+              se = c(N = 1e-5, gm1.sigma = 1e-3, gm1.tc = NA, gm2.sigma = 1e-4, gm2.tc = 5))
+  rd <- data.frame(term = "N", folded = "gm1", stringsAsFactors = FALSE)
+  tv <- asNamespace("allanvar")$own_term_verdicts(fit, cf, rd)
+  expect_named(tv, "gm1")
+  expect_identical(tv$gm1$verdict, "measured")
+  expect_equal(c(tv$gm1$lo, tv$gm1$hi), 50 * exp(c(-1, 1) * 1.96 * 0.1), tolerance = 1e-3)
+  # not folded, both are their own terms, under their own names
+  rd$folded <- ""
+  tv <- asNamespace("allanvar")$own_term_verdicts(fit, cf, rd)
+  expect_named(tv, c("gm1", "gm2"))
+  expect_identical(tv$gm1$verdict, "not_determined")
 })

@@ -97,3 +97,21 @@ test_that("spikes left in the raw series are reported with how to remove them", 
   c0 <- suppressWarnings(analyze_imu(r, progress = FALSE, refine = FALSE))
   expect_identical(grep("spike", imu_guidance(c0)$message, value = TRUE), line)
 })
+
+test_that("a term the record does not determine is reported as kalman_params() reports it", {
+  # own generator: white + an AR(1) of tc 100 s over 3000 s; its tc is not
+  # determined within a factor 2 at 95%, and the guidance says so in the
+  # words of the verdict column (it had its own rule: relative SE > 50%)
+  set.seed(12)
+  n <- 3e5
+  phi <- exp(-1 / (100 * 100))
+  g <- as.numeric(stats::filter(rnorm(n, sd = 0.002 * sqrt(1 - phi^2)), phi, "recursive"))
+  f <- avfit(allan(rnorm(n, sd = 0.01) + g, 100), terms = c("N", "gm"))
+  kp <- kalman_params(f, unit = "rad/s")
+  why <- unique(kp$why[kp$term == "gm1"])
+  expect_identical(unique(kp$verdict[kp$term == "gm1"]), "not_determined")
+  expect_match(why, "^tc's 95% interval .* is wider than a factor 2 either way of")
+  msg <- imu_guidance(f, unit = "rad/s")$message
+  expect_true(paste0("term gm1 is not determined from this record: ", why, ".") %in% msg)
+  expect_false(any(grepl("not resolvable", msg)))
+})
