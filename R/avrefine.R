@@ -49,7 +49,13 @@
 #' * A sinusoid proposed by a periodogram line keeps the line's frequency
 #'   (the periodogram measures it far better than the curve) and is matched
 #'   to lines within the periodogram's resolution. Raw-data checks of the
-#'   other effects see the series with the significant lines removed.
+#'   other effects see the series with the significant lines removed. Its
+#'   check confirms it when the line carries the amplitude the curve fits,
+#'   within a factor 3 either way (far weaker on the curve: undecided).
+#' * A further line of a harmonic set whose stronger lines the model holds
+#'   adds no new source: confirmed by the raw data, it is kept unless it
+#'   costs the criterion more than `min_gain` (the worth of that support);
+#'   otherwise the criterion must prefer it.
 #' * What no catalogue effect explains is reported in `$unexplained`, not
 #'   papered over; a reading whose tau range meets such a run is not
 #'   "measured" (a bound or not determined, its `why` naming the run).
@@ -157,7 +163,8 @@
 #'   effect, params, `series_kind`, `ratio` = the AV that series effect
 #'   adds over the term's own AV, at `tau`, `how`: `"share"` when that
 #'   ratio is 1 or more, `"refit"` when the term no longer pays on the
-#'   curve with the effect's excess taken out; the readings of such a run
+#'   curve with the effect's excess taken out (by `2 * min_gain` for a
+#'   term the raw data leave undecided); the readings of such a run
 #'   carry that series effect's bias, see [series_reading_bias()]),
 #'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range),
 #'   `revisit` (NULL, or when the greedy order was revisited a data frame

@@ -32,6 +32,10 @@ evidence_sinusoid <- function(par, raw, x, freq) {
       # 1/7 its amplitude while the added line was 0.1 Hz away)
       amp <- abs(par[["amp"]] %||% NA_real_)
       big <- is.finite(amp) && l$amp[j] > 0 && amp > sin_amp_factor * l$amp[j]
+      # and a sinusoid the curve sizes far below the line is not the line
+      # the raw data see: undecided (a harmonic of a held set, fitted at amp
+      # 0, passed as confirmed)
+      small <- is.finite(amp) && amp < l$amp[j] / sin_amp_factor
       # the line's frequency is measured to a fraction of a bin that shrinks
       # as it stands out (the log peak's interpolation): a fitted f0 beyond
       # that is the curve's own, not the line's (a curve far from its model
@@ -40,14 +44,18 @@ evidence_sinusoid <- function(par, raw, x, freq) {
       off <- abs(f0 - l$f0[j])
       prec <- res * min(1.5, sin_f0_bins / sqrt(max(l$ratio[j], 1)))
       away <- off > prec
-      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)%s%s",
+      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)%s%s%s",
                                  format_num(l$f0[j], 4), format_num(l$amp[j]),
                                  l$p_value[j],
                                  if (big) sprintf(", %.1f x weaker than the fitted amp %s",
                                                   amp / l$amp[j], format_num(amp)) else "",
+                                 if (small && amp > 0) sprintf(", %s x stronger than the fitted amp %s",
+                                                    format_num(l$amp[j] / amp, 2),
+                                                    format_num(amp))
+                                 else if (small) ", the fitted amp 0" else "",
                                  if (away) sprintf(", %s Hz from the fitted f0 (it reads f0 to %s Hz)",
                                                    format_num(off, 2), format_num(prec, 2)) else ""),
-                  support = !big && !away))
+                  support = if (!big && !away && small) NA else !big && !away))
     }
   }
   if (is.finite(f0) && f0 < 4 * res) {

@@ -145,6 +145,13 @@ test_that("a sinusoid's f0 must lie within its periodogram line's own precision"
   expect_match(off$text, "from the fitted f0")
   # the weak line: half a bin off is within what it can tell
   expect_true(ev(list(amp = 0.03, f0 = weak$f0 + 0.5 * res), raw, x, freq)$support)
+  # a sinusoid the curve sizes far below the line is not the line the raw
+  # data see (a harmonic fitted at amp 0 passed as confirmed): undecided
+  expect_true(ev(list(amp = 0.4, f0 = strong$f0), raw, x, freq)$support)
+  small <- ev(list(amp = 0.2, f0 = strong$f0), raw, x, freq)
+  expect_identical(small$support, NA)
+  expect_match(small$text, "5 x stronger than the fitted amp 0.2", fixed = TRUE)
+  expect_match(ev(list(amp = 0, f0 = strong$f0), raw, x, freq)$text, "the fitted amp 0$")
 })
 
 test_that("a harmonic set's further lines do not spend the step budget", {
@@ -422,4 +429,26 @@ test_that("a filter form the curve cannot tell from the moving average is told b
                    sort(r0$terms[startsWith(r0$terms, "filter")]))
   expect_false(any(r$steps$confirmed %in% FALSE))
   expect_lt(r$chi2, 4)
+})
+
+test_that("a measured axis's own 3rd harmonic is named with and without a line added", {
+  # unit 1 accel_y carries a 0.564 Hz line and its 3rd harmonic at 1.691 Hz
+  # (periodogram amp 1.3e-4, p = 2e-38). Held to no gain of its own, the
+  # harmonic cost the curve 2.9 alone and gained 1.7 beside an added 2.7
+  # Hz line: it was named only when the line was added (on b66a8d2). Its
+  # confirmation by the raw data now counts as min_gain, as for any effect.
+  skip_if_no_shared()
+  skip_on_cran()
+  ax <- measured_axis(1, "accel_y")
+  harmonic <- function(r) {
+    f <- fitted_f0(r)
+    any(abs(f / (3 * f[which.min(abs(f - 0.564))]) - 1) < 1e-3)
+  }
+  r0 <- loop(ax$b, ax$freq)
+  expect_true(harmonic(r0))
+  set.seed(3)
+  r1 <- loop(with_wave(ax, 0.3, 2.7, stats::runif(1, 0, 2 * pi)), ax$freq)
+  expect_true(any(abs(fitted_f0(r1) / 2.7 - 1) < 0.03))
+  expect_true(harmonic(r1))
+  expect_equal(n_reading(r1), n_reading(r0), tolerance = 0.05)
 })
