@@ -18,3 +18,10 @@ skip_if_no_shared <- function() {
 }
 
 shared_file <- function(name) file.path(shared_data_dir(), name)
+
+# a measured ADIS16405 axis: the series, its rate and its white sd a sample
+measured_axis <- function(unit, axis) {
+  m <- readRDS(shared_file(sprintf("adis16405_unit%d.rds", unit)))
+  b <- as.numeric(m[, axis])
+  list(b = b, freq = attr(m, "freq"), s = stats::sd(diff(b)) / sqrt(2))
+}

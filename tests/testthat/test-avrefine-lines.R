@@ -9,12 +9,6 @@ loop <- function(x, freq) {
   fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
   suppressMessages(avrefine(fit, data = x))
 }
-# a measured ADIS16405 axis: the series, its rate and its white sd a sample
-measured_axis <- function(unit, axis) {
-  m <- readRDS(shared_file(sprintf("adis16405_unit%d.rds", unit)))
-  b <- as.numeric(m[, axis])
-  list(b = b, freq = attr(m, "freq"), s = stats::sd(diff(b)) / sqrt(2))
-}
 # the axis with a periodic wave (a line; `wave`: its shape) of `amp` x its
 # white sd at f0 Hz added
 with_wave <- function(ax, amp, f0, phase, wave = sin) {

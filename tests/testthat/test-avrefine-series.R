@@ -163,12 +163,10 @@ test_that("a GM the raw data do not confirm must pay twice min_gain without the 
   # a 130 s GM that the ACF confirms at 103 s: the axis's own process.)
   skip_if_no_shared()
   skip_on_cran()
-  m <- readRDS(shared_file("adis16405_unit2.rds"))
-  b <- as.numeric(m[, "accel_z"])
-  freq <- attr(m, "freq")
-  n <- length(b)
-  ad60 <- allan(b, freq, taus = I(60))$adev
-  x <- b - 50 * ad60 * exp(-(seq_len(n) - 1) / freq / 60)
+  ax <- measured_axis(2, "accel_z")
+  freq <- ax$freq
+  ad60 <- allan(ax$b, freq, taus = I(60))$adev
+  x <- ax$b - 50 * ad60 * exp(-(seq_along(ax$b) - 1) / freq / 60)
   ref <- suppressWarnings(suppressMessages(
     avrefine(avfit(allan(x, freq), terms = c("N", "B", "K")), data = x)))
   wu <- ref$series$table[ref$series$table$kind == "warmup", , drop = FALSE]
