@@ -157,7 +157,9 @@
 #'   arguments, the raw-data diagnostics ([avdiagnose()]) and the
 #'   signatures left when the loop stopped and `failures` (a data frame
 #'   `step`, `effect`, `stage`, `message`, with the conditions in the list
-#'   column `condition`), `rejected` (step, effect, params, reason),
+#'   column `condition`), `rejected` (step, effect, params, reason; an
+#'   instance the final model holds at amplitude 0 is left out and listed
+#'   here, its step's `label` then reads `"left:"` and the old label),
 #'   `series_duplicates` (the rejected terms that would have described a
 #'   series effect of this run again, which was left in the data: step,
 #'   effect, params, `series_kind`, `ratio` = the AV that series effect

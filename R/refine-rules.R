@@ -46,14 +46,7 @@ model_terms <- function(terms, effect, par = NULL, fit = NULL) {
 relabel_values <- function(v, terms, new_terms, keep_gone = FALSE) {
   gone <- attr(new_terms, "gone")
   if (!length(v) || !any(gone)) return(v)
-  # labels number the instances of one kind in order (term_labels() sorts
-  # the kinds): the j-th kept instance of a kind takes its kind's j-th label
-  kinds <- split_term(terms)$kind
-  map <- character()
-  for (k in unique(kinds[!gone])) {
-    i <- which(kinds == k)
-    map[term_labels(terms[i])[!gone[i]]] <- term_labels(terms[i][!gone[i]])
-  }
+  map <- label_map(terms, gone)
   lab <- sub("\\.[^.]*$", "", names(v))
   par <- sub("^.*\\.", "", names(v))
   ok <- lab %in% names(map)
@@ -65,6 +58,20 @@ relabel_values <- function(v, terms, new_terms, keep_gone = FALSE) {
     out <- c(out, stats::setNames(v[!ok], paste0("left:", names(v)[!ok])))
   }
   out
+}
+
+# The labels of `terms` that stay when the instances `gone` (logical, one
+# per term) leave, named by their labels before: labels number the
+# instances of one kind in order (term_labels() sorts the kinds), so the
+# j-th kept instance of a kind takes its kind's j-th label.
+label_map <- function(terms, gone) {
+  kinds <- split_term(terms)$kind
+  map <- character()
+  for (k in unique(kinds[!gone])) {
+    i <- which(kinds == k)
+    map[term_labels(terms[i])[!gone[i]]] <- term_labels(terms[i][!gone[i]])
+  }
+  map
 }
 
 # Kinds that may still be added next to `present`: repeatable ones or those

@@ -12,6 +12,7 @@ refine_stages <- function() {
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
        release = stage_release,      # values the last screening held, freed
+       prune = stage_prune,          # instances the final model holds at 0 leave
        assemble = stage_assemble)    # the refined avfit object
 }
 
@@ -307,6 +308,60 @@ stage_release <- function(st) {
     intersect(to_free, r$won$fit$layout$name[r$won$fit$layout$fixed])
   st$settings$fixed <- c(st$settings$fixed, pinned[kept])
   if (!is.null(r$won)) st$current <- r$won$fit
+  st
+}
+
+# An instance this call added that the final model holds at amplitude 0
+# describes nothing: it leaves the model, refitted without it (taken when
+# no worse by the criterion), and is listed in $refine$rejected. (The
+# curve cannot tell lines 0.1 Hz apart: on measured accelerometers an
+# axis's 1.60 Hz line went to 0 once its set's 1.70 Hz harmonic entered
+# and took their power.) The steps keep their rows, under the labels the
+# model now gives their instances ("left:" and the old label for one that
+# left).
+stage_prune <- function(st) {
+  cur <- st$current
+  lay <- cur$layout
+  cf <- stats::coef(cur)
+  added <- unique(vapply(st$steps, function(s) s$label[1L], ""))
+  dead <- vapply(added, function(l) {
+    a <- lay$label == l & lay$role == "amp"
+    any(a) && all(cf[lay$name[a]] == 0)
+  }, NA)
+  dead <- added[dead]
+  if (!length(dead)) return(st)
+  labs <- term_labels(cur$terms)
+  gone <- labs %in% dead
+  tm <- structure(cur$terms[!gone], gone = gone)
+  settings <- st$settings
+  settings$fixed <- relabel_values(settings$fixed, cur$terms, tm)
+  start <- relabel_values(cf[lay$role == "nonlinear"], cur$terms, tm)
+  start <- start[!names(start) %in% names(settings$fixed)]
+  step <- length(st$steps) + 1L
+  r <- state_refit(st, refit_args(cur, c(tm), settings, start = start),
+                   "refit without the instances at 0", "prune", step)
+  st <- r$st
+  f <- r$fit
+  if (is.null(f) || !(refine_crit(st, f) <= refine_crit(st, cur) + 1e-6)) return(st)
+  for (l in dead) {
+    st$rejected <- add_rejected(st$rejected, step, cur$terms[match(l, labs)],
+                                instance_params(cf, lay, l),
+                                "at amplitude 0 in the final model: left out")
+  }
+  # (a step whose instance left is labelled "left:" as relabel_values()
+  # names values that left, and says why)
+  map <- label_map(cur$terms, gone)
+  st$steps <- lapply(st$steps, function(s) {
+    if (s$label[1L] %in% dead) {
+      s$label <- paste0("left:", s$label)
+      s$evidence <- paste0(s$evidence, "; left out at the end: amplitude 0 in the final model")
+    } else if (s$label[1L] %in% names(map)) {
+      s$label <- unname(map[s$label])
+    }
+    s
+  })
+  st$settings <- settings
+  st$current <- f
   st
 }
 

@@ -47,7 +47,18 @@ n_of <- function(r) {
   # N, or the white noise a filter term (any variant) carries
   unname(cf[grepl("^N$|^filter[^.]*\\.Nf$", names(cf))][1L])
 }
-kinds <- function(r) sub(":.*", "", r$terms)
+# (an instance the model holds at amplitude 0 names nothing, and is no
+# effect the run added)
+live_labels <- function(r) {
+  lay <- r$layout
+  unique(lay$label[lay$role == "amp" & coef(r)[lay$name] != 0])
+}
+kinds <- function(r) {
+  lay <- r$layout
+  start <- lay$kind %in% c("N", "B", "K")      # the fit's own terms, at 0 or not
+  lay <- lay[!duplicated(lay$label) & (start | lay$label %in% live_labels(r)), , drop = FALSE]
+  lay$kind
+}
 named <- function(r, kind, value) {
   if (kind %in% c("warmup", "steps")) return(named_series(r, kind, value))
   cf <- coef(r)
@@ -57,6 +68,7 @@ named <- function(r, kind, value) {
     # a measured band's centre: its power centroid
     band = c(cf[grepl("^resonance[0-9]*\\.fr$", names(cf))],
              cf[grepl("^band[0-9]*\\.f_c$", names(cf))]))
+  v <- v[sub("\\..*$", "", names(v)) %in% live_labels(r)]
   tol <- switch(kind, sinusoid = 0.03, gm = 0.25, band = 0.05)
   if (!length(v)) return(c(ok = FALSE, got = NA))
   j <- which.min(abs(log(v / value)))

@@ -446,3 +446,29 @@ test_that("a measured axis's own 3rd harmonic is named with and without a line a
   expect_true(harmonic(r1))
   expect_equal(n_reading(r1), n_reading(r0), tolerance = 0.05)
 })
+
+test_that("an instance the final model holds at amplitude 0 leaves it, and the steps say so", {
+  # the curve cannot tell lines 0.1 Hz apart: on unit 2 accel_x the
+  # axis's 1.60 Hz line went to amplitude 0 once its set's 1.70 Hz
+  # harmonic entered, and stayed in the model at 0 (on 9dd16f2)
+  lm <- asNamespace("allanvar")$label_map
+  expect_identical(lm(c("B", "gm", "sinusoid", "sinusoid", "sinusoid"), c(FALSE, FALSE, FALSE, TRUE, FALSE)),
+                   c(B = "B", gm1 = "gm1", sinusoid1 = "sinusoid1", sinusoid3 = "sinusoid2"))
+  skip_if_no_shared()
+  skip_on_cran()
+  ax <- measured_axis(2, "accel_x")
+  r <- loop(ax$b, ax$freq)
+  lay <- r$layout
+  added <- unique(r$steps$label)
+  amp0 <- vapply(unique(lay$label), function(l) {
+    a <- lay$label == l & lay$role == "amp"
+    any(a) && all(coef(r)[lay$name[a]] == 0)
+  }, NA)
+  expect_false(any(amp0[names(amp0) %in% added]))
+  expect_true(all(added %in% lay$label | startsWith(added, "left:")))
+  left <- r$steps[startsWith(r$steps$label, "left:"), , drop = FALSE]
+  expect_true(all(grepl("amplitude 0 in the final model", left$evidence)))
+  expect_identical(sum(grepl("at amplitude 0 in the final model", r$refine$rejected$reason)), nrow(left))
+  # every line the model keeps carries its periodogram line's amplitude
+  expect_false(any(grepl("stronger than the fitted amp", r$steps$evidence[!startsWith(r$steps$label, "left:")])))
+})
