@@ -17,6 +17,16 @@ loop_raw <- function(v, freq) {
   suppressMessages(avrefine(avfit(allan(v, freq), terms = c("N", "B", "K")), data = v))
 }
 
+# White noise, a random walk and a resonance (`res`: amplitude, fr, tc of
+# an own AR(2)), and the same with a band (`band`, likewise) added: the
+# loop on each, r0 without and r1 with the band.
+loop_band_beside <- function(n, freq, res, band) {
+  base <- stats::rnorm(n, sd = 0.01) + cumsum(stats::rnorm(n, sd = 1e-5)) +
+    res[[1L]] * ar2_unit(n, res[[2L]], res[[3L]], freq)
+  x <- base + band[[1L]] * ar2_unit(n, band[[2L]], band[[3L]], freq)
+  list(r0 = loop_raw(base, freq), r1 = loop_raw(x, freq))
+}
+
 # AR(2) resonance at fr with damping time tc (innovation sd s).
 ar2_resonance <- function(n, fr, tc, s, freq) {
   r <- exp(-1 / (freq * tc))
@@ -190,13 +200,9 @@ test_that("a band beside a resonance: no filter term, N within 5% of the run wit
   # sensor filter that carried the white noise (N +12-14% on seeds 1-3)
   skip_on_cran()
   set.seed(1)
-  n <- 2e5
-  freq <- 100
-  base <- stats::rnorm(n, sd = 0.01) + cumsum(stats::rnorm(n, sd = 1e-5)) +
-    0.01 * ar2_unit(n, 18, 0.1, freq)
-  x <- base + 0.006 * ar2_unit(n, 7, 0.3, freq)
-  r0 <- loop_raw(base, freq)
-  r1 <- loop_raw(x, freq)
+  runs <- loop_band_beside(2e5, 100, res = c(0.01, 18, 0.1), band = c(0.006, 7, 0.3))
+  r0 <- runs$r0
+  r1 <- runs$r1
   expect_false(any(grepl("^filter", r1$terms)))
   expect_true("N" %in% r0$terms && "N" %in% r1$terms)
   expect_equal(unname(coef(r1)[["N"]]), unname(coef(r0)[["N"]]), tolerance = 0.05)
@@ -236,13 +242,9 @@ test_that("a band added beside a sensor's resonance in one run: two resonances, 
   # (one resonance at 8.25 Hz, the axis's own lost; on main 2e5d30c).
   skip_on_cran()
   set.seed(1)
-  freq <- 100
-  n <- 5e5
-  base <- stats::rnorm(n, sd = 0.01) + cumsum(stats::rnorm(n, sd = 1e-5)) +
-    0.002 * ar2_unit(n, 9.86, 0.47, freq)
-  x <- base + 0.005 * ar2_unit(n, 8.1, 0.3, freq)
-  r0 <- loop_raw(base, freq)
-  r1 <- loop_raw(x, freq)
+  runs <- loop_band_beside(5e5, 100, res = c(0.002, 9.86, 0.47), band = c(0.005, 8.1, 0.3))
+  r0 <- runs$r0
+  r1 <- runs$r1
   fr <- coef(r1)[grepl("^resonance[0-9]*\\.fr$", names(coef(r1)))]
   expect_length(fr, 2L)
   expect_equal(sort(unname(fr)), c(8.1, 9.86), tolerance = 0.03)
