@@ -159,7 +159,12 @@
 #'   `step`, `effect`, `stage`, `message`, with the conditions in the list
 #'   column `condition`), `rejected` (step, effect, params, reason; an
 #'   instance the final model holds at amplitude 0 is left out and listed
-#'   here, its step's `label` then reads `"left:"` and the old label),
+#'   here, its step's `label` then reads `"left:"` and the old label; one
+#'   the final model sizes far off what the raw data measure, a sinusoid
+#'   below a third or above 3 times its periodogram line's amplitude, is
+#'   first held at the raw data's value (fixed in `layout`) when that
+#'   costs the criterion less than `min_gain` and no effect loses its
+#'   raw-data support, and its step's `evidence` says so),
 #'   `series_duplicates` (the rejected terms that would have described a
 #'   series effect of this run again, which was left in the data: step,
 #'   effect, params, `series_kind`, `ratio` = the AV that series effect

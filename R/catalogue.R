@@ -54,6 +54,9 @@
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
 #                 the raw series says about a fitted instance
+#   raw_hold(par, raw)  NULL, or for an instance the curve sizes far off
+#                 what the raw data measure: list(values (named parameter
+#                 values the raw data measure, to hold it at), note)
 #   peak_tau(par)  characteristic tau of an instance (where its residual
 #                 signature sits), or NULL
 #   reading     NULL, or how the entry is read off a curve for a datasheet:
@@ -181,7 +184,7 @@ new_effect <- function(name, title, params, component = "av",
                        basis = NULL, psd = NULL, acf = NULL, sim = NULL,
                        sim_check = NULL, edf_alpha = NULL, nl_range = NULL,
                        nl_bounds = NULL,
-                       trace = NULL, propose = NULL, evidence = NULL,
+                       trace = NULL, propose = NULL, evidence = NULL, raw_hold = NULL,
                        peak_tau = NULL, reading = NULL, fold = NULL,
                        discrete = NULL, describe = NULL, detect = NULL,
                        remove = NULL, replaces = character(),
@@ -194,7 +197,8 @@ new_effect <- function(name, title, params, component = "av",
        basis = basis, psd = psd, acf = acf, sim = sim, sim_check = sim_check,
        edf_alpha = edf_alpha, nl_range = nl_range, nl_bounds = nl_bounds,
        trace = trace,
-       propose = propose, evidence = evidence, peak_tau = peak_tau,
+       propose = propose, evidence = evidence, raw_hold = raw_hold,
+       peak_tau = peak_tau,
        reading = reading, fold = fold, discrete = discrete,
        describe = describe, detect = detect, remove = remove,
        replaces = replaces, replaces_instance = replaces_instance,
@@ -234,7 +238,8 @@ validate_effect <- function(e) {
   e$params <- p
   fun_ok <- function(f) is.null(f) || is.function(f)
   for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
-              "nl_range", "nl_bounds", "trace", "propose", "evidence", "peak_tau",
+              "nl_range", "nl_bounds", "trace", "propose", "evidence", "raw_hold",
+              "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible",
               "statespace", "exact_edf")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")

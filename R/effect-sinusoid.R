@@ -16,48 +16,57 @@ sin_amp_factor <- 3
 # a line 2192 x its background, the full 1.5 for one 11 x.
 sin_f0_bins <- 5
 
-# Raw-data evidence: a periodogram line near f0.
-evidence_sinusoid <- function(par, raw, x, freq) {
+# The periodogram line an instance stands on (the strongest within 1.5 bins
+# of the periodogram's resolution, not a fraction of f0) and how the fitted
+# values sit against it; NULL when there is none.
+sin_line_of <- function(par, raw) {
   l <- diag_part(raw, "lines")
   f0 <- par[["f0"]] %||% NA_real_
+  if (!nrow(l) || !is.finite(f0)) return(NULL)
+  j <- match_line(f0, l, tol = 1.5, pick = "strongest")
+  if (is.na(j)) return(NULL)
   res <- attr(l, "resolution") %||% 0
-  if (nrow(l) && is.finite(f0)) {
-    # the strongest line within 1.5 bins of the periodogram's resolution,
-    # not a fraction of f0
-    j <- match_line(f0, l, tol = 1.5, pick = "strongest")
-    if (!is.na(j)) {
-      # the line must carry the power the curve asks for: a weak line next
-      # to f0 does not back a sinusoid sized for a stronger one elsewhere
-      # (on a measured accelerometer a bump's sinusoid landed on a line of
-      # 1/7 its amplitude while the added line was 0.1 Hz away)
-      amp <- abs(par[["amp"]] %||% NA_real_)
-      big <- is.finite(amp) && l$amp[j] > 0 && amp > sin_amp_factor * l$amp[j]
-      # and a sinusoid the curve sizes far below the line is not the line
-      # the raw data see: undecided (a harmonic of a held set, fitted at amp
-      # 0, passed as confirmed)
-      small <- is.finite(amp) && amp < l$amp[j] / sin_amp_factor
-      # the line's frequency is measured to a fraction of a bin that shrinks
-      # as it stands out (the log peak's interpolation): a fitted f0 beyond
-      # that is the curve's own, not the line's (a curve far from its model
-      # took 0.6123 Hz for a line the periodogram reads at 0.60997 Hz, 2192 x
-      # its background, and the line's AV oscillation at 5-20 s went wrong)
-      off <- abs(f0 - l$f0[j])
-      prec <- res * min(1.5, sin_f0_bins / sqrt(max(l$ratio[j], 1)))
-      away <- off > prec
-      return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)%s%s%s",
-                                 format_num(l$f0[j], 4), format_num(l$amp[j]),
-                                 l$p_value[j],
-                                 if (big) sprintf(", %.1f x weaker than the fitted amp %s",
-                                                  amp / l$amp[j], format_num(amp)) else "",
-                                 if (small && amp > 0) sprintf(", %s x stronger than the fitted amp %s",
-                                                    format_num(l$amp[j] / amp, 2),
-                                                    format_num(amp))
-                                 else if (small) ", the fitted amp 0" else "",
-                                 if (away) sprintf(", %s Hz from the fitted f0 (it reads f0 to %s Hz)",
-                                                   format_num(off, 2), format_num(prec, 2)) else ""),
-                  support = if (!big && !away && small) NA else !big && !away))
-    }
+  amp <- abs(par[["amp"]] %||% NA_real_)
+  # the line's frequency is measured to a fraction of a bin that shrinks
+  # as it stands out (the log peak's interpolation): a fitted f0 beyond
+  # that is the curve's own, not the line's (a curve far from its model
+  # took 0.6123 Hz for a line the periodogram reads at 0.60997 Hz, 2192 x
+  # its background, and the line's AV oscillation at 5-20 s went wrong)
+  off <- abs(f0 - l$f0[j])
+  prec <- res * min(1.5, sin_f0_bins / sqrt(max(l$ratio[j], 1)))
+  list(line = l[j, , drop = FALSE], amp = amp, off = off, prec = prec,
+       # the line must carry the power the curve asks for: a weak line next
+       # to f0 does not back a sinusoid sized for a stronger one elsewhere
+       # (on a measured accelerometer a bump's sinusoid landed on a line of
+       # 1/7 its amplitude while the added line was 0.1 Hz away)
+       big = is.finite(amp) && l$amp[j] > 0 && amp > sin_amp_factor * l$amp[j],
+       # and a sinusoid the curve sizes far below the line is not the line
+       # the raw data see: undecided (a harmonic of a held set, fitted at amp
+       # 0, passed as confirmed)
+       small = is.finite(amp) && amp < l$amp[j] / sin_amp_factor,
+       away = off > prec)
+}
+
+# Raw-data evidence: a periodogram line near f0.
+evidence_sinusoid <- function(par, raw, x, freq) {
+  m <- sin_line_of(par, raw)
+  f0 <- par[["f0"]] %||% NA_real_
+  if (!is.null(m)) {
+    l <- m$line
+    amp <- m$amp
+    return(list(text = sprintf("periodogram line at %s Hz (amp %s, p = %.1g)%s%s%s",
+                               format_num(l$f0, 4), format_num(l$amp), l$p_value,
+                               if (m$big) sprintf(", %.1f x weaker than the fitted amp %s",
+                                                  amp / l$amp, format_num(amp)) else "",
+                               if (m$small && amp > 0) sprintf(", %s x stronger than the fitted amp %s",
+                                                  format_num(l$amp / amp, 2),
+                                                  format_num(amp))
+                               else if (m$small) ", the fitted amp 0" else "",
+                               if (m$away) sprintf(", %s Hz from the fitted f0 (it reads f0 to %s Hz)",
+                                                   format_num(m$off, 2), format_num(m$prec, 2)) else ""),
+                support = if (!m$big && !m$away && m$small) NA else !m$big && !m$away))
   }
+  res <- attr(diag_part(raw, "lines"), "resolution") %||% 0
   if (is.finite(f0) && f0 < 4 * res) {
     # Within 4 bins of DC the raw data cannot tell a sinusoid from the drift
     # or random walk beside it: with the raw data at hand such a "sinusoid"
@@ -68,6 +77,17 @@ evidence_sinusoid <- function(par, raw, x, freq) {
   }
   list(text = sprintf("no periodogram line near %s Hz", format_num(f0)),
        support = FALSE)
+}
+
+# The amplitude the periodogram measures, for a sinusoid on its line that
+# the curve sizes far off it (two lines 0.1 Hz apart look alike on the
+# curve, which gives one the other's power).
+hold_sinusoid <- function(par, raw) {
+  m <- sin_line_of(par, raw)
+  if (is.null(m) || !(m$small || m$big) || m$away || !(m$line$amp > 0)) return(NULL)
+  list(values = c(amp = m$line$amp),
+       note = sprintf("amp held at the periodogram line's %s (the curve put it at %s)",
+                      format_num(m$line$amp), format_num(m$amp)))
 }
 
 effect_sinusoid <- function() {
@@ -164,6 +184,7 @@ effect_sinusoid <- function() {
       out
     },
     evidence = evidence_sinusoid,
+    raw_hold = hold_sinusoid,
     # The periodogram's lines, less the bins of the broad bands (a
     # resonance's bins are not sinusoids); the checks of the other effects
     # see the series with them taken out (a line disturbs the ACF that
