@@ -25,6 +25,14 @@ n_reading <- function(r) {
   unname(cf[grepl("^N$|^filter[^.]*\\.Nf$", names(cf))][1L])
 }
 
+# own generator: white noise, a line at 1.7 Hz of amplitude 0.3 and one at
+# 1.59 Hz five times weaker
+two_close_lines <- function(freq) {
+  set.seed(27)
+  t <- seq_len(2e5) / freq
+  rnorm(length(t)) + 0.3 * sin(2 * pi * 1.7 * t + 1) + 0.06 * sin(2 * pi * 1.59 * t + 2)
+}
+
 test_that("a line at 49.3 Hz (100 Hz sampling, amplitude the white sd) is named; no Q in its place", {
   set.seed(2711)
   freq <- 100
@@ -104,10 +112,8 @@ test_that("a sinusoid sized for a strong line is not backed by a weak line besid
   # own generator: white noise, a line at 1.7 Hz of amplitude 0.3 and one
   # at 1.59 Hz five times weaker (on a measured accelerometer the loop
   # once fitted the strong line's power at the weak line's frequency)
-  set.seed(27)
   freq <- 100
-  t <- seq_len(2e5) / freq
-  x <- rnorm(length(t)) + 0.3 * sin(2 * pi * 1.7 * t + 1) + 0.06 * sin(2 * pi * 1.59 * t + 2)
+  x <- two_close_lines(freq)
   raw <- avdiagnose(x, freq)
   ev <- allanvar:::evidence_sinusoid
   expect_false(ev(list(amp = 0.3, f0 = 1.59), raw, x, freq)$support)
@@ -450,10 +456,8 @@ test_that("a measured axis's own 3rd harmonic is named with and without a line a
 test_that("a line the curve sizes far off its periodogram line is held at the line's amplitude", {
   # own generator: white noise, a line at 1.7 Hz of amplitude 0.3 and one
   # at 1.59 Hz five times weaker: on the curve the two look alike
-  set.seed(27)
   freq <- 100
-  t <- seq_len(2e5) / freq
-  x <- rnorm(length(t)) + 0.3 * sin(2 * pi * 1.7 * t + 1) + 0.06 * sin(2 * pi * 1.59 * t + 2)
+  x <- two_close_lines(freq)
   raw <- avdiagnose(x, freq)
   hold <- allanvar:::hold_sinusoid
   h <- hold(list(amp = 0, f0 = 1.59), raw)
