@@ -213,7 +213,7 @@ raw_evidence <- function(effect, par, raw, x, freq) {
 }
 
 # What the raw series measures of a fitted instance the curve sizes far
-# below it: NULL, or list(values, note) from the entry's raw_hold().
+# off it: NULL, or list(values, note) from the entry's raw_hold().
 raw_hold_values <- function(effect, par, raw) {
   if (is.null(raw)) return(NULL)
   sp <- split_term(effect)

@@ -12,7 +12,7 @@ refine_stages <- function() {
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
        release = stage_release,      # values the last screening held, freed
-       hold = stage_hold,            # instances the curve sizes below the raw data's
+       hold = stage_hold,            # instances the curve sizes off the raw data's
        prune = stage_prune,          # instances the final model holds at 0 leave
        assemble = stage_assemble)    # the refined avfit object
 }
@@ -312,9 +312,10 @@ stage_release <- function(st) {
   st
 }
 
-# An instance this call added that the final model sizes far below what
+# An instance this call added that the final model sizes far off what
 # the raw data measure (the catalogue's raw_hold(): a line the curve put
-# at a fraction of its periodogram amplitude, or at 0) is held at the raw
+# at a fraction of its periodogram amplitude, or at 0, or at many times
+# it) is held at the raw
 # data's values. The curve cannot tell lines 0.1 Hz apart: on measured
 # accelerometers an axis's 1.60 Hz line went to 0 in one run and kept its
 # amplitude in the next, once its 1.70 Hz neighbour had entered and taken
@@ -367,7 +368,7 @@ raw_holds <- function(st, f, fixed) {
   lay <- f$layout
   cf <- stats::coef(f)
   labs <- term_labels(f$terms)
-  added <- intersect(unique(vapply(st$steps, function(s) s$label[1L], "")), labs)
+  added <- intersect(added_labels(st), labs)
   values <- numeric()
   notes <- character()
   for (l in added) {
@@ -382,18 +383,20 @@ raw_holds <- function(st, f, fixed) {
   list(values = values, notes = notes)
 }
 
+# The labels of the instances this call added, one per step, in order.
+added_labels <- function(st) unique(vapply(st$steps, function(s) s$label[1L], ""))
+
 # An instance this call added that the final model holds at amplitude 0
 # (and stage_hold() could not hold at what the raw data measure)
 # describes nothing: it leaves the model, refitted without it (taken when
 # no worse by the criterion), and is listed in $refine$rejected. The
-# steps keep their rows, under the labels the
-# model now gives their instances ("left:" and the old label for one that
-# left).
+# steps keep their rows, under the labels the model now gives their
+# instances ("left:" and the old label for one that left).
 stage_prune <- function(st) {
   cur <- st$current
   lay <- cur$layout
   cf <- stats::coef(cur)
-  added <- unique(vapply(st$steps, function(s) s$label[1L], ""))
+  added <- added_labels(st)
   dead <- vapply(added, function(l) {
     a <- lay$label == l & lay$role == "amp"
     any(a) && all(cf[lay$name[a]] == 0)
