@@ -314,6 +314,22 @@ test_that("a ramp is not a step, and a short pulse is a transient, not two steps
   expect_equal(pu$size, 0.05, tolerance = 0.2)
 })
 
+test_that("a measured excursion is a step or not whatever the phase of a line added far above the block rate", {
+  skip_if_no_shared()
+  # unit 1 accel_y has a level change near 5778 s whose split over the long
+  # window is loose by a few blocks: read at that split alone, its
+  # sharpness crossed the step/ramp rule in 2 of 8 phases of a 2.7 Hz line
+  # (0.3 white sd) and the series gained a step the record without the
+  # line did not have
+  a <- measured_axis(1, 5)
+  t <- seq_along(a$b) / a$freq
+  near <- function(x) any(abs(detect_steps(x, a$freq)$time - 5778) < 5)
+  base <- near(a$b)
+  for (ph in seq(0, 2 * pi, length.out = 9)[-9]) {
+    expect_identical(near(a$b + 0.3 * a$s * sin(2 * pi * 2.7 * t + ph)), base)
+  }
+})
+
 test_that("remove_steps() gives the values of the full jump series' cumsum", {
   # the dense reference: the sizes placed at their indices, summed with
   # cumsum() over every sample (the sparse form must agree bit for bit)
