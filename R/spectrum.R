@@ -169,7 +169,9 @@ growing_medians <- function(e) {
 #' background (octave_background()); under the null a bin is
 #' \eqn{\chi^2_\nu/\nu} times the background (\eqn{\nu} the Welch EDF)
 #' and the p-value is Bonferroni-corrected over the bins. Adjacent
-#' significant bins form one line; its frequency is the parabolic
+#' significant bins form one line when their highest bin is a peak (no
+#' neighbour above it: else they are the flank of red noise rolling off
+#' below the bins searched); its frequency is the parabolic
 #' interpolation of the log peak, its amplitude \eqn{\sqrt{2P}} from the
 #' power \eqn{P} above the background within +-3 bins. A narrow-band
 #' process (a resonance) raises many neighbouring bins instead: each line
@@ -205,6 +207,12 @@ spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 24L,
     groups <- split(cand, cumsum(c(1, diff(cand) > 3)))
     rows <- lapply(groups, function(g) {
       i <- g[which.max(p[g])]
+      # A line is a peak of the periodogram: a group whose highest bin has
+      # a higher neighbour is the flank of something below the bins
+      # searched (a Gauss-Markov corner and a random walk, flat over the
+      # first five bins, read as a "line" at the first bin allowed, 2.5 x
+      # the falling background, p = 4e-5).
+      if (p[i] < p[i - 1L] || p[i] < p[i + 1L]) return(NULL)
       # Parabolic interpolation of the log peak for a sub-bin f0.
       a <- lp[i - 1L]; b <- lp[i]; c <- lp[i + 1L]
       d <- 0.5 * (a - c) / (a - 2 * b + c)
@@ -218,9 +226,12 @@ spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 24L,
                  concentration = sh$concentration, kind = sh$kind,
                  stringsAsFactors = FALSE)
     })
-    lines <- do.call(rbind, rows)
-    lines <- lines[order(-lines$ratio), , drop = FALSE]
-    lines <- utils::head(lines, max_lines)
+    rows <- rows[!vapply(rows, is.null, NA)]
+    if (length(rows)) {
+      lines <- do.call(rbind, rows)
+      lines <- lines[order(-lines$ratio), , drop = FALSE]
+      lines <- utils::head(lines, max_lines)
+    }
   }
   rownames(lines) <- NULL
   attr(lines, "resolution") <- w$df

@@ -62,6 +62,30 @@ test_that("white plus random walk shows no line in 10 seeds (at most one false a
   expect_lte(hits, 1L)
 })
 
+test_that("a Gauss-Markov corner beside a random walk is no line at the lowest bins", {
+  # white + an AR(1) of Tc 14 s + a random walk, 5000 s: the periodogram is
+  # flat over its first five bins and falls after the corner; the first
+  # bin searched stood 2.5 x above the falling background (p = 4e-5) in 1
+  # seed of 20 and was read as a line at 0.0122 Hz (the loop then added a
+  # sinusoid of period 82 s beside the GM)
+  n <- 5e5
+  phi <- exp(-1 / (100 * 14))
+  low <- vapply(1:20, function(seed) {
+    set.seed(seed)
+    g <- as.numeric(stats::filter(rnorm(n, sd = 0.004 * sqrt(1 - phi^2)), phi,
+                                  method = "recursive"))
+    x <- rnorm(n, sd = 0.009) + g + cumsum(rnorm(n, sd = 1.2e-5))
+    sum(spectral_lines(x, 100)$f0 < 0.05)
+  }, 0)
+  expect_identical(sum(low), 0)
+  # a line there is still a line
+  set.seed(3)
+  g <- as.numeric(stats::filter(rnorm(n, sd = 0.004 * sqrt(1 - phi^2)), phi,
+                                method = "recursive"))
+  x <- rnorm(n, sd = 0.009) + g + 0.003 * sin(2 * pi * 0.03 * seq_len(n) / 100)
+  expect_false(is.na(match_line(0.03, spectral_lines(x, 100))))
+})
+
 test_that("the visible band follows the curve's tau range and the Nyquist frequency", {
   b <- visible_band(0.01, 1000, 100)
   expect_equal(unname(b), c(1e-3, 50))
