@@ -181,9 +181,7 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
       lo <- max(wq, iq - wq)
       hi <- min(nb - wq, iq + wq)
       if (lo > hi) return(1)
-      js <- lo:hi
-      dq <- (cr[js + wq + 1L] - 2 * cr[js + 1L] + cr[js - wq + 1L]) / wq
-      max(dq / best$d)
+      max(split_differences(cr, (lo:hi) + 1L, wq) / best$d)
     }, 0)
     if (mean(ratios) < 0.65) {
       rejected <- rejected + 1L
@@ -202,7 +200,7 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
     cs <- steps_prefix(x, lv, lo - W, hi + W)
     cand <- lo:hi
     p <- cand - (lo - W) + 1L           # their places in cs
-    dd <- (cs[p + W] - 2 * cs[p] + cs[p - W]) / W
+    dd <- split_differences(cs, p, W)
     at <- cand[which.max(abs(dd))]      # first sample after the step
     if (any(abs(idx - at) < b)) {       # the same step again: set aside
       excluded[max(1L, best$i - w):min(nb, best$i + w)] <- TRUE
@@ -307,6 +305,11 @@ detect_steps <- function(x, freq, alpha = 0.01, max_steps = 20L,
   steps
 }
 
+# The difference of the means of the W samples after and the W before
+# each split: `cs` a c(0, cumsum()) of the series (or a slice of it), `p`
+# the positions in cs of the sums up to each split.
+split_differences <- function(cs, p, W) (cs[p + W] - 2 * cs[p] + cs[p - W]) / W
+
 # Does the level come back across a pulse from step `a` to step `c2` (rows
 # of detect_steps()' table)? The level after the return less the level
 # before the onset (means over the shorter of their windows, the `others`
@@ -395,7 +398,7 @@ step_return <- function(x, steps, k, gap, alpha, tau0, W_min, se_at) {
     if (!length(cand)) next
     M <- M + length(cand) / W
     p <- cand - c0 + 1L
-    d <- (cs[p + W] - 2 * cs[p] + cs[p - W]) / W
+    d <- split_differences(cs, p, W)
     se <- se_at(W)
     z <- -sign(steps$size[k]) * d / se
     j <- which.max(z)
