@@ -11,6 +11,11 @@ sin_peak_adev <- 0.7246       # ... where ADEV = 0.7246 A
 # accelerometers' own 1.6-1.7 Hz lines are fitted at 2.0-2.5x the amp read
 # there, the curve's misplaced sinusoids at 5-9x.
 sin_amp_factor <- 3
+# A line is sharp (one frequency over the whole record) when its
+# least-squares sinusoid holds at least this share of the Welch line's
+# amplitude: 0.99-1.06 for a square wave's harmonics, 0.1-0.65 for the
+# ADIS16405 accelerometers' own lines, whose frequency wanders.
+sin_sharp_share <- 0.8
 # A line's frequency is read to this many Welch bins over the square root
 # of its peak's ratio to the background (at most 1.5 bins): 0.11 bins for
 # a line 2192 x its background, the full 1.5 for one 11 x.
@@ -45,6 +50,11 @@ sin_line_of <- function(par, raw) {
        # 0, passed as confirmed)
        small = is.finite(amp) && amp < l$amp[j] / sin_amp_factor,
        away = off > prec)
+}
+
+# Is line j of `lines` (the loop's lines part) sharp?
+sharp_line <- function(lines, j) {
+  isTRUE(lines$record_amp[j] >= sin_sharp_share * lines$amp[j])
 }
 
 # Raw-data evidence: a periodogram line near f0.
@@ -176,8 +186,14 @@ effect_sinusoid <- function() {
           after = if (any(stronger)) list(f0 = lines$f0[stronger]),
           init = list(f0 = f0, amp = lines$amp[j]), tau_from = t1 / 2,
           tau_to = 2 / f0, score = 2,
-          # the periodogram measures f0 far better than the curve does
-          pin = list(f0 = f0),
+          # the periodogram measures f0 far better than the curve does,
+          # and a sharp line's amp too: a further line of a set pinned
+          # there cannot take the power of the set's lines not yet in the
+          # model (a square wave's 9th and 11th harmonics, free, took 2.8
+          # x their lines, and the axis's resonance beside them was lost)
+          pin = if (any(stronger) && sharp_line(lines, j)) {
+            list(f0 = f0, amp = lines$amp[j])
+          } else list(f0 = f0),
           note = sprintf("proposed by a periodogram line at %s Hz%s",
                          format_num(f0, 4), src))
       }
@@ -192,10 +208,20 @@ effect_sinusoid <- function() {
     diagnose = list(
       part = "lines", reads = "raw", needs = "bands",
       make = function(x, freq, dg) {
-        lines_outside_bands(diag_value(dg, "lines"), diag_part(dg, "bands"))
+        lines <- lines_outside_bands(diag_value(dg, "lines"), diag_part(dg, "bands"))
+        # each line's least-squares sinusoid over the whole record: its
+        # amplitude says whether the line holds one frequency (sharp), and
+        # clean() takes the same sinusoids out
+        fits <- record_line_fits(x, freq, lines$f0)
+        lines$record_amp <- fits$amp
+        attr(lines, "fits") <- fits
+        lines
       },
       clean = function(x, freq, lines) {
-        if (nrow(lines)) remove_lines(x, freq, lines$f0) else x
+        fits <- attr(lines, "fits")
+        if (!nrow(lines)) x
+        else if (!is.null(fits)) subtract_line_fits(x, freq, fits)
+        else remove_lines(x, freq, lines$f0)
       }),
     peak_tau = function(par) sin_peak_ratio / par[["f0"]],
     describe = function(values) {

@@ -41,8 +41,28 @@ screen_trial <- function(st, tr, nl_now) {
   new <- r$fit
   if (is.null(new)) return(list(st = st, cand = NULL))
   c1 <- crit_s(new)
+  # (a set's line whose amplitude the raw data pin may also raise chi2:
+  # the terms fitted before it took its power on the curve; the criterion
+  # bounds what that costs)
+  amp_pinned <- set_line && pins_amp(tr)
   pays <- is.finite(c1) && c1 < c0 - need &&
-    new$chi2 < (if (set_line) 1 else 0.9) * cur$chi2
+    (new$chi2 < (if (set_line) 1 else 0.9) * cur$chi2 || amp_pinned)
+  # Held where the terms before it took its power, such a line is refitted
+  # once with the others free (its pinned values kept) before it is
+  # refused (a square wave's 5th harmonic beside an axis's resonance and
+  # filter)
+  if (!pays && amp_pinned && length(hold_now)) {
+    args <- refit_args(cur, new$terms, settings,
+                       start = stats::coef(new)[new$layout$role == "nonlinear"],
+                       hold = pin)
+    r <- state_refit(st, args, "free refit of a pinned line", tr$effect)
+    st <- r$st
+    if (!is.null(r$fit) && is.finite(crit(r$fit)) && crit(r$fit) < c0 - need) {
+      new <- r$fit
+      c1 <- crit(new)
+      pays <- TRUE
+    }
+  }
   if (!pays) {
     # raw-data values that do not pay alone may pay beside a family form
     # the raw data refused alone (family_pairs())
@@ -118,7 +138,12 @@ screen_trial <- function(st, tr, nl_now) {
     st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, jd$why)
     # raw-data values the raw data then contradict: family_pairs() may try
     # them beside another form of the model's family
-    if (length(pin) && isFALSE(jd$ev$support)) st$refused <- add_refused(st$refused, tr)
+    # them beside another form of the model's family, as it may values
+    # that move an earlier effect (a square wave's harmonic pinned at its
+    # line beside a first-order low-pass that had taken its power)
+    if (length(pin) && (isFALSE(jd$ev$support) || isTRUE(jd$moved))) {
+      st$refused <- add_refused(st$refused, tr)
+    }
     # a form of a family the model lacks, fitted alone to what another
     # effect also shapes: family_pairs() may add it beside that effect
     kind <- split_term(tr$effect)$kind

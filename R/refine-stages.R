@@ -112,6 +112,13 @@ continues_set <- function(trial) {
   !is.null(trial) && !is.null(trial$after) && length(unlist(trial$after)) > 0L
 }
 
+# Does a trial pin an amplitude of its effect (the raw data measure it)?
+pins_amp <- function(trial) {
+  tk <- split_term(trial$effect)
+  p <- effect_entry(tk$kind, tk$variant)$params
+  any(names(trial$pin[[1L]]) %in% p$name[p$role == "amp"])
+}
+
 # The loop may have ended on a step that chose a family again. A loop that
 # ended because nothing paid has just chosen them on this same model
 # (step_settle()): that is not done twice.

@@ -122,6 +122,75 @@ test_that("a sinusoid sized for a strong line is not backed by a weak line besid
   expect_true(ev(list(amp = 0.06, f0 = 1.59), raw, x, freq)$support)
 })
 
+test_that("a further line of a sharp harmonic set is proposed at its measured amplitude", {
+  # own generator: white noise, a square wave at 0.8 Hz (amplitude 0.25:
+  # lines 4 a / (pi k) at the odd k, one frequency each) and a 0.5 Hz line
+  # with its 3rd harmonic whose frequency wanders (a random walk of sd
+  # 0.004 Hz over the record, as the measured accelerometers' own lines do)
+  set.seed(2716)
+  freq <- 100
+  n <- 4e5
+  t <- seq_len(n) / freq
+  ph <- 2 * pi * cumsum(0.5 + 0.004 * cumsum(rnorm(n)) / sqrt(n)) / freq
+  x <- rnorm(n) + 0.25 * sign(sin(2 * pi * 0.8 * t + 1)) + 0.4 * sin(ph) + 0.2 * sin(3 * ph + 1)
+  # the least-squares sinusoid over the whole record holds all of a sharp
+  # line's amplitude (the generator's), a fraction of a wandering one's
+  fits <- allanvar:::record_line_fits(x, freq, c(0.8, 1.5))
+  expect_equal(fits$amp[1], 4 * 0.25 / pi, tolerance = 0.02)
+  expect_lt(fits$amp[2], 0.6 * 0.2)
+  # the series less those sinusoids is remove_lines()'
+  expect_identical(allanvar:::subtract_line_fits(x, freq, fits),
+                   allanvar:::remove_lines(x, freq, c(0.8, 1.5)))
+  raw <- allanvar:::refine_diagnostics(x, freq)
+  l <- allanvar:::diag_part(raw, "lines")
+  at <- function(f) which.min(abs(l$f0 - f))
+  expect_gt(l$record_amp[at(2.4)] / l$amp[at(2.4)], 0.9)
+  expect_lt(l$record_amp[at(1.5)] / l$amp[at(1.5)], 0.6)
+  props <- allanvar:::effect_entry("sinusoid")$propose(raw, 2^(0:12) / freq, NULL)
+  pinned <- function(f) {
+    p <- props[[which.min(vapply(props, function(q) abs(q$init$f0 - f), 0))]]
+    p$pin
+  }
+  # the square wave's 3rd and 5th harmonics: f0 and amp (the generator's)
+  for (k in c(3, 5)) {
+    pk <- pinned(0.8 * k)
+    expect_equal(pk$f0, 0.8 * k, tolerance = 1e-3)
+    expect_equal(pk$amp, 4 * 0.25 / (pi * k), tolerance = 0.1)
+  }
+  # a set's strongest line, and a wandering line's harmonic: f0 only
+  expect_named(pinned(0.8), "f0")
+  expect_named(pinned(1.5), "f0")
+})
+
+test_that("a square wave's harmonics beside a resonance keep their own amplitudes", {
+  skip_on_cran()
+  # own generator: white noise through a two-tap average, a resonance at
+  # 9.8 Hz (an AR(2), 0.45e-3 rms), a slow random walk and a square wave
+  # of amplitude 1.5e-3 at 0.7 Hz (lines 4 a / (pi k) at the odd k). Each
+  # further harmonic free on the curve took the power of the harmonics not
+  # yet in the model: the 5th at 1.29 x its line, the 7th at 0.60 x.
+  set.seed(2)
+  freq <- 100
+  n <- 5e5
+  t <- seq_len(n) / freq
+  r <- exp(-1 / (freq * 0.42))
+  w <- 2 * pi * 9.8 / freq
+  res <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w), -r^2), method = "recursive"))
+  res <- 4.5e-4 * res / sd(res)
+  wn <- as.numeric(stats::filter(rnorm(n, sd = 4.8e-3), c(0.6, 0.4), sides = 1))
+  wn[1] <- 0
+  x <- wn + res + cumsum(rnorm(n, sd = 4e-5 / sqrt(freq))) +
+    1.5e-3 * sign(sin(2 * pi * 0.7 * t + runif(1, 0, 2 * pi)))
+  rl <- loop(x, freq)
+  f0 <- fitted_f0(rl)
+  k <- round(f0 / 0.7)
+  expect_true(all(abs(f0 / (0.7 * k) - 1) < 0.01 & k %% 2 == 1))
+  expect_true(all(c(1, 3, 5, 7) %in% k))
+  amp <- coef(rl)[sub("f0$", "amp", names(f0))]
+  expect_true(all(abs(amp / (4 * 1.5e-3 / (pi * k)) - 1) < 0.15))
+  expect_true(any(grepl("^(resonance|band)", rl$terms)))
+})
+
 test_that("a sinusoid's f0 must lie within its periodogram line's own precision", {
   # own generator: white noise, a strong line at 0.61 Hz (2000 x its
   # background) and a weak one at 2.3 Hz. The curve took 0.6123 Hz for
