@@ -55,7 +55,13 @@
 #' * A further line of a harmonic set whose stronger lines the model holds
 #'   adds no new source: confirmed by the raw data, it is kept unless it
 #'   costs the criterion more than `min_gain` (the worth of that support);
-#'   otherwise the criterion must prefer it.
+#'   otherwise the criterion must prefer it. Where the line holds one
+#'   frequency over the whole record (its least-squares sinusoid carries at
+#'   least 0.8 of the periodogram line's amplitude, as a square wave's
+#'   harmonics do and an axis's wandering lines do not), its amplitude is
+#'   held at the periodogram's too: on the curve a further harmonic takes
+#'   the power of the set's lines not yet in the model, and of a resonance
+#'   beside them.
 #' * What no catalogue effect explains is reported in `$unexplained`, not
 #'   papered over; a reading whose tau range meets such a run is not
 #'   "measured" (a bound or not determined, its `why` naming the run).
