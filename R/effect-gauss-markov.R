@@ -68,9 +68,25 @@ evidence_gm <- function(par, raw, x, freq) {
     r1 <- diag_value(raw, "acf1")
     z1 <- diag_value(raw, "acf1_z")
     ok <- is.finite(pred) && z1 > 3 && r1 > pred / 3 && r1 < 3 * pred
-    return(list(text = sprintf(
-      "raw lag-1 ACF %.3f (z = %.0f) against %.3f predicted by the fitted GM",
-      r1, z1, pred), support = ok))
+    text <- sprintf("raw lag-1 ACF %.3f (z = %.0f) against %.3f predicted by the fitted GM",
+                    r1, z1, pred)
+    # At lag 2 a GM keeps phi of its lag-1 correlation; a sensor's filter
+    # of a sample or two has none left (a GM of Tc 2.0 samples took a
+    # two-tap average's lag-1 ACF, and the filter and the resonance beside
+    # it could not enter): the short-lag ACF beyond the slow processes,
+    # lines and bands (the filter's diagnostics) must not fall below a
+    # third of the GM's lag-2 value
+    fe <- diag_part(raw, "filter")
+    if (ok && !is.null(fe) && nrow(fe$acf) >= 2L) {
+      e2 <- fe$acf$excess[2L]
+      pred2 <- pred * phi
+      if (is.finite(e2) && e2 < pred2 / 3 && pred2 - e2 > 5 * fe$acf$se[2L]) {
+        ok <- FALSE
+        text <- sprintf("%s; at lag 2 %.3f against its %.3f: a filter's short correlation",
+                        text, e2, pred2)
+      }
+    }
+    return(list(text = text, support = ok))
   }
   if (!is.finite(tc) || tc * freq * 40 / 8 > length(x)) {
     return(list(text = "record too short for an ACF check", support = NA))

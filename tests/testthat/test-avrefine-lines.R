@@ -182,27 +182,33 @@ test_that("a square wave's harmonics beside a resonance keep their own amplitude
   # 9.8 Hz (an AR(2), 0.45e-3 rms), a slow random walk and a square wave
   # of amplitude 1.5e-3 at 0.7 Hz (lines 4 a / (pi k) at the odd k). Each
   # further harmonic free on the curve took the power of the harmonics not
-  # yet in the model: the 5th at 1.29 x its line, the 7th at 0.60 x.
-  set.seed(2)
+  # yet in the model (seed 2: the 5th at 1.29 x its line, the 7th at 0.60
+  # x). On seed 1 a GM of Tc 2.0 samples took the average's lag-1 ACF at
+  # the first step, and neither the filter nor the resonance could follow.
   freq <- 100
   n <- 5e5
   t <- seq_len(n) / freq
-  r <- exp(-1 / (freq * 0.42))
-  w <- 2 * pi * 9.8 / freq
-  res <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w), -r^2), method = "recursive"))
-  res <- 4.5e-4 * res / sd(res)
-  wn <- as.numeric(stats::filter(rnorm(n, sd = 4.8e-3), c(0.6, 0.4), sides = 1))
-  wn[1] <- 0
-  x <- wn + res + cumsum(rnorm(n, sd = 4e-5 / sqrt(freq))) +
-    1.5e-3 * sign(sin(2 * pi * 0.7 * t + runif(1, 0, 2 * pi)))
-  rl <- loop(x, freq)
-  f0 <- fitted_f0(rl)
-  k <- round(f0 / 0.7)
-  expect_true(all(abs(f0 / (0.7 * k) - 1) < 0.01 & k %% 2 == 1))
-  expect_true(all(c(1, 3, 5, 7) %in% k))
-  amp <- coef(rl)[sub("f0$", "amp", names(f0))]
-  expect_true(all(abs(amp / (4 * 1.5e-3 / (pi * k)) - 1) < 0.15))
-  expect_true(any(grepl("^(resonance|band)", rl$terms)))
+  for (seed in 1:2) {
+    set.seed(seed)
+    r <- exp(-1 / (freq * 0.42))
+    w <- 2 * pi * 9.8 / freq
+    res <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(w), -r^2), method = "recursive"))
+    res <- 4.5e-4 * res / sd(res)
+    wn <- as.numeric(stats::filter(rnorm(n, sd = 4.8e-3), c(0.6, 0.4), sides = 1))
+    wn[1] <- 0
+    x <- wn + res + cumsum(rnorm(n, sd = 4e-5 / sqrt(freq))) +
+      1.5e-3 * sign(sin(2 * pi * 0.7 * t + runif(1, 0, 2 * pi)))
+    rl <- loop(x, freq)
+    f0 <- fitted_f0(rl)
+    k <- round(f0 / 0.7)
+    expect_true(all(abs(f0 / (0.7 * k) - 1) < 0.01 & k %% 2 == 1))
+    expect_true(all(c(1, 3, 5, 7) %in% k))
+    amp <- coef(rl)[sub("f0$", "amp", names(f0))]
+    expect_true(all(abs(amp / (4 * 1.5e-3 / (pi * k)) - 1) < 0.15))
+    expect_true(any(grepl("^(resonance|band)", rl$terms)))
+    expect_true(any(grepl("^filter", rl$terms)))
+    expect_false("gm" %in% rl$terms)
+  }
 })
 
 test_that("a sinusoid's f0 must lie within its periodogram line's own precision", {

@@ -156,6 +156,32 @@ test_that("a random walk's own drift is no ramp: the trend's likelihood beside t
   expect_match(ev$text, "likelihood z")
 })
 
+test_that("a GM of a few samples must keep its correlation at lag 2, as a filter does not", {
+  # own generators: white noise through a two-tap average (0.6, 0.4): lag-1
+  # ACF 0.46, none at lag 2; and white noise beside a GM of Tc 3 samples
+  set.seed(2718)
+  n <- 4e5
+  freq <- 100
+  e <- rnorm(n)
+  ma <- 0.6 * e + 0.4 * c(0, e[-n])
+  phi <- exp(-1 / 3)
+  gm <- as.numeric(stats::filter(rnorm(n, sd = sqrt(1 - phi^2)), phi, method = "recursive"))
+  ar <- rnorm(n) + gm
+  ev <- function(x, tc) {
+    raw <- allanvar:::refine_diagnostics(x, freq)
+    # the GM sized for the raw lag-1 ACF: sigma^2 phi / var = r1
+    ph <- exp(-1 / (tc * freq))
+    sigma <- sqrt(allanvar:::diag_value(raw, "acf1") * stats::var(x) / ph)
+    raw_evidence("gm", list(sigma = sigma, tc = tc), raw, x, freq)
+  }
+  two <- ev(ma, 2.05 / freq)
+  expect_false(two$support)
+  expect_match(two$text, "at lag 2 -?0[.]0[0-9]* against its 0[.]2[0-9]*: a filter's short correlation")
+  expect_true(ev(ar, 3 / freq)$support)
+  # without the filter's diagnostics (a bare avdiagnose()) the lag-1 check alone
+  expect_true(raw_evidence("gm", list(sigma = 0.8, tc = 2.05 / freq), avdiagnose(ma, freq), ma, freq)$support)
+})
+
 test_that("avdiagnose validates its arguments and prints", {
   expect_error(avdiagnose(), "`x` is missing",
     class = "allanvar_error_missing_argument")
