@@ -39,6 +39,8 @@
 #'   the band the curve can see, \eqn{1/\tau_{max}} to
 #'   \eqn{1/(2\tau_{min})}, or above Nyquist). Both are listed in
 #'   `$refine$rejected`.
+#'   A Gauss-Markov process of a few samples must also keep its
+#'   correlation at lag 2, as a filter of a sample or two does not.
 #' * An effect whose raw-data check neither confirms nor contradicts it (a
 #'   Gauss-Markov whose fitted \eqn{T_c} is 2-3 times the one the ACF of
 #'   block means reads) must lower the criterion by `2 * min_gain` on the
