@@ -11,11 +11,6 @@ sin_peak_adev <- 0.7246       # ... where ADEV = 0.7246 A
 # accelerometers' own 1.6-1.7 Hz lines are fitted at 2.0-2.5x the amp read
 # there, the curve's misplaced sinusoids at 5-9x.
 sin_amp_factor <- 3
-# A line is sharp (one frequency over the whole record) when its
-# least-squares sinusoid holds at least this share of the Welch line's
-# amplitude: 0.99-1.06 for a square wave's harmonics, 0.1-0.65 for the
-# ADIS16405 accelerometers' own lines, whose frequency wanders.
-sin_sharp_share <- 0.8
 # A line's frequency is read to this many Welch bins over the square root
 # of its peak's ratio to the background (at most 1.5 bins): 0.11 bins for
 # a line 2192 x its background, the full 1.5 for one 11 x.
@@ -52,9 +47,9 @@ sin_line_of <- function(par, raw) {
        away = off > prec)
 }
 
-# Is line j of `lines` (the loop's lines part) sharp?
+# Is line j of `lines` (the loop's lines part) sharp (line_sharp_share)?
 sharp_line <- function(lines, j) {
-  isTRUE(lines$record_amp[j] >= sin_sharp_share * lines$amp[j])
+  isTRUE(lines$record_amp[j] >= line_sharp_share * lines$amp[j])
 }
 
 # Raw-data evidence: a periodogram line near f0.

@@ -15,7 +15,11 @@
 #' Allan variance so that red noise is not read as steps) and transients
 #' (two steps of opposite sign and similar size less than 120 s apart).
 #' Each detector sees the series with the instances found before it taken
-#' out (a spike does not disturb the step search). Thresholds are
+#' out (a spike does not disturb the step search), and with its sharp
+#' spectral lines taken out (a line that holds one frequency over the whole
+#' record: its least-squares sinusoid, which carries at least 0.8 of the
+#' line's periodogram amplitude; a periodic disturbance is no step, and
+#' what it leaves in window means hid a step of z 6.6). Thresholds are
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
 #' steps) standard deviations. A spike is an additive outlier of the
 #' series' own AR model (its filter, lines and colour), so that a line or a
@@ -127,12 +131,12 @@ series_columns <- c("kind", "index", "time", "size", "tc", "duration", "z",
                     "removed", "evidence")
 
 # Every kind's instances, in catalogue order, each detector seeing the
-# series with the instances found before it removed.
+# series with its sharp lines and the instances found before it removed.
 detect_series <- function(x, freq, kinds) {
   # detectors that read the same thing of the same series compute it once
   series_pass_open()
   on.exit(series_pass_close(), add = TRUE)
-  work <- x
+  work <- without_sharp_lines(x, freq)
   parts <- list()
   for (k in intersect(effect_kinds("series"), kinds)) {
     e <- effect_entry(k)

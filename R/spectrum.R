@@ -409,6 +409,27 @@ record_line_fits <- function(x, freq, f0) {
   do.call(rbind, rows)
 }
 
+# A line is sharp (one frequency over the whole record) when its
+# least-squares sinusoid over the record holds at least this share of the
+# Welch line's amplitude: 0.99-1.06 for a square wave's harmonics,
+# 0.1-0.65 for the ADIS16405 accelerometers' own lines, whose frequency
+# wanders.
+line_sharp_share <- 0.8
+
+# The series less its sharp lines, for the detectors of steps, transients,
+# spikes and warm-up: a periodic component is none of those, and what it
+# leaves in window means is noise to them (a 0.48 Hz line moved a step's
+# read size by 26% and its time by 1 s). A wandering line is left in: a
+# single sinusoid takes out a part of it only.
+without_sharp_lines <- function(x, freq) {
+  lines <- spectral_lines(x, freq)
+  if (!nrow(lines)) return(x)
+  fits <- record_line_fits(x, freq, lines$f0)
+  sharp <- fits$amp >= line_sharp_share * lines$amp
+  if (!any(sharp)) return(x)
+  subtract_line_fits(x, freq, fits[sharp, , drop = FALSE])
+}
+
 # `x` less the sinusoids of record_line_fits() (its mean kept).
 subtract_line_fits <- function(x, freq, fits) {
   if (!nrow(fits)) return(x)

@@ -270,12 +270,14 @@ test_that("a harmonic set's further lines do not spend the step budget", {
   expect_true(all(abs(f0 / 0.8 - round(f0 / 0.8)) < 0.01))
 })
 
-test_that("a line beside a measured axis's own: the greedy order is revisited with the line first", {
+test_that("a line beside a measured axis's own is named, not taken as a GM of a few samples", {
   # unit 2 accel_y carries the sensor's filter, a 0.57 Hz line, a band near
   # 10 Hz and a slow GM; a 1.7 Hz line (0.3 x the white sd a sample) added
-  # to it is first taken as a GM of tc 0.025 s, which then stays. The
-  # revisit takes the periodogram's lines first: the line is named, N
-  # stays where the run without it puts it, and the model fits.
+  # to it was first taken as a GM of tc 0.025 s, which then stayed until a
+  # revisit took the periodogram's lines first. Such a GM keeps no
+  # correlation at lag 2 in the raw data (a filter's), so it is refused:
+  # the line is named, N stays where the run without it puts it, and the
+  # model fits without a revisit.
   skip_if_no_shared()
   skip_on_cran()
   ax <- measured_axis(2, "accel_y")
@@ -287,13 +289,43 @@ test_that("a line beside a measured axis's own: the greedy order is revisited wi
   expect_true(any(abs(f0 / 1.7 - 1) <= 0.03))
   expect_false(any(r$steps$confirmed %in% FALSE))
   expect_lt(r$chi2, 4)
-  rv <- r$refine$revisit
+  expect_false("gm" %in% r$terms[seq_len(2)])
+  rj <- r$refine$rejected
+  expect_true(any(rj$effect == "gm" & grepl("a filter's short correlation", rj$reason)))
+  r0 <- loop(b, freq)
+  expect_equal(n_reading(r), n_reading(r0), tolerance = 0.05)
+})
+
+test_that("a greedy order far from the curve is revisited with the raw data's values first", {
+  skip_on_cran()
+  # own generator: white noise through a first-order low-pass (AR(1) 0.3),
+  # a band at 15.5 Hz (an AR(2)), a 0.48 Hz line, a random walk and a 0.9
+  # Hz square wave. The greedy order takes a GM first and ends at chi2/dof
+  # 6.7; taking the periodogram's lines and the band's spectrum first, the
+  # run fits, and is the one kept.
+  set.seed(1)
+  freq <- 100
+  n <- 5e5
+  t <- seq_len(n) / freq
+  w <- as.numeric(stats::filter(rnorm(n, sd = 0.009), 0.3, method = "recursive"))
+  r <- exp(-1 / (freq * 0.35))
+  om <- 2 * pi * 15.5 / freq
+  band <- as.numeric(stats::filter(rnorm(n), c(2 * r * cos(om), -r^2), method = "recursive"))
+  band <- 0.008 * band / sd(band)
+  b <- w + band + 0.009 * sin(2 * pi * 0.48 * t + runif(1, 0, 2 * pi)) +
+    cumsum(rnorm(n, sd = 1.2e-4 / sqrt(freq)))
+  x <- b + 0.004 * sign(sin(2 * pi * 0.9 * t + runif(1, 0, 2 * pi)))
+  rl <- loop(x, freq)
+  rv <- rl$refine$revisit
   expect_s3_class(rv, "data.frame")
+  expect_identical(rv$order, c("greedy", "raw-data values first"))
   expect_identical(rv$kept, c(FALSE, TRUE))
   expect_gt(rv$chi2[1], 4)
-  r0 <- loop(b, freq)
-  expect_null(r0$refine$revisit)
-  expect_equal(n_reading(r), n_reading(r0), tolerance = 0.05)
+  expect_lt(rl$chi2, 4)
+  f0 <- fitted_f0(rl)
+  for (f in c(0.48, 0.9, 2.7, 4.5)) expect_true(any(abs(f0 / f - 1) < 0.01))
+  expect_true(any(grepl("^(resonance|band)", rl$terms)))
+  expect_false("gm" %in% rl$terms)
 })
 
 test_that("late_pins(): steps that pinned raw-data values behind one that pinned nothing, still held", {
@@ -592,7 +624,7 @@ test_that("an instance the final model holds at amplitude 0 leaves it, and the s
   # Hz harmonics at amplitude 0, and held at their periodogram lines they
   # cost the criterion 34
   ax <- measured_axis(3, "accel_z")
-  r <- with_package_constant("sin_sharp_share", Inf,
+  r <- with_package_constant("line_sharp_share", Inf,
                              loop(with_wave(ax, 0.4, 0.7, 1, function(p) sign(sin(p))), ax$freq))
   lay <- r$layout
   added <- unique(r$steps$label)

@@ -31,6 +31,29 @@ test_that("a bias step: time within 1% of the record, size within 20%; removed o
   }
 })
 
+test_that("a sharp line does not move what the series pass finds", {
+  # own generator: white noise, a random walk and a step of 8 x ADEV(10 s)
+  # at 1500 s (z 6.6); then a 0.3 Hz line of twice the white sd added. The
+  # line's leakage into the window means hid the step from the detector.
+  set.seed(2719)
+  freq <- 100
+  n <- 4e5
+  b <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+  sz <- 8 * allan(b, freq, taus = I(10))$adev
+  b <- b + sz * ((seq_len(n) - 1) / freq >= 1500)
+  x <- b + 0.02 * sin(2 * pi * 0.3 * seq_len(n) / freq + 1)
+  s0 <- detect_series_effects(b, freq)$table
+  s1 <- detect_series_effects(x, freq)$table
+  expect_identical(s0$kind, "steps")
+  expect_equal(s0$time, 1500, tolerance = 1e-3)
+  expect_identical(s1$kind, s0$kind)
+  expect_identical(s1$index, s0$index)
+  expect_equal(s1$size, s0$size, tolerance = 1e-3)
+  # removed on request from the series as given (the line stays in it)
+  y <- detect_series_effects(x, freq, remove = "steps")$x
+  expect_equal(y - x, -s1$size * ((seq_len(n) - 1) / freq >= s1$time), tolerance = 1e-6)
+})
+
 test_that("an exponential warm-up: time constant within 30%", {
   n <- 2e5
   freq <- 100
