@@ -137,7 +137,6 @@ screen_trial <- function(st, tr, nl_now) {
   if (!is.null(jd$why)) {
     st$rejected <- add_rejected(st$rejected, st$step, tr$effect, jd$par, jd$why)
     # raw-data values the raw data then contradict: family_pairs() may try
-    # them beside another form of the model's family
     # them beside another form of the model's family, as it may values
     # that move an earlier effect (a square wave's harmonic pinned at its
     # line beside a first-order low-pass that had taken its power)
