@@ -70,6 +70,10 @@
 #   describe(values)  datasheet text for the instances of this kind added by
 #                 the loop (values: data frame, one row per instance)
 #   detect(x, freq), remove(x, freq, par)  for "series" components
+#   detect_again  TRUE: a "series" entry whose detector, run before the
+#                 later kinds are out, takes their edges for its own (an
+#                 outlier detector, a step's first sample): it reads the
+#                 series again with the other kinds' instances removed
 #   replaces    kinds this entry takes the place of when the loop adds it
 #                 (the filter replaces N: its DC level is the white level)
 #   replaces_instance  NULL (every instance of those kinds goes), or
@@ -190,7 +194,8 @@ new_effect <- function(name, title, params, component = "av",
                        remove = NULL, replaces = character(),
                        replaces_instance = NULL, admissible = NULL, proposed_only = FALSE,
                        statespace = NULL, diagnose = NULL, family = NULL,
-                       exact_edf = NULL, noise_lookalike = FALSE) {
+                       exact_edf = NULL, noise_lookalike = FALSE,
+                       detect_again = FALSE) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -205,7 +210,7 @@ new_effect <- function(name, title, params, component = "av",
        admissible = admissible,
        proposed_only = proposed_only, statespace = statespace,
        diagnose = diagnose, family = family, exact_edf = exact_edf,
-       noise_lookalike = noise_lookalike)
+       noise_lookalike = noise_lookalike, detect_again = detect_again)
 }
 
 validate_effect <- function(e) {

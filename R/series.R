@@ -19,7 +19,9 @@
 #' spectral lines taken out (a line that holds one frequency over the whole
 #' record: its least-squares sinusoid, which carries at least 0.8 of the
 #' line's periodogram amplitude; a periodic disturbance is no step, and
-#' what it leaves in window means hid a step of z 6.6). Thresholds are
+#' what it leaves in window means hid a step of z 6.6). Spikes are read
+#' again once the other kinds found are out: a step's first sample is an
+#' outlier of the AR model until the step is removed. Thresholds are
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
 #' steps) standard deviations. A spike is an additive outlier of the
 #' series' own AR model (its filter, lines and colour), so that a line or a
@@ -136,16 +138,30 @@ detect_series <- function(x, freq, kinds) {
   # detectors that read the same thing of the same series compute it once
   series_pass_open()
   on.exit(series_pass_close(), add = TRUE)
-  work <- without_sharp_lines(x, freq)
+  base <- without_sharp_lines(x, freq)
+  work <- base
   parts <- list()
+  as_part <- function(d, k) {
+    d$kind <- rep(k, nrow(d))
+    for (cl in setdiff(series_columns, names(d))) d[[cl]] <- NA
+    d[series_columns]
+  }
   for (k in intersect(effect_kinds("series"), kinds)) {
     e <- effect_entry(k)
     d <- e$detect(work, freq)
     if (!NROW(d)) next
     work <- e$remove(work, freq, d)
-    d$kind <- rep(k, nrow(d))
-    for (cl in setdiff(series_columns, names(d))) d[[cl]] <- NA
-    parts[[k]] <- d[series_columns]
+    parts[[k]] <- as_part(d, k)
+  }
+  # an entry that takes the later kinds' edges for its own reads the
+  # series again with the other kinds' instances out (catalogue field
+  # detect_again)
+  for (k in names(parts)) {
+    e <- effect_entry(k)
+    others <- parts[names(parts) != k]
+    if (!isTRUE(e$detect_again) || !length(others)) next
+    d <- e$detect(remove_series(base, freq, do.call(rbind, others)), freq)
+    parts[[k]] <- if (NROW(d)) as_part(d, k)
   }
   out <- if (length(parts)) do.call(rbind, parts) else
     data.frame(kind = character(), index = integer(), time = numeric(),

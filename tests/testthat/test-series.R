@@ -54,6 +54,29 @@ test_that("a sharp line does not move what the series pass finds", {
   expect_equal(y - x, -s1$size * ((seq_len(n) - 1) / freq >= s1$time), tolerance = 1e-6)
 })
 
+test_that("a step's edge is no spike; a spike beside a step still is", {
+  # own generator: white noise (sd 0.001) and a step of 10 sd at 100 s. Read
+  # before the step was out, its first sample was an outlier of the AR
+  # model: a "spike" there in 5 of 12 seeds.
+  freq <- 100
+  t <- seq_len(20000) / freq
+  n_spikes <- vapply(1:12, function(s) {
+    set.seed(s)
+    x <- 0.001 * rnorm(20000) + 0.01 * (t > 100)
+    tb <- detect_series_effects(x, freq)$table
+    expect_identical(sum(tb$kind == "steps"), 1L)
+    sum(tb$kind == "spikes")
+  }, 0)
+  expect_identical(sum(n_spikes), 0)
+  set.seed(3)
+  x <- 0.001 * rnorm(20000) + 0.01 * (t > 100)
+  x[5000] <- x[5000] + 0.02
+  tb <- detect_series_effects(x, freq)$table
+  expect_identical(tb$kind, c("spikes", "steps"))
+  expect_identical(tb$index[1], 5000L)
+  expect_equal(tb$size[1], 0.02, tolerance = 0.1)
+})
+
 test_that("an exponential warm-up: time constant within 30%", {
   n <- 2e5
   freq <- 100
