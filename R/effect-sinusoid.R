@@ -47,11 +47,6 @@ sin_line_of <- function(par, raw) {
        away = off > prec)
 }
 
-# Is line j of `lines` (the loop's lines part) sharp (line_sharp_share)?
-sharp_line <- function(lines, j) {
-  isTRUE(lines$record_amp[j] >= line_sharp_share * lines$amp[j])
-}
-
 # Raw-data evidence: a periodogram line near f0.
 evidence_sinusoid <- function(par, raw, x, freq) {
   m <- sin_line_of(par, raw)
@@ -164,6 +159,8 @@ effect_sinusoid <- function() {
       # only lines the curve can see; harmonics of one source say so
       lines <- visible_lines(harmonic_sets(lines), min(tau), max(tau),
                              diag_value(raw, "freq"))
+      sharp <- if (is.null(lines$record_amp)) logical(nrow(lines))
+        else is_sharp(lines$record_amp, lines$amp)
       for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
         if (!lines$visible[j]) next
@@ -186,9 +183,8 @@ effect_sinusoid <- function() {
           # there cannot take the power of the set's lines not yet in the
           # model (a square wave's 9th and 11th harmonics, free, took 2.8
           # x their lines, and the axis's resonance beside them was lost)
-          pin = if (any(stronger) && sharp_line(lines, j)) {
-            list(f0 = f0, amp = lines$amp[j])
-          } else list(f0 = f0),
+          pin = if (any(stronger) && sharp[j]) list(f0 = f0, amp = lines$amp[j])
+            else list(f0 = f0),
           note = sprintf("proposed by a periodogram line at %s Hz%s",
                          format_num(f0, 4), src))
       }

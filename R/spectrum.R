@@ -415,6 +415,11 @@ record_line_fits <- function(x, freq, f0) {
 # 0.1-0.65 for the ADIS16405 accelerometers' own lines, whose frequency
 # wanders.
 line_sharp_share <- 0.8
+# Which lines are sharp, from their record and Welch amplitudes (FALSE
+# where the record's is unknown).
+is_sharp <- function(record_amp, amp) {
+  !is.na(record_amp) & record_amp >= line_sharp_share * amp
+}
 
 # The series less its sharp lines, for the detectors of steps, transients,
 # spikes and warm-up: a periodic component is none of those, and what it
@@ -425,7 +430,7 @@ without_sharp_lines <- function(x, freq) {
   lines <- spectral_lines(x, freq)
   if (!nrow(lines)) return(x)
   fits <- record_line_fits(x, freq, lines$f0)
-  sharp <- fits$amp >= line_sharp_share * lines$amp
+  sharp <- is_sharp(fits$amp, lines$amp)
   if (!any(sharp)) return(x)
   subtract_line_fits(x, freq, fits[sharp, , drop = FALSE])
 }
