@@ -52,10 +52,8 @@ screen_trial <- function(st, tr, nl_now) {
   # refused (a square wave's 5th harmonic beside an axis's resonance and
   # filter)
   if (!pays && amp_pinned && length(hold_now)) {
-    args <- refit_args(cur, new$terms, settings,
-                       start = stats::coef(new)[new$layout$role == "nonlinear"],
-                       hold = pin)
-    r <- state_refit(st, args, "free refit of a pinned line", tr$effect)
+    r <- refit_from(st, cur, new, settings, pin, "free refit of a pinned line",
+                    tr$effect)
     st <- r$st
     if (!is.null(r$fit) && is.finite(crit(r$fit)) && crit(r$fit) < c0 - need) {
       new <- r$fit
@@ -79,10 +77,8 @@ screen_trial <- function(st, tr, nl_now) {
   # everything free before it is rejected: held at the one-term
   # compromise, a second GM lands at the wrong Tc.
   if (!is.null(jd$why) && length(hold_now)) {
-    args <- refit_args(cur, new$terms, settings,
-                       start = stats::coef(new)[new$layout$role == "nonlinear"],
-                       hold = pin)
-    r <- state_refit(st, args, "free refit of a rejected screen", tr$effect)
+    r <- refit_from(st, cur, new, settings, pin, "free refit of a rejected screen",
+                    tr$effect)
     st <- r$st
     free <- r$fit
     if (!is.null(free) && is.finite(crit(free)) && crit(free) < c0 - min_gain &&
@@ -116,10 +112,8 @@ screen_trial <- function(st, tr, nl_now) {
       any(startsWith(nm, paste0(broken, "."))) || nm %in% broken
     }, NA)]
     if (length(keep)) {
-      args <- refit_args(cur, new$terms, settings,
-                         start = stats::coef(new)[new$layout$role == "nonlinear"],
-                         hold = c(keep, pin))
-      r <- state_refit(st, args, "refit with earlier effects held", tr$effect)
+      r <- refit_from(st, cur, new, settings, c(keep, pin),
+                      "refit with earlier effects held", tr$effect)
       st <- r$st
       held <- r$fit
       c_held <- if (is.null(held)) Inf else refine_crit_held(st, held, length(keep))
@@ -205,6 +199,15 @@ screen_trial <- function(st, tr, nl_now) {
   list(st = st, cand = list(fit = new, crit = c1, adj = adj, trial = tr, label = lab,
                             params = jd$par, ev = jd$ev, pin = pin,
                             fixed = settings$fixed, also = jd$also))
+}
+
+# The trial's model `new` refitted from its own nonlinear values with
+# `hold` held (the current model's settings): list(st, fit).
+refit_from <- function(st, cur, new, settings, hold, what, effect) {
+  args <- refit_args(cur, new$terms, settings,
+                     start = stats::coef(new)[new$layout$role == "nonlinear"],
+                     hold = hold)
+  state_refit(st, args, what, effect)
 }
 
 # One instance over two processes: the raw data read the instance's value
