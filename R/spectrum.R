@@ -162,6 +162,19 @@ growing_medians <- function(e) {
 
 # ---- lines ------------------------------------------------------------------------
 
+# The series pass and the loop's raw-data diagnostics read the same record
+# one after the other: its lines and their least-squares sinusoids (0.2 s
+# of a 1e6-sample axis) are kept for the last record, under everything
+# they depend on.
+record_store <- new.env(parent = emptyenv())
+remember_record <- function(what, key, make) {
+  hit <- record_store[[what]]
+  if (!is.null(hit) && identical(hit$key, key)) return(hit$value)
+  value <- make()
+  record_store[[what]] <- list(key = key, value = value)
+  value
+}
+
 #' Spectral lines of a rate series (internal)
 #'
 #' A Welch periodogram (Hann, 50% overlap; `seg` samples per segment,
@@ -186,6 +199,11 @@ growing_medians <- function(e) {
 #' @noRd
 spectral_lines <- function(x, freq, alpha = 1e-3, seg = NULL, max_lines = 24L,
                            band_bins = 64L) {
+  remember_record("lines", list(x, freq, alpha, seg, max_lines, band_bins),
+                  function() find_lines(x, freq, alpha, seg, max_lines, band_bins))
+}
+
+find_lines <- function(x, freq, alpha, seg, max_lines, band_bins) {
   w <- welch_psd(x, freq, seg)
   p <- w$psd
   nb <- length(p)
@@ -379,6 +397,10 @@ remove_lines <- function(x, freq, f0) {
 # a line whose frequency wanders keeps a fraction of it (0.1-0.65 on the
 # ADIS16405 accelerometers' own lines).
 record_line_fits <- function(x, freq, f0) {
+  remember_record("fits", list(x, freq, f0), function() fit_lines(x, freq, f0))
+}
+
+fit_lines <- function(x, freq, f0) {
   fits <- data.frame(f0 = numeric(), f = numeric(), s = numeric(), c = numeric(),
                      amp = numeric())
   if (!length(f0)) return(fits)
