@@ -72,7 +72,8 @@
 #   detect(x, freq), remove(x, freq, par)  for "series" components
 #   detect_again  TRUE: a "series" entry whose detector, run before the
 #                 later kinds are out, takes their edges for its own (an
-#                 outlier detector, a step's first sample): it reads the
+#                 outlier detector, a step's first sample) or whose
+#                 shape they bend (a warm-up beside a step): it reads the
 #                 series again with the other kinds' instances removed
 #   replaces    kinds this entry takes the place of when the loop adds it
 #                 (the filter replaces N: its DC level is the white level)

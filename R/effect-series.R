@@ -153,6 +153,10 @@ effect_warmup <- function() {
       effect_param("size", "amp", "u", "rate unit (offset at the first sample)"),
       effect_param("tc", "nonlinear", "s", "second (time constant)")),
     repeatable = TRUE,
+    # a step near the start bends the exponential (its time constant read
+    # 163 s for 120 s beside a step at 40 s): read again with the steps,
+    # transients and spikes out
+    detect_again = TRUE,
     signature = paste("a decaying offset at the start, size exp(-t / tc);",
                       "raises the Allan variance around tau = tc"),
     sim = function(n, tau0, amp, nl) {

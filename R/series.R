@@ -19,9 +19,12 @@
 #' spectral lines taken out (a line that holds one frequency over the whole
 #' record: its least-squares sinusoid, which carries at least 0.8 of the
 #' line's periodogram amplitude; a periodic disturbance is no step, and
-#' what it leaves in window means hid a step of z 6.6). Spikes are read
-#' again once the other kinds found are out: a step's first sample is an
-#' outlier of the AR model until the step is removed. Thresholds are
+#' what it leaves in window means hid a step of z 6.6). Spikes and the
+#' warm-up are then read again with the other kinds found taken out (a
+#' step's first sample is an outlier of the AR model until the step is
+#' removed; a step at a warm-up's start bends the exponential), and
+#' where that changed what they found, the steps and transients are
+#' read again beside them (at most two such rounds). Thresholds are
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
 #' steps) standard deviations. A spike is an additive outlier of the
 #' series' own AR model (its filter, lines and colour), so that a line or a
@@ -134,34 +137,56 @@ series_columns <- c("kind", "index", "time", "size", "tc", "duration", "z",
 
 # Every kind's instances, in catalogue order, each detector seeing the
 # series with its sharp lines and the instances found before it removed.
+# The entries marked detect_again then read the series again with every
+# other kind's instances out (found or not the first time: a warm-up and a
+# step at its start hide each other), and when that changed what they
+# found, the kinds after them are read again beside it (at most twice).
 detect_series <- function(x, freq, kinds) {
   # detectors that read the same thing of the same series compute it once
   series_pass_open()
   on.exit(series_pass_close(), add = TRUE)
   base <- without_sharp_lines(x, freq)
-  work <- base
-  parts <- list()
   as_part <- function(d, k) {
-    d$kind <- rep(k, nrow(d))
-    for (cl in setdiff(series_columns, names(d))) d[[cl]] <- NA
+    if (is.null(d)) d <- data.frame()
+    d$kind <- rep(k, NROW(d))
+    for (cl in setdiff(series_columns, names(d))) d[[cl]] <- rep(NA, NROW(d))
     d[series_columns]
   }
-  for (k in intersect(effect_kinds("series"), kinds)) {
-    e <- effect_entry(k)
-    d <- e$detect(work, freq)
-    if (!NROW(d)) next
-    work <- e$remove(work, freq, d)
-    parts[[k]] <- as_part(d, k)
+  kinds <- intersect(effect_kinds("series"), kinds)
+  again <- kinds[vapply(kinds, function(k) isTRUE(effect_entry(k)$detect_again), TRUE)]
+  # the pass in catalogue order; the kinds in `held` keep their instances
+  # (an empty table: none)
+  pass <- function(held) {
+    work <- base
+    parts <- list()
+    for (k in kinds) {
+      e <- effect_entry(k)
+      d <- if (k %in% names(held)) held[[k]] else as_part(e$detect(work, freq), k)
+      if (!NROW(d)) next
+      work <- e$remove(work, freq, d)
+      parts[[k]] <- d
+    }
+    parts
   }
-  # an entry that takes the later kinds' edges for its own reads the
-  # series again with the other kinds' instances out (catalogue field
-  # detect_again)
-  for (k in names(parts)) {
-    e <- effect_entry(k)
-    others <- parts[names(parts) != k]
-    if (!isTRUE(e$detect_again) || !length(others)) next
-    d <- e$detect(remove_series(base, freq, do.call(rbind, others)), freq)
-    parts[[k]] <- if (NROW(d)) as_part(d, k)
+  parts <- pass(list())
+  held <- list()
+  read_beside <- list()          # what each kind was last read beside
+  for (round in 1:2) {
+    changed <- FALSE
+    for (k in again) {
+      others <- parts[names(parts) != k]
+      if (!length(others)) next
+      others <- do.call(rbind, unname(others))
+      if (identical(others, read_beside[[k]])) next
+      read_beside[[k]] <- others
+      d <- as_part(effect_entry(k)$detect(remove_series(base, freq, others), freq), k)
+      before <- parts[[k]]
+      if (NROW(d) || NROW(before)) changed <- changed || !identical(d, before)
+      held[[k]] <- d
+      parts[[k]] <- if (NROW(d)) d
+    }
+    if (!changed) break
+    parts <- pass(held)
   }
   out <- if (length(parts)) do.call(rbind, parts) else
     data.frame(kind = character(), index = integer(), time = numeric(),
