@@ -179,10 +179,7 @@
 #'   adds over the term's own AV, at `tau`, `how`: `"share"` when that
 #'   ratio is 1 or more, `"refit"` when the term no longer pays on the
 #'   curve with the effect's excess taken out (by `2 * min_gain` for a
-#'   term the raw data leave undecided); a term taken at an earlier step
-#'   is judged so again on the final model, and one that fails there
-#'   leaves it (listed here and in `rejected`, its step's `label`
-#'   "left:"); the readings of such a run
+#'   term the raw data leave undecided); the readings of such a run
 #'   carry that series effect's bias, see [series_reading_bias()]),
 #'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range),
 #'   `revisit` (NULL, or when the greedy order was revisited a data frame

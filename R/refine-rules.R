@@ -282,11 +282,10 @@ series_duplicate <- function(series, fit, label, share = 1) {
 # describes the series effect. Kinds a noise term's own
 # excursions can produce (the entry's `noise_lookalike`: transients) are
 # not taken out: a measured accelerometer's 20 s GM is also six transients
-# to the series pass. `without()`: the model without the term, and `gain`
-# when a function, asked only past the share check. Returns NULL or a one-row data
+# to the series pass. Returns NULL or a one-row data
 # frame like series_duplicate()'s (`ratio` the kinds' share at that tau).
 series_pays_without <- function(st, new, label, gain = st$args$min_gain,
-                                min_share = 0.1, without = function() st$current) {
+                                min_share = 0.1) {
   series <- st$series
   if (is.null(series) || !NROW(series$table) || !NROW(series$adev_kinds)) return(NULL)
   left <- unique(series$table$kind[!series$table$removed])
@@ -313,10 +312,7 @@ series_pays_without <- function(st, new, label, gain = st$args$min_gain,
     args$av <- cv
     try_refit(args, "refit without the series effects")$fit
   }
-  if (is.function(gain)) gain <- gain()
-  f_out <- without()
-  if (is.null(f_out)) return(NULL)
-  f_out <- refit_on(f_out)
+  f_out <- refit_on(st$current)
   f_in <- refit_on(new)
   if (is.null(f_out) || is.null(f_in)) return(NULL)
   if (refine_crit(st, f_in) < refine_crit(st, f_out) - gain) return(NULL)

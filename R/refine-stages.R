@@ -9,7 +9,6 @@ refine_stages <- function() {
        rechoose = stage_rechoose,    # families chosen again on the final model
        revisit = stage_revisit,      # raw-data values first, if the greedy order failed
        redescribe = stage_redescribe, # one thing described by another entry
-       series_again = stage_series_again, # a term the final model takes for a series effect
        remaining = stage_remaining,  # residual structure no effect explains
        trim = stage_trim,            # leave out a short end nothing describes
        release = stage_release,      # values the last screening held, freed
@@ -397,7 +396,9 @@ added_labels <- function(st) unique(vapply(st$steps, function(s) s$label[1L], ""
 # An instance this call added that the final model holds at amplitude 0
 # (and stage_hold() could not hold at what the raw data measure)
 # describes nothing: it leaves the model, refitted without it (taken when
-# no worse by the criterion), and is listed in $refine$rejected.
+# no worse by the criterion), and is listed in $refine$rejected. The
+# steps keep their rows, under the labels the model now gives their
+# instances ("left:" and the old label for one that left).
 stage_prune <- function(st) {
   cur <- st$current
   lay <- cur$layout
@@ -409,109 +410,37 @@ stage_prune <- function(st) {
   }, NA)
   dead <- added[dead]
   if (!length(dead)) return(st)
-  r <- without_instances(st, dead, "refit without the instances at 0", "prune")
-  f <- r$fit
-  if (is.null(f) || !(refine_crit(r$st, f) <= refine_crit(r$st, cur) + 1e-6)) return(r$st)
-  leave(r$st, f, dead, "at amplitude 0 in the final model: left out",
-        "amplitude 0 in the final model")
-}
-
-# A term taken early may stand in, on the final model, for a series effect
-# the run found and left in the data: a GM taken for a long-tau excess
-# while a band was still missing pays then, and on the final model only
-# for the steps' excess (the same axis without an added 3.7 Hz line
-# refused that GM at its last step). Each term this call added is judged
-# again by that acceptance rule (judge_instance()'s series_duplicate()
-# and series_pays_without()) on the final model, the last taken first; a
-# term that fails leaves, refitted without it, and is listed in
-# $refine$rejected and $refine$series_duplicates.
-stage_series_again <- function(st) {
-  if (is.null(st$series) || !NROW(st$series$table)) return(st)
-  for (l in rev(added_labels(st))) {
-    cur <- st$current
-    labs <- term_labels(cur$terms)
-    if (!l %in% labs) next
-    effect <- cur$terms[match(l, labs)]
-    dup <- series_duplicate(st$series, cur, l)
-    out <- NULL
-    if (is.null(dup)) {
-      need <- function() {
-        par <- instance_params(stats::coef(cur), cur$layout, l)
-        ev <- raw_evidence(effect, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
-        st$args$min_gain * (1 + rests_on_curve(effect, ev, st$raw))
-      }
-      dup <- series_pays_without(st, cur, l, gain = need, without = function() {
-        r <- without_instances(st, l, "refit without a term the series describes",
-                               "series again")
-        st <<- r$st
-        out <<- r$fit
-        out
-      })
-    }
-    if (is.null(dup)) next
-    if (is.null(out)) {
-      r <- without_instances(st, l, "refit without a term the series describes",
-                             "series again")
-      st <- r$st
-      out <- r$fit
-    }
-    if (is.null(out)) next
-    st$duplicates <- rbind(st$duplicates, cbind(
-      data.frame(step = length(st$steps) + 1L, effect = effect,
-                 params = format_params(instance_params(stats::coef(cur), cur$layout, l), effect),
-                 stringsAsFactors = FALSE), dup))
-    st <- leave(st, out, l, sprintf(
-      "on the final model it describes the %s found in the series (not removed): left out",
-      dup$series_kind), sprintf("on the final model it describes the %s found in the series",
-                                dup$series_kind))
-  }
-  st
-}
-
-# The current model refitted without the instances `labels`: list(st, fit)
-# (fit NULL when the refit failed).
-without_instances <- function(st, labels, stage, effect) {
-  cur <- st$current
   labs <- term_labels(cur$terms)
-  gone <- labs %in% labels
+  gone <- labs %in% dead
   tm <- structure(cur$terms[!gone], gone = gone)
   settings <- st$settings
   settings$fixed <- relabel_values(settings$fixed, cur$terms, tm)
-  start <- relabel_values(stats::coef(cur)[cur$layout$role == "nonlinear"], cur$terms, tm)
+  start <- relabel_values(cf[lay$role == "nonlinear"], cur$terms, tm)
   start <- start[!names(start) %in% names(settings$fixed)]
-  r <- state_refit(st, refit_args(cur, c(tm), settings, start = start), stage, effect,
-                   length(st$steps) + 1L)
-  if (!is.null(r$fit)) attr(r$fit, "settings") <- settings
-  r
-}
-
-# The instances `labels` leave: `f` (from without_instances()) becomes the
-# model, each is listed in $refine$rejected with `reason`, and the steps
-# keep their rows under the labels the model now gives their instances
-# ("left:" and the old label for one that left, its evidence saying why:
-# `note`).
-leave <- function(st, f, labels, reason, note) {
-  cur <- st$current
-  lay <- cur$layout
-  cf <- stats::coef(cur)
-  labs <- term_labels(cur$terms)
   step <- length(st$steps) + 1L
-  for (l in labels) {
+  r <- state_refit(st, refit_args(cur, c(tm), settings, start = start),
+                   "refit without the instances at 0", "prune", step)
+  st <- r$st
+  f <- r$fit
+  if (is.null(f) || !(refine_crit(st, f) <= refine_crit(st, cur) + 1e-6)) return(st)
+  for (l in dead) {
     st$rejected <- add_rejected(st$rejected, step, cur$terms[match(l, labs)],
-                                instance_params(cf, lay, l), reason)
+                                instance_params(cf, lay, l),
+                                "at amplitude 0 in the final model: left out")
   }
-  map <- label_map(cur$terms, labs %in% labels)
+  # (a step whose instance left is labelled "left:" as relabel_values()
+  # names values that left, and says why)
+  map <- label_map(cur$terms, gone)
   st$steps <- lapply(st$steps, function(s) {
-    if (s$label[1L] %in% labels) {
+    if (s$label[1L] %in% dead) {
       s$label <- paste0("left:", s$label)
-      s$evidence <- paste0(s$evidence, "; left out at the end: ", note)
+      s$evidence <- paste0(s$evidence, "; left out at the end: amplitude 0 in the final model")
     } else if (s$label[1L] %in% names(map)) {
       s$label <- unname(map[s$label])
     }
     s
   })
-  st$settings <- attr(f, "settings")
-  attr(f, "settings") <- NULL
+  st$settings <- settings
   st$current <- f
   st
 }

@@ -296,27 +296,6 @@ test_that("a line beside a measured axis's own is named, not taken as a GM of a 
   expect_equal(n_reading(r), n_reading(r0), tolerance = 0.05)
 })
 
-test_that("a term taken early that the final model owes to the series' steps leaves", {
-  # unit 3 accel_x carries a filter, lines, a band near 9.9 Hz and steps
-  # the series pass finds and leaves in. With a 3.7 Hz line added (0.3 x
-  # the white sd), a GM of tc 35 s was taken before the band, and stayed;
-  # the run without the line refuses that GM at its last step, since it
-  # pays only for the steps' excess. Judged again on the final model it
-  # leaves, and is listed as a series duplicate.
-  skip_if_no_shared()
-  skip_on_cran()
-  ax <- measured_axis(3, "accel_x")
-  r <- loop(with_wave(ax, 0.3, 3.7, 0.7), ax$freq)
-  expect_true(any(abs(fitted_f0(r) / 3.7 - 1) <= 0.03))
-  expect_false("gm" %in% r$terms)
-  dup <- r$refine$series_duplicates
-  expect_true(any(dup$effect == "gm" & dup$series_kind == "steps"))
-  expect_true(any(grepl("^left:gm", r$steps$label)))
-  r0 <- loop(ax$b, ax$freq)
-  expect_false("gm" %in% r0$terms)
-  expect_equal(n_reading(r), n_reading(r0), tolerance = 0.05)
-})
-
 test_that("a greedy order far from the curve is revisited with the raw data's values first", {
   skip_on_cran()
   # own generator: white noise through a first-order low-pass (AR(1) 0.3),
