@@ -166,9 +166,13 @@ effect_warmup <- function() {
       w <- detect_warmup(x, freq)$all
       series_rows(size = w$amplitude, tc = w$tc, time = rep(0, nrow(w)),
                   index = rep(1L, nrow(w)), z = w$z,
-                  evidence = sprintf(
-                    "GLS fit of exp(-t / tc) on block means under the series' own noise model (white, random walk, Gauss-Markov from its Allan variance) at z = %s",
-                    format_num(w$z, 2)))
+                  evidence = sprintf(paste(
+                    "GLS fit of exp(-t / tc) on block means under the series' own noise model",
+                    "(white, random walk, Gauss-Markov from its Allan variance) at z = %s;",
+                    "tc 95%% interval %s"), format_num(w$z, 2),
+                    ifelse(is.na(w$tc_lower), "not determined (flat likelihood)",
+                           sprintf("%s-%s s (profile likelihood)", format_num(w$tc_lower, 2),
+                                   format_num(w$tc_upper, 2)))))
     },
     remove = function(x, freq, par) {
       if (!nrow(par)) return(x)

@@ -36,7 +36,9 @@
 #' random walk and Gauss-Markov components from its Allan variance), and a
 #' warm-up is named by a likelihood ratio in which the series with and
 #' without it each fit their own noise model (a random walk's excursion is
-#' not a warm-up); up to two exponentials are named.
+#' not a warm-up); up to two exponentials are named. Each time constant's
+#' 95% interval, from the profile likelihood (the noise refitted at each
+#' time constant), is given in the row's `evidence`.
 #'
 #' The Allan deviation of the series as given is compared with that of the
 #' series with every effect found taken out, on the octave grid of

@@ -81,6 +81,7 @@ test_that("an exponential warm-up: time constant within 30%", {
   n <- 2e5
   freq <- 100
   t <- (seq_len(n) - 1) / freq
+  covered <- logical()
   for (seed in 1:2) {
     for (tc in c(30, 120)) {
       x <- gen_white_walk(n, rw = 2e-5, seed = seed) + 0.1 * exp(-t / tc)
@@ -90,10 +91,22 @@ test_that("an exponential warm-up: time constant within 30%", {
       expect_equal(w$tc, tc, tolerance = 0.3)
       expect_equal(w$size, 0.1, tolerance = 0.3)
       expect_identical(se$table$kind, "warmup")
+      # its 95% interval (profile likelihood) holds the estimate and is
+      # reported in the evidence
+      ci <- asNamespace("allanvar")$detect_warmup(x, freq)$all
+      expect_true(ci$tc_lower < w$tc && w$tc < ci$tc_upper)
+      expect_lt(ci$tc_upper / ci$tc_lower, 2)
+      expect_match(w$evidence, sprintf("tc 95%% interval %s-%s s",
+                                       format_num(ci$tc_lower, 2), format_num(ci$tc_upper, 2)),
+                   fixed = TRUE)
+      covered <- c(covered, ci$tc_lower <= tc && tc <= ci$tc_upper)
       # the corrected start is level with the rest
       expect_lt(abs(mean(se$x[1:500]) - mean(se$x[(5 * tc * freq):(6 * tc * freq)])), 0.02)
     }
   }
+  # the generator's tc in 3 of the 4 intervals (seed 1 at 120 s reads
+  # 137 s, 120.6-155.9; bench/warmup-interval.R measures the coverage)
+  expect_gte(sum(covered), 3L)
 })
 
 test_that("a warm-up and a step at its start: each read with the other out", {
