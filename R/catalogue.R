@@ -75,6 +75,11 @@
 #                 outlier detector, a step's first sample) or whose
 #                 shape they bend (a warm-up beside a step): it reads the
 #                 series again with the other kinds' instances removed
+#   known_av(raw, fit, tau, tau0)  the AV, at `tau`, of the instances of
+#                 this entry the raw data measure exactly (every parameter)
+#                 and `fit` does not hold yet (a square wave's sharp
+#                 harmonics), or NULL: a family's form is chosen on the
+#                 curve without it during the steps
 #   replaces    kinds this entry takes the place of when the loop adds it
 #                 (the filter replaces N: its DC level is the white level)
 #   replaces_instance  NULL (every instance of those kinds goes), or
@@ -196,7 +201,7 @@ new_effect <- function(name, title, params, component = "av",
                        replaces_instance = NULL, admissible = NULL, proposed_only = FALSE,
                        statespace = NULL, diagnose = NULL, family = NULL,
                        exact_edf = NULL, noise_lookalike = FALSE,
-                       detect_again = FALSE) {
+                       detect_again = FALSE, known_av = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -211,7 +216,8 @@ new_effect <- function(name, title, params, component = "av",
        admissible = admissible,
        proposed_only = proposed_only, statespace = statespace,
        diagnose = diagnose, family = family, exact_edf = exact_edf,
-       noise_lookalike = noise_lookalike, detect_again = detect_again)
+       noise_lookalike = noise_lookalike, detect_again = detect_again,
+       known_av = known_av)
 }
 
 validate_effect <- function(e) {

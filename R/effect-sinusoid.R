@@ -90,6 +90,24 @@ hold_sinusoid <- function(par, raw) {
                       format_num(m$line$amp), format_num(m$amp)))
 }
 
+# The AV of the sharp lines (one frequency over the whole record: the
+# periodogram measures f0 and the record's least-squares sinusoid its
+# amplitude) that `fit` holds no sinusoid at (within 1% of f0), at `tau`;
+# NULL when there are none.
+known_av_sinusoid <- function(raw, fit, tau, tau0) {
+  lines <- diag_part(raw, "lines")
+  if (is.null(lines) || !nrow(lines) || is.null(lines$record_amp)) return(NULL)
+  lines <- lines[is_sharp(lines$record_amp, lines$amp), , drop = FALSE]
+  cf <- stats::coef(fit)
+  held <- cf[grepl("^sinusoid[0-9]*\\.f0$", names(cf))]
+  lines <- lines[!vapply(lines$f0, function(f) any(abs(held / f - 1) < 0.01), NA), , drop = FALSE]
+  if (!nrow(lines)) return(NULL)
+  basis <- effect_entry("sinusoid")$basis
+  rowSums(vapply(seq_len(nrow(lines)), function(j) {
+    lines$record_amp[j]^2 * basis(tau, tau0, list(f0 = lines$f0[j]))
+  }, numeric(length(tau))))
+}
+
 effect_sinusoid <- function() {
   new_effect(
     name = "sinusoid", title = "sinusoidal disturbance",
@@ -192,6 +210,7 @@ effect_sinusoid <- function() {
     },
     evidence = evidence_sinusoid,
     raw_hold = hold_sinusoid,
+    known_av = known_av_sinusoid,
     # The periodogram's lines, less the bins of the broad bands (a
     # resonance's bins are not sinusoids); the checks of the other effects
     # see the series with them taken out (a line disturbs the ACF that

@@ -321,7 +321,7 @@ judge_instance <- function(st, f, effect, label, tau) {
 # values; the criterion chooses, and the new form must be admissible and
 # not contradicted by the raw data, nor move an effect accepted earlier to
 # values the raw data contradict. Returns list(st, swapped).
-rechoose_families <- function(st) {
+rechoose_families <- function(st, known = FALSE) {
   if (!length(st$steps)) return(list(st = st, swapped = FALSE))
   for (e in entries_with("family")) {
     ff <- family_forms(st, e)
@@ -332,7 +332,22 @@ rechoose_families <- function(st) {
     stage <- paste(e$name, "family chosen again")
     swap <- NULL
     near <- list()
-    c_cur <- refine_crit(st, cur)
+    # During the steps the forms are compared on the curve without what the
+    # raw data measure exactly and the model does not hold yet (known_av
+    # fields: a square wave's sharp harmonics): a first-order low-pass
+    # mimics the bumps of the harmonics not yet in, beats the moving
+    # average there, and then keeps them and the axis's resonance out.
+    cv <- if (known) curve_without_known(st, cur)
+    crit_of <- function(g) {
+      if (is.null(cv)) return(refine_crit(st, g))
+      args <- refit_args(g, g$terms, st$settings)
+      args$av <- cv
+      r <- state_refit(st, args, paste(stage, "without the known lines"), e$name,
+                       length(st$steps) + 1L)
+      st <<- r$st
+      if (is.null(r$fit)) Inf else refine_crit(st, r$fit)
+    }
+    c_cur <- crit_of(cur)
     for (fm in ff$forms) {
       v <- fm$term
       lab <- fm$label
@@ -342,17 +357,20 @@ rechoose_families <- function(st) {
       st <- r$st
       g <- r$fit
       if (is.null(g) || !is.finite(refine_crit(st, g))) next
-      if (refine_crit(st, g) >= min(c_cur, swap$crit %||% Inf) - st$args$min_gain) {
+      c_g <- crit_of(g)
+      if (!is.finite(c_g)) next
+      if (c_g >= min(c_cur, swap$crit %||% Inf) - st$args$min_gain) {
         # a form the curve cannot tell from the current one
-        if (refine_crit(st, g) < c_cur + st$args$min_gain) {
+        if (c_g < c_cur + st$args$min_gain) {
           near[[length(near) + 1L]] <- list(fit = g, effect = v, label = lab)
         }
         next
       }
       fj <- judge_form(st, g, v, lab)
       if (is.null(fj)) next
-      swap <- list(fit = g, crit = refine_crit(st, g), effect = v, label = lab,
-                   par = fj$par, ev = fj$ev)
+      swap <- list(fit = g, crit = c_g, effect = v, label = lab,
+                   par = fj$par, ev = fj$ev,
+                   note = if (!is.null(cv)) "; chosen on the curve without the sharp lines not yet in the model")
     }
     if (is.null(swap) && length(near)) swap <- acov_choice(st, cur, near)
     if (!is.null(swap)) {
@@ -362,12 +380,28 @@ rechoose_families <- function(st) {
       if (nzchar(swap$ev$text)) evidence <- paste0(evidence, "; raw data: ", swap$ev$text)
       st$steps[[length(st$steps) + 1L]] <- step_row(
         swap$effect, swap$label, loc, swap$par, evidence, swap$ev$support,
-        cur, swap$fit, refine_crit(st, cur), swap$crit)
+        cur, swap$fit, refine_crit(st, cur), refine_crit(st, swap$fit))
       st$current <- swap$fit
       return(list(st = st, swapped = TRUE))
     }
   }
   list(st = st, swapped = FALSE)
+}
+
+# The curve of `fit` less the AV the catalogue's known_av fields give (what
+# the raw data measure exactly and `fit` does not hold), each point kept at
+# 10% at least; NULL when there is none.
+curve_without_known <- function(st, fit) {
+  if (is.null(st$raw) || is.null(st$args$freq)) return(NULL)
+  cv <- curve_of_fit(fit)
+  known <- 0
+  for (e in entries_with("known_av")) {
+    k <- e$known_av(st$raw, fit, cv$data$tau, 1 / st$args$freq)
+    if (!is.null(k)) known <- known + k
+  }
+  if (!any(known > 0)) return(NULL)
+  cv$data$avar <- pmax(cv$data$avar - known, 0.1 * cv$data$avar)
+  cv
 }
 
 # Forms the curve cannot tell apart (criteria within min_gain: beside a

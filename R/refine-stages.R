@@ -513,7 +513,7 @@ step_reform <- function(st) {
     return(st)
   }
   st$reform <- FALSE
-  r <- rechoose_families(st)
+  r <- rechoose_families(st, known = TRUE)
   st <- r$st
   if (r$swapped) st$flow <- "next"
   st
@@ -570,7 +570,7 @@ screen_trials <- function(st) {
 # loop stops.
 step_settle <- function(st) {
   if (!is.null(st$best)) return(st)
-  r <- rechoose_families(st)
+  r <- rechoose_families(st, known = TRUE)
   st <- r$st
   # no form pays alone: one may pay beside a trial the old form kept out
   if (!r$swapped) {
