@@ -107,7 +107,11 @@
 #' never `FALSE` for a step of this loop.
 #'
 #' When nothing pays, the forms of a family (the sensor filter's) are
-#' chosen again on the current model; when none pays alone and the model is
+#' chosen again on the current model, compared on the curve without the
+#' sharp lines the model does not hold yet (their frequencies and
+#' amplitudes are the periodogram's and the record's: a first-order
+#' low-pass mimics the bumps of a square wave's harmonics not yet in);
+#' when none pays alone and the model is
 #' still far from the curve (\eqn{\chi^2} per degree of freedom above 4),
 #' each trial of that step the raw data refused at values it pins is
 #' refitted beside each other form, everything free, and the best such pair
