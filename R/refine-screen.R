@@ -338,16 +338,17 @@ rechoose_families <- function(st, known = FALSE) {
     # mimics the bumps of the harmonics not yet in, beats the moving
     # average there, and then keeps them and the axis's resonance out.
     cv <- if (known) curve_without_known(st, cur)
-    crit_of <- function(g) {
-      if (is.null(cv)) return(refine_crit(st, g))
+    crit_of <- function(st, g) {
+      if (is.null(cv)) return(list(st = st, crit = refine_crit(st, g)))
       args <- refit_args(g, g$terms, st$settings)
       args$av <- cv
       r <- state_refit(st, args, paste(stage, "without the known lines"), e$name,
                        length(st$steps) + 1L)
-      st <<- r$st
-      if (is.null(r$fit)) Inf else refine_crit(st, r$fit)
+      list(st = r$st, crit = if (is.null(r$fit)) Inf else refine_crit(r$st, r$fit))
     }
-    c_cur <- crit_of(cur)
+    k <- crit_of(st, cur)
+    st <- k$st
+    c_cur <- k$crit
     for (fm in ff$forms) {
       v <- fm$term
       lab <- fm$label
@@ -357,7 +358,9 @@ rechoose_families <- function(st, known = FALSE) {
       st <- r$st
       g <- r$fit
       if (is.null(g) || !is.finite(refine_crit(st, g))) next
-      c_g <- crit_of(g)
+      k <- crit_of(st, g)
+      st <- k$st
+      c_g <- k$crit
       if (!is.finite(c_g)) next
       if (c_g >= min(c_cur, swap$crit %||% Inf) - st$args$min_gain) {
         # a form the curve cannot tell from the current one
