@@ -98,8 +98,8 @@ known_av_sinusoid <- function(raw, fit, tau, tau0) {
   lines <- diag_part(raw, "lines")
   if (is.null(lines) || !nrow(lines) || is.null(lines$record_amp)) return(NULL)
   lines <- lines[is_sharp(lines$record_amp, lines$amp), , drop = FALSE]
-  cf <- stats::coef(fit)
-  held <- cf[grepl("^sinusoid[0-9]*\\.f0$", names(cf))]
+  lay <- fit$layout
+  held <- stats::coef(fit)[lay$name[lay$kind == "sinusoid" & lay$param == "f0"]]
   lines <- lines[!vapply(lines$f0, function(f) any(abs(held / f - 1) < 0.01), NA), , drop = FALSE]
   if (!nrow(lines)) return(NULL)
   basis <- effect_entry("sinusoid")$basis

@@ -75,31 +75,35 @@ screen_trial <- function(st, tr, nl_now) {
   # variance, at 1.2% of the AV beside a held filter, 2.7% free, was left
   # out behind a square wave's 13 harmonics): it is refitted once with
   # everything free first.
+  # (a free refit, from the screen's values with the pins held, pays as a
+  # screened instance must)
+  free_pays <- function(f) {
+    !is.null(f) && is.finite(crit(f)) && crit(f) < c0 - min_gain && f$chi2 < 0.9 * cur$chi2
+  }
+  freed <- FALSE
   if (!set_line && max_share(new, lab) < 0.02) {
     if (!length(hold_now)) return(list(st = st, cand = NULL))
     r <- refit_from(st, cur, new, settings, pin, "free refit of a screen that explains little",
                     tr$effect)
     st <- r$st
     free <- r$fit
-    if (is.null(free) || !is.finite(crit(free)) || !(crit(free) < c0 - min_gain) ||
-        !(free$chi2 < 0.9 * cur$chi2) || max_share(free, lab) < 0.02) {
-      return(list(st = st, cand = NULL))
-    }
+    if (!free_pays(free) || max_share(free, lab) < 0.02) return(list(st = st, cand = NULL))
     new <- free
     c1 <- crit(free)
+    freed <- TRUE
   }
   tau <- cur$data$tau
   jd <- judge_instance(st, new, tr$effect, lab, tau)
   # A screened instance (others held) that fails is refitted once with
   # everything free before it is rejected: held at the one-term
-  # compromise, a second GM lands at the wrong Tc.
-  if (!is.null(jd$why) && length(hold_now)) {
+  # compromise, a second GM lands at the wrong Tc. (One freed above is
+  # that refit already.)
+  if (!is.null(jd$why) && length(hold_now) && !freed) {
     r <- refit_from(st, cur, new, settings, pin, "free refit of a rejected screen",
                     tr$effect)
     st <- r$st
     free <- r$fit
-    if (!is.null(free) && is.finite(crit(free)) && crit(free) < c0 - min_gain &&
-        free$chi2 < 0.9 * cur$chi2) {
+    if (free_pays(free)) {
       jf <- judge_instance(st, free, tr$effect, lab, tau)
       if (is.null(jf$why)) {
         new <- free
