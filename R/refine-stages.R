@@ -14,6 +14,7 @@ refine_stages <- function() {
        release = stage_release,      # values the last screening held, freed
        hold = stage_hold,            # instances the curve sizes off the raw data's
        prune = stage_prune,          # instances the final model holds at 0 leave
+       reconsider = stage_reconsider, # instances the final model does without leave
        assemble = stage_assemble)    # the refined avfit object
 }
 
@@ -396,9 +397,7 @@ added_labels <- function(st) unique(vapply(st$steps, function(s) s$label[1L], ""
 # An instance this call added that the final model holds at amplitude 0
 # (and stage_hold() could not hold at what the raw data measure)
 # describes nothing: it leaves the model, refitted without it (taken when
-# no worse by the criterion), and is listed in $refine$rejected. The
-# steps keep their rows, under the labels the model now gives their
-# instances ("left:" and the old label for one that left).
+# no worse by the criterion), and is listed in $refine$rejected.
 stage_prune <- function(st) {
   cur <- st$current
   lay <- cur$layout
@@ -410,38 +409,117 @@ stage_prune <- function(st) {
   }, NA)
   dead <- added[dead]
   if (!length(dead)) return(st)
+  step <- length(st$steps) + 1L
+  w <- refit_without(st, cur, dead, "refit without the instances at 0", "prune", step)
+  st <- w$st
+  if (is.null(w$fit) || !(refine_crit(st, w$fit) <= refine_crit(st, cur) + 1e-6)) return(st)
+  leave_model(st, w, dead, step, "at amplitude 0 in the final model: left out",
+              "amplitude 0 in the final model")
+}
+
+# Each instance this call added is judged again on the final model, by
+# the rule that took it: one whose removal raises the criterion by less
+# than `min_gain` leaves the model (the least needed first, then the others
+# again). A greedy step can take an effect while the model still lacks
+# another that then describes the same part of the curve better (a GM
+# taken at the step before a band's resonance entered); the order of the
+# steps must not decide the description. Instances whose values the raw
+# data measure (a periodogram line's frequency, a harmonic set's further
+# lines kept at a cost to the curve; the curve cannot tell two lines 0.1 Hz
+# apart and would drop one run's and keep another's) and entries that
+# replace a term (the filter) are not judged again by the curve; a removal
+# that leaves an earlier effect contradicted by the raw data is not taken.
+stage_reconsider <- function(st) {
+  before <- st$current
+  for (round in seq_along(st$steps)) {
+    cur <- st$current
+    groups <- judged_again(st, cur)
+    if (!length(groups)) break
+    c_cur <- refine_crit_held(st, cur, length(held_values(cur, st$settings)))
+    broken <- earlier_broken(st, cur)
+    step <- length(st$steps) + 1L
+    best <- NULL
+    for (l in groups) {
+      w <- refit_without(st, cur, l, "refit without one instance", "reconsider", step)
+      st <- w$st
+      if (is.null(w$fit) || !all(earlier_broken(st, w$fit) %in% broken)) next
+      gain <- refine_crit(st, w$fit) - c_cur
+      if (gain < st$args$min_gain && (is.null(best) || gain < best$gain)) {
+        best <- list(w = w, label = l, gain = gain)
+      }
+    }
+    if (is.null(best)) break
+    why <- sprintf("the final model does without it (the criterion %s by %s without it, under min_gain %s)",
+                   if (best$gain < 0) "falls" else "rises", format_num(abs(best$gain)),
+                   format_num(st$args$min_gain))
+    st <- leave_model(st, best$w, best$label, step, why, why)
+  }
+  if (!identical(st$current, before)) st <- stage_remaining(st)
+  st
+}
+
+# The instances stage_reconsider() judges again, in groups that leave
+# together (the two instances of a split, taken in one step, are judged as
+# the step took them): added by this call, in the model, none of whose
+# values the raw data measure (pinned: a periodogram line's frequency, a
+# measured band's spectrum), not an entry that replaces a term.
+judged_again <- function(st, cur) {
+  lay <- cur$layout
+  labs <- term_labels(cur$terms)
+  measured <- lay$label[lay$name %in% names(st$settings$fixed)]
+  kinds <- split_term(cur$terms)$kind
+  ok <- labs[!labs %in% measured &
+               vapply(kinds, function(k) !length(effect_entry(k)$replaces), NA)]
+  rows <- vapply(st$steps, function(s) s$label[1L], "")
+  group <- vapply(seq_along(rows), function(i) {
+    j <- if (i <= length(st$taken_with)) st$taken_with[i] else NA_integer_
+    if (is.na(j)) i else j
+  }, 0L)
+  out <- lapply(unique(group[rows %in% labs]), function(g) unique(rows[group == g]))
+  Filter(function(l) all(l %in% ok), out)
+}
+
+# The current model refitted without the instances `dead` (labels), from
+# its values, on its tau range: list(st, fit, settings, terms).
+refit_without <- function(st, cur, dead, stage, effect, step) {
+  lay <- cur$layout
   labs <- term_labels(cur$terms)
   gone <- labs %in% dead
   tm <- structure(cur$terms[!gone], gone = gone)
   settings <- st$settings
   settings$fixed <- relabel_values(settings$fixed, cur$terms, tm)
-  start <- relabel_values(cf[lay$role == "nonlinear"], cur$terms, tm)
+  start <- relabel_values(stats::coef(cur)[lay$role == "nonlinear"], cur$terms, tm)
   start <- start[!names(start) %in% names(settings$fixed)]
-  step <- length(st$steps) + 1L
-  r <- state_refit(st, refit_args(cur, c(tm), settings, start = start),
-                   "refit without the instances at 0", "prune", step)
-  st <- r$st
-  f <- r$fit
-  if (is.null(f) || !(refine_crit(st, f) <= refine_crit(st, cur) + 1e-6)) return(st)
+  args <- refit_args(cur, c(tm), settings, start = start)
+  if (!is.null(st$tau_range)) args$tau_range <- c(st$tau_range[1L], Inf)
+  r <- state_refit(st, args, stage, effect, step)
+  list(st = r$st, fit = r$fit, settings = settings, terms = tm, from = cur)
+}
+
+# The model of refit_without() `w` taken: the instances `dead` listed in
+# $refine$rejected (`reason`), the steps that added them labelled "left:"
+# and their evidence saying why (`note`), the other steps under the labels
+# the model now gives their instances.
+leave_model <- function(st, w, dead, step, reason, note) {
+  cur <- w$from
+  cf <- stats::coef(cur)
+  labs <- term_labels(cur$terms)
   for (l in dead) {
     st$rejected <- add_rejected(st$rejected, step, cur$terms[match(l, labs)],
-                                instance_params(cf, lay, l),
-                                "at amplitude 0 in the final model: left out")
+                                instance_params(cf, cur$layout, l), reason)
   }
-  # (a step whose instance left is labelled "left:" as relabel_values()
-  # names values that left, and says why)
-  map <- label_map(cur$terms, gone)
+  map <- label_map(cur$terms, attr(w$terms, "gone"))
   st$steps <- lapply(st$steps, function(s) {
     if (s$label[1L] %in% dead) {
       s$label <- paste0("left:", s$label)
-      s$evidence <- paste0(s$evidence, "; left out at the end: amplitude 0 in the final model")
+      s$evidence <- paste0(s$evidence, "; left out at the end: ", note)
     } else if (s$label[1L] %in% names(map)) {
       s$label <- unname(map[s$label])
     }
     s
   })
-  st$settings <- settings
-  st$current <- f
+  st$settings <- w$settings
+  st$current <- w$fit
   st
 }
 
@@ -669,6 +747,7 @@ step_record <- function(st) {
              if (nzchar(ev2$text)) paste0("; raw data: ", ev2$text)),
       ev2$support, best$fit, best$fit, best$crit, best$crit)
     st$pins[length(st$steps)] <- list(numeric(0))
+    st$taken_with[length(st$steps)] <- length(st$steps) - 1L
   }
   st$current <- best$fit
   st

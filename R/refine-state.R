@@ -34,6 +34,7 @@ new_refine_state <- function(fit, args, settings) {
     start = NULL,              # the model the steps started from
     pins = list(),             # per accepted step, the raw-data values it pinned
     release_late = character(), # pinned values an entry frees at the end (stage_release())
+    taken_with = integer(),    # per accepted step, the step it was taken with (a split's), or NA
     blocked = list(),          # raw-data values of trials an earlier effect kept out
     refused = list(),          # this step's trials the raw data refused (family_pairs())
     unpaid = list(),           # this step's raw-pinned trials that did not pay alone

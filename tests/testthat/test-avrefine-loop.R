@@ -271,3 +271,48 @@ test_that("values held in screening are freed alone where freeing all breaks an 
   expect_false(any(ref$layout$fixed[ref$layout$name %in% tcs]))
   expect_true(all(ref$se[tcs] > 0))
 })
+
+test_that("an instance the final model does without leaves it; one the raw data measure is not judged so", {
+  # The stage on a state built here (own generator): white noise, a random
+  # walk, a strong GM of 5 s and a weak one of 200 s that the curve cannot
+  # tell from the walk; the model N + K + both GMs, each taken at a step of
+  # its own. The weak GM holds a nonzero amplitude but the criterion is no
+  # worse without it: it leaves, the strong one stays.
+  ns <- asNamespace("allanvar")
+  set.seed(1)
+  freq <- 100
+  n <- 5e5
+  x <- gen_white(n, freq, 0.001) + gen_rrw(n, freq, 2e-4) + gen_gm(n, freq, 0.004, 5) +
+    gen_gm(n, freq, 6e-4, 200)
+  fit <- avfit(allan(x, freq), terms = c("N", "K", "gm", "gm"),
+               start = c(gm1.tc = 5, gm2.tc = 200))
+  expect_gt(coef(fit)[["gm2.sigma"]], 1e-4)
+  st <- list(current = fit,
+             steps = list(list(effect = "gm", label = "gm1", evidence = "a bump at 9 s"),
+                          list(effect = "gm", label = "gm2", evidence = "a bump at 200 s")),
+             settings = list(fixed = NULL), rejected = ns$new_rejected(),
+             failures = ns$new_failures(),
+             args = list(criterion = "BIC", min_gain = 10, freq = freq, level = 3.5))
+  out <- ns$stage_reconsider(st)
+  expect_identical(out$current$terms, c("N", "K", "gm"))
+  expect_equal(coef(out$current)[["gm1.tc"]], 5, tolerance = 0.25)
+  expect_identical(vapply(out$steps, function(s) s$label, ""), c("gm1", "left:gm2"))
+  expect_match(out$steps[[2]]$evidence, "left out at the end: the final model does without it")
+  expect_identical(nrow(out$rejected), 1L)
+  expect_match(out$rejected$reason, "the criterion (falls|rises) by [0-9.]+ without it, under min_gain 10")
+  expect_true(is.data.frame(out$unexplained))
+  # an instance with a value the raw data measure (pinned, as a
+  # periodogram line's frequency is) is not judged by the curve
+  st_measured <- st
+  st_measured$settings$fixed <- coef(fit)["gm2.tc"]
+  expect_identical(ns$judged_again(st_measured, fit), list("gm1"))
+  fit_m <- avfit(allan(x, freq), terms = c("N", "K", "gm", "gm"),
+                 start = c(gm1.tc = 5), fixed = coef(fit)["gm2.tc"])
+  st_measured$current <- fit_m
+  expect_identical(ns$stage_reconsider(st_measured)$current, fit_m)
+  # the two instances of a split, taken in one step, leave only together
+  st_split <- st
+  st_split$taken_with <- c(NA, 1L)
+  expect_identical(ns$judged_again(st_split, fit), list(c("gm1", "gm2")))
+  expect_identical(ns$stage_reconsider(st_split)$current, fit)
+})
