@@ -27,7 +27,14 @@
 #'    one only if it pays by the information criterion (a decrease of at
 #'    least `min_gain`) and lowers \eqn{\chi^2} per degree of freedom by at
 #'    least 10 percent;
-#' 4. repeats until nothing pays or `max_steps` effects were added.
+#' 4. repeats until nothing pays or `max_steps` effects were added;
+#' 5. judges each effect it added again on the final model: one whose
+#'    removal raises the criterion by less than `min_gain` leaves it (a
+#'    greedy step can take an effect that the model does without once a
+#'    later one describes the same part of the curve). The two instances
+#'    of a split are judged together; effects whose values the raw data
+#'    measure (a periodogram line's frequency, a measured band's spectrum)
+#'    and the filter are not judged by the curve alone.
 #'
 #' The rules of acceptance:
 #' * Candidates are compared by the criterion, not gated by a residual
@@ -170,8 +177,9 @@
 #'   signatures left when the loop stopped and `failures` (a data frame
 #'   `step`, `effect`, `stage`, `message`, with the conditions in the list
 #'   column `condition`), `rejected` (step, effect, params, reason; an
-#'   instance the final model holds at amplitude 0 is left out and listed
-#'   here, its step's `label` then reads `"left:"` and the old label; one
+#'   instance the final model holds at amplitude 0, or does without (point
+#'   5 above), is left out and listed here, its step's `label` then reads
+#'   `"left:"` and the old label and its `evidence` says why; one
 #'   the final model sizes far off what the raw data measure, a sinusoid
 #'   below a third or above 3 times its periodogram line's amplitude, is
 #'   first held at the raw data's value (fixed in `layout`) when that
