@@ -242,6 +242,7 @@ effect_resonance <- function() {
       }
       out
     },
+    raw_hold = hold_resonance,
     peak_tau = function(par) 0.371 / par[["fr"]],
     # the broad bands of the raw periodogram; the checks of the other
     # effects see them brought down to their background

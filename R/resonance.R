@@ -119,33 +119,58 @@ band_resonances <- function(bands) {
 # something else that shapes the curve near 1/(2 f_r) (unit 3 accel_y with
 # a warm-up added took an 8.15 Hz resonance at 2.9x its band's power).
 resonance_raw_support <- function(sigma, fr, tc, bands) {
-  # a band's own fit and, where two resonances fit it better, each of them
+  m <- resonance_band_match(fr, tc, bands)
+  if (is.null(m)) {
+    return(list(text = sprintf("no spectral band near %s Hz", format(signif(fr, 3))),
+                support = FALSE))
+  }
+  pr <- m$band$power / sigma^2
+  txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x and width %.2g x the fitted)",
+                 format(signif(m$band$f_center, 4)), format(signif(m$band$width, 2)),
+                 100 * m$band$share, pr, m$wr)
+  list(text = txt, support = m$near && pr > 1 / 2 && pr < 2 && m$wr > 1 / 3 && m$wr < 3)
+}
+
+# The band of find_bands() nearest a resonance at fr (a band's own fit and,
+# where two resonances fit it better, each of them): list(band (its row),
+# near (centre within half its width or 2 resolution bins), wr (its width
+# over the resonance's 1/(pi tc))), or NULL when there is no band.
+resonance_band_match <- function(fr, tc, bands) {
   if (nrow(bands) && !is.null(bands$pair_fr1) && any(!is.na(bands$pair_fr1))) {
     res <- attr(bands, "resolution")
-    cols <- c("f_center", "width", "power", "share")
+    cols <- c("f_center", "width", "tc", "power", "share")
     bands <- rbind(bands[, cols, drop = FALSE],
                    band_resonances(bands[!is.na(bands$pair_fr1), , drop = FALSE])[, cols, drop = FALSE])
     attr(bands, "resolution") <- res
   }
-  if (!nrow(bands)) {
-    return(list(text = sprintf("no spectral band near %s Hz", format(signif(fr, 3))),
-                support = FALSE))
-  }
+  if (!nrow(bands)) return(NULL)
   res <- attr(bands, "resolution")
   if (is.null(res)) res <- 0
   d <- abs(bands$f_center - fr)
   j <- which.min(d)
-  near <- d[j] <= max(0.5 * bands$width[j], 2 * res)
-  pr <- bands$power[j] / sigma^2
   # a resonance is a band, not a tone: its width 1/(pi tc) must match the
   # band's within a factor 3 (both at least the resolution), and be no
   # narrower than a tenth of the resolution the band was measured at (a
   # resonance of tc 2620 s took a 2.05 Hz line's place beside a band of
   # FWHM 0.22 Hz, one Welch bin: floored there, the widths agreed)
   fw <- 1 / (pi * tc)
-  wr <- max(bands$width[j], res) / (if (fw < res / 10) fw else max(fw, res))
-  txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x and width %.2g x the fitted)",
-                 format(signif(bands$f_center[j], 4)), format(signif(bands$width[j], 2)),
-                 100 * bands$share[j], pr, wr)
-  list(text = txt, support = near && pr > 1 / 2 && pr < 2 && wr > 1 / 3 && wr < 3)
+  list(band = bands[j, , drop = FALSE],
+       near = d[j] <= max(0.5 * bands$width[j], 2 * res),
+       wr = max(bands$width[j], res) / (if (fw < res / 10) fw else max(fw, res)))
+}
+
+# A resonance the curve makes more than twice as narrow or as wide as the
+# band the raw data measure at its centre is held at the band's centre
+# and width (stage_hold()): beside a measured band its tc runs off where
+# the other band's edge leaves the curve room (a 27 Hz band of FWHM 2.2 Hz
+# fitted at 1.0 Hz beside a 13 Hz band, N +5%).
+hold_resonance <- function(par, raw) {
+  bands <- diag_part(raw, "bands")
+  if (is.null(bands)) return(NULL)
+  m <- resonance_band_match(par[["fr"]], par[["tc"]], bands)
+  if (is.null(m) || !m$near || (m$wr > 1 / 2 && m$wr < 2)) return(NULL)
+  list(values = c(fr = m$band$f_center, tc = m$band$tc),
+       note = sprintf("fr and tc held at the spectral band's %s Hz and %s s (the curve put tc at %s s)",
+                      format_num(m$band$f_center, 4), format_num(m$band$tc),
+                      format_num(par[["tc"]])))
 }

@@ -278,3 +278,36 @@ test_that("a band added beside a measured accelerometer's own resonance: both na
   expect_false(any(r1$steps$confirmed %in% FALSE))
   expect_lt(r1$chi2, 4)
 })
+
+test_that("a resonance the curve makes far narrower than its raw band is held at the band's centre and width", {
+  # hold_resonance() on a band of own data (an AR(2) at 13 Hz, tc 0.3 s):
+  # sized within a factor 2 of the band's width, nothing to hold; twice as
+  # narrow or as wide, held at the band's fr and tc
+  set.seed(2)
+  freq <- 100
+  n <- 2e5
+  x <- stats::rnorm(n, sd = 0.01) + 0.006 * ar2_unit(n, 13, 0.3, freq)
+  raw <- allanvar:::refine_diagnostics(x, freq)
+  hold <- allanvar:::hold_resonance
+  expect_null(hold(c(sigma = 0.006, fr = 13, tc = 0.3), raw))
+  expect_null(hold(c(sigma = 0.006, fr = 13, tc = 0.45), raw))
+  h <- hold(c(sigma = 0.006, fr = 13.3, tc = 0.7), raw)
+  expect_equal(h$values[["fr"]], 13, tolerance = 0.01)
+  expect_equal(h$values[["tc"]], 0.3, tolerance = 0.2)
+  expect_match(h$note, "fr and tc held at the spectral band's 1[23][.][0-9]+ Hz and 0[.][0-9]+ s \\(the curve put tc at 0.7 s\\)")
+  expect_identical(names(hold(c(sigma = 0.006, fr = 13, tc = 0.1), raw)$values), c("fr", "tc"))
+  # far from any band: nothing
+  expect_null(hold(c(sigma = 0.006, fr = 40, tc = 0.7), raw))
+  skip_on_cran()
+  # the loop: white, a walk and a 27 Hz resonance, a 13 Hz band added.
+  # Beside the 27 Hz one the curve ran the 13 Hz resonance's tc to 0.61 s
+  # at 13.3 Hz (seed 4), twice as narrow as its band
+  set.seed(4)
+  runs <- loop_band_beside(5e5, 100, res = c(0.01, 27, 0.1), band = c(0.006, 13, 0.3))
+  cf <- coef(runs$r1)
+  fr <- cf[grepl("^resonance[0-9]*\\.fr$", names(cf))]
+  j <- which.min(abs(fr - 13))
+  expect_equal(unname(fr[j]), 13, tolerance = 0.01)
+  expect_equal(unname(cf[[sub("fr$", "tc", names(fr)[j])]]), 0.3, tolerance = 0.25)
+  expect_equal(unname(cf[["N"]]), unname(coef(runs$r0)[["N"]]), tolerance = 0.05)
+})
