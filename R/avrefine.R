@@ -181,7 +181,9 @@
 #'   5 above), is left out and listed here, its step's `label` then reads
 #'   `"left:"` and the old label and its `evidence` says why; one
 #'   the final model sizes far off what the raw data measure, a sinusoid
-#'   below a third or above 3 times its periodogram line's amplitude, is
+#'   below a third or above 3 times its periodogram line's amplitude or a
+#'   resonance more than twice as narrow or as wide as its spectral band
+#'   (held at the band's centre and width), is
 #'   first held at the raw data's value (fixed in `layout`) when that
 #'   costs the criterion less than `min_gain` and no effect loses its
 #'   raw-data support, and its step's `evidence` says so),
