@@ -128,6 +128,8 @@ resonance_raw_support <- function(sigma, fr, tc, bands) {
   txt <- sprintf("spectral band at %s Hz (FWHM %s Hz, %.0f%% of the variance, power %.2g x and width %.2g x the fitted)",
                  format(signif(m$band$f_center, 4)), format(signif(m$band$width, 2)),
                  100 * m$band$share, pr, m$wr)
+  # a resonance is a band, not a tone: its width matches the band's
+  # within a factor 3
   list(text = txt, support = m$near && pr > 1 / 2 && pr < 2 && m$wr > 1 / 3 && m$wr < 3)
 }
 
@@ -148,11 +150,10 @@ resonance_band_match <- function(fr, tc, bands) {
   if (is.null(res)) res <- 0
   d <- abs(bands$f_center - fr)
   j <- which.min(d)
-  # a resonance is a band, not a tone: its width 1/(pi tc) must match the
-  # band's within a factor 3 (both at least the resolution), and be no
-  # narrower than a tenth of the resolution the band was measured at (a
-  # resonance of tc 2620 s took a 2.05 Hz line's place beside a band of
-  # FWHM 0.22 Hz, one Welch bin: floored there, the widths agreed)
+  # both widths are read at least at the resolution, but a resonance
+  # narrower than a tenth of it keeps its own (a resonance of tc 2620 s
+  # took a 2.05 Hz line's place beside a band of FWHM 0.22 Hz, one Welch
+  # bin: floored there, the widths agreed)
   fw <- 1 / (pi * tc)
   list(band = bands[j, , drop = FALSE],
        near = d[j] <= max(0.5 * bands$width[j], 2 * res),
