@@ -442,7 +442,7 @@ stage_reconsider <- function(st) {
     for (l in groups) {
       w <- refit_without(st, cur, l, "refit without one instance", "reconsider", step)
       st <- w$st
-      if (is.null(w$fit) || !all(earlier_broken(st, w$fit) %in% broken)) next
+      if (is.null(w$fit) || !all(broken_without(st, w) %in% broken)) next
       gain <- refine_crit(st, w$fit) - c_cur
       if (gain < st$args$min_gain && (is.null(best) || gain < best$gain)) {
         best <- list(w = w, label = l, gain = gain)
@@ -456,6 +456,15 @@ stage_reconsider <- function(st) {
   }
   if (!identical(st$current, before)) st <- stage_remaining(st)
   st
+}
+
+# The instances earlier_broken() finds in refit_without()'s model `w`,
+# under the labels they had before the drop (without gm1, the model's gm1 is
+# the gm2 that was).
+broken_without <- function(st, w) {
+  now <- earlier_broken(st, w$fit)
+  map <- label_map(w$from$terms, attr(w$terms, "gone"))
+  names(map)[match(now, map)]
 }
 
 # The instances stage_reconsider() judges again, in groups that leave

@@ -315,4 +315,17 @@ test_that("an instance the final model does without leaves it; one the raw data 
   st_split$taken_with <- c(NA, 1L)
   expect_identical(ns$judged_again(st_split, fit), list(c("gm1", "gm2")))
   expect_identical(ns$stage_reconsider(st_split)$current, fit)
+  # an instance already broken before the drop is read under its own label
+  # after it: the weak GM taken first (gm1), the strong one second (gm2),
+  # made inadmissible by a sampling rate at which 5 s is under 2 samples;
+  # without gm1 the model's gm1 is the old gm2, broken as it was
+  fit_r <- avfit(allan(x, freq), terms = c("N", "K", "gm", "gm"),
+                 start = c(gm1.tc = 200, gm2.tc = 5))
+  st_r <- st
+  st_r$current <- fit_r
+  st_r$args$freq <- 0.3
+  expect_identical(ns$earlier_broken(st_r, fit_r), "gm2")
+  out_r <- ns$stage_reconsider(st_r)
+  expect_identical(vapply(out_r$steps, function(s) s$label, ""), c("left:gm1", "gm1"))
+  expect_equal(coef(out_r$current)[["gm1.tc"]], 5, tolerance = 0.25)
 })
