@@ -225,6 +225,10 @@ spike_ao_values <- function(x, sc, mu, pi, denom) {
     .Call(`_allanvar_spike_ao_values`, x, sc, mu, pi, denom)
 }
 
+centred_moving_mean <- function(x, h) {
+    .Call(`_allanvar_centred_moving_mean`, x, h)
+}
+
 running_median_keep <- function(x, k) {
     .Call(`_allanvar_running_median_keep`, x, k)
 }

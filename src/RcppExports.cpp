@@ -711,6 +711,17 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// centred_moving_mean
+Rcpp::NumericVector centred_moving_mean(const Rcpp::NumericVector& x, R_xlen_t h);
+RcppExport SEXP _allanvar_centred_moving_mean(SEXP xSEXP, SEXP hSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type x(xSEXP);
+    Rcpp::traits::input_parameter< R_xlen_t >::type h(hSEXP);
+    rcpp_result_gen = Rcpp::wrap(centred_moving_mean(x, h));
+    return rcpp_result_gen;
+END_RCPP
+}
 // running_median_keep
 Rcpp::NumericVector running_median_keep(const Rcpp::NumericVector& x, int k);
 RcppExport SEXP _allanvar_running_median_keep(SEXP xSEXP, SEXP kSEXP) {
@@ -957,6 +968,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_spike_burg", (DL_FUNC) &_allanvar_spike_burg, 2},
     {"_allanvar_ar_filter", (DL_FUNC) &_allanvar_ar_filter, 3},
     {"_allanvar_spike_ao_values", (DL_FUNC) &_allanvar_spike_ao_values, 5},
+    {"_allanvar_centred_moving_mean", (DL_FUNC) &_allanvar_centred_moving_mean, 2},
     {"_allanvar_running_median_keep", (DL_FUNC) &_allanvar_running_median_keep, 2},
     {"_allanvar_trimmed_mean_square", (DL_FUNC) &_allanvar_trimmed_mean_square, 3},
     {"_allanvar_abs_rank_band_mean", (DL_FUNC) &_allanvar_abs_rank_band_mean, 3},

@@ -329,6 +329,31 @@ Rcpp::NumericVector spike_ao_values(const Rcpp::NumericVector& x, double sc, dou
   return out;
 }
 
+// The centred moving mean of x over the 2 h + 1 samples around each (fewer
+// at the ends), the spike pass's slow part (R/nonstationary.R,
+// spike_slow_part()): a running sum of x less its mean, in long double so
+// that n updates do not drift.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector centred_moving_mean(const Rcpp::NumericVector& x, R_xlen_t h) {
+  const R_xlen_t n = x.size();
+  Rcpp::NumericVector out(n);
+  if (n == 0) return out;
+  if (h < 0) h = 0;
+  const double* v = x.begin();
+  long double mu = 0;
+  for (R_xlen_t i = 0; i < n; i++) mu += v[i];
+  mu /= n;
+  long double sum = 0;
+  R_xlen_t lo = 0, hi = -1;             // the window [lo, hi] summed
+  for (R_xlen_t i = 0; i < n; i++) {
+    const R_xlen_t want_hi = std::min(n - 1, i + h), want_lo = std::max<R_xlen_t>(0, i - h);
+    while (hi < want_hi) sum += v[++hi] - mu;
+    while (lo < want_lo) sum -= v[lo++] - mu;
+    out[i] = static_cast<double>(mu + sum / (hi - lo + 1));
+  }
+  return out;
+}
+
 // min(q, p) and max(p, q) as SSE2's minpd and maxpd take them (the window
 // network of running_median_keep())
 static inline double median7_min(double q, double p) { return q < p ? q : p; }

@@ -261,6 +261,35 @@ test_that("heavy-tailed noise is the noise, not spikes: gross outliers beyond it
   expect_true(all(diff(tab$B) < 0))
 })
 
+test_that("a slow process added (a Gauss-Markov drift, a warm-up) leaves the spike count as it was", {
+  skip_on_cran()
+  n <- 1e6
+  freq <- 100
+  gm <- function(sigma, tc) {
+    phi <- exp(-1 / (freq * tc))
+    w <- rnorm(n, sd = sigma * sqrt(1 - phi^2))
+    w[1L] <- rnorm(1L, sd = sigma)
+    as.numeric(stats::filter(w, phi, method = "recursive"))
+  }
+  counts <- NULL
+  for (seed in 1:8) {
+    set.seed(seed)
+    # heavy-tailed noise (Student t, 5 degrees of freedom) through a short
+    # moving average, a random walk, quantized to 0.002
+    x <- as.numeric(stats::filter(0.01 * rt(n, 5), c(0.5, 0.3, 0.2), sides = 1))
+    x[1:2] <- 0
+    x <- round((x + cumsum(rnorm(n, sd = 2e-5))) / 0.002) * 0.002
+    counts <- rbind(counts, c(nrow(detect_spikes(x, freq)),
+                              nrow(detect_spikes(x + gm(0.004, 20), freq)),
+                              nrow(detect_spikes(x - 0.05 * exp(-(seq_len(n) - 1) / (freq * 900)),
+                                                 freq))))
+  }
+  # judged beside the slow part, seed 7's count went from 0 to 1 with
+  # either added
+  expect_identical(counts[, 2L], counts[, 1L])
+  expect_identical(counts[, 3L], counts[, 1L])
+})
+
 test_that("a line near Nyquist does not hide spikes: they are outliers of the series' own AR model", {
   # 60 outliers of 6.5-10 sd; a 48.1 Hz line of the white's amplitude. On
   # the running median's residual (the line stays in it, the scale grows

@@ -131,3 +131,23 @@ test_that("ADIS16405 unit 3 accel_x: its pulse at 1844 s stays a transient when 
   expect_true(any(near & tab$kind == "transients"))
   expect_false(any(near & tab$kind == "steps"))
 })
+
+test_that("ADIS16405 unit 1 accel_z: a slow Gauss-Markov term added leaves its spike count as it was", {
+  skip_if_no_shared()
+  m <- readRDS(shared_file("adis16405_unit1.rds"))
+  freq <- attr(m, "freq")
+  b <- as.numeric(m[, "accel_z"])
+  n0 <- nrow(detect_spikes(b, freq))
+  counts <- integer()
+  for (seed in 1:3) {
+    # slow against the 10 s the statistic's slow part is read over (a GM
+    # of 1-5 s is local noise to it, and moves the level as noise does)
+    for (tc in c(12, 60)) {
+      set.seed(seed)
+      counts <- c(counts, nrow(detect_spikes(b + gm_raising_adev(b, freq, tc), freq)))
+    }
+  }
+  # judged with the slow part in, the GM lightened the statistic's tail
+  # and the count went from 3 to 5
+  expect_true(all(counts == n0))
+})
