@@ -777,8 +777,9 @@ robust_scale <- function(r, trim = 0.005) {
 #'
 #' A spike is an additive outlier of the series' own noise model: an
 #' AR(`p`) model fitted by Burg to the winsorised series less its slow
-#' part (spike_slow_part(); its first 2e5 samples) carries the sensor's filter, its lines (a line near Nyquist is
-#' two AR roots) and the colour of the noise, and the additive-outlier
+#' part (spike_slow_part(); its first 2e5 samples) carries the sensor's
+#' filter, its lines (a line near Nyquist is two AR roots) and the colour
+#' of the noise, and the additive-outlier
 #' statistic (Fox 1972; Chang, Tiao and Chen 1988) of every sample,
 #' w = sum_j pi_j e(t + j) / sum pi_j^2 over its standard error (the
 #' innovations' robust scale), is compared with the Gaussian Bonferroni
