@@ -768,7 +768,13 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     }
     wd <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) 1 / (pi * ft$tc), 0)
     pw <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) ft$sigma^2, 0)
-    two <- !is.null(pf) && !is.na(pf$cut) && pf$stand > 0.25 &&
+    # (the background's error is smooth on the stronger one's scale: a
+    # weaker one narrower than it need only clear the run search's
+    # false-alarm level)
+    level <- if (!is.null(wd) && wd[which.min(pw)] < wd[which.max(pw)]) {
+      stats::qchisq(1 - alpha / nb, w$nu) / w$nu - 1
+    } else 0.25
+    two <- !is.null(pf) && !is.na(pf$cut) && pf$stand > level &&
       wd[which.min(pw)] <= 2 * wd[which.max(pw)] &&
       pf$chi2_one - pf$chi2_two > stats::qchisq(1 - alpha, 3L) &&
       all(wd >= w$df) &&
@@ -968,6 +974,9 @@ band_pair_fit <- function(j, reg, fit1, f, p, bg, tau0, nu) {
   between <- which(f[j] > a$fr & f[j] < b$fr)
   if (!length(between)) return(out)
   over <- between[one(b, f[j[between]]) >= one(a, f[j[between]])]
+  # a weak resonance on a strong one's skirt may never take over: its side
+  # starts a half-width below its centre
+  if (!length(over)) over <- between[f[j[between]] >= b$fr - 1 / (2 * pi * b$tc)]
   if (!length(over)) return(out)
   out$cut <- over[1L]
   # how far each side's peak stands above the background plus the other's
