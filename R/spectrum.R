@@ -743,12 +743,16 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
   # better too) and each side's peak a quarter above the background plus
   # the other's fitted PSD (as the skirt check below: the background under
   # a broad run is read to 10-20%; a strong band added to a measured gyro
-  # left a second "resonance" on its flank standing 10-19% above), the
+  # left a second "resonance" on its flank standing 10-19% above, 1.8 x as
+  # wide; a weaker one narrower than the stronger, which that error cannot
+  # make, need only clear the false-alarm level: an accelerometer's own
+  # 9.84 Hz resonance stood 19% above a 7.9 Hz band's skirt), the
   # weaker no more than twice as wide as the stronger (a broad excess beside
   # a band is the background's curvature under the run, read by a median
   # interpolated across it: a second-order low-pass's roll-off left one of
   # FWHM 4.7 Hz beside a 15 Hz resonance of 1.2 Hz). The run is cut where
-  # the upper one takes over. Judged on the background re-read beside the
+  # the upper one takes over (or a half-width below the upper one's centre
+  # when it never does). Judged on the background re-read beside the
   # fits (the first, read with a run and its flanks masked, leaves a strong
   # band's skirts as excess), which is read again beside the split bands.
   # Two such resonances closer than the sum of their widths stay one run
@@ -768,9 +772,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     }
     wd <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) 1 / (pi * ft$tc), 0)
     pw <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) ft$sigma^2, 0)
-    # (the background's error is smooth on the stronger one's scale: a
-    # weaker one narrower than it need only clear the run search's
-    # false-alarm level)
+    # (the level for a weaker one narrower than the stronger: see above)
     level <- if (!is.null(wd) && wd[which.min(pw)] < wd[which.max(pw)]) {
       stats::qchisq(1 - alpha / nb, w$nu) / w$nu - 1
     } else 0.25
