@@ -590,15 +590,12 @@ step_trace <- function(st) {
 # A family's form chosen before an effect the raw data pinned and confirm
 # (a line's frequency) may have been chosen for that effect's bump (a
 # first-order low-pass taken for a 2.2 Hz line's bump beside a moving
-# average's own: N +24%); once the effect is in, the form is chosen again.
-# Not while a set that effect opened is incomplete (its further lines are
-# trials of this step): a form chosen again then takes their bumps in turn.
+# average's own: N +24%); once the effect is in, the form is chosen again,
+# on the curve without the sharp lines the model does not hold yet (a set
+# that effect opened, whose further lines a form would otherwise take in
+# turn).
 step_reform <- function(st) {
   if (!isTRUE(st$reform)) return(st)
-  if (nrow(st$trials) && any(vapply(seq_len(nrow(st$trials)),
-                                    function(i) continues_set(st$trials[i, ]), NA))) {
-    return(st)
-  }
   st$reform <- FALSE
   r <- rechoose_families(st, known = TRUE)
   st <- r$st
