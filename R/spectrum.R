@@ -832,6 +832,28 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
       on_band <- on_band[!skirt]
     }
   }
+  # Runs were found against the first background (a running median, and
+  # across masked runs an interpolation) and a strong band's skirt can lift
+  # a stretch of it above that (a 12.5 Hz "band" beside a 20.8 Hz one of
+  # 0.5 x the white sd); judged again over the background re-read beside
+  # the fits plus the other bands' fitted PSD, a run none of whose bins
+  # stands out at the false-alarm level is no band.
+  if (length(fits)) {
+    stands <- vapply(seq_along(regs), function(k) {
+      j <- regs[[k]]$j
+      ratio <- p[j] / (bg[j] + if (length(fits) > 1L) fitted_psd(fits[-k])[j] else 0)
+      any(ratio > 1 & stats::pchisq(ratio * w$nu, w$nu, lower.tail = FALSE) * nb < alpha)
+    }, NA)
+    if (!all(stands)) {
+      r2$from <- r2$from[stands]
+      r2$to <- r2$to[stands]
+      regs <- make_regs(r2)
+      fits <- fits[stands]
+      pairs <- pairs[stands]
+      on_band <- on_band[stands]
+      reread()
+    }
+  }
   on_band <- unlist(on_band)
   if (is.null(on_band)) on_band <- numeric()
   rows <- lapply(seq_along(regs), function(k) {

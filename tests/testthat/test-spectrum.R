@@ -363,6 +363,30 @@ test_that("find_bands(): a narrow resonance that never rises above a strong band
   }
 })
 
+test_that("find_bands(): a stretch of a strong band's skirt that the first background left standing is no band", {
+  # own generator: an MA(1) sensor filter and a strong two-pole band (0.5
+  # x the white sd) at 15-21 Hz, with and without a weaker one beside it.
+  # Against the first background a stretch of the strong band's low skirt
+  # formed a run of its own, which stood nowhere above the background
+  # re-read beside the fits: a band at 12.5 Hz beside the 20.8 Hz one
+  # (seed 24 alone), at 10.2 Hz beside 15.6 and 17.9 Hz (seed 28 with the
+  # weaker one) on main 4d5e657
+  freq <- 100
+  n <- 1e6
+  for (s in c(24L, 28L)) {
+    set.seed(s)
+    fs <- stats::runif(1, 15, 35)
+    fw <- fs + sample(c(-1, 1), 1) * stats::runif(1, 1.8, 3)
+    w <- rnorm(n + 1L, sd = 0.01)
+    x <- w[-1L] + 0.2 * w[-(n + 1L)] + 0.005 * ar2_unit(n, fs, 0.3, freq)
+    if (s == 28L) x <- x + 0.15 * 0.005 * ar2_unit(n, fw, 0.5, freq)
+    b <- allanvar:::find_bands(x, freq)
+    want <- if (s == 28L) sort(c(fs, fw)) else fs
+    expect_equal(nrow(b), length(want))
+    expect_equal(sort(b$f_center), want, tolerance = 0.02)
+  }
+})
+
 test_that("find_bands(): a band with a line on top is measured without the line", {
   # own generator: an MA(1) sensor filter, a weak 8.2 Hz two-pole band and
   # a 7.6 Hz line of 0.3 x the white sd in the same run. Fitted with the
