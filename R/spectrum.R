@@ -580,7 +580,9 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
 #' resonance model fitted to the excess over the background by least
 #' squares (relative to the background): centre `f_center`, `tc` (its
 #' FWHM is about 1/(pi tc), given as `width`), `power` (its variance,
-#' sigma^2) and `share` of the series' variance; a run that two resonances
+#' sigma^2) and `share` of the series' variance. A run none of whose bins
+#' stands out at that rate over the background re-read beside the fits
+#' plus the other bands' fitted PSD is dropped. A run that two resonances
 #' fit better but that stays one (their centres closer than the sum of
 #' their widths) with the excess dipping between them also carries the two (`pair_fr1`, `pair_tc1`,
 #' `pair_power1`, `pair_fr2`, ...; NA otherwise).
