@@ -600,13 +600,16 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
   corr <- log(stats::qchisq(0.5, w$nu) / w$nu)
   octave <- function(i) 2L * as.integer(pmax(8, 0.35 * i)) + 1L
   edge <- octave(1L) %/% 2L + 1L
+  # bins whose ratio to a background is significant against the Welch
+  # estimate's chi-square (EDF nu), with a false-alarm rate alpha over the
+  # nb bins searched (Bonferroni); no fixed power ratio (a weak band over a
+  # long record is still a band)
+  stands_out <- function(ratio) {
+    ratio > 1 & stats::pchisq(ratio * w$nu, w$nu, lower.tail = FALSE) * nb < alpha
+  }
   runs <- function(bg) {
     ratio <- p / bg
-    pval <- stats::pchisq(ratio * w$nu, w$nu, lower.tail = FALSE)
-    # significant against the Welch estimate's chi-square (EDF nu), with a
-    # false-alarm rate alpha over the nb bins searched (Bonferroni); no
-    # fixed power ratio (a weak band over a long record is still a band)
-    hot <- ratio > 1 & pval * nb < alpha
+    hot <- stands_out(ratio)
     # only where the background window is centred: at the low end it slides
     # up in frequency and under-reads a falling spectrum (RW, GM, roll-off)
     hot[seq_len(min(nb, edge))] <- FALSE
@@ -774,11 +777,10 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     }
     wd <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) 1 / (pi * ft$tc), 0)
     pw <- if (!is.null(pf$fits)) vapply(pf$fits, function(ft) ft$sigma^2, 0)
-    # (the level for a weaker one narrower than the stronger: see above)
-    level <- if (!is.null(wd) && wd[which.min(pw)] < wd[which.max(pw)]) {
-      stats::qchisq(1 - alpha / nb, w$nu) / w$nu - 1
-    } else 0.25
-    two <- !is.null(pf) && !is.na(pf$cut) && pf$stand > level &&
+    # (a weaker one narrower than the stronger need only stand out: see above)
+    narrow <- !is.null(wd) && wd[which.min(pw)] < wd[which.max(pw)]
+    two <- !is.null(pf) && !is.na(pf$cut) &&
+      (if (narrow) stands_out(1 + pf$stand) else pf$stand > 0.25) &&
       wd[which.min(pw)] <= 2 * wd[which.max(pw)] &&
       pf$chi2_one - pf$chi2_two > stats::qchisq(1 - alpha, 3L) &&
       all(wd >= w$df) &&
@@ -843,8 +845,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
   if (length(fits)) {
     stands <- vapply(seq_along(regs), function(k) {
       j <- regs[[k]]$j
-      ratio <- p[j] / (bg[j] + if (length(fits) > 1L) fitted_psd(fits[-k])[j] else 0)
-      any(ratio > 1 & stats::pchisq(ratio * w$nu, w$nu, lower.tail = FALSE) * nb < alpha)
+      any(stands_out(p[j] / (bg[j] + if (length(fits) > 1L) fitted_psd(fits[-k])[j] else 0)))
     }, NA)
     if (!all(stands)) {
       r2$from <- r2$from[stands]
