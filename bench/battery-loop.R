@@ -673,9 +673,9 @@ if (identical(set, "h")) {
   cases[["control: Q + N + K (h)"]] <- function() {
     list(x = round(sim_base() / (2 * h_white)) * (2 * h_white), base = NULL)
   }
-  kinds <- c("line", "nyquist", "band", "gm", "warmup", "step", "square", "saw")
+  h_kinds <- c("line", "nyquist", "band", "gm", "warmup", "step", "square", "saw")
   # each kind on 4 or 5 of the 36 (axis, effect) slots, two kinds per axis
-  slots <- matrix(sample(rep(kinds, length.out = 36L)), 2L)
+  slots <- matrix(sample(rep(h_kinds, length.out = 36L)), 2L)
   while (any(slots[1L, ] == slots[2L, ])) slots <- matrix(sample(slots), 2L)
   real <- list()
   for (u in 1:3) for (j in 1:6) for (what in slots[, 6L * (u - 1L) + j]) {
