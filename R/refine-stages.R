@@ -660,6 +660,9 @@ step_settle <- function(st) {
   if (!r$swapped) {
     st <- family_pairs(st)
     if (!is.null(st$best)) return(st)
+    # nor a trial alone: two the raw data measure may pay together
+    st <- raw_pairs(st)
+    if (!is.null(st$best)) return(st)
   }
   st$flow <- if (r$swapped) "next" else "stop"
   if (!r$swapped) st$settled <- st$current
