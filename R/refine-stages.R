@@ -742,21 +742,23 @@ step_record <- function(st) {
   }
   # the second instance of a split (split_trial()): its own row, at the
   # values the final refit gave it (the step's gain is on the first row)
-  if (!is.null(best$also)) {
-    lab2 <- best$also$label
-    effect2 <- best$also$effect %||% best$trial$effect
+  # (and a form chosen again beside them: raw_pairs())
+  first <- length(st$steps)
+  for (also in c(if (!is.null(best$also)) list(best$also), best$extras)) {
+    lab2 <- also$label
+    effect2 <- also$effect %||% best$trial$effect
     par2 <- instance_params(stats::coef(best$fit), best$fit$layout, lab2)
     loc2 <- locate_signature(st$sig, best$fit, lab2)
     ev2 <- raw_evidence(effect2, as.list(par2), st$raw,
                         diag_series(st$raw), st$args$freq)
     st$steps[[length(st$steps) + 1L]] <- step_row(
       effect2, lab2, loc2, par2,
-      paste0(loc2$text, "; ", best$also$note %||%
+      paste0(loc2$text, "; ", also$note %||%
                paste0("split from ", best$label, "'s one-term compromise"),
              if (nzchar(ev2$text)) paste0("; raw data: ", ev2$text)),
       ev2$support, best$fit, best$fit, best$crit, best$crit)
     st$pins[length(st$steps)] <- list(numeric(0))
-    st$taken_with[length(st$steps)] <- length(st$steps) - 1L
+    st$taken_with[length(st$steps)] <- first
   }
   st$current <- best$fit
   st
