@@ -304,7 +304,10 @@ series_pays_without <- function(st, new, label, gain = st$args$min_gain,
   at <- kind_excess(series$adev_kinds, left, new$data$tau[j])
   if (is.null(at) || !(own > 0) || sum(at) < min_share * own) return(NULL)
   cv <- curve_of_fit(new)
-  total <- rowSums(kind_excess(series$adev_kinds, left, cv$data$tau))
+  # signed: a step against the axis's own wander lowers the long-tau
+  # points (a measured accelerometer's 1310-2620 s points fell to a third),
+  # a drop a GM's tail then describes; without the step they come back
+  total <- rowSums(kind_excess(series$adev_kinds, left, cv$data$tau, signed = TRUE))
   # taken out to at most 90% of a point: the excess is an estimate too
   cv$data$avar <- pmax(cv$data$avar - total, 0.1 * cv$data$avar)
   refit_on <- function(fit) {
@@ -329,16 +332,17 @@ term_peak <- function(comp, label) {
 }
 
 # The AV each kind left in adds at the taus `tau` (ADEV^2 with it minus
-# without it, interpolated on log tau; 0 outside the pass's taus and where
-# taking it out raised the curve): a matrix, one column per kind, or NULL.
-kind_excess <- function(adev_kinds, kinds, tau) {
+# without it, interpolated on log tau; 0 outside the pass's taus, and
+# where taking it out raised the curve unless `signed`): a matrix, one
+# column per kind, or NULL.
+kind_excess <- function(adev_kinds, kinds, tau, signed = FALSE) {
   out <- NULL
   for (k in kinds) {
     a <- adev_kinds[adev_kinds$kind == k, , drop = FALSE]
     e <- a$before^2 - a$after^2
     ok <- is.finite(e) & a$tau > 0
     if (sum(ok) < 2L) next
-    v <- stats::approx(log(a$tau[ok]), pmax(e[ok], 0), log(tau))$y
+    v <- stats::approx(log(a$tau[ok]), if (signed) e[ok] else pmax(e[ok], 0), log(tau))$y
     v[is.na(v)] <- 0
     out <- cbind(out, v)
     colnames(out)[ncol(out)] <- k
