@@ -91,11 +91,8 @@ evidence_gm <- function(par, raw, x, freq) {
   if (!is.finite(tc) || tc * freq * 40 / 8 > length(x)) {
     return(list(text = "record too short for an ACF check", support = NA))
   }
-  # avrefine()'s per-call store (NULL elsewhere); the series without the
-  # steps and warm-ups the series pass found, when it found any
-  slow <- diag_slow(raw)
-  a <- if (is.null(slow)) acf_exponential(x, freq, tc, cache = diag_cache(raw))
-    else acf_exponential(slow$x, freq, tc, cache = slow$cache)
+  # avrefine()'s per-call store (NULL elsewhere)
+  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw))
   # an exponential that explains less than half of the ACF's variation
   # about a line is not the ACF's shape (an oscillating residue)
   if (is.finite(a$tc) && a$z > 5 && isTRUE(a$shape >= 0.5)) {

@@ -138,31 +138,6 @@ diag_series <- function(dg) {
   if (inherits(dg, "refine_diagnostics")) dg$series else NULL
 }
 
-# The series the checks of slow processes read (a Gauss-Markov term's
-# block-mean ACF), with its own store: the checked series less the bias
-# steps and warm-ups the series pass found and left in the data, which a
-# block mean's ACF would otherwise read as a slow correlation of the noise
-# (a step of 2.3 mg at 1571 s on a measured accelerometer confirmed a
-# 241 s GM the axis alone does not have); spikes go too. Kinds a noise
-# term's own excursions produce (transients) stay. NULL outside a loop or when the
-# pass left nothing such in: the checked series is read.
-diag_slow <- function(dg) {
-  if (inherits(dg, "refine_diagnostics")) dg$cache$slow else NULL
-}
-
-# Set the slow checks' series of `dg` from series pass `series` (R/series.R).
-with_slow_series <- function(dg, series, freq) {
-  tab <- series$table
-  if (!inherits(dg, "refine_diagnostics") || is.null(tab) || !NROW(tab)) return(dg)
-  keep <- !tab$removed &
-    !vapply(tab$kind, function(k) isTRUE(effect_entry(k)$noise_lookalike), NA) &
-    tab$kind %in% effect_kinds("series")
-  if (!any(keep)) return(dg)
-  dg$cache$slow <- list(x = remove_series(dg$series, freq, tab[keep, , drop = FALSE]),
-                        cache = new.env(parent = emptyenv()))
-  dg
-}
-
 # The diagnostics as the result reports them (`$refine$diagnostics`): the
 # avdiagnose() list with each part in place of, or after, its fields.
 diag_report <- function(dg) {

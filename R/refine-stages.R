@@ -47,7 +47,7 @@ stage_prepare <- function(st) {
   } else {
     st$series <- a$series
   }
-  st$raw <- with_slow_series(refine_diagnostics(st$data, a$freq), st$series, a$freq)
+  st$raw <- refine_diagnostics(st$data, a$freq)
   # a trend is a ramp only beyond what the series pass found and left in
   # the data (a warm-up or a step projects onto a line)
   beside <- series_shapes(st$series, length(st$data), a$freq)
