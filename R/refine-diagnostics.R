@@ -138,6 +138,18 @@ diag_series <- function(dg) {
   if (inherits(dg, "refine_diagnostics")) dg$series else NULL
 }
 
+# The diagnostics with the series effects of `table` (rows of a series
+# pass's table) taken out of the checked series, its parts as they are and
+# a store of its own; made once per call and set of effects.
+diag_without <- function(dg, table, freq) {
+  key <- paste0("without.", paste(table$kind, table$index, collapse = ","))
+  hit <- dg$cache[[key]]
+  if (!is.null(hit)) return(hit)
+  out <- new_refine_diagnostics(dg$base, dg$parts, remove_series(dg$series, freq, table))
+  dg$cache[[key]] <- out
+  out
+}
+
 # The diagnostics as the result reports them (`$refine$diagnostics`): the
 # avdiagnose() list with each part in place of, or after, its fields.
 diag_report <- function(dg) {

@@ -323,7 +323,7 @@ judge_instance <- function(st, f, effect, label, tau) {
   dup <- if (is.null(why)) series_duplicate(st$series, f, label)
   if (is.null(why) && is.null(dup)) {
     need <- st$args$min_gain * (1 + rests_on_curve(effect, ev, st$raw))
-    dup <- series_pays_without(st, f, label, gain = need)
+    dup <- series_pays_without(st, f, label, gain = need, effect = effect, par = par, ev = ev)
   }
   if (!is.null(dup)) {
     why <- if (dup$how == "share") {
