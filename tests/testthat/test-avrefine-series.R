@@ -183,3 +183,29 @@ test_that("a GM the raw data do not confirm must pay twice min_gain without the 
   expect_false(rests_on_curve("gm", list(support = NA), NULL))
   expect_false(rests_on_curve("gm", list(support = FALSE), raw))
 })
+
+test_that("a bias step left in a measured axis is no GM's raw support", {
+  # unit 2 accel_z with a step of 10 x its ADEV(10 s) at 1571 s. The axis
+  # alone reads an exponential ACF of 88 s for a 255 s GM (undecided), and
+  # the curve gains too little for one the raw data leave undecided; with
+  # the step left in, the block means read 139 s (confirmed), and a 241 s
+  # GM entered (main 48ab052). Without the step the support is gone: the
+  # GM must pay twice min_gain on the curve without the step's excess.
+  skip_if_no_shared()
+  skip_on_cran()
+  a <- measured_axis(2, "accel_z")
+  n <- length(a$b)
+  loop <- function(v) {
+    suppressWarnings(suppressMessages(avrefine(avfit(allan(v, a$freq), terms = c("N", "B", "K")),
+                                               data = v)))
+  }
+  r0 <- loop(a$b)
+  expect_false("gm" %in% r0$terms)
+  size <- 10 * allan(a$b, a$freq, taus = I(10))$adev
+  r <- loop(a$b + size * ((seq_len(n) - 1) / a$freq >= 1571))
+  st <- r$series$table[r$series$table$kind == "steps", , drop = FALSE]
+  expect_lte(min(abs(st$time - 1571)), 2)
+  expect_false("gm" %in% r$terms)
+  d <- r$refine$series_duplicates
+  expect_true(any(d$effect == "gm" & d$series_kind == "steps"))
+})
