@@ -685,10 +685,14 @@ raw_pairs <- function(st) {
       r <- state_refit(st, args, "two raw-data trials together", t1$effect)
       st <- r$st
       f <- r$fit
-      if (is.null(f)) next
+      # (the other forms are tried only for a pair that pays beside the
+      # model's own and is refused there: the screen's cost stays small)
+      pays <- !is.null(f) && is.finite(refine_crit(st, f)) &&
+        refine_crit(st, f) < c0 - 2 * min_gain && f$chi2 < 0.9 * cur$chi2
+      if (!pays && is.null(fm)) break
+      if (!pays) next
       c1 <- refine_crit(st, f)
-      if (!is.finite(c1) || c1 >= c0 - 2 * min_gain || f$chi2 >= 0.9 * cur$chi2 ||
-          c1 >= (st$best$crit %||% Inf) ||
+      if (c1 >= (st$best$crit %||% Inf) ||
           min(max_share(f, lab1), max_share(f, lab2)) < 0.02) next
       j1 <- judge_instance(st, f, t1$effect, lab1, tau)
       if (!is.null(j1$why) || !isTRUE(j1$ev$support)) next
@@ -715,6 +719,7 @@ raw_pairs <- function(st) {
                                   note = sprintf("chosen again (was %s) beside %s and %s",
                                                  fm$current, lab1, lab2)))
                       })
+      if (is.null(fm)) break
     }
   }
   st
