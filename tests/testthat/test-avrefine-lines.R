@@ -685,21 +685,3 @@ test_that("a line near Nyquist on a measured gyro: the filter refused at the cur
   expect_lt(r$chi2, 4)
   expect_false(any(r$steps$confirmed %in% FALSE))
 })
-
-test_that("a harmonic set's further lines do not keep a measured axis's own GM from being screened", {
-  # unit 1 accel_y (a 101 s GM of its own) with a 0.8 Hz square wave of
-  # 0.4 x its white sd. Each further odd harmonic (10.4 to 23.2 Hz) paid by
-  # its periodogram line alone, barely moving the curve; winning step
-  # after step in the traced tier, they kept the GM (worth 28 on the
-  # criterion) from ever being screened, and the axis lost it (b9700aa)
-  skip_if_no_shared()
-  skip_on_cran()
-  a <- measured_axis(1, "accel_y")
-  r0 <- loop(a$b, a$freq)
-  expect_true("gm" %in% r0$terms)
-  set.seed(2)
-  r <- loop(with_wave(a, 0.4, 0.8, runif(1, 0, 2 * pi), wave = function(p) sign(sin(p))), a$freq)
-  expect_true("gm" %in% r$terms)
-  expect_lte(min(abs(fitted_f0(r) / 2.4 - 1)), 0.03)
-  expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.05)
-})
