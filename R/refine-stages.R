@@ -642,16 +642,8 @@ screen_trials <- function(st) {
           st$best <- r$cand
         }
       }
-      # A further line of a held harmonic set pays by its raw confirmation
-      # alone (it may cost the curve up to min_gain): such a winner does not
-      # keep the other trials from being screened beside it. (A 0.8 Hz
-      # square wave on a measured accelerometer: its 13th-29th harmonics,
-      # each barely moving the curve, won step after step until the loop
-      # ended, and the axis's own 101 s GM, worth 28 on the criterion, was
-      # never screened.)
-      if (!is.null(st$best) && st$best$crit < st$c0 - st$args$min_gain) return(st)
+      if (!is.null(st$best)) return(st)
     }
-    if (!is.null(st$best)) return(st)
   }
   st
 }
