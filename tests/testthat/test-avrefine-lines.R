@@ -288,10 +288,10 @@ test_that("a greedy order far from the curve is revisited with the raw data's va
   # a band at 15.5 Hz (an AR(2)), a 0.48 Hz line, a random walk and a 0.9
   # Hz square wave. The greedy order took a GM first and ended at chi2/dof
   # 6.7; taking the periodogram's lines and the band's spectrum first, the
-  # run fits, and was the one kept (main 48ab052). Since the screen goes
-  # on past a further set line that pays by its confirmation alone, the
-  # greedy order reaches that model itself; a revisit, if one is made,
-  # must keep it.
+  # run fits, and was the one kept (main 48ab052). Since a filter form the
+  # raw data refuse at the curve's shape is tried at the raw data's, a
+  # low-pass enters at step 2 in place of the GM and the greedy order
+  # reaches that model itself; a revisit, if one is made, must keep it.
   set.seed(1)
   freq <- 100
   n <- 5e5
