@@ -128,8 +128,7 @@ screen_trial <- function(st, tr, nl_now) {
                       "refit at the raw data's shape", tr$effect)
       st <- r$st
       g <- r$fit
-      if (!is.null(g) && is.finite(crit(g)) && crit(g) < c0 - min_gain &&
-          g$chi2 < 0.9 * cur$chi2 && max_share(g, lab) >= 0.02) {
+      if (free_pays(g) && max_share(g, lab) >= 0.02) {
         jg <- judge_instance(st, g, tr$effect, lab, tau)
         if (is.null(jg$why)) {
           new <- g
@@ -518,15 +517,9 @@ rechoose_descriptions <- function(st) {
       # as the model holds it, and beside each other form of its families
       # (a form fitted to what the old description missed may be
       # contradicted once the new one carries it)
-      sets <- list(list(terms = c(tm), start = NULL, form = NULL))
-      for (fe in entries_with("family")) {
-        ff <- family_forms(st, fe)
-        if (is.null(ff)) next
-        for (fm in ff$forms) {
-          sets[[length(sets) + 1L]] <- list(terms = replace(c(tm), c(tm) == ff$current, fm$term),
-                                            start = fm$start, form = fm)
-        }
-      }
+      sets <- lapply(form_choices(st), function(fm) {
+        list(terms = with_form(tm, fm), start = fm$start, form = fm)
+      })
       for (ts in sets) {
         sv <- c(start, ts$start)
         sv <- sv[!duplicated(names(sv)) & names(sv) %in% coef_layout(ts$terms)$name]
@@ -620,6 +613,23 @@ raw_shape <- function(st, terms, effect) {
   pin_values(terms, effect, s0)
 }
 
+# The choices of the model's family forms: NULL (as they are) first, then
+# each other form of each family, carrying the form it would replace
+# (`current`).
+form_choices <- function(st) {
+  out <- list(NULL)
+  for (fe in entries_with("family")) {
+    ff <- family_forms(st, fe)
+    if (!is.null(ff)) out <- c(out, lapply(ff$forms, function(fm) c(fm, list(current = ff$current))))
+  }
+  out
+}
+
+# Terms `tm` with form choice `fm` (form_choices()) in place of its current.
+with_form <- function(tm, fm) {
+  if (is.null(fm)) c(tm) else replace(c(tm), c(tm) == fm$current, fm$term)
+}
+
 # A family's form `v` (label `lab`) in refit `g`: valid on the curve, not
 # contradicted by the raw data, and the effects accepted earlier hold.
 # Returns list(par, ev), or NULL when it fails.
@@ -656,11 +666,7 @@ raw_pairs <- function(st) {
   # the model's family forms as they are, and each other form in place of
   # its own (a second-order low-pass taken at 45 Hz for two bands the model
   # lacked holds their power: beside it the pair is refused)
-  forms <- list(NULL)
-  for (fe in entries_with("family")) {
-    ff <- family_forms(st, fe)
-    if (!is.null(ff)) forms <- c(forms, lapply(ff$forms, function(fm) c(fm, list(current = ff$current))))
-  }
+  forms <- form_choices(st)
   for (pr in utils::combn(length(trials), 2L, simplify = FALSE)) {
     t1 <- trials[[pr[1L]]]
     t2 <- trials[[pr[2L]]]
@@ -677,7 +683,7 @@ raw_pairs <- function(st) {
     start <- c(pin_values(cur$terms, t1$effect, t1$init[[1L]]),
                pin_values(c(tm1), t2$effect, t2$init[[1L]]))
     for (fm in forms) {
-      terms <- if (is.null(fm)) c(tm) else replace(c(tm), c(tm) == fm$current, fm$term)
+      terms <- with_form(tm, fm)
       sv <- c(start, fm$start)
       sv <- sv[!duplicated(names(sv)) & !names(sv) %in% names(pin) &
                  names(sv) %in% coef_layout(terms)$name]
@@ -687,11 +693,10 @@ raw_pairs <- function(st) {
       f <- r$fit
       # (the other forms are tried only for a pair that pays beside the
       # model's own and is refused there: the screen's cost stays small)
-      pays <- !is.null(f) && is.finite(refine_crit(st, f)) &&
-        refine_crit(st, f) < c0 - 2 * min_gain && f$chi2 < 0.9 * cur$chi2
+      c1 <- if (is.null(f)) NA_real_ else refine_crit(st, f)
+      pays <- is.finite(c1) && c1 < c0 - 2 * min_gain && f$chi2 < 0.9 * cur$chi2
       if (!pays && is.null(fm)) break
       if (!pays) next
-      c1 <- refine_crit(st, f)
       if (c1 >= (st$best$crit %||% Inf) ||
           min(max_share(f, lab1), max_share(f, lab2)) < 0.02) next
       j1 <- judge_instance(st, f, t1$effect, lab1, tau)
