@@ -285,6 +285,10 @@ allan_type_table_cpp <- function(all = FALSE) {
     .Call(`_allanvar_allan_type_table_cpp`, all)
 }
 
+warmup_gls_ll <- function(Y, q, phis, s) {
+    .Call(`_allanvar_warmup_gls_ll`, Y, q, phis, s)
+}
+
 zstd_available_cpp <- function() {
     .Call(`_allanvar_zstd_available_cpp`)
 }

@@ -153,6 +153,13 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
   x <- check_values(x, min_n = 256L, arg = "x")
   alpha <- check_number(alpha, "alpha", 0, 1, open = TRUE)
   check_diagnosable(x, "x")
+  diagnose_record(x, freq, alpha)
+}
+
+# avdiagnose() of a checked series. `beside`: linear_trend()'s, the shapes
+# of the series effects the trend is read beyond (the loop's; NULL for
+# none).
+diagnose_record <- function(x, freq, alpha = 1e-3, beside = NULL) {
   n <- length(x)
   a1 <- acf_sums(x - mean(x), 1L)
   r1 <- a1[2L] / a1[1L]
@@ -165,7 +172,7 @@ avdiagnose <- function(x, freq = NULL, alpha = 1e-3) {
     noise_id = data.frame(m = ms, tau = ms / freq, alpha = alphas,
                           noise = noise_name(alphas)),
     grid = quantization_grid(x),
-    trend = linear_trend(x, freq)
+    trend = linear_trend(x, freq, beside = beside)
   ), class = "avdiagnose")
 }
 

@@ -57,11 +57,11 @@ diagnose_order <- function() {
   out
 }
 
-# Assemble the diagnostics of raw series `x`: avdiagnose(), then the parts
-# read from the raw series, the cleaned series, then the parts read from
-# it.
-refine_diagnostics <- function(x, freq) {
-  dg <- new_refine_diagnostics(avdiagnose(x, freq), list(), x)
+# Assemble the diagnostics of raw series `x`: avdiagnose() (its trend read
+# beyond the shapes `beside`, linear_trend()'s), then the parts read from
+# the raw series, the cleaned series, then the parts read from it.
+refine_diagnostics <- function(x, freq, beside = NULL) {
+  dg <- new_refine_diagnostics(diagnose_record(x, freq, beside = beside), list(), x)
   steps <- diagnose_order()
   for (d in steps) {
     if (identical(d$reads, "raw")) dg$parts[[d$part]] <- d$make(x, freq, dg)

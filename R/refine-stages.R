@@ -47,13 +47,10 @@ stage_prepare <- function(st) {
   } else {
     st$series <- a$series
   }
-  st$raw <- refine_diagnostics(st$data, a$freq)
   # a trend is a ramp only beyond what the series pass found and left in
   # the data (a warm-up or a step projects onto a line)
-  beside <- series_shapes(st$series, length(st$data), a$freq)
-  if (!is.null(beside)) {
-    st$raw$base$trend <- linear_trend(st$data, a$freq, beside = beside)
-  }
+  st$raw <- refine_diagnostics(st$data, a$freq,
+                               beside = series_shapes(st$series, length(st$data), a$freq))
   st
 }
 

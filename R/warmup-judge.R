@@ -17,27 +17,21 @@
 warmup_ml <- function(y, X, starts) {
   nb <- length(y)
   phis <- exp(-1 / 4^(0:floor(log(nb / 4, 4))))
-  if (!is.null(X)) X <- as.matrix(X)
+  Y <- cbind(y, if (!is.null(X)) as.matrix(X))
+  storage.mode(Y) <- "double"
+  # (src/warmup_ml.cpp: the filter, the GLS and the likelihood in one call)
   fit <- function(th) {
-    mod <- list(h = 1, q = exp(th[1L]), phi = phis, s = exp(th[-1L]))
-    E <- warmup_whiten(cbind(y, X), mod)
-    e <- E[, 1L]
-    beta <- numeric(0)
-    if (!is.null(X)) {
-      q <- qr(E[, -1L, drop = FALSE])
-      beta <- qr.coef(q, e)
-      e <- qr.resid(q, e)
-    }
-    n <- length(e)
-    rss <- max(sum(e^2), .Machine$double.xmin)
+    q <- exp(th[1L])
+    s <- exp(th[-1L])
+    r <- warmup_gls_ll(Y, q, phis, s)
+    rss <- r$rss
+    n <- r$n
     # the scale concentrated out: c = rss / n
-    list(ll = -attr(E, "logdet") - n / 2 * log(rss / n) - n / 2,
-         model = list(h = rss / n, q = mod$q * rss / n, phi = phis,
-                      s = mod$s * rss / n),
-         beta = beta)
+    list(ll = r$ll, model = list(h = rss / n, q = q * rss / n, phi = phis, s = s * rss / n),
+         beta = r$beta)
   }
   nll <- function(th) {
-    v <- fit(th)$ll
+    v <- warmup_gls_ll(Y, exp(th[1L]), phis, exp(th[-1L]))$ll
     if (is.finite(v)) -v else 1e300
   }
   best <- NULL

@@ -890,6 +890,19 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// warmup_gls_ll
+Rcpp::List warmup_gls_ll(const Rcpp::NumericMatrix& Y, double q, const Rcpp::NumericVector& phis, const Rcpp::NumericVector& s);
+RcppExport SEXP _allanvar_warmup_gls_ll(SEXP YSEXP, SEXP qSEXP, SEXP phisSEXP, SEXP sSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type Y(YSEXP);
+    Rcpp::traits::input_parameter< double >::type q(qSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phis(phisSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type s(sSEXP);
+    rcpp_result_gen = Rcpp::wrap(warmup_gls_ll(Y, q, phis, s));
+    return rcpp_result_gen;
+END_RCPP
+}
 // zstd_available_cpp
 bool zstd_available_cpp();
 RcppExport SEXP _allanvar_zstd_available_cpp() {
@@ -983,6 +996,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_tierms_sums_cpp", (DL_FUNC) &_allanvar_tierms_sums_cpp, 4},
     {"_allanvar_total_sums_cpp", (DL_FUNC) &_allanvar_total_sums_cpp, 6},
     {"_allanvar_allan_type_table_cpp", (DL_FUNC) &_allanvar_allan_type_table_cpp, 1},
+    {"_allanvar_warmup_gls_ll", (DL_FUNC) &_allanvar_warmup_gls_ll, 4},
     {"_allanvar_zstd_available_cpp", (DL_FUNC) &_allanvar_zstd_available_cpp, 0},
     {"_allanvar_zstd_decompress_cpp", (DL_FUNC) &_allanvar_zstd_decompress_cpp, 2},
     {NULL, NULL, 0}

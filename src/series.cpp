@@ -11,6 +11,7 @@
 #include <cmath>
 #include <memory>
 #include <vector>
+#include "warmup_kalman.h"
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
@@ -97,10 +98,7 @@ Rcpp::NumericVector shifted_prefix(const Rcpp::NumericVector& x,
 
 // The data half of warmup_whiten() (R/nonstationary.R): every column of Y
 // through the Kalman filter whose gains K (m x nb) and innovation sds sF
-// are given. Per row j, as the R loop it replaces: v = Y[j, ] - colSums of
-// the state a (summed in order from 0, as BLAS dgemv does one %*% a),
-// E[j, ] = v / sF[j], a = phi * a + (0 + K[, j] v) (tcrossprod()'s product
-// added to 0). Returns E without its first row.
+// are given (warmup_whiten_core()). Returns E without its first row.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericMatrix warmup_whiten_data(const Rcpp::NumericMatrix& Y,
                                        const Rcpp::NumericMatrix& K,
@@ -109,75 +107,21 @@ Rcpp::NumericMatrix warmup_whiten_data(const Rcpp::NumericMatrix& Y,
   const R_xlen_t nb = Y.nrow(), nc = Y.ncol(), m = phi.size();
   Rcpp::NumericMatrix E(nb > 0 ? nb - 1 : 0, nc);
   if (nb < 1) return E;
-  const double* y = Y.begin();
-  const double* k = K.begin();
-  const double* f = sF.begin();
-  const double* p = phi.begin();
-  double* e = E.begin();
-  std::vector<double> a(m * nc, 0.0);      // the states, column c at a[c m]
-  for (R_xlen_t j = 0; j < nb; ++j) {
-    const double* kj = k + j * m;
-    for (R_xlen_t c = 0; c < nc; ++c) {
-      double* ac = a.data() + c * m;
-      double s = 0.0;
-      for (R_xlen_t l = 0; l < m; ++l) s = s + ac[l] * 1.0;
-      const double v = y[j + c * nb] - s;
-      if (j > 0) e[(j - 1) + c * (nb - 1)] = v / f[j];
-      for (R_xlen_t l = 0; l < m; ++l) ac[l] = p[l] * ac[l] + (0.0 + v * kj[l]);
-    }
-    if ((j & 255) == 255) Rcpp::checkUserInterrupt();
-  }
+  warmup_whiten_core(Y.begin(), nb, nc, K.begin(), sF.begin(), phi.begin(), m, E.begin());
   return E;
 }
 
 // The gain half of warmup_whiten(): the Kalman gains K (m x nb) and the
-// innovation sds sF from the initial covariance P (m x m), PP = phi phi',
-// the state noise Q and the white variance h, as the R loop made them:
-// Pz = rowSums(P) and F = sum(Pz) + h in long double sums, K = phi Pz / F,
-// stopped at the steady state (the remaining gains are the last one).
+// innovation sds sF (warmup_gains_core()).
 // [[Rcpp::export(rng = false)]]
 Rcpp::List warmup_gains(const Rcpp::NumericMatrix& P0, const Rcpp::NumericMatrix& PP,
                         const Rcpp::NumericVector& Q, const Rcpp::NumericVector& phi,
                         double h, R_xlen_t nb) {
   const R_xlen_t m = phi.size();
-  std::vector<double> P(P0.begin(), P0.end()), Pz(m);
-  const double* pp = PP.begin();
   Rcpp::NumericMatrix K(m, nb);
   Rcpp::NumericVector sF(nb);
-  double* k = K.begin();
-  for (R_xlen_t j = 0; j < nb; ++j) {
-    for (R_xlen_t i = 0; i < m; ++i) {
-      long double r = 0;
-      for (R_xlen_t c = 0; c < m; ++c) r += P[i + c * m];
-      Pz[i] = static_cast<double>(r);
-    }
-    long double t = 0;
-    for (R_xlen_t i = 0; i < m; ++i) t += Pz[i];
-    const double F = static_cast<double>(t) + h;
-    double* kj = k + j * m;
-    for (R_xlen_t i = 0; i < m; ++i) kj[i] = phi[i] * Pz[i] / F;
-    sF[j] = std::sqrt(F);
-    if (j > 1 && std::fabs(sF[j] / sF[j - 1] - 1) < 1e-12) {
-      double dmax = 0, kmax = 0;
-      for (R_xlen_t i = 0; i < m; ++i) {
-        dmax = std::max(dmax, std::fabs(kj[i] - kj[i - m]));
-        kmax = std::max(kmax, std::fabs(kj[i]));
-      }
-      if (dmax < 1e-12 * kmax) {
-        for (R_xlen_t q = j + 1; q < nb; ++q) {
-          std::copy(kj, kj + m, k + q * m);
-          sF[q] = sF[j];
-        }
-        break;
-      }
-    }
-    for (R_xlen_t c = 0; c < m; ++c) {
-      for (R_xlen_t i = 0; i < m; ++i) {
-        P[i + c * m] = pp[i + c * m] * (P[i + c * m] - (Pz[i] * Pz[c]) / F);
-      }
-    }
-    for (R_xlen_t i = 0; i < m; ++i) P[i + i * m] = P[i + i * m] + Q[i];
-  }
+  warmup_gains_core(P0.begin(), PP.begin(), Q.begin(), phi.begin(), h, m, nb, K.begin(),
+                    sF.begin());
   return Rcpp::List::create(Rcpp::Named("K") = K, Rcpp::Named("sF") = sF);
 }
 

@@ -538,3 +538,37 @@ test_that("a pulse beside a Gauss-Markov of tc 20 s is a transient, not a lone s
   }
   expect_gte(named, 11L)
 })
+
+test_that("the warm-up likelihood kernel is R's whitening, qr() and sums to the bit", {
+  # the expression warmup_ml() evaluated before src/warmup_ml.cpp
+  by_r <- function(y, X, q, phis, s) {
+    E <- warmup_whiten(cbind(y, X), list(h = 1, q = q, phi = phis, s = s))
+    e <- E[, 1L]
+    beta <- numeric(0)
+    if (!is.null(X)) {
+      qx <- qr(E[, -1L, drop = FALSE])
+      beta <- qr.coef(qx, e)
+      e <- qr.resid(qx, e)
+    }
+    n <- length(e)
+    rss <- max(sum(e^2), .Machine$double.xmin)
+    list(ll = -attr(E, "logdet") - n / 2 * log(rss / n) - n / 2, rss = rss, beta = beta)
+  }
+  set.seed(27)
+  for (nb in c(64L, 333L)) {
+    phis <- exp(-1 / 4^(0:floor(log(nb / 4, 4))))
+    y <- cumsum(rnorm(nb)) * 0.05 + rnorm(nb)
+    t <- seq_len(nb)
+    for (X in list(NULL, cbind(exp(-t / 20)), cbind(exp(-t / 20), t / nb, exp(-t / 3)),
+                   cbind(t, 2 * t))) {
+      for (th in list(c(-3, rep(-1, length(phis))), runif(length(phis) + 1L, -12, 3))) {
+        a <- by_r(y, X, exp(th[1L]), phis, exp(th[-1L]))
+        b <- warmup_gls_ll(cbind(y, X), exp(th[1L]), phis, exp(th[-1L]))
+        expect_identical(b$ll, a$ll)
+        expect_identical(b$rss, a$rss)
+        # an aliased column (2 t beside t) has no coefficient, as qr.coef() says
+        expect_identical(b$beta, if (is.null(X)) numeric(0) else unname(a$beta))
+      }
+    }
+  }
+})

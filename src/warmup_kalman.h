@@ -1,0 +1,78 @@
+// The warm-up's Kalman filter (R/nonstationary.R, warmup_whiten()): the
+// gains of a diffuse level, AR(1) states and white noise, and the columns
+// of Y whitened by them. Shared by the R-facing kernels in series.cpp and
+// the likelihood in warmup_ml.cpp, so that both run the same arithmetic.
+#ifndef ALLANVAR_WARMUP_KALMAN_H
+#define ALLANVAR_WARMUP_KALMAN_H
+
+#include <Rcpp.h>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+// Gains K (m x nb, column j at K + j m) and innovation sds sF (nb) from
+// the initial covariance P0 (m x m), PP = phi phi', the state noise Q and
+// the white variance h: Pz = rowSums(P) and F = sum(Pz) + h in long double
+// sums, K = phi Pz / F, stopped at the steady state (sF and K still to
+// 1e-12: the remaining gains are the last one).
+inline void warmup_gains_core(const double* P0, const double* pp, const double* Q,
+                              const double* phi, double h, R_xlen_t m, R_xlen_t nb,
+                              double* k, double* sF) {
+  std::vector<double> P(P0, P0 + m * m), Pz(m);
+  for (R_xlen_t j = 0; j < nb; ++j) {
+    for (R_xlen_t i = 0; i < m; ++i) {
+      long double r = 0;
+      for (R_xlen_t c = 0; c < m; ++c) r += P[i + c * m];
+      Pz[i] = static_cast<double>(r);
+    }
+    long double t = 0;
+    for (R_xlen_t i = 0; i < m; ++i) t += Pz[i];
+    const double F = static_cast<double>(t) + h;
+    double* kj = k + j * m;
+    for (R_xlen_t i = 0; i < m; ++i) kj[i] = phi[i] * Pz[i] / F;
+    sF[j] = std::sqrt(F);
+    if (j > 1 && std::fabs(sF[j] / sF[j - 1] - 1) < 1e-12) {
+      double dmax = 0, kmax = 0;
+      for (R_xlen_t i = 0; i < m; ++i) {
+        dmax = std::max(dmax, std::fabs(kj[i] - kj[i - m]));
+        kmax = std::max(kmax, std::fabs(kj[i]));
+      }
+      if (dmax < 1e-12 * kmax) {
+        for (R_xlen_t q = j + 1; q < nb; ++q) {
+          std::copy(kj, kj + m, k + q * m);
+          sF[q] = sF[j];
+        }
+        break;
+      }
+    }
+    for (R_xlen_t c = 0; c < m; ++c) {
+      for (R_xlen_t i = 0; i < m; ++i) {
+        P[i + c * m] = pp[i + c * m] * (P[i + c * m] - (Pz[i] * Pz[c]) / F);
+      }
+    }
+    for (R_xlen_t i = 0; i < m; ++i) P[i + i * m] = P[i + i * m] + Q[i];
+  }
+}
+
+// Every column of Y (nb x nc) through the filter: per row j, v = Y[j, ]
+// minus the sum of the state a (summed in order from 0, as BLAS dgemv does
+// one %*% a), E[j - 1, ] = v / sF[j] (the first row, the diffuse start,
+// dropped), a = phi * a + (0 + K[, j] v). E is (nb - 1) x nc.
+inline void warmup_whiten_core(const double* y, R_xlen_t nb, R_xlen_t nc, const double* k,
+                               const double* f, const double* p, R_xlen_t m, double* e) {
+  std::vector<double> a(m * nc, 0.0);      // the states, column c at a[c m]
+  for (R_xlen_t j = 0; j < nb; ++j) {
+    const double* kj = k + j * m;
+    for (R_xlen_t c = 0; c < nc; ++c) {
+      double* ac = a.data() + c * m;
+      double s = 0.0;
+      for (R_xlen_t l = 0; l < m; ++l) s = s + ac[l] * 1.0;
+      const double v = y[j + c * nb] - s;
+      if (j > 0) e[(j - 1) + c * (nb - 1)] = v / f[j];
+      for (R_xlen_t l = 0; l < m; ++l) ac[l] = p[l] * ac[l] + (0.0 + v * kj[l]);
+    }
+    if ((j & 255) == 255) Rcpp::checkUserInterrupt();
+  }
+}
+
+#endif

@@ -1,0 +1,78 @@
+// The log-likelihood warmup_ml() (R/warmup-judge.R) maximises, in one call
+// per evaluation: the block means y and regressors X (the columns of Y)
+// whitened by the warm-up's Kalman filter (warmup_kalman.h) under the
+// noise model white 1, random walk q, AR(1)s phis of variances s; the
+// regressors taken out by least squares; the scale concentrated out. The
+// optimiser calls it hundreds of times per fit, and the R expression it
+// replaces spent most of its time building and factorising. The
+// arithmetic is that expression's: R's qr() (LINPACK dqrdc2, tol 1e-7),
+// qr.coef() and qr.resid() (dqrcf, dqrrsd), sums in long double as R's
+// sum() makes them, so the likelihood and the fits are identical.
+#include <Rcpp.h>
+#include <R_ext/Applic.h>
+#include <climits>
+#include <cmath>
+#include <limits>
+#include <vector>
+#include "warmup_kalman.h"
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::List warmup_gls_ll(const Rcpp::NumericMatrix& Y, double q,
+                         const Rcpp::NumericVector& phis, const Rcpp::NumericVector& s) {
+  const R_xlen_t nb = Y.nrow(), nc = Y.ncol(), m = phis.size() + 1;
+  if (nb < 2 || nc < 1 || s.size() != phis.size() || nb > INT_MAX / nc) {
+    Rcpp::stop("warmup_gls_ll: Y needs two rows and a column, s one value per phi");
+  }
+  const R_xlen_t n = nb - 1;
+  int k = static_cast<int>(nc - 1);
+  // the model of warmup_whiten(): phi = c(1, phis), Q = c(q, s (1 - phis^2)),
+  // P0 = diag(c(big, s)), the level diffuse
+  std::vector<double> phi(m), Q(m), P0(m * m, 0.0), PP(m * m);
+  long double ssum = 0;
+  for (R_xlen_t i = 0; i < m - 1; ++i) ssum += s[i];
+  const double big = 1e6 * (1.0 + static_cast<double>(ssum) + q * static_cast<double>(nb));
+  phi[0] = 1;
+  Q[0] = q;
+  P0[0] = big;
+  for (R_xlen_t i = 1; i < m; ++i) {
+    phi[i] = phis[i - 1];
+    Q[i] = s[i - 1] * (1 - phis[i - 1] * phis[i - 1]);
+    P0[i + i * m] = s[i - 1];
+  }
+  for (R_xlen_t c = 0; c < m; ++c)
+    for (R_xlen_t i = 0; i < m; ++i) PP[i + c * m] = phi[i] * phi[c];
+  std::vector<double> K(m * nb), sF(nb), E(n * nc);
+  warmup_gains_core(P0.data(), PP.data(), Q.data(), phi.data(), 1.0, m, nb, K.data(), sF.data());
+  warmup_whiten_core(Y.begin(), nb, nc, K.data(), sF.data(), phi.data(), m, E.data());
+  long double ld = 0;
+  for (R_xlen_t j = 1; j < nb; ++j) ld += std::log(sF[j]);
+  const double logdet = static_cast<double>(ld);
+  std::vector<double> e(E.begin(), E.begin() + n);
+  Rcpp::NumericVector beta(k, NA_REAL);
+  if (k > 0) {
+    int ni = static_cast<int>(n), rank = 0, ny = 1, info = 0;
+    double tol = 1e-7;
+    std::vector<double> X(E.begin() + n, E.end()), qraux(k), work(2 * k);
+    std::vector<int> pivot(k);
+    for (int j = 0; j < k; ++j) pivot[j] = j + 1;
+    F77_CALL(dqrdc2)(X.data(), &ni, &ni, &k, &tol, &rank, qraux.data(), pivot.data(),
+                     work.data());
+    if (rank > 0) {
+      // (each routine overwrites its y with Q'y: a copy each, as .Fortran()
+      // gives them)
+      std::vector<double> coef(rank), y1(e), y2(e), rsd(e);
+      F77_CALL(dqrcf)(X.data(), &ni, &rank, qraux.data(), y1.data(), &ny, coef.data(), &info);
+      if (info) Rcpp::stop("exact singularity in 'qr.coef'");
+      for (int j = 0; j < rank; ++j) beta[pivot[j] - 1] = coef[j];
+      F77_CALL(dqrrsd)(X.data(), &ni, &rank, qraux.data(), y2.data(), &ny, rsd.data());
+      e = rsd;
+    }
+  }
+  long double ss = 0;
+  for (R_xlen_t j = 0; j < n; ++j) ss += e[j] * e[j];
+  const double rss = std::max(static_cast<double>(ss), std::numeric_limits<double>::min());
+  const double nn = static_cast<double>(n);
+  const double ll = -logdet - nn / 2 * std::log(rss / nn) - nn / 2;
+  return Rcpp::List::create(Rcpp::Named("ll") = ll, Rcpp::Named("rss") = rss,
+                            Rcpp::Named("n") = nn, Rcpp::Named("beta") = beta);
+}
