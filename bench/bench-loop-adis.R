@@ -10,7 +10,8 @@
 #   (elapsed), the reading (readRDS + imu_record()) timed apart.
 # Builds alternate unit by unit so that the machine's load moves them
 # alike. Prints a per-axis table and the summary; CPU is the figure to
-# compare (elapsed follows the shared machine's load).
+# compare (elapsed follows the shared machine's load); the machine's own
+# speed (a fixed sort and sum() at the start and the end) is printed last.
 # The recordings stay in the shared data directory (never shipped).
 
 args <- commandArgs(TRUE)
@@ -72,6 +73,17 @@ libs <- sub("=.*$", "", args)
 labels <- ifelse(grepl("=", args), sub("^[^=]*=", "", args), basename(libs))
 me <- sub("^--file=", "", grep("^--file=", commandArgs(FALSE), value = TRUE)[1L])
 res <- list()
+# The machine's own speed, the same fixed work at the start and the end:
+# this machine kind's speed has moved by up to 1.9 x between runs an hour
+# apart (the same build read 0.93 s and 1.74 s per axis), so runs are
+# compared through it, builds only within one run.
+yardstick <- function() {
+  set.seed(1)
+  x <- stats::runif(2e6)
+  c(sort = stats::median(replicate(5, system.time(sort(x))[["elapsed"]])),
+    sum = stats::median(replicate(5, system.time(for (i in 1:50) sum(x))[["elapsed"]])) / 50)
+}
+ys0 <- yardstick()
 cat(sprintf("load average at start: %s\n", paste(readLines("/proc/loadavg", warn = FALSE), collapse = " ")))
 for (u in 1:3) {
   for (b in seq_along(libs)) {
@@ -106,3 +118,7 @@ for (lb in labels) {
               stats::median(v$sequential_elapsed), stats::median(v$read_elapsed)))
 }
 cat(sprintf("load average at end: %s\n", paste(readLines("/proc/loadavg", warn = FALSE), collapse = " ")))
+ys1 <- yardstick()
+cat(sprintf(paste("machine yardstick (start, end): sort(runif(2e6)) %.3f, %.3f s;",
+                  "sum() of 2e6 doubles %.2f, %.2f ms\n"),
+            ys0[["sort"]], ys1[["sort"]], 1e3 * ys0[["sum"]], 1e3 * ys1[["sum"]]))
