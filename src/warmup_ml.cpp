@@ -6,10 +6,12 @@
 // optimiser calls it hundreds of times per fit, and the R expression it
 // replaces spent most of its time building and factorising. The
 // arithmetic is that expression's: R's qr() (LINPACK dqrdc2, tol 1e-7),
-// qr.coef() and qr.resid() (dqrcf, dqrrsd), sums in long double as R's
-// sum() makes them, so the likelihood and the fits are identical.
+// qr.coef() and qr.resid() (dqrsl, as dqrcf and dqrrsd call it), sums in
+// long double as R's sum() makes them, so the likelihood and the fits are
+// identical.
 #include <Rcpp.h>
 #include <R_ext/Applic.h>
+#include <R_ext/Linpack.h>
 #include <climits>
 #include <cmath>
 #include <limits>
@@ -58,13 +60,18 @@ Rcpp::List warmup_gls_ll(const Rcpp::NumericMatrix& Y, double q,
     F77_CALL(dqrdc2)(X.data(), &ni, &ni, &k, &tol, &rank, qraux.data(), pivot.data(),
                      work.data());
     if (rank > 0) {
-      // (each routine overwrites its y with Q'y: a copy each, as .Fortran()
-      // gives them)
+      // qr.coef()'s dqrcf and qr.resid()'s dqrrsd are each one dqrsl call
+      // (jobs 100 and 10) that overwrites its y with Q'y: a copy each, as
+      // .Fortran() gives them
       std::vector<double> coef(rank), y1(e), y2(e), rsd(e);
-      F77_CALL(dqrcf)(X.data(), &ni, &rank, qraux.data(), y1.data(), &ny, coef.data(), &info);
+      double dummy = 0;
+      int job_coef = 100, job_resid = 10;
+      F77_CALL(dqrsl)(X.data(), &ni, &ni, &rank, qraux.data(), y1.data(), &dummy, y1.data(),
+                      coef.data(), &dummy, &dummy, &job_coef, &info);
       if (info) Rcpp::stop("exact singularity in 'qr.coef'");
       for (int j = 0; j < rank; ++j) beta[pivot[j] - 1] = coef[j];
-      F77_CALL(dqrrsd)(X.data(), &ni, &rank, qraux.data(), y2.data(), &ny, rsd.data());
+      F77_CALL(dqrsl)(X.data(), &ni, &ni, &rank, qraux.data(), y2.data(), &dummy, y2.data(),
+                      &dummy, rsd.data(), &dummy, &job_resid, &info);
       e = rsd;
     }
   }
