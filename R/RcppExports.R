@@ -205,12 +205,8 @@ shifted_prefix <- function(x, at, level, lo, hi) {
     .Call(`_allanvar_shifted_prefix`, x, at, level, lo, hi)
 }
 
-warmup_whiten_data <- function(Y, K, sF, phi) {
-    .Call(`_allanvar_warmup_whiten_data`, Y, K, sF, phi)
-}
-
-warmup_gains <- function(P0, PP, Q, phi, h, nb) {
-    .Call(`_allanvar_warmup_gains`, P0, PP, Q, phi, h, nb)
+warmup_whiten_cpp <- function(Y, h, q, phis, s) {
+    .Call(`_allanvar_warmup_whiten_cpp`, Y, h, q, phis, s)
 }
 
 spike_burg <- function(x, pmax) {

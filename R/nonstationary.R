@@ -679,24 +679,10 @@ warmup_noise <- function(y, dt) {
 # noise h. The first row (the diffuse start) is dropped.
 warmup_whiten <- function(Y, model) {
   Y <- as.matrix(Y)
-  nb <- nrow(Y)
-  phi <- c(1, model$phi)
-  Q <- c(model$q, model$s * (1 - model$phi^2))
-  m <- length(phi)
-  big <- 1e6 * (model$h + sum(model$s) + model$q * nb)
-  # the gains first (they do not depend on the data): m x m work only
-  # (src/series.cpp: each step, Pz = rowSums(P), F = sum(Pz) + h,
-  # K = phi Pz / F, sF = sqrt(F); at the steady state (sF and K still to
-  # 1e-12) the remaining gains are this one; else P = PP (P - Pz Pz' / F)
-  # plus Q on its diagonal; the R loop's operations in its order)
-  g <- warmup_gains(diag(c(big, model$s), m), phi %o% phi, as.double(Q), phi,
-                    model$h, nb)
-  # then every column at once: a(j+1) = phi a(j) + K(j) v(j), the same way
   storage.mode(Y) <- "double"
-  E <- warmup_whiten_data(Y, g$K, g$sF, phi)
-  # the log-determinant the likelihood needs (warmup_ml())
-  attr(E, "logdet") <- sum(log(g$sF[-1L]))
-  E
+  # (src/warmup_kalman.h: the filter as the R loop it replaced ran it, and
+  # the log-determinant warmup_ml() needs in attribute "logdet")
+  warmup_whiten_cpp(Y, model$h, model$q, as.double(model$phi), as.double(model$s))
 }
 
 # Profile of the warm-up's time constant: GLS of the block means on each

@@ -646,31 +646,17 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// warmup_whiten_data
-Rcpp::NumericMatrix warmup_whiten_data(const Rcpp::NumericMatrix& Y, const Rcpp::NumericMatrix& K, const Rcpp::NumericVector& sF, const Rcpp::NumericVector& phi);
-RcppExport SEXP _allanvar_warmup_whiten_data(SEXP YSEXP, SEXP KSEXP, SEXP sFSEXP, SEXP phiSEXP) {
+// warmup_whiten_cpp
+Rcpp::NumericMatrix warmup_whiten_cpp(const Rcpp::NumericMatrix& Y, double h, double q, const Rcpp::NumericVector& phis, const Rcpp::NumericVector& s);
+RcppExport SEXP _allanvar_warmup_whiten_cpp(SEXP YSEXP, SEXP hSEXP, SEXP qSEXP, SEXP phisSEXP, SEXP sSEXP) {
 BEGIN_RCPP
     Rcpp::RObject rcpp_result_gen;
     Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type Y(YSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type K(KSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type sF(sFSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phi(phiSEXP);
-    rcpp_result_gen = Rcpp::wrap(warmup_whiten_data(Y, K, sF, phi));
-    return rcpp_result_gen;
-END_RCPP
-}
-// warmup_gains
-Rcpp::List warmup_gains(const Rcpp::NumericMatrix& P0, const Rcpp::NumericMatrix& PP, const Rcpp::NumericVector& Q, const Rcpp::NumericVector& phi, double h, R_xlen_t nb);
-RcppExport SEXP _allanvar_warmup_gains(SEXP P0SEXP, SEXP PPSEXP, SEXP QSEXP, SEXP phiSEXP, SEXP hSEXP, SEXP nbSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type P0(P0SEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericMatrix& >::type PP(PPSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type Q(QSEXP);
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phi(phiSEXP);
     Rcpp::traits::input_parameter< double >::type h(hSEXP);
-    Rcpp::traits::input_parameter< R_xlen_t >::type nb(nbSEXP);
-    rcpp_result_gen = Rcpp::wrap(warmup_gains(P0, PP, Q, phi, h, nb));
+    Rcpp::traits::input_parameter< double >::type q(qSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type phis(phisSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type s(sSEXP);
+    rcpp_result_gen = Rcpp::wrap(warmup_whiten_cpp(Y, h, q, phis, s));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -976,8 +962,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_rosbag_decode_cpp", (DL_FUNC) &_allanvar_rosbag_decode_cpp, 4},
     {"_allanvar_shifted_block_means", (DL_FUNC) &_allanvar_shifted_block_means, 5},
     {"_allanvar_shifted_prefix", (DL_FUNC) &_allanvar_shifted_prefix, 5},
-    {"_allanvar_warmup_whiten_data", (DL_FUNC) &_allanvar_warmup_whiten_data, 4},
-    {"_allanvar_warmup_gains", (DL_FUNC) &_allanvar_warmup_gains, 6},
+    {"_allanvar_warmup_whiten_cpp", (DL_FUNC) &_allanvar_warmup_whiten_cpp, 5},
     {"_allanvar_spike_burg", (DL_FUNC) &_allanvar_spike_burg, 2},
     {"_allanvar_ar_filter", (DL_FUNC) &_allanvar_ar_filter, 3},
     {"_allanvar_spike_ao_values", (DL_FUNC) &_allanvar_spike_ao_values, 5},

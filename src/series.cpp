@@ -96,33 +96,23 @@ Rcpp::NumericVector shifted_prefix(const Rcpp::NumericVector& x,
   return out;
 }
 
-// The data half of warmup_whiten() (R/nonstationary.R): every column of Y
-// through the Kalman filter whose gains K (m x nb) and innovation sds sF
-// are given (warmup_whiten_core()). Returns E without its first row.
+// warmup_whiten() (R/nonstationary.R): the columns of Y through the
+// warm-up's Kalman filter under the noise model (h, q, phis, s)
+// (warmup_filter()); E without its first row, the log-determinant of the
+// innovations in its attribute "logdet".
 // [[Rcpp::export(rng = false)]]
-Rcpp::NumericMatrix warmup_whiten_data(const Rcpp::NumericMatrix& Y,
-                                       const Rcpp::NumericMatrix& K,
-                                       const Rcpp::NumericVector& sF,
-                                       const Rcpp::NumericVector& phi) {
-  const R_xlen_t nb = Y.nrow(), nc = Y.ncol(), m = phi.size();
-  Rcpp::NumericMatrix E(nb > 0 ? nb - 1 : 0, nc);
-  if (nb < 1) return E;
-  warmup_whiten_core(Y.begin(), nb, nc, K.begin(), sF.begin(), phi.begin(), m, E.begin());
+Rcpp::NumericMatrix warmup_whiten_cpp(const Rcpp::NumericMatrix& Y, double h, double q,
+                                      const Rcpp::NumericVector& phis,
+                                      const Rcpp::NumericVector& s) {
+  const R_xlen_t nb = Y.nrow(), nc = Y.ncol();
+  if (nb < 1 || s.size() != phis.size()) {
+    Rcpp::stop("warmup_whiten_cpp: Y needs a row, s one value per phi");
+  }
+  Rcpp::NumericMatrix E(nb - 1, nc);
+  const double logdet = warmup_filter(Y.begin(), nb, nc, h, q, phis.begin(), s.begin(),
+                                      phis.size(), E.begin());
+  E.attr("logdet") = logdet;
   return E;
-}
-
-// The gain half of warmup_whiten(): the Kalman gains K (m x nb) and the
-// innovation sds sF (warmup_gains_core()).
-// [[Rcpp::export(rng = false)]]
-Rcpp::List warmup_gains(const Rcpp::NumericMatrix& P0, const Rcpp::NumericMatrix& PP,
-                        const Rcpp::NumericVector& Q, const Rcpp::NumericVector& phi,
-                        double h, R_xlen_t nb) {
-  const R_xlen_t m = phi.size();
-  Rcpp::NumericMatrix K(m, nb);
-  Rcpp::NumericVector sF(nb);
-  warmup_gains_core(P0.begin(), PP.begin(), Q.begin(), phi.begin(), h, m, nb, K.begin(),
-                    sF.begin());
-  return Rcpp::List::create(Rcpp::Named("K") = K, Rcpp::Named("sF") = sF);
 }
 
 // The spike pass's AR model (R/nonstationary.R, spike_ao_z()): Burg's

@@ -75,4 +75,35 @@ inline void warmup_whiten_core(const double* y, R_xlen_t nb, R_xlen_t nc, const 
   }
 }
 
+// The whole filter of a noise model: white h, a diffuse level of random
+// walk q, AR(1) states phis of variances s (np of them), as
+// warmup_whiten() states it: phi = c(1, phis), Q = c(q, s (1 - phis^2)),
+// P0 = diag(c(big, s)), big = 1e6 (h + sum(s) + q nb) (the sum in long
+// double, as R's sum()). Y (nb x nc) whitened into E ((nb - 1) x nc);
+// returns the log-determinant sum(log(sF[-1])), in long double likewise.
+inline double warmup_filter(const double* Y, R_xlen_t nb, R_xlen_t nc, double h, double q,
+                            const double* phis, const double* s, R_xlen_t np, double* E) {
+  const R_xlen_t m = np + 1;
+  std::vector<double> phi(m), Q(m), P0(m * m, 0.0), PP(m * m);
+  long double ssum = 0;
+  for (R_xlen_t i = 0; i < np; ++i) ssum += s[i];
+  const double big = 1e6 * (h + static_cast<double>(ssum) + q * static_cast<double>(nb));
+  phi[0] = 1;
+  Q[0] = q;
+  P0[0] = big;
+  for (R_xlen_t i = 1; i < m; ++i) {
+    phi[i] = phis[i - 1];
+    Q[i] = s[i - 1] * (1 - phis[i - 1] * phis[i - 1]);
+    P0[i + i * m] = s[i - 1];
+  }
+  for (R_xlen_t c = 0; c < m; ++c)
+    for (R_xlen_t i = 0; i < m; ++i) PP[i + c * m] = phi[i] * phi[c];
+  std::vector<double> K(m * nb), sF(nb);
+  warmup_gains_core(P0.data(), PP.data(), Q.data(), phi.data(), h, m, nb, K.data(), sF.data());
+  warmup_whiten_core(Y, nb, nc, K.data(), sF.data(), phi.data(), m, E);
+  long double ld = 0;
+  for (R_xlen_t j = 1; j < nb; ++j) ld += std::log(sF[j]);
+  return static_cast<double>(ld);
+}
+
 #endif

@@ -21,34 +21,15 @@
 // [[Rcpp::export(rng = false)]]
 Rcpp::List warmup_gls_ll(const Rcpp::NumericMatrix& Y, double q,
                          const Rcpp::NumericVector& phis, const Rcpp::NumericVector& s) {
-  const R_xlen_t nb = Y.nrow(), nc = Y.ncol(), m = phis.size() + 1;
+  const R_xlen_t nb = Y.nrow(), nc = Y.ncol();
   if (nb < 2 || nc < 1 || s.size() != phis.size() || nb > INT_MAX / nc) {
     Rcpp::stop("warmup_gls_ll: Y needs two rows and a column, s one value per phi");
   }
   const R_xlen_t n = nb - 1;
   int k = static_cast<int>(nc - 1);
-  // the model of warmup_whiten(): phi = c(1, phis), Q = c(q, s (1 - phis^2)),
-  // P0 = diag(c(big, s)), the level diffuse
-  std::vector<double> phi(m), Q(m), P0(m * m, 0.0), PP(m * m);
-  long double ssum = 0;
-  for (R_xlen_t i = 0; i < m - 1; ++i) ssum += s[i];
-  const double big = 1e6 * (1.0 + static_cast<double>(ssum) + q * static_cast<double>(nb));
-  phi[0] = 1;
-  Q[0] = q;
-  P0[0] = big;
-  for (R_xlen_t i = 1; i < m; ++i) {
-    phi[i] = phis[i - 1];
-    Q[i] = s[i - 1] * (1 - phis[i - 1] * phis[i - 1]);
-    P0[i + i * m] = s[i - 1];
-  }
-  for (R_xlen_t c = 0; c < m; ++c)
-    for (R_xlen_t i = 0; i < m; ++i) PP[i + c * m] = phi[i] * phi[c];
-  std::vector<double> K(m * nb), sF(nb), E(n * nc);
-  warmup_gains_core(P0.data(), PP.data(), Q.data(), phi.data(), 1.0, m, nb, K.data(), sF.data());
-  warmup_whiten_core(Y.begin(), nb, nc, K.data(), sF.data(), phi.data(), m, E.data());
-  long double ld = 0;
-  for (R_xlen_t j = 1; j < nb; ++j) ld += std::log(sF[j]);
-  const double logdet = static_cast<double>(ld);
+  std::vector<double> E(n * nc);
+  const double logdet = warmup_filter(Y.begin(), nb, nc, 1.0, q, phis.begin(), s.begin(),
+                                      phis.size(), E.data());
   std::vector<double> e(E.begin(), E.begin() + n);
   Rcpp::NumericVector beta(k, NA_REAL);
   if (k > 0) {
