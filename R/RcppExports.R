@@ -97,12 +97,16 @@ info_kalman <- function(sys, deriv, opts) {
     .Call(`_allanvar_info_kalman`, sys, deriv, opts)
 }
 
-line_sums <- function(y, f, freq) {
-    .Call(`_allanvar_line_sums`, y, f, freq)
-}
-
 line_subtract <- function(y, f, freq, a, b) {
     .Call(`_allanvar_line_subtract`, y, f, freq, a, b)
+}
+
+line_moments <- function(y, f0, freq, span) {
+    .Call(`_allanvar_line_moments`, y, f0, freq, span)
+}
+
+line_sums_near <- function(mom, f) {
+    .Call(`_allanvar_line_sums_near`, mom, f)
 }
 
 lz4_decompress_cpp <- function(x, expected) {

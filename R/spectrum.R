@@ -382,8 +382,8 @@ lines_outside_bands <- function(lines, bands) {
 # over the whole record; the frequency refined within +-2 Fourier bins of
 # the record, 1/T, since a periodogram's f0 is good to a fraction of its
 # own coarser bin only; to 0.02 bin, where what a frequency error leaves
-# is 0.1% of the line's power) is subtracted. O(n) per evaluation, about
-# 10 per line. Raw-data checks of other effects (a Gauss-Markov process's
+# is 0.1% of the line's power) is subtracted. One O(n) pass per line (its
+# block moments) and one to take it out. Raw-data checks of other effects (a Gauss-Markov process's
 # exponential ACF) then see no line.
 remove_lines <- function(x, freq, f0) {
   subtract_line_fits(x, freq, record_line_fits(x, freq, f0))
@@ -396,39 +396,74 @@ remove_lines <- function(x, freq, f0) {
 # record has all its power in that sinusoid (`amp` is the Welch line's);
 # a line whose frequency wanders keeps a fraction of it (0.1-0.65 on the
 # ADIS16405 accelerometers' own lines).
+#
+# Each row depends only on the lines before it, so the fits of the last
+# record are kept and a request whose lines begin as the kept ones did
+# reuses those rows (the loop asks for the series pass's lines less those
+# inside a band, usually the last ones: 0.35 s of a 1e6-sample axis).
 record_line_fits <- function(x, freq, f0) {
-  remember_record("fits", list(x, freq, f0), function() fit_lines(x, freq, f0))
+  hit <- record_store[["fits"]]
+  done <- NULL
+  if (!is.null(hit) && identical(hit$key, list(x, freq))) {
+    k <- common_prefix(hit$value$f0, f0)
+    done <- hit$value[seq_len(k), , drop = FALSE]
+    rownames(done) <- NULL
+    if (k == length(f0)) return(done)
+  }
+  fits <- fit_lines(x, freq, f0, done)
+  # the longer table stays: a shorter request is its prefix again
+  if (is.null(hit) || !identical(hit$key, list(x, freq)) || nrow(fits) >= nrow(hit$value)) {
+    record_store[["fits"]] <- list(key = list(x, freq), value = fits)
+  }
+  fits
 }
 
-fit_lines <- function(x, freq, f0) {
+# How many leading elements `a` and `b` share.
+common_prefix <- function(a, b) {
+  k <- min(length(a), length(b))
+  same <- a[seq_len(k)] == b[seq_len(k)]
+  if (all(same)) k else which.min(same) - 1L
+}
+
+# `done`: the fits of the first nrow(done) lines of `f0`, made before (by
+# this function, on the same series), taken out and kept as they are.
+fit_lines <- function(x, freq, f0, done = NULL) {
   fits <- data.frame(f0 = numeric(), f = numeric(), s = numeric(), c = numeric(),
                      amp = numeric())
   if (!length(f0)) return(fits)
   n <- length(x)
   xc <- x - mean(x)
-  # least-squares amplitudes on sin and cos at f from their sums (C++,
-  # src/lines.cpp: no trig per sample, no n x 2 matrix); the fitted power
-  # sum(fitted^2) is b'X'y
-  amps <- function(f, y) {
-    m <- line_sums(y, f, freq)
+  # least-squares amplitudes on sin and cos at f from their sums, the
+  # fitted power sum(fitted^2) being b'X'y; the sums near a line from its
+  # block moments (C++, src/lines.cpp: one pass over the record per line,
+  # then O(n / 700) per frequency tried)
+  amps <- function(f, mom) {
+    m <- line_sums_near(mom, f)
     xy <- m[4:5]
     b <- solve(matrix(m[c(1L, 3L, 3L, 2L)], 2L), xy)
     list(b = b, power = sum(b * xy))
   }
   bin <- freq / n
   rows <- vector("list", length(f0))
-  for (k in seq_along(f0)) {
+  for (k in seq_len(NROW(done))) {
+    rows[[k]] <- done[k, , drop = FALSE]
+    xc <- line_subtract(xc, done$f[k], freq, done$s[k], done$c[k])
+  }
+  for (k in seq_along(f0)[seq_along(f0) > NROW(done)]) {
     f <- f0[k]
-    o <- stats::optimize(function(g) -amps(g, xc)$power,
+    mom <- line_moments(xc, f, freq, 2 * bin)
+    o <- stats::optimize(function(g) -amps(g, mom)$power,
                          c(max(bin / 2, f - 2 * bin), f + 2 * bin),
                          tol = bin * 0.02)
-    b <- amps(o$minimum, xc)$b
+    b <- amps(o$minimum, mom)$b
     rows[[k]] <- data.frame(f0 = f, f = o$minimum, s = b[1L], c = b[2L],
                             amp = sqrt(sum(b^2)))
     # the next line is fitted with this one out
     if (k < length(f0)) xc <- line_subtract(xc, o$minimum, freq, b[1L], b[2L])
   }
-  do.call(rbind, rows)
+  out <- do.call(rbind, rows)
+  rownames(out) <- NULL
+  out
 }
 
 # A line is sharp (one frequency over the whole record) when its

@@ -313,18 +313,6 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
-// line_sums
-Rcpp::NumericVector line_sums(const Rcpp::NumericVector& y, double f, double freq);
-RcppExport SEXP _allanvar_line_sums(SEXP ySEXP, SEXP fSEXP, SEXP freqSEXP) {
-BEGIN_RCPP
-    Rcpp::RObject rcpp_result_gen;
-    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
-    Rcpp::traits::input_parameter< double >::type f(fSEXP);
-    Rcpp::traits::input_parameter< double >::type freq(freqSEXP);
-    rcpp_result_gen = Rcpp::wrap(line_sums(y, f, freq));
-    return rcpp_result_gen;
-END_RCPP
-}
 // line_subtract
 Rcpp::NumericVector line_subtract(const Rcpp::NumericVector& y, double f, double freq, double a, double b);
 RcppExport SEXP _allanvar_line_subtract(SEXP ySEXP, SEXP fSEXP, SEXP freqSEXP, SEXP aSEXP, SEXP bSEXP) {
@@ -336,6 +324,30 @@ BEGIN_RCPP
     Rcpp::traits::input_parameter< double >::type a(aSEXP);
     Rcpp::traits::input_parameter< double >::type b(bSEXP);
     rcpp_result_gen = Rcpp::wrap(line_subtract(y, f, freq, a, b));
+    return rcpp_result_gen;
+END_RCPP
+}
+// line_moments
+Rcpp::List line_moments(const Rcpp::NumericVector& y, double f0, double freq, double span);
+RcppExport SEXP _allanvar_line_moments(SEXP ySEXP, SEXP f0SEXP, SEXP freqSEXP, SEXP spanSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type y(ySEXP);
+    Rcpp::traits::input_parameter< double >::type f0(f0SEXP);
+    Rcpp::traits::input_parameter< double >::type freq(freqSEXP);
+    Rcpp::traits::input_parameter< double >::type span(spanSEXP);
+    rcpp_result_gen = Rcpp::wrap(line_moments(y, f0, freq, span));
+    return rcpp_result_gen;
+END_RCPP
+}
+// line_sums_near
+Rcpp::NumericVector line_sums_near(const Rcpp::List& mom, double f);
+RcppExport SEXP _allanvar_line_sums_near(SEXP momSEXP, SEXP fSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::List& >::type mom(momSEXP);
+    Rcpp::traits::input_parameter< double >::type f(fSEXP);
+    rcpp_result_gen = Rcpp::wrap(line_sums_near(mom, f));
     return rcpp_result_gen;
 END_RCPP
 }
@@ -935,8 +947,9 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_gchisq_cdf_cpp", (DL_FUNC) &_allanvar_gchisq_cdf_cpp, 2},
     {"_allanvar_gchisq_quantile_cpp", (DL_FUNC) &_allanvar_gchisq_quantile_cpp, 2},
     {"_allanvar_info_kalman", (DL_FUNC) &_allanvar_info_kalman, 3},
-    {"_allanvar_line_sums", (DL_FUNC) &_allanvar_line_sums, 3},
     {"_allanvar_line_subtract", (DL_FUNC) &_allanvar_line_subtract, 5},
+    {"_allanvar_line_moments", (DL_FUNC) &_allanvar_line_moments, 4},
+    {"_allanvar_line_sums_near", (DL_FUNC) &_allanvar_line_sums_near, 2},
     {"_allanvar_lz4_decompress_cpp", (DL_FUNC) &_allanvar_lz4_decompress_cpp, 2},
     {"_allanvar_mcap_index_cpp", (DL_FUNC) &_allanvar_mcap_index_cpp, 1},
     {"_allanvar_mcap_read_cpp", (DL_FUNC) &_allanvar_mcap_read_cpp, 6},

@@ -144,19 +144,57 @@ test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinu
   expect_true(is.na(match_line(0.2, spectral_lines(y, freq))))
 })
 
-test_that("line_sums() (phase rotation in blocks) equals the sums of sin and cos", {
+test_that("line_sums_near() (block moments) equals the sums of sin and cos near f0", {
   set.seed(14)
-  n <- 100003
   freq <- 100
-  y <- rnorm(n)
-  t <- (seq_len(n) - 1) / freq
-  for (f in c(0.013, 1.3, 49.7)) {
-    s <- sin(2 * pi * f * t)
-    c <- cos(2 * pi * f * t)
-    expect_equal(line_sums(y, f, freq),
-                 c(sum(s * s), sum(c * c), sum(s * c), sum(s * y), sum(c * y)),
-                 tolerance = 1e-10)
+  # one long record (blocks of about 700 samples) and short ones (blocks of
+  # a few samples, and of one)
+  for (n in c(100003, 5001, 301)) {
+    y <- rnorm(n)
+    t <- (seq_len(n) - 1) / freq
+    bin <- freq / n
+    for (f0 in c(2.5 * bin, 1.3, 49.7, 50 - 3 * bin)) {
+      mom <- line_moments(y, f0, freq, 2 * bin)
+      for (f in f0 + c(-2, -0.37, 0, 1.1, 2) * bin) {
+        s <- sin(2 * pi * f * t)
+        c <- cos(2 * pi * f * t)
+        expect_equal(line_sums_near(mom, f),
+                     c(sum(s * s), sum(c * c), sum(s * c), sum(s * y), sum(c * y)),
+                     tolerance = 1e-10)
+      }
+      # beyond the span the moments were read for, no value
+      expect_error(line_sums_near(mom, f0 + 2.1 * bin), "farther")
+    }
   }
+})
+
+test_that("a record's line fits asked again with the same first lines reuse them, as fitted afresh", {
+  set.seed(16)
+  freq <- 100
+  n <- 2e5
+  t <- (seq_len(n) - 1) / freq
+  x <- rnorm(n) + 0.3 * sin(2 * pi * 0.71 * t) + 0.2 * cos(2 * pi * 2.13 * t + 1) +
+    0.1 * sin(2 * pi * 9.4 * t)
+  f0 <- c(0.7101, 2.1298, 9.4003)
+  fresh <- function(f) {
+    rm(list = ls(record_store), envir = record_store)
+    record_line_fits(x, freq, f)
+  }
+  every <- fresh(f0)
+  expect_equal(every$f, c(0.71, 2.13, 9.4), tolerance = 1e-4)
+  # (an amplitude's sd is sqrt(2 / n) = 0.003 here)
+  expect_lt(max(abs(every$amp - c(0.3, 0.2, 0.1))), 0.015)
+  # the loop asks for the series pass's lines less one inside a band (a
+  # prefix), or others that begin alike, or the first ones again
+  for (f in list(f0[1:2], f0[c(1, 3)], f0[c(2, 1)], numeric(), f0)) {
+    rm(list = ls(record_store), envir = record_store)
+    record_line_fits(x, freq, f0)
+    expect_identical(record_line_fits(x, freq, f), fresh(f))
+  }
+  # a shorter request first: the longer one continues from its rows
+  rm(list = ls(record_store), envir = record_store)
+  record_line_fits(x, freq, f0[1])
+  expect_identical(record_line_fits(x, freq, f0), every)
 })
 
 test_that("line_subtract() (phases rotated in blocks) takes out a sinusoid as the R expression does", {
