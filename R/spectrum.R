@@ -436,7 +436,7 @@ fit_lines <- function(x, freq, f0, done = NULL) {
   # least-squares amplitudes on sin and cos at f from their sums, the
   # fitted power sum(fitted^2) being b'X'y; the sums near a line from its
   # block moments (C++, src/lines.cpp: one pass over the record per line,
-  # then O(n / 700) per frequency tried)
+  # then O(n / 800) per frequency tried)
   amps <- function(f, mom) {
     m <- line_sums_near(mom, f)
     xy <- m[4:5]

@@ -77,8 +77,8 @@ Rcpp::NumericVector line_subtract(const Rcpp::NumericVector& y, double f, double
 //   M_bk = sum_{j in b} y_j e^{-i w0 j} v_j^k,  v_j = (j - c_b) / h,
 // with d = w - w0, c_b the block's centre and h its half-width; the series
 // stops at kMoments terms, whose remainder (|d h| <= kMaxArg) is below
-// 1e-17 relative. Blocks are as long as that allows (700 samples at 1e6,
-// f within 2 bins), so an evaluation costs O(n / 700).
+// 1e-17 relative. Blocks are as long as that allows (796 samples at 1e6,
+// f within 2 bins), so an evaluation costs O(n / 800).
 namespace {
 const int kMoments = 6;
 const double kMaxArg = 0.005;  // kMaxArg^6 / 6! = 2e-17
