@@ -383,8 +383,8 @@ lines_outside_bands <- function(lines, bands) {
 # the record, 1/T, since a periodogram's f0 is good to a fraction of its
 # own coarser bin only; to 0.02 bin, where what a frequency error leaves
 # is 0.1% of the line's power) is subtracted. One O(n) pass per line (its
-# block moments) and one to take it out. Raw-data checks of other effects (a Gauss-Markov process's
-# exponential ACF) then see no line.
+# block moments) and one to take it out. Raw-data checks of other effects
+# (a Gauss-Markov process's exponential ACF) then see no line.
 remove_lines <- function(x, freq, f0) {
   subtract_line_fits(x, freq, record_line_fits(x, freq, f0))
 }
