@@ -163,7 +163,7 @@ test_that("line_sums_near() (block moments) equals the sums of sin and cos near 
                      tolerance = 1e-10)
       }
       # beyond the span the moments were read for, no value
-      expect_error(line_sums_near(mom, f0 + 2.1 * bin), "farther")
+      expect_error(line_sums_near(mom, f0 + 2.1 * bin), "farther", class = "Rcpp::exception")
     }
   }
 })
