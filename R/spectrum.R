@@ -403,8 +403,9 @@ remove_lines <- function(x, freq, f0) {
 # inside a band, usually the last ones: 0.35 s of a 1e6-sample axis).
 record_line_fits <- function(x, freq, f0) {
   hit <- record_store[["fits"]]
+  same <- !is.null(hit) && identical(hit$key, list(x, freq))
   done <- NULL
-  if (!is.null(hit) && identical(hit$key, list(x, freq))) {
+  if (same) {
     k <- common_prefix(hit$value$f0, f0)
     done <- hit$value[seq_len(k), , drop = FALSE]
     rownames(done) <- NULL
@@ -412,7 +413,7 @@ record_line_fits <- function(x, freq, f0) {
   }
   fits <- fit_lines(x, freq, f0, done)
   # the longer table stays: a shorter request is its prefix again
-  if (is.null(hit) || !identical(hit$key, list(x, freq)) || nrow(fits) >= nrow(hit$value)) {
+  if (!same || nrow(fits) >= nrow(hit$value)) {
     record_store[["fits"]] <- list(key = list(x, freq), value = fits)
   }
   fits
