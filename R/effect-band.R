@@ -149,6 +149,13 @@ band_params <- function() {
     })))
 }
 
+# The scale the curve asks for must be the measured one, within twice the
+# band power's relative uncertainty.
+band_scale_ok <- function(par) {
+  sc <- par[["amp"]]^2
+  is.finite(sc) && sc > 0 && abs(log(sc)) <= 2 * par[["u"]]
+}
+
 band_spectrum <- function(nl) {
   vapply(seq_len(band_knots), function(j) nl[[paste0("s", j)]], 0)
 }
@@ -213,17 +220,20 @@ effect_band <- function() {
                             format_num(m$power)))
       })
     },
-    # the scale the curve asks for must be the measured one, within twice
-    # the band power's relative uncertainty
     evidence = function(par, raw, x, freq) {
       sc <- par[["amp"]]^2
-      u <- par[["u"]]
-      ok <- is.finite(sc) && sc > 0 && abs(log(sc)) <= 2 * u
       list(text = sprintf(paste("the measured band %s-%s Hz: the curve asks for %.3f x its",
                                 "power (uncertainty %.1f%%)"),
                           format_num(par[["f_lo"]], 4), format_num(par[["f_hi"]], 4),
-                          sc, 100 * u),
-           support = ok)
+                          sc, 100 * par[["u"]]),
+           support = band_scale_ok(par))
+    },
+    # sized off its measured power, the band is held at that power (scale 1)
+    raw_hold = function(par, raw) {
+      if (band_scale_ok(par)) return(NULL)
+      list(values = c(amp = 1),
+           note = sprintf("amp held at the measured band's power (the curve asked for %.3f x it)",
+                          par[["amp"]]^2))
     },
     peak_tau = function(par) 0.371 * 2 / (par[["f_lo"]] + par[["f_hi"]]),
     # each band of the raw periodogram's own spectrum, read once per call

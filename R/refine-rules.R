@@ -285,7 +285,8 @@ series_duplicate <- function(series, fit, label, share = 1) {
 # to the series pass. Returns NULL or a one-row data
 # frame like series_duplicate()'s (`ratio` the kinds' share at that tau).
 series_pays_without <- function(st, new, label, gain = st$args$min_gain,
-                                min_share = 0.1, effect = NULL, par = NULL, ev = NULL) {
+                                min_share = 0.1, effect = NULL, par = NULL, ev = NULL,
+                                without = st$current, without_settings = st$settings) {
   series <- st$series
   if (is.null(series) || !NROW(series$table) || !NROW(series$adev_kinds)) return(NULL)
   left <- unique(series$table$kind[!series$table$removed])
@@ -322,17 +323,45 @@ series_pays_without <- function(st, new, label, gain = st$args$min_gain,
   total <- rowSums(kind_excess(series$adev_kinds, left, cv$data$tau, signed = TRUE))
   # taken out to at most 90% of a point: the excess is an estimate too
   cv$data$avar <- pmax(cv$data$avar - total, 0.1 * cv$data$avar)
-  refit_on <- function(fit) {
-    args <- refit_args(fit, fit$terms, st$settings)
+  refit_on <- function(fit, settings = st$settings) {
+    args <- refit_args(fit, fit$terms, settings)
     args$av <- cv
     try_refit(args, "refit without the series effects")$fit
   }
-  f_out <- refit_on(st$current)
+  f_out <- refit_on(without, without_settings)
   f_in <- refit_on(new)
   if (is.null(f_out) || is.null(f_in)) return(NULL)
   if (refine_crit(st, f_in) < refine_crit(st, f_out) - gain) return(NULL)
   data.frame(series_kind = colnames(at)[which.max(at[1L, ])], ratio = sum(at) / own,
              tau = new$data$tau[j], how = "refit", stringsAsFactors = FALSE)
+}
+
+# Does instance `label` of model `f` (entry `effect`, values `par`, raw-data
+# evidence `ev`) stand in for a series effect this run found and left in
+# the data: by the share rule, or by paying only for what those effects
+# add to the curve against the model `without` it (twice min_gain for a
+# term the raw data leave undecided)? NULL or series_duplicate()'s row.
+series_stand_in <- function(st, f, label, effect, par, ev, without = st$current,
+                            without_settings = st$settings) {
+  dup <- series_duplicate(st$series, f, label)
+  if (!is.null(dup)) return(dup)
+  need <- st$args$min_gain * (1 + rests_on_curve(effect, ev, st$raw))
+  series_pays_without(st, f, label, gain = need, effect = effect, par = par, ev = ev,
+                      without = without, without_settings = without_settings)
+}
+
+# Why such an instance is refused, for $refine$rejected.
+series_stand_in_text <- function(dup) {
+  if (dup$how == "share") {
+    sprintf(paste("describes the %s found in the series (not removed): it adds",
+                  "%s%% of this term's AV at tau %s s"), dup$series_kind,
+            format_num(100 * dup$ratio), format_num(dup$tau))
+  } else {
+    sprintf(paste("pays only for the %s found in the series (not removed): with",
+                  "its excess (%s%% of this term's AV at tau %s s) taken out of",
+                  "the curve the term no longer pays"), dup$series_kind,
+            format_num(100 * dup$ratio), format_num(dup$tau))
+  }
 }
 
 # Where a term instance weighs most: of the taus where it holds at least

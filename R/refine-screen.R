@@ -319,23 +319,8 @@ judge_instance <- function(st, f, effect, label, tau) {
   }
   # a term standing in for a series effect this run found and left in the
   # data describes one thing twice (remove it in the series instead)
-  dup <- if (is.null(why)) series_duplicate(st$series, f, label)
-  if (is.null(why) && is.null(dup)) {
-    need <- st$args$min_gain * (1 + rests_on_curve(effect, ev, st$raw))
-    dup <- series_pays_without(st, f, label, gain = need, effect = effect, par = par, ev = ev)
-  }
-  if (!is.null(dup)) {
-    why <- if (dup$how == "share") {
-      sprintf(paste("describes the %s found in the series (not removed): it adds",
-                    "%s%% of this term's AV at tau %s s"), dup$series_kind,
-              format_num(100 * dup$ratio), format_num(dup$tau))
-    } else {
-      sprintf(paste("pays only for the %s found in the series (not removed): with",
-                    "its excess (%s%% of this term's AV at tau %s s) taken out of",
-                    "the curve the term no longer pays"), dup$series_kind,
-              format_num(100 * dup$ratio), format_num(dup$tau))
-    }
-  }
+  dup <- if (is.null(why)) series_stand_in(st, f, label, effect, par, ev)
+  if (!is.null(dup)) why <- series_stand_in_text(dup)
   moved <- FALSE
   if (is.null(why) && !earlier_hold(st, f)) {
     why <- "moves an effect accepted earlier to values the raw data contradict"
