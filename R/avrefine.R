@@ -34,7 +34,11 @@
 #'    later one describes the same part of the curve). The two instances
 #'    of a split are judged together; effects whose values the raw data
 #'    measure (a periodogram line's frequency, a measured band's spectrum)
-#'    and the filter are not judged by the curve alone.
+#'    and the filter are not judged by the curve alone. One that the
+#'    refits after its step moved to where it stands in for a series effect
+#'    left in the data (the rule that refuses such a candidate) leaves too,
+#'    whatever it gains; an effect its removal sizes off what the raw data
+#'    measure is then held there.
 #'
 #' The rules of acceptance:
 #' * Candidates are compared by the criterion, not gated by a residual
