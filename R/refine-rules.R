@@ -221,13 +221,16 @@ max_share <- function(fit, label) {
 # parameters, the evidence, and the fit before and after it.
 step_row <- function(effect, label, loc, par, evidence, confirmed, before,
                      after, crit_before, crit_after) {
-  new_steps(effect = effect, label = label,
-            tau_from = loc$tau_from, tau_to = loc$tau_to,
-            params = format_params(par, effect),
-            evidence = evidence, confirmed = confirmed,
-            chi2_before = before$chi2, chi2_after = after$chi2,
-            rms_before = before$rms, rms_after = after$rms,
-            crit_before = crit_before, crit_after = crit_after)
+  out <- new_steps(effect = effect, label = label,
+                   tau_from = loc$tau_from, tau_to = loc$tau_to,
+                   params = format_params(par, effect),
+                   evidence = evidence, confirmed = confirmed,
+                   chi2_before = before$chi2, chi2_after = after$chi2,
+                   rms_before = before$rms, rms_after = after$rms,
+                   crit_before = crit_before, crit_after = crit_after)
+  # the values it was taken at (final_stand_in() reads how far they moved)
+  attr(out, "values") <- par
+  out
 }
 
 # ---- terms that describe a series effect again --------------------------------

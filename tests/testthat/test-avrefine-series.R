@@ -248,3 +248,12 @@ test_that("a measured band sized off its power is held at it", {
   expect_match(h$note, "held at the measured band's power \\(the curve asked for 1.053 x it\\)")
   expect_false(is.null(hold(list(amp = sqrt(0.9), u = 0.022), NULL)))
 })
+
+test_that("values_moved() reads an instance's nonlinear values only", {
+  expect_true(values_moved("gm", c(sigma = 4e-4, tc = 13.1), c(sigma = 3.6e-4, tc = 35.4)))
+  expect_false(values_moved("gm", c(sigma = 4e-4, tc = 90.8), c(sigma = 4e-4, tc = 104)))
+  # an amplitude is no value the instance moved to
+  expect_false(values_moved("gm", c(sigma = 1e-4, tc = 84), c(sigma = 9e-4, tc = 84)))
+  expect_true(values_moved("gm", NULL, c(sigma = 1e-4, tc = 84)))
+  expect_false(values_moved("N", c(N = 1), c(N = 3)))
+})
