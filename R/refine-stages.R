@@ -544,7 +544,10 @@ hold_broken <- function(st, w, step) {
     values <- c(values, v)
     notes[[l]] <- h$note
   }
-  if (!length(values)) return(utils::modifyList(w, list(fit = NULL)))
+  if (!length(values)) {
+    w$fit <- NULL
+    return(w)
+  }
   settings <- w$settings
   settings$fixed <- c(settings$fixed, values)
   start <- cf[lay$role == "nonlinear"]
