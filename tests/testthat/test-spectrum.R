@@ -471,3 +471,38 @@ test_that("find_bands(): two resolved resonances in one run are kept as a pair; 
   expect_true(is.na(b0$pair_fr1))
   expect_false(allanvar:::band_resonances(b0)$paired)
 })
+
+test_that("find_bands(): a run that only lines made is no band, with or without a band under them", {
+  # unit 1 accel_z with a sawtooth of 0.63 Hz (half its white sd): its
+  # harmonics made a Welch run of 1.56-5.27 Hz, and the spectrum between
+  # them stood 4.4% above the background read across the run (6 sd over
+  # its bins, within that background's error): a "band" at 2.53 Hz of
+  # FWHM 1.8 Hz, at every phase (on main d7dd14c). The axis's own 10.15 Hz
+  # resonance stays.
+  skip_if_no_shared()
+  a <- measured_axis(1, "accel_z")
+  ph <- (0.63 * seq_along(a$b) / a$freq + 0.1) %% 1
+  x <- a$b + 0.5 * a$s * (2 * ph - 1)
+  b <- allanvar:::find_bands(x, a$freq)
+  expect_equal(nrow(b), 1L)
+  expect_equal(b$f_center, 10.15, tolerance = 0.01)
+  # own generator: lines over a band stay a band once the lines are out;
+  # the same lines over white noise alone make no run without them
+  set.seed(3)
+  freq <- 100
+  n <- 5e5
+  t <- seq_len(n) / freq
+  lines <- c(2.2, 2.6, 3.0)
+  tones <- rowSums(vapply(lines, function(f) 0.004 * sin(2 * pi * f * t + f), numeric(n)))
+  w <- rnorm(n, sd = 0.01)
+  bands <- function(x) {
+    welch <- allanvar:::centred_welch(x, freq, 512L)
+    bg <- rep(stats::median(welch$psd[welch$f > 10 & welch$f < 40]), length(welch$psd))
+    out <- function(r) r > 1 & stats::pchisq(r * welch$nu, welch$nu, lower.tail = FALSE) *
+      length(r) < 1e-3
+    j <- which(welch$f >= 1.8 & welch$f <= 3.4)
+    allanvar:::line_free_run(x, freq, 512L, lines, j, bg, out, 3L)
+  }
+  expect_false(bands(w + tones))
+  expect_true(bands(w + tones + 0.002 * ar2_unit(n, 2.6, 0.5, freq)))
+})
