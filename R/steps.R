@@ -50,6 +50,9 @@ validate_steps <- function(x) {
 bind_steps <- function(old, new) {
   out <- rbind(validate_steps(old), validate_steps(new))
   rownames(out) <- NULL
+  # (a step row's `values`, the loop's record of what it took, is no part
+  # of the table: rbind() would keep the first row's)
+  attr(out, "values") <- NULL
   out
 }
 

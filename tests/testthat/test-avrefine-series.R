@@ -257,3 +257,12 @@ test_that("values_moved() reads an instance's nonlinear values only", {
   expect_true(values_moved("gm", NULL, c(sigma = 1e-4, tc = 84)))
   expect_false(values_moved("N", c(N = 1), c(N = 3)))
 })
+
+test_that("the steps table carries no row's record of its values", {
+  row <- step_row("gm", "gm1", list(tau_from = 1, tau_to = 2), c(sigma = 1, tc = 2), "e", TRUE,
+                  list(chi2 = 2, rms = 0.1), list(chi2 = 1, rms = 0.1), 10, 0)
+  expect_equal(attr(row, "values"), c(sigma = 1, tc = 2))
+  tab <- bind_steps(new_steps(), row)
+  expect_null(attr(tab, "values"))
+  expect_equal(tab$params, "sigma=1, tc=2 s")
+})
