@@ -355,28 +355,35 @@ stage_hold <- function(st) {
       !all(earlier_broken(st, f) %in% earlier_broken(st, cur))) {
     return(st)
   }
+  st <- note_at_end(st, notes)
+  st$settings <- settings
+  st$current <- f
+  st
+}
+
+# Each step whose label `notes` names gets that note at the end of its
+# evidence ("; at the end, ...").
+note_at_end <- function(st, notes) {
   st$steps <- lapply(st$steps, function(s) {
     if (s$label[1L] %in% names(notes)) {
       s$evidence <- paste0(s$evidence, "; at the end, ", notes[[s$label[1L]]])
     }
     s
   })
-  st$settings <- settings
-  st$current <- f
   st
 }
 
-# The values the raw data measure for the instances this call added that
-# fit `f` sizes off them (raw_hold_values()), less those `fixed` already
-# holds: list(values (named by coefficient), notes (named by label)).
-raw_holds <- function(st, f, fixed) {
+# The values the raw data measure for the instances `labels` (those this
+# call added) that fit `f` sizes off them (raw_hold_values()), less those
+# `fixed` already holds: list(values (named by coefficient), notes (named
+# by label)).
+raw_holds <- function(st, f, fixed, labels = added_labels(st)) {
   lay <- f$layout
   cf <- stats::coef(f)
   labs <- term_labels(f$terms)
-  added <- intersect(added_labels(st), labs)
   values <- numeric()
   notes <- character()
-  for (l in added) {
+  for (l in intersect(labels, labs)) {
     h <- raw_hold_values(f$terms[match(l, labs)], as.list(instance_params(cf, lay, l)), st$raw)
     if (is.null(h)) next
     v <- stats::setNames(h$values, paste0(l, ".", names(h$values)))
@@ -388,8 +395,11 @@ raw_holds <- function(st, f, fixed) {
   list(values = values, notes = notes)
 }
 
+# The label of each step's instance, in step order.
+step_labels <- function(st) vapply(st$steps, function(s) s$label[1L], "")
+
 # The labels of the instances this call added, one per step, in order.
-added_labels <- function(st) unique(vapply(st$steps, function(s) s$label[1L], ""))
+added_labels <- function(st) unique(step_labels(st))
 
 # An instance this call added that the final model holds at amplitude 0
 # (and stage_hold() could not hold at what the raw data measure)
@@ -472,11 +482,11 @@ stage_reconsider <- function(st) {
               format_num(st$args$min_gain))
     }
     # (the notes are under the refit's labels, the steps under the model's)
-    map <- label_map(best$w$from$terms, attr(best$w$terms, "gone"))
-    for (h in names(best$w$notes)) {
-      k <- which(vapply(st$steps, function(s) s$label[1L], "") == names(map)[match(h, map)])
-      for (i in k) st$steps[[i]]$evidence <- paste0(st$steps[[i]]$evidence, "; at the end, ",
-                                                   best$w$notes[[h]])
+    if (length(best$w$notes)) {
+      map <- label_map(best$w$from$terms, attr(best$w$terms, "gone"))
+      notes <- best$w$notes
+      names(notes) <- names(map)[match(names(notes), map)]
+      st <- note_at_end(st, notes)
     }
     if (!is.null(best$dup)) {
       st$duplicates <- rbind(st$duplicates, cbind(
@@ -504,7 +514,7 @@ final_stand_in <- function(st, cur, l, w) {
   if (length(l) != 1L || is.null(st$series)) return(NULL)
   effect <- cur$terms[match(l, term_labels(cur$terms))]
   par <- instance_params(stats::coef(cur), cur$layout, l)
-  k <- match(l, vapply(st$steps, function(s) s$label[1L], ""))
+  k <- match(l, step_labels(st))
   if (!is.na(k) && !values_moved(effect, attr(st$steps[[k]], "values"), par)) return(NULL)
   ev <- raw_evidence(effect, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
   dup <- series_stand_in(st, cur, l, effect, par, ev, without = w$fit,
@@ -526,31 +536,19 @@ values_moved <- function(effect, then, now, by = 1.5) {
 
 # refit_without()'s model `w` refitted with the instances it leaves
 # contradicted by the raw data held at the values the raw data measure
-# (raw_hold_values(); a measured band the refit sized 5% over its power,
+# (raw_holds(); a measured band the refit sized 5% over its power,
 # beyond twice its uncertainty): `w` with fit, settings and `notes` (by
 # label) of that refit, or with fit NULL when none can be held.
 hold_broken <- function(st, w, step) {
   f <- w$fit
-  lay <- f$layout
-  cf <- stats::coef(f)
-  labs <- term_labels(f$terms)
-  values <- numeric()
-  notes <- character()
-  for (l in intersect(earlier_broken(st, f), labs)) {
-    h <- raw_hold_values(f$terms[match(l, labs)], as.list(instance_params(cf, lay, l)), st$raw)
-    v <- if (!is.null(h)) stats::setNames(h$values, paste0(l, ".", names(h$values)))
-    v <- v[names(v) %in% lay$name & !names(v) %in% names(w$settings$fixed)]
-    if (!length(v)) next
-    values <- c(values, v)
-    notes[[l]] <- h$note
-  }
-  if (!length(values)) {
+  h <- raw_holds(st, f, w$settings$fixed, earlier_broken(st, f))
+  if (!length(h$values)) {
     w$fit <- NULL
     return(w)
   }
   settings <- w$settings
-  settings$fixed <- c(settings$fixed, values)
-  start <- cf[lay$role == "nonlinear"]
+  settings$fixed <- c(settings$fixed, h$values)
+  start <- stats::coef(f)[f$layout$role == "nonlinear"]
   start <- start[!names(start) %in% names(settings$fixed)]
   args <- refit_args(f, f$terms, settings, start = start)
   if (!is.null(st$tau_range)) args$tau_range <- c(st$tau_range[1L], Inf)
@@ -559,7 +557,7 @@ hold_broken <- function(st, w, step) {
   w$st <- r$st
   w$fit <- r$fit
   w$settings <- settings
-  w$notes <- notes
+  w$notes <- h$notes
   w
 }
 
@@ -584,7 +582,7 @@ judged_again <- function(st, cur) {
   kinds <- split_term(cur$terms)$kind
   ok <- labs[!labs %in% measured &
                vapply(kinds, function(k) !length(effect_entry(k)$replaces), NA)]
-  rows <- vapply(st$steps, function(s) s$label[1L], "")
+  rows <- step_labels(st)
   group <- vapply(seq_along(rows), function(i) {
     j <- if (i <= length(st$taken_with)) st$taken_with[i] else NA_integer_
     if (is.na(j)) i else j
