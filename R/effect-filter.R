@@ -7,11 +7,13 @@
 filter_spec_of <- function(variant, nl, tau0) {
   switch(variant,
     ma = list(family = "ma", L = max(1, nl[["L"]])),
-    lp1 = , lp2 = list(family = variant, fc = nl[["fc"]], freq = 1 / tau0))
+    lp1 = , lp2 = list(family = variant, fc = nl[["fc"]], freq = 1 / tau0),
+    ar2 = list(family = "ar2", fn = nl[["fn"]], zeta = nl[["zeta"]], freq = 1 / tau0))
 }
 
-# One variant's fields: the nonlinear parameter (L in samples for the
-# moving average, fc in Hz for the low-passes) and its search range.
+# One variant's fields: the nonlinear parameters (L in samples for the
+# moving average, fc in Hz for the low-passes, fn in Hz and the damping
+# zeta for the all-pole section) and their search ranges.
 filter_variant <- function(variant) {
   nlp <- switch(variant,
     ma = effect_param("L", "nonlinear", "samples",
@@ -19,6 +21,10 @@ filter_variant <- function(variant) {
                       profile = "smooth"),
     lp1 = , lp2 = effect_param("fc", "nonlinear", "Hz", "hertz (-3 dB cutoff)",
                                profile = "smooth", print_unit = TRUE),
+    ar2 = rbind(effect_param("fn", "nonlinear", "Hz", "hertz (natural frequency)",
+                             profile = "smooth", print_unit = TRUE),
+                effect_param("zeta", "nonlinear", "1", "damping ratio",
+                             profile = "smooth")),
     NULL)
   if (is.null(nlp)) return(NULL)
   list(
@@ -27,6 +33,7 @@ filter_variant <- function(variant) {
                    nlp),
     nl_range = function(tau, freq) {
       if (variant == "ma") list(L = c(1.001, 64))
+      else if (variant == "ar2") list(fn = c(freq / 2000, 0.499 * freq), zeta = c(0.4, 3))
       else list(fc = c(freq / 2000, if (variant == "lp2") 0.499 * freq else 0.5 * freq))
     },
     # The filter acts between the sampling interval and the longest tau:
@@ -35,9 +42,10 @@ filter_variant <- function(variant) {
     nl_bounds = function(tau, freq) {
       span <- if (is.null(freq)) max(tau) / min(tau) else max(tau) * freq
       nyq <- if (is.null(freq)) 0.5 / min(tau) else 0.5 * freq
-      if (variant == "ma") list(L = c(1, max(span, 1.001)))
-      else list(fc = c(min(1 / (2 * pi * max(tau)), nyq / 1000),
-                       if (variant == "lp2") 0.998 * nyq else nyq))
+      if (variant == "ma") return(list(L = c(1, max(span, 1.001))))
+      fc <- c(min(1 / (2 * pi * max(tau)), nyq / 1000),
+              if (variant == "lp1") nyq else 0.998 * nyq)
+      if (variant == "ar2") list(fn = fc, zeta = ar2_zeta_bounds) else list(fc = fc)
     },
     # At its bounds the filter is no filter the data show: L = 1 is white
     # noise, and a first-order low-pass at Nyquist is as near white as
@@ -56,6 +64,19 @@ filter_variant <- function(variant) {
                              "noise), not a cutoff the data show"),
                        format_num(par[["fc"]])))
       }
+      if (variant == "ar2") {
+        z <- par[["zeta"]]
+        if (!is.finite(z) || z <= ar2_zeta_bounds[1L] * 1.001) {
+          return(sprintf(paste("zeta = %s: a peak that sharp is a resonance's,",
+                               "not a low-pass filter's"), format_num(z)))
+        }
+        if (z >= ar2_zeta_bounds[2L] / 1.001 ||
+            (!is.null(freq) && par[["fn"]] >= 0.997 * 0.5 * freq)) {
+          return(sprintf(paste("fn = %s Hz, zeta = %s is at the edge of the",
+                               "second-order family, not a filter the data show"),
+                         format_num(par[["fn"]]), format_num(z)))
+        }
+      }
       NULL
     },
     formula = paste0("N^2 x exact AV of the ", variant,
@@ -64,7 +85,7 @@ filter_variant <- function(variant) {
 }
 
 # The families the loop chooses among (the bare "filter" is the first).
-filter_family_variants <- c("ma", "lp1", "lp2")
+filter_family_variants <- c("ma", "lp1", "lp2", "ar2")
 
 effect_filter <- function() {
   base <- filter_variant("ma")
@@ -94,9 +115,12 @@ effect_filter <- function() {
         sp <- filter_spec_of(variant, par, 1 / freq)
         # the diagnostics' filter part: filter_evidence() of this same
         # series, read once
-        filter_raw_support(sp, par[["Nf"]],
-                           diag_part(raw, "filter") %||% filter_evidence(x, freq),
-                           diag_var(raw, x), freq)
+        ev <- filter_raw_support(sp, par[["Nf"]],
+                                 diag_part(raw, "filter") %||% filter_evidence(x, freq),
+                                 diag_var(raw, x), freq)
+        # a second shape parameter must be seen beyond lag 1
+        if (variant == "ar2") ev <- filter_shape_support(ev, sp, par[["Nf"]], raw, x, freq)
+        ev
       }
     ))
   }

@@ -693,6 +693,158 @@ if (set %in% c("h", "i")) {
   }
 }
 
+# ---- set "j" -------------------------------------------------------------------
+# The classes at other sampling rates (session 34, written before any run
+# on it): 200 to 1000 Hz, 1e6 samples (1000-5000 s), every frequency,
+# time constant and step time drawn from a fixed seed relative to the
+# rate and the record's length, the white noise at the same density as
+# sets h and i. Simulated only (the measured axes are 100 Hz).
+if (identical(set, "j")) {
+  set.seed(4800)
+  rates <- c(200, 400, 1000, 250, 500)
+  n_j <- 1e6
+  ru <- function(lo, hi, d = 2) round(runif(1, lo, hi), d)
+  lu <- function(lo, hi) signif(exp(runif(1, log(lo), log(hi))), 3)
+  j_white <- ru(0.005, 0.02, 4)                # per sample at 100 Hz
+  j_K <- signif(exp(runif(1, log(4e-5), log(2e-4))), 2)
+  sim_base <- function(n = n_j) g_white(n, j_white * sqrt(freq / 100)) + g_rw(n, j_K)
+  j_fr <- ru(0.08, 0.16); j_line <- ru(0.4, 0.7)
+  sensor_base <- function(n = n_j) {
+    # a two-pole low-pass at a quarter of the rate, a band and a line of
+    # the sensor's own (the band at a fraction of the rate), a random walk
+    s <- j_white * sqrt(freq / 100)
+    w <- as.numeric(stats::filter(rnorm(n, sd = s), c(0.5, -0.15), method = "recursive"))
+    w + g_band(n, 0.8 * s, round(j_fr * freq, 1), 0.4) + g_line(n, 0.9 * s, j_line) + g_rw(n, j_K)
+  }
+  cases <- list()
+  k <- 0L
+  add_case <- function(label, make) {
+    k <<- k + 1L
+    fs <- rates[(k - 1L) %% length(rates) + 1L]
+    T <- n_j / fs
+    v <- make(fs, T)
+    nm <- if (startsWith(label, "control")) sprintf("control: sim %g Hz, %s", fs, sub("^control ", "", label))
+      else sprintf("sim %g Hz: %s", fs, sprintf(label, v$show))
+    cases[[nm]] <<- function() {
+      freq <<- fs
+      v$run()
+    }
+  }
+  wsd <- function() j_white * sqrt(freq / 100)
+  # a GM at the same absolute level as sets h and i (the white noise's
+  # density, hence its ADEV at a given tau, does not depend on the rate)
+  gm_s <- 3 * j_white / 10
+  add_case("line %s Hz, amp = white sd", function(fs, T) {
+    f0 <- ru(0.88, 0.996, 3) * fs / 2
+    list(show = f0, run = function() {
+      b <- sim_base(); list(x = b + g_line(n_j, wsd(), f0), base = b, expect = list(list("sinusoid", f0)))
+    })
+  })
+  add_case("line %s Hz, amp = 0.5 white sd", function(fs, T) {
+    f0 <- ru(0.9, 0.99, 3) * fs / 2
+    list(show = f0, run = function() {
+      b <- sim_base(); list(x = b + g_line(n_j, 0.5 * wsd(), f0), base = b, expect = list(list("sinusoid", f0)))
+    })
+  })
+  for (i in 1:2) add_case("line %s Hz, amp = 0.3 white sd", function(fs, T) {
+    f0 <- ru(0.5, 0.3 * fs)
+    list(show = f0, run = function() {
+      b <- sim_base(); list(x = b + g_line(n_j, 0.3 * wsd(), f0), base = b, expect = list(list("sinusoid", f0)))
+    })
+  })
+  add_case("square wave %s Hz", function(fs, T) {
+    f0 <- ru(0.3, 3)
+    list(show = f0, run = function() {
+      b <- sim_base(); list(x = b + g_square(n_j, 0.35 * wsd(), f0), base = b,
+        expect = list(list("sinusoid", f0), list("sinusoid", 3 * f0), list("sinusoid", 5 * f0)),
+        harmonics_of = f0)
+    })
+  })
+  add_case("sawtooth %s Hz", function(fs, T) {
+    f0 <- ru(0.3, 3)
+    list(show = f0, run = function() {
+      b <- sim_base(); list(x = b + g_saw(n_j, 0.6 * wsd(), f0), base = b,
+        expect = list(list("sinusoid", f0), list("sinusoid", 2 * f0), list("sinusoid", 3 * f0)),
+        harmonics_of = f0)
+    })
+  })
+  for (i in 1:3) add_case("GM tc %s s", function(fs, T) {
+    tc <- lu(0.001 * T, 0.012 * T)
+    list(show = tc, run = function() {
+      b <- sim_base(); g <- g_gm(n_j, gm_s, tc)
+      list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    })
+  })
+  add_case("GMs %s s", function(fs, T) {
+    tcs <- c(lu(0.0002 * T, 0.0008 * T), lu(0.004 * T, 0.012 * T))
+    list(show = paste(tcs, collapse = " s and "), run = function() {
+      b <- sim_base() + g_gm(n_j, 1.3 * gm_s, tcs[1])
+      g <- g_gm(n_j, gm_s, tcs[2])
+      list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    })
+  })
+  for (i in 1:2) add_case("band %s", function(fs, T) {
+    fr <- c(ru(0.05, 0.35, 3), ru(0.05, 0.35, 3)) * fs
+    while (abs(log(fr[1] / fr[2])) < 0.3) fr[2] <- ru(0.05, 0.35, 3) * fs
+    list(show = sprintf("%g Hz beside a resonance at %g Hz", fr[1], fr[2]), run = function() {
+      b <- sim_base() + g_band(n_j, wsd(), fr[2], 0.15)
+      list(x = b + g_band(n_j, 0.6 * wsd(), fr[1], 0.3), base = b, expect = list(list("band", fr[1])))
+    })
+  })
+  for (i in 1:3) add_case("warm-up tc %s s", function(fs, T) {
+    tc <- lu(0.01 * T, 0.3 * T)
+    list(show = tc, run = function() {
+      b <- sim_base(); list(x = b + g_warmup(b, tc), base = b, expect = list(list("warmup", tc)))
+    })
+  })
+  add_case("step at %s s", function(fs, T) {
+    t0 <- round(ru(0.1, 0.9) * T)
+    list(show = t0, run = function() {
+      b <- sim_base(); sz <- g_step_size(b)
+      list(x = b + g_step(n_j, t0, sz), base = b, expect = list(list("steps", c(t0, sz))))
+    })
+  })
+  add_case("sensor + line %s Hz", function(fs, T) {
+    f0 <- ru(0.88, 0.99, 3) * fs / 2
+    list(show = f0, run = function() {
+      b <- sensor_base(); list(x = b + g_line(n_j, 0.7 * wsd(), f0), base = b,
+                               expect = list(list("sinusoid", f0)))
+    })
+  })
+  add_case("sensor + line %s Hz beside its own", function(fs, T) {
+    f0 <- ru(1.5, 0.1 * fs)
+    list(show = f0, run = function() {
+      b <- sensor_base(); list(x = b + g_line(n_j, 0.4 * wsd(), f0), base = b,
+                               expect = list(list("sinusoid", f0)))
+    })
+  })
+  add_case("sensor + GM tc %s s", function(fs, T) {
+    tc <- lu(0.002 * T, 0.01 * T)
+    list(show = tc, run = function() {
+      b <- sensor_base(); g <- g_gm(n_j, gm_s, tc)
+      list(x = b + g, base = b, expect = list(list("gm", realised_tc(g))))
+    })
+  })
+  add_case("sensor + warm-up tc %s s", function(fs, T) {
+    tc <- lu(0.02 * T, 0.2 * T)
+    list(show = tc, run = function() {
+      b <- sensor_base(); list(x = b + g_warmup(b, tc), base = b, expect = list(list("warmup", tc)))
+    })
+  })
+  for (what in c("sensor", "N + K", "N + B + K", "Q + N + K")) local({
+    what <- what
+    add_case(paste("control", what), function(fs, T) {
+      list(show = "", run = function() {
+        x <- switch(what, sensor = sensor_base(), "N + K" = sim_base(),
+                    "N + B + K" = sim_base() + g_flicker(n_j, 0.04 * j_white),
+                    "Q + N + K" = round(sim_base() / (2 * wsd())) * (2 * wsd()))
+        list(x = x, base = NULL)
+      })
+    })
+  })
+  real <- list()
+}
+
 for (rc in real) local({
   rc <- rc
   nm <- sprintf("real: unit %d col %d + %s", rc$u, rc$j,
@@ -741,7 +893,7 @@ for (rc in real) local({
       })
   }
 })
-for (u in 1:3) for (j in 1:6) local({
+if (!identical(set, "j")) for (u in 1:3) for (j in 1:6) local({
   u <- u; j <- j
   cases[[sprintf("control: real unit %d col %d as it is", u, j)]] <<- function() {
     b <- real_axis(u, j)
@@ -761,7 +913,7 @@ for (nm in grep(only, names(cases), value = TRUE)) {
   # (BATTERY_SEED_OFFSET=k shifts every case's seed: the same cases on
   # other noise, to see whether a change generalises)
   set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500, f = 3700, g = 3900, h = 4100,
-             i = 4700)[[set]] +
+             i = 4700, j = 4900)[[set]] +
              match(nm, names(cases)) + as.integer(Sys.getenv("BATTERY_SEED_OFFSET", "0")))
   cs <- cases[[nm]]()
   if (is.null(cs)) next

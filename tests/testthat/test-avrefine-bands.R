@@ -118,6 +118,44 @@ test_that("a filtered sensor with a resonance: the low-pass family, the band's c
   expect_false("sinusoid" %in% st$effect)
 })
 
+test_that("a sensor's two-pole recursive filter is the all-pole section, at another rate", {
+  skip_on_cran()
+  set.seed(21)
+  n <- 2e5
+  freq <- 200
+  # white noise through y = w + 0.5 y[-1] - 0.15 y[-2] (complex poles: fn =
+  # 0.2048 freq, zeta = 0.737; DC gain 1 / 0.65), and a random walk
+  s <- 0.02
+  x <- as.numeric(stats::filter(stats::rnorm(n + 100L, sd = s), c(0.5, -0.15),
+                                method = "recursive"))[-(1:100)] +
+    cumsum(stats::rnorm(n, sd = 1e-4 / sqrt(freq)))
+  N <- s / sqrt(freq) / 0.65
+  ref <- loop_raw(x, freq)
+  cf <- stats::coef(ref)
+  expect_true("filter:ar2" %in% ref$terms)
+  expect_equal(unname(cf[["filter_ar2.fn"]]), 0.2048 * freq, tolerance = 0.1)
+  expect_equal(unname(cf[["filter_ar2.zeta"]]), 0.737, tolerance = 0.15)
+  expect_equal(unname(cf[["filter_ar2.Nf"]]), N, tolerance = 0.03)
+  expect_lt(ref$chi2, 2)
+  expect_false(any(ref$steps$confirmed %in% FALSE))
+})
+
+test_that("a moving average over a sample and a bit is not read as a two-pole section", {
+  skip_on_cran()
+  set.seed(22)
+  n <- 2e5
+  freq <- 100
+  # taps 0.55, 0.45 (lag-2 autocorrelation 0), a random walk and a line
+  x <- as.numeric(stats::filter(stats::rnorm(n + 1L, sd = 0.01), c(0.55, 0.45),
+                                sides = 1L))[-1L] +
+    cumsum(stats::rnorm(n, sd = 1e-5)) + 0.004 * sin(2 * pi * 0.55 * seq_len(n) / freq)
+  ref <- loop_raw(x, freq)
+  fl <- ref$terms[startsWith(ref$terms, "filter")]
+  expect_length(fl, 1L)
+  expect_false(fl == "filter:ar2")
+  expect_false(any(ref$steps$confirmed %in% FALSE))
+})
+
 test_that("with raw data, a sinusoid within 4 periodogram bins of DC is not taken", {
   set.seed(5)
   n <- 1e5

@@ -46,6 +46,35 @@ test_that("the exact AV of every filter family matches the linear-functional ref
   hb <- as.numeric(stats::filter(c(b, numeric(3997)), ar, method = "recursive"))
   expect_equal(filter_av(m, filter_spec("lp2", fc = fc, freq = 100), tau0),
                av_linear(hb, m, 1 / tau0), tolerance = 1e-10)
+  # second-order all-pole section: poles of s = wn (-zeta +- i sqrt(1 -
+  # zeta^2)) at z = exp(s tau0), unit DC gain; complex and real poles
+  for (zeta in c(0.6, 1.7)) {
+    wn <- 2 * pi * 15
+    p <- exp(wn * tau0 * (-zeta + c(1, -1) * sqrt(as.complex(zeta^2 - 1))))
+    a2 <- c(Re(sum(p)), -Re(prod(p)))
+    h2p <- as.numeric(stats::filter(c(1 - sum(a2), numeric(3999)), a2, method = "recursive"))
+    expect_equal(filter_av(m, filter_spec("ar2", fn = 15, zeta = zeta, freq = 100), tau0),
+                 av_linear(h2p, m, 1 / tau0), tolerance = 1e-10)
+  }
+})
+
+test_that("the all-pole section's start is read from the raw lag-1 and lag-2 autocorrelation", {
+  skip_on_cran()
+  set.seed(11)
+  # white noise through y = w + 0.5 y[-1] - 0.15 y[-2]: poles 0.387 at
+  # +-49.8 degrees, i.e. fn = 20.48 Hz and zeta = 0.737 at 100 Hz
+  y <- as.numeric(stats::filter(stats::rnorm(4e5), c(0.5, -0.15), method = "recursive"))
+  st <- filter_evidence(y[-(1:100)], 100)$start$ar2
+  expect_equal(st$fn, 20.48, tolerance = 0.03)
+  expect_equal(st$zeta, 0.737, tolerance = 0.03)
+  # simulated with the package's recursion: variance g(0) per N^2
+  sp <- filter_spec("ar2", fn = 20.48, zeta = 0.737, freq = 100)
+  s <- sim_filtered_white(2e5, tau0, 1, sp)
+  expect_equal(stats::var(s), filter_acf(sp, tau0, 0), tolerance = 0.02)
+  expect_error(filter_spec("ar2", fn = 60, zeta = 0.7, freq = 100),
+               class = "allanvar_error_argument")
+  expect_error(filter_spec("ar2", fn = 20, zeta = 0, freq = 100),
+               class = "allanvar_error_argument")
 })
 
 test_that("a fractional moving average is the MA whose autocovariance is the triangle", {
