@@ -54,6 +54,10 @@
 #                 alone: a list of list(init, tau_from, tau_to, note, score)
 #   evidence(par, raw, x, freq)  list(text, support = TRUE/FALSE/NA): what
 #                 the raw series says about a fitted instance
+#   model_evidence(ev, fit, label, raw, freq)  NULL, or evidence() read
+#                 again beside the other terms of the model `fit` that holds
+#                 the instance `label` (what the raw series shows of a shape
+#                 only the whole model predicts): the list evidence() gives
 #   raw_hold(par, raw)  NULL, or for an instance the curve sizes far off
 #                 what the raw data measure: list(values (named parameter
 #                 values the raw data measure, to hold it at), note)
@@ -201,7 +205,7 @@ new_effect <- function(name, title, params, component = "av",
                        replaces_instance = NULL, admissible = NULL, proposed_only = FALSE,
                        statespace = NULL, diagnose = NULL, family = NULL,
                        exact_edf = NULL, noise_lookalike = FALSE,
-                       detect_again = FALSE, known_av = NULL) {
+                       detect_again = FALSE, known_av = NULL, model_evidence = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -217,7 +221,7 @@ new_effect <- function(name, title, params, component = "av",
        proposed_only = proposed_only, statespace = statespace,
        diagnose = diagnose, family = family, exact_edf = exact_edf,
        noise_lookalike = noise_lookalike, detect_again = detect_again,
-       known_av = known_av)
+       known_av = known_av, model_evidence = model_evidence)
 }
 
 validate_effect <- function(e) {
@@ -250,7 +254,8 @@ validate_effect <- function(e) {
   e$params <- p
   fun_ok <- function(f) is.null(f) || is.function(f)
   for (f in c("basis", "psd", "acf", "sim", "sim_check", "edf_alpha",
-              "nl_range", "nl_bounds", "trace", "propose", "evidence", "raw_hold",
+              "nl_range", "nl_bounds", "trace", "propose", "evidence", "model_evidence",
+              "raw_hold",
               "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible",
               "statespace", "exact_edf")) {

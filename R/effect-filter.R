@@ -115,12 +115,16 @@ effect_filter <- function() {
         sp <- filter_spec_of(variant, par, 1 / freq)
         # the diagnostics' filter part: filter_evidence() of this same
         # series, read once
-        ev <- filter_raw_support(sp, par[["Nf"]],
-                                 diag_part(raw, "filter") %||% filter_evidence(x, freq),
-                                 diag_var(raw, x), freq)
-        # a second shape parameter must be seen beyond lag 1
-        if (variant == "ar2") ev <- filter_shape_support(ev, sp, par[["Nf"]], raw, x, freq)
-        ev
+        filter_raw_support(sp, par[["Nf"]],
+                           diag_part(raw, "filter") %||% filter_evidence(x, freq),
+                           diag_var(raw, x), freq)
+      },
+      # a second shape parameter must be seen beyond lag 1, beside the
+      # model's other terms
+      model_evidence = if (variant == "ar2") function(ev, fit, label, raw, freq) {
+        par <- instance_params(stats::coef(fit), fit$layout, label)
+        sp <- filter_spec_of(variant, as.list(par), 1 / freq)
+        filter_shape_support(ev, sp, par[["Nf"]], fit, raw, freq)
       }
     ))
   }

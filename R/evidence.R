@@ -209,14 +209,20 @@ print.avdiagnose <- function(x, ...) {
 
 # Evidence from the raw series for one fitted effect (`par`: its parameters
 # by name): a short string and whether the data support it (TRUE),
-# contradict it (FALSE) or cannot tell (NA). The entry's evidence() decides.
-raw_evidence <- function(effect, par, raw, x, freq) {
+# contradict it (FALSE) or cannot tell (NA). The entry's evidence() decides;
+# given the model `fit` that holds the instance (`label`), an entry's
+# model_evidence() reads the raw data beside the model's other terms too.
+raw_evidence <- function(effect, par, raw, x, freq, fit = NULL, label = NULL) {
   if (is.null(raw)) return(list(text = "", support = NA))
   e <- effect_entry(split_term(effect)$kind, split_term(effect)$variant)
   if (is.null(e$evidence)) {
     return(list(text = "no raw-data check for this effect", support = NA))
   }
-  e$evidence(par, raw, x, freq)
+  ev <- e$evidence(par, raw, x, freq)
+  if (is.function(e$model_evidence) && !is.null(fit) && !is.null(label)) {
+    ev <- e$model_evidence(ev, fit, label, raw, freq)
+  }
+  ev
 }
 
 # What the raw series measures of a fitted instance the curve sizes far

@@ -15,8 +15,9 @@
 #           lines taken out, the bands brought to their background)
 #   cache   an environment for statistics of `series` that many candidate
 #           checks share (the block-mean ACF of each block size, its
-#           variance), and the raw series' Welch PSD the parts share
-#           (raw_welch())
+#           variance), the raw series' Welch PSD the parts share
+#           (raw_welch()), and the raw series itself (`data`) for its
+#           short-lag autocovariance steps (diag_acov_steps())
 #
 # An entry's `diagnose` field: list(part, reads = "raw" or "clean", needs
 # (parts made first), make(x, freq, dg) -> the part, clean(x, freq, part)
@@ -75,6 +76,7 @@ refine_diagnostics <- function(x, freq, beside = NULL) {
     }
   }
   dg$series <- clean
+  assign("data", x, envir = dg$cache)
   for (d in steps) {
     if (identical(d$reads, "clean")) dg$parts[[d$part]] <- d$make(clean, freq, dg)
   }
@@ -131,6 +133,15 @@ raw_welch <- function(dg) {
     if (!is.null(cache)) cache[[key]] <- list(x = x, freq = freq, w = w)
     w
   }
+}
+
+# The short-lag autocovariance steps of the raw series (acov_steps()),
+# made once per call; NULL without it.
+diag_acov_steps <- function(dg) {
+  cache <- diag_cache(dg)
+  if (is.null(cache) || is.null(cache$data)) return(NULL)
+  if (is.null(cache$acov_steps)) cache$acov_steps <- acov_steps(cache$data)
+  cache$acov_steps
 }
 
 # The series the raw-data checks see.

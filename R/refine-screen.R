@@ -313,7 +313,7 @@ judge_instance <- function(st, f, effect, label, tau) {
   par <- instance_params(stats::coef(f), f$layout, label)
   why <- inadmissible(effect, par, tau, freq)
   ev <- if (is.null(why)) raw_evidence(effect, as.list(par), st$raw,
-                                       diag_series(st$raw), freq)
+                                       diag_series(st$raw), freq, f, label)
   if (is.null(why) && isFALSE(ev$support)) {
     why <- paste("contradicted by the raw data:", ev$text)
   }
@@ -457,12 +457,7 @@ acov_choice <- function(st, cur, near) {
 # read once per call.
 acov_misfit <- function(st, f) {
   if (is.null(st$data) || is.null(st$args$freq)) return(NA_real_)
-  cache <- diag_cache(st$raw)
-  raw <- if (!is.null(cache)) cache$acov_steps
-  if (is.null(raw)) {
-    raw <- acov_steps(st$data)
-    if (!is.null(cache)) cache$acov_steps <- raw
-  }
+  raw <- diag_acov_steps(st$raw) %||% acov_steps(st$data)
   h <- seq_len(length(raw$d) + 1L)
   md <- -diff(model_acov(f$layout, stats::coef(f), h, 1 / st$args$freq))
   sum(((raw$d - md) / raw$se)^2)
@@ -621,7 +616,7 @@ with_form <- function(tm, fm) {
 judge_form <- function(st, g, v, lab) {
   par <- instance_params(stats::coef(g), g$layout, lab)
   if (!is.null(inadmissible(v, par, g$data$tau, st$args$freq))) return(NULL)
-  ev <- raw_evidence(v, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
+  ev <- raw_evidence(v, as.list(par), st$raw, diag_series(st$raw), st$args$freq, g, lab)
   if (isFALSE(ev$support) || !earlier_hold(st, g)) return(NULL)
   list(par = par, ev = ev)
 }

@@ -516,7 +516,8 @@ final_stand_in <- function(st, cur, l, w) {
   par <- instance_params(stats::coef(cur), cur$layout, l)
   k <- match(l, step_labels(st))
   if (!is.na(k) && !values_moved(effect, attr(st$steps[[k]], "values"), par)) return(NULL)
-  ev <- raw_evidence(effect, as.list(par), st$raw, diag_series(st$raw), st$args$freq)
+  ev <- raw_evidence(effect, as.list(par), st$raw, diag_series(st$raw), st$args$freq,
+                     cur, l)
   dup <- series_stand_in(st, cur, l, effect, par, ev, without = w$fit,
                          without_settings = w$settings)
   if (is.null(dup)) NULL else list(effect = effect, par = par, dup = dup)
@@ -795,7 +796,8 @@ step_refit_winner <- function(st) {
     crit <- refine_crit_held(st, full, held)
     if (crit > best$crit + 1e-6) return(NULL)
     p2 <- instance_params(stats::coef(full), full$layout, best$label)
-    ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq)
+    ev2 <- raw_evidence(effect, as.list(p2), st$raw, diag_series(st$raw), st$args$freq,
+                        full, best$label)
     ok <- !isFALSE(ev2$support) &&
       is.null(unconfirmed_marginal(effect, ev2, st$c0 - crit, st$args$min_gain, st$raw)) &&
       is.null(inadmissible(effect, p2, st$current$data$tau, st$args$freq)) &&
@@ -853,7 +855,7 @@ step_record <- function(st) {
     par2 <- instance_params(stats::coef(best$fit), best$fit$layout, lab2)
     loc2 <- locate_signature(st$sig, best$fit, lab2)
     ev2 <- raw_evidence(effect2, as.list(par2), st$raw,
-                        diag_series(st$raw), st$args$freq)
+                        diag_series(st$raw), st$args$freq, best$fit, lab2)
     st$steps[[length(st$steps) + 1L]] <- step_row(
       effect2, lab2, loc2, par2,
       paste0(loc2$text, "; ", also$note %||%

@@ -106,7 +106,7 @@ earlier_broken <- function(st, f) {
       out <- c(out, s$label)
       next
     }
-    ev <- raw_evidence(s$effect, as.list(par), st$raw, diag_series(st$raw), freq)
+    ev <- raw_evidence(s$effect, as.list(par), st$raw, diag_series(st$raw), freq, f, s$label)
     if (isFALSE(ev$support)) out <- c(out, s$label)
   }
   out

@@ -19,7 +19,7 @@
 #' | R | R \[u/s\] | \eqn{R^2\tau^2/2} |
 #' | gm | sigma \[u\], tc \[s\] | \eqn{\sigma^2 (t_c/\tau)^2 (2\tau/t_c - 3 + 4e^{-\tau/t_c} - e^{-2\tau/t_c})} |
 #' | sinusoid | amp \[u\], f0 \[Hz\] | \eqn{A^2 \sin^4(\pi f_0 \tau)/(\pi f_0\tau)^2} |
-#' | filter | Nf \[u sqrt(s)\], L \[samples\] (`filter:ma`) or fc \[Hz\] (`filter:lp1`, `filter:lp2`) | \eqn{N_f^2} times the exact AV of the filter's autocovariance (unit DC gain: \eqn{N_f^2/\tau} beyond a few samples) |
+#' | filter | Nf \[u sqrt(s)\], L \[samples\] (`filter:ma`) or fc \[Hz\] (`filter:lp1`, `filter:lp2`) or fn \[Hz\] and zeta (`filter:ar2`, a two-pole recursive section) | \eqn{N_f^2} times the exact AV of the filter's autocovariance (unit DC gain: \eqn{N_f^2/\tau} beyond a few samples) |
 #' | resonance | sigma \[u\], fr \[Hz\], tc \[s\] | white noise through a damped oscillator: the real AR(2) with poles \eqn{e^{-\tau_0/t_c \pm 2\pi i f_r\tau_0}} (sigma its sd, FWHM about \eqn{1/(\pi t_c)}) |
 #'
 #' With the sampling frequency known, the exact expectations for a sampled
