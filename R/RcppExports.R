@@ -41,6 +41,14 @@ avfit_exact_edf <- function(m, M, overlapping, shape, coef, phi) {
     .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, shape, coef, phi)
 }
 
+gm_basis_cpp <- function(tau, tau0, tc, fact) {
+    .Call(`_allanvar_gm_basis_cpp`, tau, tau0, tc, fact)
+}
+
+filter_ma_av_cpp <- function(m, L, tau0) {
+    .Call(`_allanvar_filter_ma_av_cpp`, m, L, tau0)
+}
+
 first_nonfinite <- function(x) {
     .Call(`_allanvar_first_nonfinite`, x)
 }

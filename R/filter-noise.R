@@ -233,6 +233,12 @@ filter_av <- function(m, spec, tau0) {
     for (j in seq_along(ra$p)) out <- out + geometric_av(m, ra$A[j], ra$p[j])
     return(Re(out) / tau0)
   }
+  # whole m of a moving average in C++ (src/basis.cpp), the same values
+  if (spec$family == "ma" && is.double(m) && length(m) && is_plain_number(spec$L) &&
+      is_plain_number(tau0)) {
+    out <- filter_ma_av_cpp(m, spec$L, tau0)
+    if (!is.null(out)) return(out)
+  }
   K <- filter_support(spec)
   # AV(m) below the support reads lags < 2m only: a moving average longer
   # than the curve (a search may try L = 1e9) must not allocate its support

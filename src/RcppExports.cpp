@@ -141,6 +141,31 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// gm_basis_cpp
+Rcpp::NumericVector gm_basis_cpp(const Rcpp::NumericVector& tau, double tau0, double tc, const Rcpp::NumericVector& fact);
+RcppExport SEXP _allanvar_gm_basis_cpp(SEXP tauSEXP, SEXP tau0SEXP, SEXP tcSEXP, SEXP factSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type tau(tauSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    Rcpp::traits::input_parameter< double >::type tc(tcSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type fact(factSEXP);
+    rcpp_result_gen = Rcpp::wrap(gm_basis_cpp(tau, tau0, tc, fact));
+    return rcpp_result_gen;
+END_RCPP
+}
+// filter_ma_av_cpp
+SEXP filter_ma_av_cpp(const Rcpp::NumericVector& m, double L, double tau0);
+RcppExport SEXP _allanvar_filter_ma_av_cpp(SEXP mSEXP, SEXP LSEXP, SEXP tau0SEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type L(LSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    rcpp_result_gen = Rcpp::wrap(filter_ma_av_cpp(m, L, tau0));
+    return rcpp_result_gen;
+END_RCPP
+}
 // first_nonfinite
 double first_nonfinite(const Rcpp::NumericVector& x);
 RcppExport SEXP _allanvar_first_nonfinite(SEXP xSEXP) {
@@ -933,6 +958,8 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_avfit_exact_edf", (DL_FUNC) &_allanvar_avfit_exact_edf, 6},
+    {"_allanvar_gm_basis_cpp", (DL_FUNC) &_allanvar_gm_basis_cpp, 4},
+    {"_allanvar_filter_ma_av_cpp", (DL_FUNC) &_allanvar_filter_ma_av_cpp, 3},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},

@@ -252,3 +252,26 @@ test_that("a moving average far longer than the curve's clusters needs only the 
   v <- filter_av(c(1, 10, 1000), filter_spec_of("ma", list(L = 1e9), tau0), tau0)
   expect_true(all(is.finite(v) & v > 0))
 })
+
+test_that("a moving average's AV at whole m in C++ is the R form to the bit", {
+  r_form <- function(m, L, tau0) {
+    sp <- list(family = "ma", L = L)
+    K <- filter_support(sp)
+    need <- min(K, 2 * ceiling(max(m)) + 2)
+    g <- filter_acf(sp, tau0, 0:(need - 1L))
+    acov_av(round(m), g, if (need < K) ma_sums(L, tau0))
+  }
+  set.seed(34)
+  for (i in 1:300) {
+    tau0 <- 10^runif(1, -3, 0)
+    L <- switch(i %% 4 + 1, 1 + 10^runif(1, -4, 0.5), 10^runif(1, 0, 3),
+                round(10^runif(1, 0, 2)), 10^runif(1, 3, 9))
+    m <- if (i %% 2) 2^(0:sample(3:18, 1)) else sort(unique(round(10^runif(25, 0, 5))))
+    # (cluster sizes as tau / tau0 give them: whole within 1e-9)
+    if (i %% 5 == 0) m <- (m * tau0) / tau0
+    expect_identical(filter_av(m, filter_spec_of("ma", list(L = L), tau0), tau0),
+                     r_form(m, L, tau0))
+  }
+  # fractional m stay with the R interpolation
+  expect_null(filter_ma_av_cpp(c(1, 2.5), 3, 0.01))
+})
