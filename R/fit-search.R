@@ -148,7 +148,11 @@ fit_problem <- function(data, tau0, lay, bias_correct, corr, model_var = 0) {
   # free ones' template, the store's grid and each searched term's key
   amp$fixed_idx <- which(amp$fixed)
   amp$cc0 <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
-  for (k in seq_along(plan_nl)) plan_nl[[k]]$key <- basis_key(plan_nl[[k]]$entry)
+  for (k in seq_along(plan_nl)) {
+    plan_nl[[k]]$key <- basis_key(plan_nl[[k]]$entry)
+    # its nonlinear values' positions in `values` (no name matching per solve)
+    plan_nl[[k]]$nl_idx <- match(plan_nl[[k]]$nl, lay$name)
+  }
   list(data = data, tau0 = tau0, lay = lay, plan = plan, y = y,
        s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct,
        amp = amp, plan_nl = plan_nl, basis0 = basis0, B0 = B0,
@@ -170,7 +174,7 @@ solve_basis <- function(pr, values, store = pr$store) {
     p <- pr$plan_nl[[k]]
     nl <- NULL
     if (length(p$nl)) {
-      nl <- values[p$nl]
+      nl <- values[p$nl_idx]
       names(nl) <- p$nl_param
     }
     hit <- memo[[p$label]]
