@@ -41,6 +41,18 @@ avfit_exact_edf <- function(m, M, overlapping, shape, coef, phi) {
     .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, shape, coef, phi)
 }
 
+bin_power_cpp <- function(X, scale, twice) {
+    .Call(`_allanvar_bin_power_cpp`, X, scale, twice)
+}
+
+bin_mean_cpp <- function(Ph, G, k) {
+    .Call(`_allanvar_bin_mean_cpp`, Ph, G, k)
+}
+
+band_gain_cpp <- function(G, B, M, S) {
+    .Call(`_allanvar_band_gain_cpp`, G, B, M, S)
+}
+
 gm_basis_cpp <- function(tau, tau0, tc, fact) {
     .Call(`_allanvar_gm_basis_cpp`, tau, tau0, tc, fact)
 }

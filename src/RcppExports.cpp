@@ -141,6 +141,43 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// bin_power_cpp
+Rcpp::NumericVector bin_power_cpp(const Rcpp::ComplexVector& X, double scale, bool twice);
+RcppExport SEXP _allanvar_bin_power_cpp(SEXP XSEXP, SEXP scaleSEXP, SEXP twiceSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::ComplexVector& >::type X(XSEXP);
+    Rcpp::traits::input_parameter< double >::type scale(scaleSEXP);
+    Rcpp::traits::input_parameter< bool >::type twice(twiceSEXP);
+    rcpp_result_gen = Rcpp::wrap(bin_power_cpp(X, scale, twice));
+    return rcpp_result_gen;
+END_RCPP
+}
+// bin_mean_cpp
+Rcpp::NumericVector bin_mean_cpp(const Rcpp::NumericVector& Ph, const Rcpp::NumericVector& G, int k);
+RcppExport SEXP _allanvar_bin_mean_cpp(SEXP PhSEXP, SEXP GSEXP, SEXP kSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type Ph(PhSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type G(GSEXP);
+    Rcpp::traits::input_parameter< int >::type k(kSEXP);
+    rcpp_result_gen = Rcpp::wrap(bin_mean_cpp(Ph, G, k));
+    return rcpp_result_gen;
+END_RCPP
+}
+// band_gain_cpp
+Rcpp::NumericVector band_gain_cpp(const Rcpp::NumericVector& G, const Rcpp::NumericVector& B, const Rcpp::NumericVector& M, const Rcpp::NumericVector& S);
+RcppExport SEXP _allanvar_band_gain_cpp(SEXP GSEXP, SEXP BSEXP, SEXP MSEXP, SEXP SSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type G(GSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type B(BSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type M(MSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type S(SSEXP);
+    rcpp_result_gen = Rcpp::wrap(band_gain_cpp(G, B, M, S));
+    return rcpp_result_gen;
+END_RCPP
+}
 // gm_basis_cpp
 Rcpp::NumericVector gm_basis_cpp(const Rcpp::NumericVector& tau, double tau0, double tc, const Rcpp::NumericVector& fact);
 RcppExport SEXP _allanvar_gm_basis_cpp(SEXP tauSEXP, SEXP tau0SEXP, SEXP tcSEXP, SEXP factSEXP) {
@@ -958,6 +995,9 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_avfit_exact_edf", (DL_FUNC) &_allanvar_avfit_exact_edf, 6},
+    {"_allanvar_bin_power_cpp", (DL_FUNC) &_allanvar_bin_power_cpp, 3},
+    {"_allanvar_bin_mean_cpp", (DL_FUNC) &_allanvar_bin_mean_cpp, 3},
+    {"_allanvar_band_gain_cpp", (DL_FUNC) &_allanvar_band_gain_cpp, 4},
     {"_allanvar_gm_basis_cpp", (DL_FUNC) &_allanvar_gm_basis_cpp, 4},
     {"_allanvar_filter_ma_av_cpp", (DL_FUNC) &_allanvar_filter_ma_av_cpp, 3},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},

@@ -506,3 +506,32 @@ test_that("find_bands(): a run that only lines made is no band, with or without 
   expect_false(bands(w + tones))
   expect_true(bands(w + tones + 0.002 * ar2_unit(n, 2.6, 0.5, freq)))
 })
+
+test_that("the whole record's per-bin arithmetic in C++ is R's expressions to the bit", {
+  set.seed(34)
+  for (i in 1:60) {
+    h <- sample(c(3:40, 1000, 4097), 1)
+    X <- complex(real = rnorm(h) * 10^runif(1, -8, 4), imaginary = rnorm(h) * 10^runif(1, -8, 4))
+    sc <- 10^runif(1, -3, 8)
+    p <- Mod(X)^2 / sc
+    p[2:(h - 1L)] <- 2 * p[2:(h - 1L)]
+    expect_identical(bin_power_cpp(X, sc, FALSE), p)
+    expect_identical(bin_power_cpp(X, sc, TRUE), 2 * Mod(X)^2 / sc)
+    Ph <- abs(rnorm(h)) * 10^runif(1, -8, 3)
+    G <- if (i %% 2) 1 else runif(h)
+    k <- sample(c(1L, 2L, 3L, 1024L), 1)
+    expect_identical(bin_mean_cpp(Ph, G, k), bin_smoother(h, k)(Ph * G^2))
+    B <- abs(rnorm(h))
+    M <- 2 * abs(rnorm(h))
+    S <- 3 * abs(rnorm(h))
+    expect_identical(band_gain_cpp(G, B, M, S), G * sqrt(B / (B + pmin(M, pmax(S - B, 0)))))
+    # the bins of a frequency range by binary search: the comparisons' own
+    fh <- (seq_len(h) - 1) * 100 / (2 * (h - 1))
+    lo <- if (i %% 3) sample(fh, 1) else runif(1, -5, 60)
+    hi <- if (i %% 4) lo + runif(1, 0, 30) else sample(fh, 1)
+    expect_identical(bins_between(fh, lo, hi), which(fh >= lo & fh <= hi))
+    expect_identical(bins_between(fh, lo, hi, lo_open = TRUE), which(fh > lo & fh <= hi))
+    expect_identical(bins_between(fh, lo, hi, hi_open = TRUE), which(fh >= lo & fh < hi))
+  }
+  expect_identical(bins_between(c(1, 2, 3), NA_real_, 3), integer(0))
+})
