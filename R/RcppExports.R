@@ -61,6 +61,10 @@ filter_ma_av_cpp <- function(m, L, tau0) {
     .Call(`_allanvar_filter_ma_av_cpp`, m, L, tau0)
 }
 
+rational_av_cpp <- function(m, c0, r, p, tau0) {
+    .Call(`_allanvar_rational_av_cpp`, m, c0, r, p, tau0)
+}
+
 first_nonfinite <- function(x) {
     .Call(`_allanvar_first_nonfinite`, x)
 }

@@ -228,7 +228,14 @@ geometric_av <- function(m, A, p) {
 # smooth form S/m - 3C/m^2 above it.
 filter_av <- function(m, spec, tau0) {
   if (spec$family %in% c("lp1", "lp2")) {
-    ra <- rational_acov(filter_rational(spec))
+    rat <- filter_rational(spec)
+    # rational_acov() and the sums below in C++ (src/basis.cpp), the same
+    # values
+    if (is.double(m) && is.null(attributes(m)) && is_plain_number(tau0) &&
+        is_plain_number(rat$c0) && is.complex(rat$r) && is.complex(rat$p)) {
+      return(rational_av_cpp(m, rat$c0, rat$r, rat$p, tau0))
+    }
+    ra <- rational_acov(rat)
     out <- ra$d0 / m
     for (j in seq_along(ra$p)) out <- out + geometric_av(m, ra$A[j], ra$p[j])
     return(Re(out) / tau0)

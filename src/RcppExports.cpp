@@ -203,6 +203,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// rational_av_cpp
+Rcpp::NumericVector rational_av_cpp(const Rcpp::NumericVector& m, double c0, const Rcpp::ComplexVector& r, const Rcpp::ComplexVector& p, double tau0);
+RcppExport SEXP _allanvar_rational_av_cpp(SEXP mSEXP, SEXP c0SEXP, SEXP rSEXP, SEXP pSEXP, SEXP tau0SEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type c0(c0SEXP);
+    Rcpp::traits::input_parameter< const Rcpp::ComplexVector& >::type r(rSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::ComplexVector& >::type p(pSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    rcpp_result_gen = Rcpp::wrap(rational_av_cpp(m, c0, r, p, tau0));
+    return rcpp_result_gen;
+END_RCPP
+}
 // first_nonfinite
 double first_nonfinite(const Rcpp::NumericVector& x);
 RcppExport SEXP _allanvar_first_nonfinite(SEXP xSEXP) {
@@ -1000,6 +1014,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_band_gain_cpp", (DL_FUNC) &_allanvar_band_gain_cpp, 4},
     {"_allanvar_gm_basis_cpp", (DL_FUNC) &_allanvar_gm_basis_cpp, 4},
     {"_allanvar_filter_ma_av_cpp", (DL_FUNC) &_allanvar_filter_ma_av_cpp, 3},
+    {"_allanvar_rational_av_cpp", (DL_FUNC) &_allanvar_rational_av_cpp, 5},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},

@@ -1,11 +1,15 @@
-// The exact discrete Allan variance per squared amplitude of two catalogue
-// terms, the Gauss-Markov process (R/effect-gauss-markov.R) and white noise
-// through a moving average (R/filter-noise.R, filter_av()): the R
-// expressions' operations in their order, R's x^2 as x * x, and sums in
-// long double as R's sum(), so the values are R's (identical(); checked in
-// the tests). The loop's searches evaluate them at every value they visit.
+// The exact discrete Allan variance per squared amplitude of catalogue
+// terms: the Gauss-Markov process (R/effect-gauss-markov.R) and white noise
+// through the sensor's filter (R/filter-noise.R, filter_av(): a moving
+// average, the IIR low-passes): the R expressions' operations in their
+// order, R's x^2 as x * x, sums in long double as R's sum(), complex
+// values in R's arithmetic (src/r_complex.h), so the values are R's
+// (identical(); checked in the tests). The loop's searches evaluate them
+// at every value they visit.
 #include <Rcpp.h>
+#include "r_complex.h"
 #include <cmath>
+#include <complex>
 #include <vector>
 
 // gm_basis_continuous(tau, tc) at the taus below a sample and
@@ -60,6 +64,16 @@ double r_sum(const double* v, size_t n) {
   long double s = 0.0;
   for (size_t i = 0; i < n; i++) s += v[i];
   return static_cast<double>(s);
+}
+
+// R's sum() of complex values: each part in long double.
+std::complex<double> r_csum(const std::vector<std::complex<double>>& v) {
+  long double sr = 0.0, si = 0.0;
+  for (const std::complex<double>& z : v) {
+    sr += z.real();
+    si += z.imag();
+  }
+  return std::complex<double>(static_cast<double>(sr), static_cast<double>(si));
 }
 
 }  // namespace
@@ -121,6 +135,60 @@ SEXP filter_ma_av_cpp(const Rcpp::NumericVector& m, double L, double tau0) {
       out[j] = S / mm - 3 * C / (mm * mm);
     }
     if ((j & 0xFF) == 0) Rcpp::checkUserInterrupt();
+  }
+  return out;
+}
+
+// filter_av(m, spec, tau0) of an IIR family from its rational form
+// (filter_rational(): c0, residues r, poles p): rational_acov()'s
+// geometric parts A and white part d0, then Re(d0 / m + sum_j
+// geometric_av(m, A_j, p_j)) / tau0.
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector rational_av_cpp(const Rcpp::NumericVector& m, double c0,
+                                    const Rcpp::ComplexVector& r,
+                                    const Rcpp::ComplexVector& p, double tau0) {
+  typedef std::complex<double> cplx;
+  const R_xlen_t k = p.size();
+  if (r.size() != k) Rcpp::stop("rational_av_cpp: as many residues as poles");
+  std::vector<cplx> rv(k), pv(k);
+  for (R_xlen_t a = 0; a < k; a++) {
+    rv[a] = cplx(r[a].r, r[a].i);
+    pv[a] = cplx(p[a].r, p[a].i);
+  }
+  // element i = a + k b of rep(., k) and rep(., each = k): index a, then b
+  const R_xlen_t kk = k * k;
+  std::vector<cplx> pp(kk), G(kk);
+  for (R_xlen_t i = 0; i < kk; i++) {
+    const R_xlen_t a = i % k, b = i / k;
+    pp[i] = cplx(1.0, 0.0) - pv[a] * pv[b];
+    G[i] = rv[a] * rv[b] / pp[i];
+  }
+  // A <- r * (c0 + colSums(matrix(r / pp, k))), colSums() of a complex
+  // matrix as R has it: colSums(Re) + 1i * colSums(Im)
+  std::vector<cplx> A(k);
+  for (R_xlen_t b = 0; b < k; b++) {
+    long double sr = 0.0, si = 0.0;
+    for (R_xlen_t a = 0; a < k; a++) {
+      const cplx q = rv[a] / pp[a + k * b];
+      sr += q.real();
+      si += q.imag();
+    }
+    const cplx cs = cplx(static_cast<double>(sr), 0.0) +
+      cplx(0.0, 1.0) * cplx(static_cast<double>(si), 0.0);
+    A[b] = rv[b] * (cplx(c0, 0.0) + cs);
+  }
+  // g0 <- c0^2 + 2 * c0 * sum(r) + sum(G); d0 <- Re(g0 - sum(A))
+  cplx g0 = cplx(c0 * c0, 0.0) + cplx(2 * c0, 0.0) * r_csum(rv);
+  g0 = g0 + r_csum(G);
+  const double d0 = (g0 - r_csum(A)).real();
+  std::vector<allanvar::GeometricAv> geom;
+  for (R_xlen_t j = 0; j < k; j++) geom.emplace_back(A[j], pv[j]);
+  const R_xlen_t n = m.size();
+  Rcpp::NumericVector out(n);
+  for (R_xlen_t i = 0; i < n; i++) {
+    double v = d0 / m[i];
+    for (R_xlen_t j = 0; j < k; j++) v = v + geom[j](m[i]).real();
+    out[i] = v / tau0;
   }
   return out;
 }

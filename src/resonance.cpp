@@ -2,6 +2,7 @@
 // frequency, in real arithmetic (band removal evaluates it on every bin
 // of a record's FFT).
 #include <Rcpp.h>
+#include "r_complex.h"
 #include <complex>
 
 // The real AR(2) with poles r exp(+-i w0), r = exp(-tau0 / tc),
@@ -38,33 +39,6 @@ Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
   return out;
 }
 
-// R's complex power X^Y (src/main/complex.c, mycpow(), R 4.2): powers by
-// repeated products for whole exponents up to 65536, else the C library's
-// cpow; 0^Y is R_pow(0, Re Y).
-static std::complex<double> r_cpow(std::complex<double> X, double yr) {
-  typedef std::complex<double> cplx;
-  if (X == cplx(0.0, 0.0)) {
-    const double z = yr == 0 ? 1.0 : (yr > 0 ? 0.0 : R_PosInf);
-    return cplx(ISNAN(yr) ? yr : z, 0.0);
-  }
-  if (std::fabs(yr) <= 65536 && yr == static_cast<double>(static_cast<int>(yr))) {
-    int k = static_cast<int>(yr);
-    if (k == 0) return cplx(1.0, 0.0);
-    if (k == 1) return X;
-    const bool neg = k < 0;
-    if (neg) k = -k;
-    cplx z(1.0, 0.0);
-    while (k > 0) {
-      if (k & 1) z = z * X;
-      if (k == 1) break;
-      k >>= 1;
-      X = X * X;
-    }
-    return neg ? cplx(1.0, 0.0) / z : z;
-  }
-  return std::pow(X, cplx(yr, 0.0));
-}
-
 // A resonance's Allan variance at cluster sizes m (R/resonance.R,
 // resonance_av()): Re(geometric_av(m, A, p)), p = exp(-tau0 / tc) *
 // exp(1i * 2 * pi * fr * tau0), A = sigma^2 (1 - i c) with
@@ -87,23 +61,9 @@ Rcpp::NumericVector resonance_av_cpp(const Rcpp::NumericVector& m, double tau0,
   const double c = (1.0 - r * r) / (1.0 + r * r) / std::tan(2.0 * pi * fr * tau0);
   const double s2 = sigma * sigma;
   const cplx A(s2, -(s2 * c));
-  const cplx p2 = r_cpow(p, 2.0);
-  const cplx p3 = cplx(3.0, 0.0) * p;
-  const cplx q2 = r_cpow(cplx(1.0, 0.0) - p, 2.0);
+  const allanvar::GeometricAv geom(A, p);
   const R_xlen_t n = m.size();
   Rcpp::NumericVector out(n);
-  for (R_xlen_t i = 0; i < n; i++) {
-    const double mi = m[i];
-    const cplx mc(mi, 0.0);
-    // A * (m - 3 * p - m * p^2 + 4 * p^(m + 1) - p^(2 * m + 1)) /
-    //   (m^2 * (1 - p)^2)
-    cplx t = mc - p3;
-    t = t - mc * p2;
-    t = t + cplx(4.0, 0.0) * r_cpow(p, mi + 1);
-    t = t - r_cpow(p, 2 * mi + 1);
-    const cplx num = A * t;
-    const cplx den = cplx(mi * mi, 0.0) * q2;
-    out[i] = (num / den).real();
-  }
+  for (R_xlen_t i = 0; i < n; i++) out[i] = geom(m[i]).real();
   return out;
 }

@@ -275,3 +275,29 @@ test_that("a moving average's AV at whole m in C++ is the R form to the bit", {
   # fractional m stay with the R interpolation
   expect_null(filter_ma_av_cpp(c(1, 2.5), 3, 0.01))
 })
+
+test_that("the low-passes' AV in C++ is the R expression to the bit", {
+  r_form <- function(m, spec, tau0) {
+    ra <- rational_acov(filter_rational(spec))
+    out <- ra$d0 / m
+    for (j in seq_along(ra$p)) out <- out + geometric_av(m, ra$A[j], ra$p[j])
+    Re(out) / tau0
+  }
+  set.seed(34)
+  for (i in 1:300) {
+    freq <- sample(c(100, 200, 819.2, 1000), 1)
+    tau0 <- 1 / freq
+    v <- if (i %% 2) "lp1" else "lp2"
+    fc <- exp(runif(1, log(freq / 1e5), log(if (v == "lp2") 0.499 * freq else 0.5 * freq)))
+    sp <- filter_spec_of(v, c(fc = fc), tau0)
+    # whole m below and above 65536 (R's repeated products and cpow),
+    # fractional m
+    m <- switch(i %% 3 + 1, 2^(0:20), unique(round(exp(runif(30, 0, log(3e5))))),
+                runif(25, 1, 1e6))
+    expect_identical(filter_av(m, sp, tau0), r_form(m, sp, tau0))
+  }
+  # a named m takes the R expression (its names kept)
+  m <- c(a = 1, b = 4)
+  sp <- filter_spec_of("lp2", c(fc = 10), 0.01)
+  expect_identical(filter_av(m, sp, 0.01), r_form(m, sp, 0.01))
+})
