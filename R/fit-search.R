@@ -205,7 +205,8 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
   if (is.null(fs)) {
     on <- if (is.null(off)) !amp$fixed else !amp$fixed & !amp$label %in% off
     fs <- list(free = amp$name[on], cols = amp$col[on],
-               key = paste(amp$name[on], collapse = "\r"))
+               key = paste(amp$name[on], collapse = "\r"),
+               pos = match(amp$name[on], names(amp$cc0)))
     fs$all <- identical(fs$cols, seq_len(ncol(Bm)))
     if (is.null(off)) assign("\001free", fs, envir = pr$memo)
   }
@@ -233,7 +234,7 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
   if (all(is.finite(r$c)) && sum(r$c) > 0) {
     assign("\001warm", list(key = key, c = r$c), envir = pr$memo)
   }
-  cc[free] <- r$c
+  cc[fs$pos] <- r$c
   list(c = cc, objective = r$objective, iterations = r$iterations,
        converged = r$converged, layout = lay)
 }
