@@ -197,6 +197,10 @@ resonance_psd_cpp <- function(f, tau0, sigma, fr, tc) {
     .Call(`_allanvar_resonance_psd_cpp`, f, tau0, sigma, fr, tc)
 }
 
+resonance_fit_obj_cpp <- function(q, f, ex, bg, tau0) {
+    .Call(`_allanvar_resonance_fit_obj_cpp`, q, f, ex, bg, tau0)
+}
+
 resonance_av_cpp <- function(m, tau0, sigma, fr, tc) {
     .Call(`_allanvar_resonance_av_cpp`, m, tau0, sigma, fr, tc)
 }

@@ -995,8 +995,10 @@ split_valleys <- function(r, p, bg, nu, min_bins) {
 # moments (centre fc, variance power, sd sdf about fc) or from a previous
 # fit `start`.
 fit_resonance_psd <- function(f, ex, bg, tau0, fc, power, sdf, start = NULL) {
-  model <- function(q) 2 * resonance_psd(f, tau0, exp(q[1L]), q[2L], exp(q[3L]))
-  obj <- function(q) sum(((ex - model(q)) / bg)^2)
+  # sum(((ex - 2 * resonance_psd(f, tau0, exp(q[1L]), q[2L], exp(q[3L]))) /
+  # bg)^2) in C++, the same values
+  f <- as.double(f)
+  obj <- function(q) resonance_fit_obj_cpp(q, f, ex, bg, tau0)
   q0 <- if (is.null(start)) c(log(sqrt(power)), fc, log(1 / (2 * pi * sdf))) else
     c(log(start$sigma), start$fr, log(start$tc))
   o <- stats::optim(q0, obj, control = list(maxit = 500L, reltol = 1e-10))
@@ -1032,7 +1034,10 @@ band_pair_fit <- function(j, reg, fit1, f, p, bg, tau0, nu) {
   if (!(pow2 > 0)) return(out)
   ex <- p[reg] - bg[reg]
   model <- function(q) one(unpack(q[1:3]), f[reg]) + one(unpack(q[4:6]), f[reg])
-  obj <- function(q) sum(((ex - model(q)) / bg[reg])^2)
+  # sum(((ex - model(q)) / bg[reg])^2) in C++, the same values
+  fr <- f[reg]
+  bgr <- bg[reg]
+  obj <- function(q) resonance_fit_obj_cpp(q, fr, ex, bgr, tau0)
   q0 <- c(log(fit1$sigma), fit1$fr, log(fit1$tc), log(sqrt(pow2)), f[j[i2]], log(fit1$tc))
   o <- stats::optim(q0, obj, control = list(maxit = 2000L, reltol = 1e-10))
   a <- unpack(o$par[1:3])

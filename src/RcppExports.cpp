@@ -620,6 +620,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// resonance_fit_obj_cpp
+double resonance_fit_obj_cpp(const Rcpp::NumericVector& q, const Rcpp::NumericVector& f, const Rcpp::NumericVector& ex, const Rcpp::NumericVector& bg, double tau0);
+RcppExport SEXP _allanvar_resonance_fit_obj_cpp(SEXP qSEXP, SEXP fSEXP, SEXP exSEXP, SEXP bgSEXP, SEXP tau0SEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type q(qSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type f(fSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type ex(exSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type bg(bgSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    rcpp_result_gen = Rcpp::wrap(resonance_fit_obj_cpp(q, f, ex, bg, tau0));
+    return rcpp_result_gen;
+END_RCPP
+}
 // resonance_av_cpp
 Rcpp::NumericVector resonance_av_cpp(const Rcpp::NumericVector& m, double tau0, double sigma, double fr, double tc);
 RcppExport SEXP _allanvar_resonance_av_cpp(SEXP mSEXP, SEXP tau0SEXP, SEXP sigmaSEXP, SEXP frSEXP, SEXP tcSEXP) {
@@ -1048,6 +1062,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_real_fft_cpp", (DL_FUNC) &_allanvar_real_fft_cpp, 2},
     {"_allanvar_real_ifft_cpp", (DL_FUNC) &_allanvar_real_ifft_cpp, 3},
     {"_allanvar_resonance_psd_cpp", (DL_FUNC) &_allanvar_resonance_psd_cpp, 5},
+    {"_allanvar_resonance_fit_obj_cpp", (DL_FUNC) &_allanvar_resonance_fit_obj_cpp, 5},
     {"_allanvar_resonance_av_cpp", (DL_FUNC) &_allanvar_resonance_av_cpp, 5},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},

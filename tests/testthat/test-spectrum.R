@@ -535,3 +535,19 @@ test_that("the whole record's per-bin arithmetic in C++ is R's expressions to th
   }
   expect_identical(bins_between(c(1, 2, 3), NA_real_, 3), integer(0))
 })
+
+test_that("the band fits' objective in C++ is the R expression to the bit", {
+  set.seed(34)
+  for (i in 1:200) {
+    tau0 <- 1 / sample(c(100, 819.2, 1000), 1)
+    n <- sample(5:200, 1)
+    f <- sort(runif(n, 0, 0.5 / tau0))
+    bg <- abs(rnorm(n)) * 10^runif(1, -8, 0)
+    ex <- rnorm(n) * 10^runif(1, -8, 0)
+    k <- 1 + i %% 2
+    q <- as.vector(rbind(rnorm(k, -3, 2), runif(k, 0, 0.5 / tau0), rnorm(k, 0, 2)))
+    M <- 2 * resonance_psd(f, tau0, exp(q[1]), q[2], exp(q[3]))
+    if (k == 2) M <- M + 2 * resonance_psd(f, tau0, exp(q[4]), q[5], exp(q[6]))
+    expect_identical(resonance_fit_obj_cpp(q, f, ex, bg, tau0), sum(((ex - M) / bg)^2))
+  }
+})
