@@ -50,10 +50,6 @@ jacobian_lnav <- function(lay, tau, tau0, plan = model_plan(lay)) {
   list(J = Jm, at_zero = at_zero, free = free)
 }
 
-model_total <- function(lay, tau, tau0, plan = model_plan(lay)) {
-  rowSums(model_components(tau, tau0, lay, plan))
-}
-
 # Pseudo-inverse of a symmetric PSD matrix, equilibrated first: parameters
 # differ by many orders of magnitude (c = K^2 ~ 1e-8 next to tc ~ 10 s).
 pinv <- function(A) {
