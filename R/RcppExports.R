@@ -41,6 +41,30 @@ avfit_exact_edf <- function(m, M, overlapping, shape, coef, phi) {
     .Call(`_allanvar_avfit_exact_edf`, m, M, overlapping, shape, coef, phi)
 }
 
+bin_power_cpp <- function(X, scale, twice) {
+    .Call(`_allanvar_bin_power_cpp`, X, scale, twice)
+}
+
+bin_mean_cpp <- function(Ph, G, k) {
+    .Call(`_allanvar_bin_mean_cpp`, Ph, G, k)
+}
+
+band_gain_cpp <- function(G, B, M, S) {
+    .Call(`_allanvar_band_gain_cpp`, G, B, M, S)
+}
+
+gm_basis_cpp <- function(tau, tau0, tc, fact) {
+    .Call(`_allanvar_gm_basis_cpp`, tau, tau0, tc, fact)
+}
+
+filter_ma_av_cpp <- function(m, L, tau0) {
+    .Call(`_allanvar_filter_ma_av_cpp`, m, L, tau0)
+}
+
+rational_av_cpp <- function(m, c0, r, p, tau0) {
+    .Call(`_allanvar_rational_av_cpp`, m, c0, r, p, tau0)
+}
+
 first_nonfinite <- function(x) {
     .Call(`_allanvar_first_nonfinite`, x)
 }
@@ -171,6 +195,10 @@ real_ifft_cpp <- function(X, n, keep) {
 
 resonance_psd_cpp <- function(f, tau0, sigma, fr, tc) {
     .Call(`_allanvar_resonance_psd_cpp`, f, tau0, sigma, fr, tc)
+}
+
+resonance_fit_obj_cpp <- function(q, f, ex, bg, tau0) {
+    .Call(`_allanvar_resonance_fit_obj_cpp`, q, f, ex, bg, tau0)
 }
 
 resonance_av_cpp <- function(m, tau0, sigma, fr, tc) {

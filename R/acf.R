@@ -85,9 +85,10 @@ acf_exponential <- function(x, freq, tc, cache = NULL) {
   # profiled on a grid within a factor 5 of the hint; a minimum on the
   # grid's edge means Tc is not identified.
   grid <- tc * 10^seq(-0.7, 0.7, by = 0.02)
+  # (.lm.fit(): lm.fit()'s QR and residuals without its bookkeeping)
   rss <- vapply(grid, function(g) {
     X <- cbind(exp(-lag * m / (freq * g)), 1, lag)
-    sum(stats::lm.fit(X, r)$residuals^2)
+    sum(stats::.lm.fit(X, r)$residuals^2)
   }, 0)
   k <- which.min(rss)
   X <- cbind(exp(-lag * m / (freq * grid[k])), 1, lag)

@@ -291,7 +291,9 @@ basis_key <- function(entry) paste0(entry[["name"]], ":", entry[["variant"]], "|
 # columns at many values on one grid).
 stored_basis_in <- function(env, entry, key, tau, tau0, nl) {
   if (is.null(env)) return(entry$basis(tau, tau0, nl))
-  key <- paste0(key, paste(sprintf("%a", nl), collapse = ","))
+  # (one value, the common case: its hex form is the collapsed string)
+  key <- paste0(key, if (length(nl) == 1L) sprintf("%a", nl) else
+    paste(sprintf("%a", nl), collapse = ","))
   b <- env[[key]]
   if (is.null(b)) {
     b <- entry$basis(tau, tau0, nl)
@@ -303,8 +305,12 @@ stored_basis_in <- function(env, entry, key, tau, tau0, nl) {
 # Per-instance AV contributions (matrix, columns = term labels).
 model_components <- function(tau, tau0, lay, plan = model_plan(lay)) {
   values <- stats::setNames(lay$value, lay$name)
-  Bm <- plan_basis(plan, tau, tau0, values)
-  out <- matrix(0, length(tau), length(plan),
+  basis_components(plan_basis(plan, tau, tau0, values), plan, values)
+}
+
+# The same from the basis columns `Bm` (plan_basis()) at `values`.
+basis_components <- function(Bm, plan, values) {
+  out <- matrix(0, nrow(Bm), length(plan),
                 dimnames = list(NULL, vapply(plan, `[[`, "", "label")))
   for (j in seq_along(plan)) {
     a <- plan[[j]]$amp

@@ -21,6 +21,9 @@ gm_basis_discrete <- function(m, eps) {
   out
 }
 
+# factorial(3:14) as R computes it, for gm_basis_cpp() (src/basis.cpp).
+gm_factorials <- factorial(3:14)
+
 # Continuous form: (tc/tau)^2 [2x - 3 + 4 e^-x - e^-2x], x = tau / tc; series
 # for small x (the bracket is (2/3) x^3 - x^4/2 + ...).
 gm_basis_continuous <- function(tau, tc) {
@@ -131,6 +134,11 @@ effect_gauss_markov <- function() {
                       "exponential ACF"),
     basis = function(tau, tau0, nl) {
       tc <- nl[["tc"]]
+      # the two forms below in C++, the same values (a search evaluates
+      # this at every value it visits)
+      if (is.double(tau) && is_plain_number(tau0) && is_plain_number(tc)) {
+        return(gm_basis_cpp(tau, tau0, tc, gm_factorials))
+      }
       out <- gm_basis_continuous(tau, tc)
       d <- discrete_tau(tau, tau0)
       if (any(d)) out[d] <- gm_basis_discrete(tau[d] / tau0, tau0 / tc)

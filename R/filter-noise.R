@@ -265,10 +265,23 @@ geometric_av <- function(m, A, p) {
 # smooth form S/m - 3C/m^2 above it.
 filter_av <- function(m, spec, tau0) {
   if (rational_family(spec)) {
-    ra <- rational_acov(filter_rational(spec))
+    rat <- filter_rational(spec)
+    # rational_acov() and the sums below in C++ (src/basis.cpp), the same
+    # values
+    if (is.double(m) && is.null(attributes(m)) && is_plain_number(tau0) &&
+        is_plain_number(rat$c0) && is.complex(rat$r) && is.complex(rat$p)) {
+      return(rational_av_cpp(m, rat$c0, rat$r, rat$p, tau0))
+    }
+    ra <- rational_acov(rat)
     out <- ra$d0 / m
     for (j in seq_along(ra$p)) out <- out + geometric_av(m, ra$A[j], ra$p[j])
     return(Re(out) / tau0)
+  }
+  # whole m of a moving average in C++ (src/basis.cpp), the same values
+  if (spec$family == "ma" && is.double(m) && length(m) && is_plain_number(spec$L) &&
+      is_plain_number(tau0)) {
+    out <- filter_ma_av_cpp(m, spec$L, tau0)
+    if (!is.null(out)) return(out)
   }
   K <- filter_support(spec)
   # AV(m) below the support reads lags < 2m only: a moving average longer

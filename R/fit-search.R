@@ -148,7 +148,11 @@ fit_problem <- function(data, tau0, lay, bias_correct, corr, model_var = 0) {
   # free ones' template, the store's grid and each searched term's key
   amp$fixed_idx <- which(amp$fixed)
   amp$cc0 <- stats::setNames(numeric(sum(!amp$fixed)), amp$name[!amp$fixed])
-  for (k in seq_along(plan_nl)) plan_nl[[k]]$key <- basis_key(plan_nl[[k]]$entry)
+  for (k in seq_along(plan_nl)) {
+    plan_nl[[k]]$key <- basis_key(plan_nl[[k]]$entry)
+    # its nonlinear values' positions in `values` (no name matching per solve)
+    plan_nl[[k]]$nl_idx <- match(plan_nl[[k]]$nl, lay$name)
+  }
   list(data = data, tau0 = tau0, lay = lay, plan = plan, y = y,
        s = s, W = whitening(s, corr), corr = corr, bias_correct = bias_correct,
        amp = amp, plan_nl = plan_nl, basis0 = basis0, B0 = B0,
@@ -170,7 +174,7 @@ solve_basis <- function(pr, values, store = pr$store) {
     p <- pr$plan_nl[[k]]
     nl <- NULL
     if (length(p$nl)) {
-      nl <- values[p$nl]
+      nl <- values[p$nl_idx]
       names(nl) <- p$nl_param
     }
     hit <- memo[[p$label]]
@@ -201,7 +205,8 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
   if (is.null(fs)) {
     on <- if (is.null(off)) !amp$fixed else !amp$fixed & !amp$label %in% off
     fs <- list(free = amp$name[on], cols = amp$col[on],
-               key = paste(amp$name[on], collapse = "\r"))
+               key = paste(amp$name[on], collapse = "\r"),
+               pos = match(amp$name[on], names(amp$cc0)))
     fs$all <- identical(fs$cols, seq_len(ncol(Bm)))
     if (is.null(off)) assign("\001free", fs, envir = pr$memo)
   }
@@ -229,7 +234,7 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
   if (all(is.finite(r$c)) && sum(r$c) > 0) {
     assign("\001warm", list(key = key, c = r$c), envir = pr$memo)
   }
-  cc[free] <- r$c
+  cc[fs$pos] <- r$c
   list(c = cc, objective = r$objective, iterations = r$iterations,
        converged = r$converged, layout = lay)
 }

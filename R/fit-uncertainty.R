@@ -12,7 +12,8 @@
 jacobian_lnav <- function(lay, tau, tau0, plan = model_plan(lay)) {
   values <- stats::setNames(lay$value, lay$name)
   Bm <- plan_basis(plan, tau, tau0, values)
-  tot <- model_total(lay, tau, tau0, plan)
+  comp <- basis_components(Bm, plan, values)
+  tot <- rowSums(comp)
   free <- which(!lay$fixed)
   Jm <- matrix(0, length(tau), length(free),
                dimnames = list(NULL, lay$name[free]))
@@ -30,18 +31,23 @@ jacobian_lnav <- function(lay, tau, tau0, plan = model_plan(lay)) {
       }
     } else {
       h <- 1e-5
-      lp <- lay; lp$value[i] <- lay$value[i] * exp(h)
-      lm <- lay; lm$value[i] <- lay$value[i] * exp(-h)
-      dp <- log(model_total(lp, tau, tau0, plan))
-      dm <- log(model_total(lm, tau, tau0, plan))
+      # ln AV with this value moved: only its own term's column changes
+      j <- which(vapply(plan, function(p) lay$name[i] %in% p$nl, NA))
+      p <- plan[[j]]
+      moved <- function(v) {
+        vals <- values
+        vals[i] <- v
+        b <- stored_basis(p$entry, tau, tau0, stats::setNames(vals[p$nl], p$nl_param))
+        cm <- comp
+        cm[, j] <- matrix(b, length(tau)) %*% (vals[p$amp]^2)
+        log(rowSums(cm))
+      }
+      dp <- moved(lay$value[i] * exp(h))
+      dm <- moved(lay$value[i] * exp(-h))
       Jm[, k] <- (dp - dm) / (2 * h) / lay$value[i]
     }
   }
   list(J = Jm, at_zero = at_zero, free = free)
-}
-
-model_total <- function(lay, tau, tau0, plan = model_plan(lay)) {
-  rowSums(model_components(tau, tau0, lay, plan))
 }
 
 # Pseudo-inverse of a symmetric PSD matrix, equilibrated first: parameters

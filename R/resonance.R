@@ -36,8 +36,12 @@ resonance_acf <- function(h, tau0, sigma, fr, tc) {
 # the R expression's operations in R's complex arithmetic), the R expression
 # for anything but plain numbers.
 resonance_av <- function(m, tau0, sigma, fr, tc) {
-  if (is.double(m) && is.null(attributes(m)) && !anyNA(m) && is_plain_number(tau0) && is_plain_number(sigma) &&
-      is_plain_number(fr) && is_plain_number(tc)) {
+  # (is_plain_number() of each scalar, in primitives: a search calls this
+  # at every value it visits)
+  if (is.double(m) && is.null(attributes(m)) && !anyNA(m) && is.double(tau0) &&
+      is.double(sigma) && is.double(fr) && is.double(tc) &&
+      length(tau0) == 1L && length(sigma) == 1L && length(fr) == 1L &&
+      length(tc) == 1L && !anyNA(c(tau0, sigma, fr, tc))) {
     return(resonance_av_cpp(m, tau0, sigma, fr, tc))
   }
   resonance_av_r(m, tau0, sigma, fr, tc)

@@ -225,10 +225,15 @@ series_shapes <- function(series, n, freq) {
   tab <- tab[!tab$removed, , drop = FALSE]
   if (!nrow(tab)) return(NULL)
   function(m) {
+    # (one series of zeros for all: each remove() modifies its own copy)
+    zero <- numeric(n)
     cols <- lapply(seq_len(nrow(tab)), function(i) {
-      shape <- -remove_series(numeric(n), freq, tab[i, , drop = FALSE])
-      b <- block_means(shape, m)
-      top <- max(abs(shape))
+      # remove() from zeros gives minus the shape: its block means and
+      # largest size negated (exact; 0 - v keeps a zero mean +0, as the
+      # shape's own), two passes over n samples fewer
+      neg <- remove_series(zero, freq, tab[i, , drop = FALSE])
+      b <- 0 - block_means(neg, m)
+      top <- max(-min(neg), max(neg))
       if (top > 0 && diff(range(b)) >= 0.01 * top) b
     })
     cols <- cols[!vapply(cols, is.null, NA)]

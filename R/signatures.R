@@ -40,8 +40,11 @@ residual_signatures <- function(tau, z, level = 3.5, z0 = 1) {
     at_end <- ends[i] == n
     kind <- if (at_start && at_end) "global" else if (at_start) "short_end"
       else if (at_end) "long_end" else if (r$values[i] > 0) "bump" else "dip"
+    # (lm()'s coefficients from its own QR, lm.fit(), without the model
+    # frame: every fit of the loop reads its signature)
     slope <- if (length(idx) >= 3L) {
-      unname(stats::coef(stats::lm(z[idx] ~ log10(tau[idx])))[2L])
+      if (anyNA(z[idx])) unname(stats::coef(stats::lm(z[idx] ~ log10(tau[idx])))[2L])
+      else unname(stats::lm.fit(cbind(1, log10(tau[idx])), z[idx])$coefficients[2L])
     } else NA_real_
     rows[[length(rows) + 1L]] <- data.frame(
       kind = kind, tau_from = tau[starts[i]], tau_to = tau[ends[i]],

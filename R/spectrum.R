@@ -519,8 +519,8 @@ record_periodogram <- function(x, freq) {
   np <- record_fft_size(n)
   X <- real_fft_cpp(detrend_linear(x) * w, np)
   half <- length(X)
-  p <- Mod(X)^2 / (freq * tp$w2)
-  p[2:(half - 1L)] <- 2 * p[2:(half - 1L)]
+  # Mod(X)^2 / (freq * w2), bins 2..half - 1 doubled (C++, src/bands.cpp)
+  p <- bin_power_cpp(X, freq * tp$w2, FALSE)
   list(f = (seq_len(half) - 1) * freq / np, psd = p, df = freq / np,
        res = freq / n, lobe = ceiling(4 * np / n) + 1L)
 }
@@ -995,8 +995,10 @@ split_valleys <- function(r, p, bg, nu, min_bins) {
 # moments (centre fc, variance power, sd sdf about fc) or from a previous
 # fit `start`.
 fit_resonance_psd <- function(f, ex, bg, tau0, fc, power, sdf, start = NULL) {
-  model <- function(q) 2 * resonance_psd(f, tau0, exp(q[1L]), q[2L], exp(q[3L]))
-  obj <- function(q) sum(((ex - model(q)) / bg)^2)
+  # sum(((ex - 2 * resonance_psd(f, tau0, exp(q[1L]), q[2L], exp(q[3L]))) /
+  # bg)^2) in C++, the same values
+  f <- as.double(f)
+  obj <- function(q) resonance_fit_obj_cpp(q, f, ex, bg, tau0)
   q0 <- if (is.null(start)) c(log(sqrt(power)), fc, log(1 / (2 * pi * sdf))) else
     c(log(start$sigma), start$fr, log(start$tc))
   o <- stats::optim(q0, obj, control = list(maxit = 500L, reltol = 1e-10))
@@ -1032,7 +1034,10 @@ band_pair_fit <- function(j, reg, fit1, f, p, bg, tau0, nu) {
   if (!(pow2 > 0)) return(out)
   ex <- p[reg] - bg[reg]
   model <- function(q) one(unpack(q[1:3]), f[reg]) + one(unpack(q[4:6]), f[reg])
-  obj <- function(q) sum(((ex - model(q)) / bg[reg])^2)
+  # sum(((ex - model(q)) / bg[reg])^2) in C++, the same values
+  fr <- f[reg]
+  bgr <- bg[reg]
+  obj <- function(q) resonance_fit_obj_cpp(q, fr, ex, bgr, tau0)
   q0 <- c(log(fit1$sigma), fit1$fr, log(fit1$tc), log(sqrt(pow2)), f[j[i2]], log(fit1$tc))
   o <- stats::optim(q0, obj, control = list(maxit = 2000L, reltol = 1e-10))
   a <- unpack(o$par[1:3])
@@ -1089,38 +1094,40 @@ remove_bands <- function(x, freq, bands) {
   X <- real_fft_cpp(x - m, np)
   h <- length(X)
   fh <- (seq_len(h) - 1) * freq / np
-  Ph <- 2 * Mod(X)^2 / (n * freq)
+  # 2 * Mod(X)^2 / (n * freq) (C++, src/bands.cpp)
+  Ph <- bin_power_cpp(X, n * freq, TRUE)
   in_run <- rep(FALSE, h)
   for (j in seq_len(nrow(bands))) {
-    in_run[fh >= bands$f_from[j] & fh <= bands$f_to[j]] <- TRUE
+    in_run[bins_between(fh, bands$f_from[j], bands$f_to[j])] <- TRUE
   }
-  smooth <- bin_smoother(h, max(1L, np %/% 512L))
   # the bands' gains multiply; each band's background is read on the
   # series with the bands before it taken out
   G <- 1
   for (k in seq_len(nrow(bands))) {
     b <- bands[k, ]
     M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)
-    P <- Ph * G^2
-    # the power the spectrum shows, smoothed over the Welch resolution
-    # (freq / 512), and the band's fitted PSD no higher than its excess
-    # over the background B: a measured band that falls faster than the
-    # fitted form (the ADIS z gyros' below 20 Hz) loses no more than it has
-    S <- smooth(P)
-    B <- band_background(fh, b, in_run, S - pmin(M, S))
+    # the power the spectrum shows, Ph * G^2, smoothed over the Welch
+    # resolution (freq / 512: bin_smoother()'s running mean, in C++), and
+    # the band's fitted PSD no higher than its excess over the background
+    # B: a measured band that falls faster than the fitted form (the ADIS
+    # z gyros' below 20 Hz) loses no more than it has
+    S <- bin_mean_cpp(Ph, G, max(1L, np %/% 512L))
+    B <- band_background(fh, b, in_run, S, M)
     if (is.null(B)) {
       warn("no background bins for the band at ", format(signif(b$f_center, 4)),
            " Hz: left in the series", class = "band_kept")
       next
     }
-    G <- G * sqrt(B / (B + pmin(M, pmax(S - B, 0))))
+    # G * sqrt(B / (B + pmin(M, pmax(S - B, 0))))
+    G <- band_gain_cpp(G, B, M, S)
   }
   if (length(G) == 1L) return(x)
   real_ifft_cpp(X * G, np, n) / np + m
 }
 
 # A running mean over k bins (centred; shorter at the ends) of vectors of
-# length n, its indices computed once.
+# length n, its indices computed once: the R form of bin_mean_cpp()
+# (src/bands.cpp), which remove_bands() uses; the tests' reference.
 bin_smoother <- function(n, k) {
   h <- k %/% 2L
   lo <- pmax(1L, seq_len(n) - h)
@@ -1132,9 +1139,30 @@ bin_smoother <- function(n, k) {
   }
 }
 
+# The bins of increasing frequencies `fh` within [lo, hi] (`lo_open`,
+# `hi_open`: that end excluded), by binary search: the `fh >= lo & fh <=
+# hi` of the whole grid (none for an NA end).
+bins_between <- function(fh, lo, hi, lo_open = FALSE, hi_open = FALSE) {
+  if (is.na(lo) || is.na(hi)) return(integer(0))
+  # the number of bins below v (or at most v): the last bin that is
+  below <- function(v, strict) {
+    a <- 0L
+    b <- length(fh)
+    while (a < b) {
+      mid <- (a + b + 1L) %/% 2L
+      if (if (strict) fh[mid] < v else fh[mid] <= v) a <- mid else b <- mid - 1L
+    }
+    a
+  }
+  from <- below(lo, !lo_open) + 1L
+  to <- below(hi, hi_open)
+  if (from <= to) from:to else integer(0)
+}
+
 # The background PSD under band `b` (a row of find_bands()) at every bin
-# fh (0..Nyquist), from `R`, the smoothed spectrum with the band's fitted
-# PSD taken off, outside every band's run (`other`, logical over fh): its
+# fh (0..Nyquist), from R = S - pmin(M, S), the smoothed spectrum `S` with
+# the band's fitted PSD `M` taken off (read at the bins used only),
+# outside every band's run (`other`, logical over fh): its
 # medians just below and just above the run (one run width, or 3 fitted
 # FWHM if wider, on each side; a median, as a window reaching 0 Hz holds
 # the random walk's few huge bins), linear in f between them, flat beyond;
@@ -1142,19 +1170,20 @@ bin_smoother <- function(n, k) {
 # the ADIS z gyros' 20 Hz bands at 100 Hz); else the median of all bins
 # outside the runs farther than one FWHM. A background that slopes under
 # the band (a filter's roll-off) is followed. NULL if no bin or a median <= 0.
-band_background <- function(fh, b, other, R) {
+band_background <- function(fh, b, other, S, M) {
   w <- max(b$f_to - b$f_from, 3 * b$width)
-  side <- function(sel) {
-    i <- which(sel & !other)
+  # `i`: the bins a side reads before those in a run are dropped
+  side <- function(i) {
+    i <- i[!other[i]]
     if (!length(i)) return(NULL)
-    v <- stats::median(R[i])
+    v <- stats::median(S[i] - pmin(M[i], S[i]))
     if (!is.finite(v) || v <= 0) return(NULL)
     c(f = mean(fh[i]), v = v)
   }
-  lo <- side(fh >= b$f_from - w & fh < b$f_from)
-  hi <- side(fh > b$f_to & fh <= b$f_to + w)
+  lo <- side(bins_between(fh, b$f_from - w, b$f_from, hi_open = TRUE))
+  hi <- side(bins_between(fh, b$f_to, b$f_to + w, lo_open = TRUE))
   if (is.null(lo) && is.null(hi)) {
-    one <- side(abs(fh - b$f_center) > b$width)
+    one <- side(which(abs(fh - b$f_center) > b$width))
     if (is.null(one)) return(NULL)
     return(rep(one[["v"]], length(fh)))
   }

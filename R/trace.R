@@ -9,7 +9,8 @@
 excess_slope <- function(tau, excess) {
   ok <- is.finite(excess) & excess > 0
   if (sum(ok) < 2L) return(NA_real_)
-  unname(stats::coef(stats::lm(log(sqrt(excess[ok])) ~ log(tau[ok])))[2L])
+  # lm()'s coefficient from lm.fit() (no model frame; the points are finite)
+  unname(stats::lm.fit(cbind(1, log(tau[ok])), log(sqrt(excess[ok])))$coefficients[2L])
 }
 
 # How well a measured slope matches a term's ADEV slope: 2 for a match, down

@@ -141,6 +141,82 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// bin_power_cpp
+Rcpp::NumericVector bin_power_cpp(const Rcpp::ComplexVector& X, double scale, bool twice);
+RcppExport SEXP _allanvar_bin_power_cpp(SEXP XSEXP, SEXP scaleSEXP, SEXP twiceSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::ComplexVector& >::type X(XSEXP);
+    Rcpp::traits::input_parameter< double >::type scale(scaleSEXP);
+    Rcpp::traits::input_parameter< bool >::type twice(twiceSEXP);
+    rcpp_result_gen = Rcpp::wrap(bin_power_cpp(X, scale, twice));
+    return rcpp_result_gen;
+END_RCPP
+}
+// bin_mean_cpp
+Rcpp::NumericVector bin_mean_cpp(const Rcpp::NumericVector& Ph, const Rcpp::NumericVector& G, int k);
+RcppExport SEXP _allanvar_bin_mean_cpp(SEXP PhSEXP, SEXP GSEXP, SEXP kSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type Ph(PhSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type G(GSEXP);
+    Rcpp::traits::input_parameter< int >::type k(kSEXP);
+    rcpp_result_gen = Rcpp::wrap(bin_mean_cpp(Ph, G, k));
+    return rcpp_result_gen;
+END_RCPP
+}
+// band_gain_cpp
+Rcpp::NumericVector band_gain_cpp(const Rcpp::NumericVector& G, const Rcpp::NumericVector& B, const Rcpp::NumericVector& M, const Rcpp::NumericVector& S);
+RcppExport SEXP _allanvar_band_gain_cpp(SEXP GSEXP, SEXP BSEXP, SEXP MSEXP, SEXP SSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type G(GSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type B(BSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type M(MSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type S(SSEXP);
+    rcpp_result_gen = Rcpp::wrap(band_gain_cpp(G, B, M, S));
+    return rcpp_result_gen;
+END_RCPP
+}
+// gm_basis_cpp
+Rcpp::NumericVector gm_basis_cpp(const Rcpp::NumericVector& tau, double tau0, double tc, const Rcpp::NumericVector& fact);
+RcppExport SEXP _allanvar_gm_basis_cpp(SEXP tauSEXP, SEXP tau0SEXP, SEXP tcSEXP, SEXP factSEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type tau(tauSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    Rcpp::traits::input_parameter< double >::type tc(tcSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type fact(factSEXP);
+    rcpp_result_gen = Rcpp::wrap(gm_basis_cpp(tau, tau0, tc, fact));
+    return rcpp_result_gen;
+END_RCPP
+}
+// filter_ma_av_cpp
+SEXP filter_ma_av_cpp(const Rcpp::NumericVector& m, double L, double tau0);
+RcppExport SEXP _allanvar_filter_ma_av_cpp(SEXP mSEXP, SEXP LSEXP, SEXP tau0SEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type L(LSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    rcpp_result_gen = Rcpp::wrap(filter_ma_av_cpp(m, L, tau0));
+    return rcpp_result_gen;
+END_RCPP
+}
+// rational_av_cpp
+Rcpp::NumericVector rational_av_cpp(const Rcpp::NumericVector& m, double c0, const Rcpp::ComplexVector& r, const Rcpp::ComplexVector& p, double tau0);
+RcppExport SEXP _allanvar_rational_av_cpp(SEXP mSEXP, SEXP c0SEXP, SEXP rSEXP, SEXP pSEXP, SEXP tau0SEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type m(mSEXP);
+    Rcpp::traits::input_parameter< double >::type c0(c0SEXP);
+    Rcpp::traits::input_parameter< const Rcpp::ComplexVector& >::type r(rSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::ComplexVector& >::type p(pSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    rcpp_result_gen = Rcpp::wrap(rational_av_cpp(m, c0, r, p, tau0));
+    return rcpp_result_gen;
+END_RCPP
+}
 // first_nonfinite
 double first_nonfinite(const Rcpp::NumericVector& x);
 RcppExport SEXP _allanvar_first_nonfinite(SEXP xSEXP) {
@@ -544,6 +620,20 @@ BEGIN_RCPP
     return rcpp_result_gen;
 END_RCPP
 }
+// resonance_fit_obj_cpp
+double resonance_fit_obj_cpp(const Rcpp::NumericVector& q, const Rcpp::NumericVector& f, const Rcpp::NumericVector& ex, const Rcpp::NumericVector& bg, double tau0);
+RcppExport SEXP _allanvar_resonance_fit_obj_cpp(SEXP qSEXP, SEXP fSEXP, SEXP exSEXP, SEXP bgSEXP, SEXP tau0SEXP) {
+BEGIN_RCPP
+    Rcpp::RObject rcpp_result_gen;
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type q(qSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type f(fSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type ex(exSEXP);
+    Rcpp::traits::input_parameter< const Rcpp::NumericVector& >::type bg(bgSEXP);
+    Rcpp::traits::input_parameter< double >::type tau0(tau0SEXP);
+    rcpp_result_gen = Rcpp::wrap(resonance_fit_obj_cpp(q, f, ex, bg, tau0));
+    return rcpp_result_gen;
+END_RCPP
+}
 // resonance_av_cpp
 Rcpp::NumericVector resonance_av_cpp(const Rcpp::NumericVector& m, double tau0, double sigma, double fr, double tc);
 RcppExport SEXP _allanvar_resonance_av_cpp(SEXP mSEXP, SEXP tau0SEXP, SEXP sigmaSEXP, SEXP frSEXP, SEXP tcSEXP) {
@@ -933,6 +1023,12 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_avfit_nnls", (DL_FUNC) &_allanvar_avfit_nnls, 2},
     {"_allanvar_avar_white_cov", (DL_FUNC) &_allanvar_avar_white_cov, 4},
     {"_allanvar_avfit_exact_edf", (DL_FUNC) &_allanvar_avfit_exact_edf, 6},
+    {"_allanvar_bin_power_cpp", (DL_FUNC) &_allanvar_bin_power_cpp, 3},
+    {"_allanvar_bin_mean_cpp", (DL_FUNC) &_allanvar_bin_mean_cpp, 3},
+    {"_allanvar_band_gain_cpp", (DL_FUNC) &_allanvar_band_gain_cpp, 4},
+    {"_allanvar_gm_basis_cpp", (DL_FUNC) &_allanvar_gm_basis_cpp, 4},
+    {"_allanvar_filter_ma_av_cpp", (DL_FUNC) &_allanvar_filter_ma_av_cpp, 3},
+    {"_allanvar_rational_av_cpp", (DL_FUNC) &_allanvar_rational_av_cpp, 5},
     {"_allanvar_first_nonfinite", (DL_FUNC) &_allanvar_first_nonfinite, 1},
     {"_allanvar_dynamic_sums_cpp", (DL_FUNC) &_allanvar_dynamic_sums_cpp, 5},
     {"_allanvar_allan_edf_cpp", (DL_FUNC) &_allanvar_allan_edf_cpp, 6},
@@ -966,6 +1062,7 @@ static const R_CallMethodDef CallEntries[] = {
     {"_allanvar_real_fft_cpp", (DL_FUNC) &_allanvar_real_fft_cpp, 2},
     {"_allanvar_real_ifft_cpp", (DL_FUNC) &_allanvar_real_ifft_cpp, 3},
     {"_allanvar_resonance_psd_cpp", (DL_FUNC) &_allanvar_resonance_psd_cpp, 5},
+    {"_allanvar_resonance_fit_obj_cpp", (DL_FUNC) &_allanvar_resonance_fit_obj_cpp, 5},
     {"_allanvar_resonance_av_cpp", (DL_FUNC) &_allanvar_resonance_av_cpp, 5},
     {"_allanvar_decode_imu_blobs", (DL_FUNC) &_allanvar_decode_imu_blobs, 3},
     {"_allanvar_stamp_rel_seconds", (DL_FUNC) &_allanvar_stamp_rel_seconds, 3},

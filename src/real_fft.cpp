@@ -27,6 +27,26 @@ void half_twiddles(std::vector<cplx>& w, const allanvar::FFTPlan& plan, size_t m
   }
 }
 
+// The plan and half twiddles of the last size, kept between calls: the
+// loop transforms records of one length several times per axis, and the
+// twiddles' cosines cost a third of a transform. (R's main thread only.)
+struct RecordPlan {
+  size_t m = 0;
+  allanvar::FFTPlan plan;
+  std::vector<cplx> w;
+};
+
+const RecordPlan& record_plan(size_t m) {
+  static RecordPlan rp;
+  if (rp.m != m) {
+    rp.m = 0;
+    rp.plan.reset(m);
+    half_twiddles(rp.w, rp.plan, m);
+    rp.m = m;
+  }
+  return rp;
+}
+
 bool valid_size(double n, R_xlen_t len) {
   if (!(n >= 4) || n > 4503599627370496.0 || n < static_cast<double>(len)) return false;
   const size_t m = static_cast<size_t>(n);
@@ -48,10 +68,9 @@ Rcpp::ComplexVector real_fft_cpp(const Rcpp::NumericVector& x, double n) {
     const R_xlen_t a = static_cast<R_xlen_t>(2 * j);
     z[j] = cplx(a < len ? v[a] : 0.0, a + 1 < len ? v[a + 1] : 0.0);
   }
-  const allanvar::FFTPlan plan(m);
-  plan.run(z.data(), false);
-  std::vector<cplx> w;
-  half_twiddles(w, plan, m);
+  const RecordPlan& rp = record_plan(m);
+  rp.plan.run(z.data(), false);
+  const std::vector<cplx>& w = rp.w;
   Rcpp::ComplexVector out(static_cast<R_xlen_t>(m + 1));
   cplx* o = reinterpret_cast<cplx*>(out.begin());
   const cplx half_i(0.0, -0.5);
@@ -77,9 +96,8 @@ Rcpp::NumericVector real_ifft_cpp(const Rcpp::ComplexVector& X, double n, double
   }
   const size_t m = static_cast<size_t>(n) / 2;
   const cplx* x = reinterpret_cast<const cplx*>(X.begin());
-  const allanvar::FFTPlan plan(m);
-  std::vector<cplx> w;
-  half_twiddles(w, plan, m);
+  const RecordPlan& rp = record_plan(m);
+  const std::vector<cplx>& w = rp.w;
   allanvar::cvec z(m);
   for (size_t k = 0; k < m; ++k) {
     const cplx xk = x[k];
@@ -88,7 +106,7 @@ Rcpp::NumericVector real_ifft_cpp(const Rcpp::ComplexVector& X, double n, double
     const cplx d = 0.5 * (xk - xc) * std::conj(w[k]);
     z[k] = e + cplx(-d.imag(), d.real());  // e + i d
   }
-  plan.run(z.data(), true);
+  rp.plan.run(z.data(), true);
   const R_xlen_t nk = static_cast<R_xlen_t>(keep);
   Rcpp::NumericVector out(nk);
   double* o = out.begin();

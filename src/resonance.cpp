@@ -2,7 +2,10 @@
 // frequency, in real arithmetic (band removal evaluates it on every bin
 // of a record's FFT).
 #include <Rcpp.h>
+#include "r_complex.h"
+#include <cmath>
 #include <complex>
+#include <vector>
 
 // The real AR(2) with poles r exp(+-i w0), r = exp(-tau0 / tc),
 // w0 = 2 pi fr tau0, variance sigma^2:
@@ -11,9 +14,11 @@
 //   s_e^2 = sigma^2 (1 - r^2) ((1 - r^2)^2 + 4 r^2 sin(w0)^2) / (1 + r^2)
 // (|1 - p^2|^2 written without cancellation), with 1 - r from expm1: no
 // digits lost where r is near 1 and d near 0 (a long tc at its peak).
-// [[Rcpp::export(rng = false)]]
-Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
-                                      double sigma, double fr, double tc) {
+namespace {
+
+// The PSD above at n frequencies f into out.
+void resonance_psd_into(const double* f, R_xlen_t n, double tau0, double sigma,
+                        double fr, double tc, double* out) {
   const double pi = 3.141592653589793238462643383279502884;
   const double a = -std::expm1(-tau0 / tc);  // 1 - r
   const double r = 1.0 - a;
@@ -25,8 +30,6 @@ Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
   const double q = a * (1.0 + r);            // 1 - r^2
   const double se2 = q * (q * q + 4.0 * r * r * s0 * s0) / (1.0 + r * r);
   const double scale = tau0 * (sigma * sigma) * se2;
-  const R_xlen_t n = f.size();
-  Rcpp::NumericVector out(n);
   for (R_xlen_t k = 0; k < n; k++) {
     const double b = pi * f[k] * tau0;
     const double sb = std::sin(b), cb = std::cos(b);
@@ -35,34 +38,43 @@ Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
     out[k] = scale / ((a2 + r4 * h1 * h1) * (a2 + r4 * h2 * h2));
     if ((k & 0xFFFFF) == 0) Rcpp::checkUserInterrupt();
   }
+}
+
+}  // namespace
+
+// [[Rcpp::export(rng = false)]]
+Rcpp::NumericVector resonance_psd_cpp(const Rcpp::NumericVector& f, double tau0,
+                                      double sigma, double fr, double tc) {
+  Rcpp::NumericVector out(f.size());
+  resonance_psd_into(f.begin(), f.size(), tau0, sigma, fr, tc, out.begin());
   return out;
 }
 
-// R's complex power X^Y (src/main/complex.c, mycpow(), R 4.2): powers by
-// repeated products for whole exponents up to 65536, else the C library's
-// cpow; 0^Y is R_pow(0, Re Y).
-static std::complex<double> r_cpow(std::complex<double> X, double yr) {
-  typedef std::complex<double> cplx;
-  if (X == cplx(0.0, 0.0)) {
-    const double z = yr == 0 ? 1.0 : (yr > 0 ? 0.0 : R_PosInf);
-    return cplx(ISNAN(yr) ? yr : z, 0.0);
+// The objective of the band fits (R/spectrum.R, fit_resonance_psd() and
+// band_pair_fit()): resonances from q = (log sigma, fr, log tc) each, their
+// one-sided PSD 2 S(f) summed in order, and sum(((ex - M) / bg)^2) (R's
+// sum() in long double); Nelder-Mead evaluates it hundreds of times a fit.
+// [[Rcpp::export(rng = false)]]
+double resonance_fit_obj_cpp(const Rcpp::NumericVector& q, const Rcpp::NumericVector& f,
+                             const Rcpp::NumericVector& ex, const Rcpp::NumericVector& bg,
+                             double tau0) {
+  const R_xlen_t n = f.size();
+  const R_xlen_t k = q.size() / 3;
+  if (k < 1 || q.size() != 3 * k || ex.size() != n || bg.size() != n) {
+    Rcpp::stop("resonance_fit_obj_cpp: bad arguments");
   }
-  if (std::fabs(yr) <= 65536 && yr == static_cast<double>(static_cast<int>(yr))) {
-    int k = static_cast<int>(yr);
-    if (k == 0) return cplx(1.0, 0.0);
-    if (k == 1) return X;
-    const bool neg = k < 0;
-    if (neg) k = -k;
-    cplx z(1.0, 0.0);
-    while (k > 0) {
-      if (k & 1) z = z * X;
-      if (k == 1) break;
-      k >>= 1;
-      X = X * X;
-    }
-    return neg ? cplx(1.0, 0.0) / z : z;
+  std::vector<double> M(n), m(n);
+  for (R_xlen_t j = 0; j < k; j++) {
+    resonance_psd_into(f.begin(), n, tau0, std::exp(q[3 * j]), q[3 * j + 1],
+                       std::exp(q[3 * j + 2]), m.data());
+    for (R_xlen_t i = 0; i < n; i++) M[i] = j == 0 ? 2 * m[i] : M[i] + 2 * m[i];
   }
-  return std::pow(X, cplx(yr, 0.0));
+  long double s = 0.0;
+  for (R_xlen_t i = 0; i < n; i++) {
+    const double d = (ex[i] - M[i]) / bg[i];
+    s += d * d;
+  }
+  return static_cast<double>(s);
 }
 
 // A resonance's Allan variance at cluster sizes m (R/resonance.R,
@@ -87,23 +99,9 @@ Rcpp::NumericVector resonance_av_cpp(const Rcpp::NumericVector& m, double tau0,
   const double c = (1.0 - r * r) / (1.0 + r * r) / std::tan(2.0 * pi * fr * tau0);
   const double s2 = sigma * sigma;
   const cplx A(s2, -(s2 * c));
-  const cplx p2 = r_cpow(p, 2.0);
-  const cplx p3 = cplx(3.0, 0.0) * p;
-  const cplx q2 = r_cpow(cplx(1.0, 0.0) - p, 2.0);
+  const allanvar::GeometricAv geom(A, p);
   const R_xlen_t n = m.size();
   Rcpp::NumericVector out(n);
-  for (R_xlen_t i = 0; i < n; i++) {
-    const double mi = m[i];
-    const cplx mc(mi, 0.0);
-    // A * (m - 3 * p - m * p^2 + 4 * p^(m + 1) - p^(2 * m + 1)) /
-    //   (m^2 * (1 - p)^2)
-    cplx t = mc - p3;
-    t = t - mc * p2;
-    t = t + cplx(4.0, 0.0) * r_cpow(p, mi + 1);
-    t = t - r_cpow(p, 2 * mi + 1);
-    const cplx num = A * t;
-    const cplx den = cplx(mi * mi, 0.0) * q2;
-    out[i] = (num / den).real();
-  }
+  for (R_xlen_t i = 0; i < n; i++) out[i] = geom(m[i]).real();
   return out;
 }

@@ -281,3 +281,52 @@ test_that("a moving average far longer than the curve's clusters needs only the 
   v <- filter_av(c(1, 10, 1000), filter_spec_of("ma", list(L = 1e9), tau0), tau0)
   expect_true(all(is.finite(v) & v > 0))
 })
+
+test_that("a moving average's AV at whole m in C++ is the R form to the bit", {
+  r_form <- function(m, L, tau0) {
+    sp <- list(family = "ma", L = L)
+    K <- filter_support(sp)
+    need <- min(K, 2 * ceiling(max(m)) + 2)
+    g <- filter_acf(sp, tau0, 0:(need - 1L))
+    acov_av(round(m), g, if (need < K) ma_sums(L, tau0))
+  }
+  set.seed(34)
+  for (i in 1:300) {
+    tau0 <- 10^runif(1, -3, 0)
+    L <- switch(i %% 4 + 1, 1 + 10^runif(1, -4, 0.5), 10^runif(1, 0, 3),
+                round(10^runif(1, 0, 2)), 10^runif(1, 3, 9))
+    m <- if (i %% 2) 2^(0:sample(3:18, 1)) else sort(unique(round(10^runif(25, 0, 5))))
+    # (cluster sizes as tau / tau0 give them: whole within 1e-9)
+    if (i %% 5 == 0) m <- (m * tau0) / tau0
+    expect_identical(filter_av(m, filter_spec_of("ma", list(L = L), tau0), tau0),
+                     r_form(m, L, tau0))
+  }
+  # fractional m stay with the R interpolation
+  expect_null(filter_ma_av_cpp(c(1, 2.5), 3, 0.01))
+})
+
+test_that("the low-passes' AV in C++ is the R expression to the bit", {
+  r_form <- function(m, spec, tau0) {
+    ra <- rational_acov(filter_rational(spec))
+    out <- ra$d0 / m
+    for (j in seq_along(ra$p)) out <- out + geometric_av(m, ra$A[j], ra$p[j])
+    Re(out) / tau0
+  }
+  set.seed(34)
+  for (i in 1:300) {
+    freq <- sample(c(100, 200, 819.2, 1000), 1)
+    tau0 <- 1 / freq
+    v <- if (i %% 2) "lp1" else "lp2"
+    fc <- exp(runif(1, log(freq / 1e5), log(if (v == "lp2") 0.499 * freq else 0.5 * freq)))
+    sp <- filter_spec_of(v, c(fc = fc), tau0)
+    # whole m below and above 65536 (R's repeated products and cpow),
+    # fractional m
+    m <- switch(i %% 3 + 1, 2^(0:20), unique(round(exp(runif(30, 0, log(3e5))))),
+                runif(25, 1, 1e6))
+    expect_identical(filter_av(m, sp, tau0), r_form(m, sp, tau0))
+  }
+  # a named m takes the R expression (its names kept)
+  m <- c(a = 1, b = 4)
+  sp <- filter_spec_of("lp2", c(fc = 10), 0.01)
+  expect_identical(filter_av(m, sp, 0.01), r_form(m, sp, 0.01))
+})

@@ -506,3 +506,48 @@ test_that("find_bands(): a run that only lines made is no band, with or without 
   expect_false(bands(w + tones))
   expect_true(bands(w + tones + 0.002 * ar2_unit(n, 2.6, 0.5, freq)))
 })
+
+test_that("the whole record's per-bin arithmetic in C++ is R's expressions to the bit", {
+  set.seed(34)
+  for (i in 1:60) {
+    h <- sample(c(3:40, 1000, 4097), 1)
+    X <- complex(real = rnorm(h) * 10^runif(1, -8, 4), imaginary = rnorm(h) * 10^runif(1, -8, 4))
+    sc <- 10^runif(1, -3, 8)
+    p <- Mod(X)^2 / sc
+    p[2:(h - 1L)] <- 2 * p[2:(h - 1L)]
+    expect_identical(bin_power_cpp(X, sc, FALSE), p)
+    expect_identical(bin_power_cpp(X, sc, TRUE), 2 * Mod(X)^2 / sc)
+    Ph <- abs(rnorm(h)) * 10^runif(1, -8, 3)
+    G <- if (i %% 2) 1 else runif(h)
+    k <- sample(c(1L, 2L, 3L, 1024L), 1)
+    expect_identical(bin_mean_cpp(Ph, G, k), bin_smoother(h, k)(Ph * G^2))
+    B <- abs(rnorm(h))
+    M <- 2 * abs(rnorm(h))
+    S <- 3 * abs(rnorm(h))
+    expect_identical(band_gain_cpp(G, B, M, S), G * sqrt(B / (B + pmin(M, pmax(S - B, 0)))))
+    # the bins of a frequency range by binary search: the comparisons' own
+    fh <- (seq_len(h) - 1) * 100 / (2 * (h - 1))
+    lo <- if (i %% 3) sample(fh, 1) else runif(1, -5, 60)
+    hi <- if (i %% 4) lo + runif(1, 0, 30) else sample(fh, 1)
+    expect_identical(bins_between(fh, lo, hi), which(fh >= lo & fh <= hi))
+    expect_identical(bins_between(fh, lo, hi, lo_open = TRUE), which(fh > lo & fh <= hi))
+    expect_identical(bins_between(fh, lo, hi, hi_open = TRUE), which(fh >= lo & fh < hi))
+  }
+  expect_identical(bins_between(c(1, 2, 3), NA_real_, 3), integer(0))
+})
+
+test_that("the band fits' objective in C++ is the R expression to the bit", {
+  set.seed(34)
+  for (i in 1:200) {
+    tau0 <- 1 / sample(c(100, 819.2, 1000), 1)
+    n <- sample(5:200, 1)
+    f <- sort(runif(n, 0, 0.5 / tau0))
+    bg <- abs(rnorm(n)) * 10^runif(1, -8, 0)
+    ex <- rnorm(n) * 10^runif(1, -8, 0)
+    k <- 1 + i %% 2
+    q <- as.vector(rbind(rnorm(k, -3, 2), runif(k, 0, 0.5 / tau0), rnorm(k, 0, 2)))
+    M <- 2 * resonance_psd(f, tau0, exp(q[1]), q[2], exp(q[3]))
+    if (k == 2) M <- M + 2 * resonance_psd(f, tau0, exp(q[4]), q[5], exp(q[6]))
+    expect_identical(resonance_fit_obj_cpp(q, f, ex, bg, tau0), sum(((ex - M) / bg)^2))
+  }
+})

@@ -175,3 +175,25 @@ test_that("the catalogue's autocovariances and PSDs give its AV forms", {
     }
   }
 })
+
+test_that("the Gauss-Markov basis in C++ is the R forms to the bit", {
+  e <- effect_entry("gm")
+  r_form <- function(tau, tau0, tc) {
+    out <- gm_basis_continuous(tau, tc)
+    d <- discrete_tau(tau, tau0)
+    if (any(d)) out[d] <- gm_basis_discrete(tau[d] / tau0, tau0 / tc)
+    out
+  }
+  set.seed(34)
+  for (i in 1:300) {
+    tau0 <- 10^runif(1, -4, 1)
+    # octave grids, whole cluster sizes, taus below a sample (the series
+    # of the continuous form) and at m eps < 1e-5 (the first-order form)
+    tau <- switch(i %% 3 + 1, tau0 * 2^(0:20), tau0 * unique(round(10^runif(40, 0, 6))),
+                  10^runif(30, -6, 4) * tau0)
+    tc <- 10^runif(1, -5, 6)
+    expect_identical(e$basis(tau, tau0, c(tc = tc)), r_form(tau, tau0, tc))
+  }
+  # without a sample period: the continuous form
+  expect_identical(e$basis(c(0.1, 1, 10), NULL, c(tc = 3)), gm_basis_continuous(c(0.1, 1, 10), 3))
+})
