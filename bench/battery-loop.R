@@ -752,22 +752,16 @@ if (identical(set, "j")) {
       b <- sim_base(); list(x = b + g_line(n_j, 0.3 * wsd(), f0), base = b, expect = list(list("sinusoid", f0)))
     })
   })
-  add_case("square wave %s Hz", function(fs, T) {
+  # a periodic source: its lines at the harmonics `mult` of f0
+  periodic <- function(label, gen, amp, mult) add_case(label, function(fs, T) {
     f0 <- ru(0.3, 3)
     list(show = f0, run = function() {
-      b <- sim_base(); list(x = b + g_square(n_j, 0.35 * wsd(), f0), base = b,
-        expect = list(list("sinusoid", f0), list("sinusoid", 3 * f0), list("sinusoid", 5 * f0)),
-        harmonics_of = f0)
+      b <- sim_base(); list(x = b + gen(n_j, amp * wsd(), f0), base = b,
+        expect = lapply(mult * f0, function(f) list("sinusoid", f)), harmonics_of = f0)
     })
   })
-  add_case("sawtooth %s Hz", function(fs, T) {
-    f0 <- ru(0.3, 3)
-    list(show = f0, run = function() {
-      b <- sim_base(); list(x = b + g_saw(n_j, 0.6 * wsd(), f0), base = b,
-        expect = list(list("sinusoid", f0), list("sinusoid", 2 * f0), list("sinusoid", 3 * f0)),
-        harmonics_of = f0)
-    })
-  })
+  periodic("square wave %s Hz", g_square, 0.35, c(1, 3, 5))
+  periodic("sawtooth %s Hz", g_saw, 0.6, c(1, 2, 3))
   for (i in 1:3) add_case("GM tc %s s", function(fs, T) {
     tc <- lu(0.001 * T, 0.012 * T)
     list(show = tc, run = function() {
