@@ -52,6 +52,10 @@
 #'   `$refine$rejected`.
 #'   A Gauss-Markov process of a few samples must also keep its
 #'   correlation at lag 2, as a filter of a sample or two does not.
+#'   Conversely the sensor filter's two-pole form (`filter:ar2`) must be
+#'   seen beyond lag 1: beside the model's other terms, its own steps of
+#'   the raw autocovariance at lags 2-3 must improve their fit by the
+#'   chi-square's 0.999 point and leave at most a quarter of the misfit.
 #' * An effect whose raw-data check neither confirms nor contradicts it (a
 #'   Gauss-Markov whose fitted \eqn{T_c} is 2-3 times the one the ACF of
 #'   block means reads) must lower the criterion by `2 * min_gain` on the
