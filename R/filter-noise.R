@@ -444,13 +444,13 @@ filter_start <- function(r1, family, freq, r2 = NA_real_) {
     ar2 = {
       st <- if (is.finite(r2)) ar2_yule_walker(r1, r2, freq) else NULL
       if (!is.null(st)) return(st)
-      f <- function(fn) {
+      gap <- function(fn) {
         filter_rho1(list(family = "ar2", fn = fn, zeta = 0.75, freq = freq), tau0) - r1
       }
       lo <- freq * 1e-4
       hi <- freq * 0.499
-      if (f(lo) * f(hi) > 0) return(NULL)
-      list(fn = stats::uniroot(f, c(lo, hi), tol = 1e-8 * freq)$root, zeta = 0.75)
+      if (gap(lo) * gap(hi) > 0) return(NULL)
+      list(fn = stats::uniroot(gap, c(lo, hi), tol = 1e-8 * freq)$root, zeta = 0.75)
     },
     bartlett = {
       # two cascaded L-tap averages: triangular taps L - |k|, k = -(L-1)..L-1
