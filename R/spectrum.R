@@ -1107,7 +1107,7 @@ remove_bands <- function(x, freq, bands) {
     b <- bands[k, ]
     M <- 2 * resonance_psd(fh, tau0, sqrt(b$power), b$f_center, b$tc)
     # the power the spectrum shows, Ph * G^2, smoothed over the Welch
-    # resolution (freq / 512: bin_smoother()'s running mean, in C++), and
+    # resolution (freq / 512: a centred running mean, in C++), and
     # the band's fitted PSD no higher than its excess over the background
     # B: a measured band that falls faster than the fitted form (the ADIS
     # z gyros' below 20 Hz) loses no more than it has
@@ -1123,20 +1123,6 @@ remove_bands <- function(x, freq, bands) {
   }
   if (length(G) == 1L) return(x)
   real_ifft_cpp(X * G, np, n) / np + m
-}
-
-# A running mean over k bins (centred; shorter at the ends) of vectors of
-# length n, its indices computed once: the R form of bin_mean_cpp()
-# (src/bands.cpp), which remove_bands() uses; the tests' reference.
-bin_smoother <- function(n, k) {
-  h <- k %/% 2L
-  lo <- pmax(1L, seq_len(n) - h)
-  hi <- pmin(n, seq_len(n) + h) + 1L
-  cnt <- hi - lo
-  function(v) {
-    cs <- c(0, cumsum(v))
-    (cs[hi] - cs[lo]) / cnt
-  }
 }
 
 # The bins of increasing frequencies `fh` within [lo, hi] (`lo_open`,

@@ -28,9 +28,10 @@ Rcpp::NumericVector bin_power_cpp(const Rcpp::ComplexVector& X, double scale, bo
   return out;
 }
 
-// bin_smoother(length(P), k)(P) of P = Ph * G^2 (G of length 1 or of Ph):
-// the running mean over the k bins centred on each (fewer at the ends),
-// from the prefix sums c(0, cumsum(P)).
+// The running mean of P = Ph * G^2 (G of length 1 or of Ph) over the k
+// bins centred on each (fewer at the ends), from the prefix sums
+// c(0, cumsum(P)); its R form is bin_smoother() in
+// tests/testthat/test-spectrum.R.
 // [[Rcpp::export(rng = false)]]
 Rcpp::NumericVector bin_mean_cpp(const Rcpp::NumericVector& Ph, const Rcpp::NumericVector& G,
                                  int k) {

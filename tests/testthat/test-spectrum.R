@@ -507,6 +507,20 @@ test_that("find_bands(): a run that only lines made is no band, with or without 
   expect_true(bands(w + tones + 0.002 * ar2_unit(n, 2.6, 0.5, freq)))
 })
 
+# The R form of bin_mean_cpp() (src/bands.cpp), which remove_bands() used
+# before: a running mean over k bins (centred; shorter at the ends) of
+# vectors of length n.
+bin_smoother <- function(n, k) {
+  h <- k %/% 2L
+  lo <- pmax(1L, seq_len(n) - h)
+  hi <- pmin(n, seq_len(n) + h) + 1L
+  cnt <- hi - lo
+  function(v) {
+    cs <- c(0, cumsum(v))
+    (cs[hi] - cs[lo]) / cnt
+  }
+}
+
 test_that("the whole record's per-bin arithmetic in C++ is R's expressions to the bit", {
   set.seed(34)
   for (i in 1:60) {
