@@ -54,7 +54,8 @@ fit_analysis <- function(fit, unit = NULL, name = NULL) {
   fitted <- data.frame(tau = fit$data$tau, fitted = fit$data$fitted * k^2)
   label <- name %||% (fit$channel %||% (fit$input$channel %||% "fit"))
   readings <- channel_readings(curve, coef, sensor, se = se, fitted = fitted,
-                               series = fit$series, unexplained = fit$unexplained)
+                               series = fit$series, unexplained = fit$unexplained,
+                               alternatives = near_alternatives(fit, k))
   ch <- list(channel = label, sensor = sensor, unit = unit %||% "u",
              freq = fit$freq, n = fit$n, curve = curve, fit = fit,
              fit_error = NULL, fit_condition = NULL, coef = coef,

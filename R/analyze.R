@@ -333,7 +333,8 @@ analyze_channel <- function(job, opts) {
   readings <- channel_readings(curve, coef, job$sensor, se = fit_se(fit),
                                fitted = if (!is.null(fit)) fit$data,
                                series = if (!is.null(fit$series)) fit$series else series,
-                               unexplained = fit$unexplained)
+                               unexplained = fit$unexplained,
+                               alternatives = near_alternatives(fit))
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = failure$message, fit_condition = failure$condition,

@@ -205,8 +205,15 @@
 #'   carry that series effect's bias, see [series_reading_bias()]),
 #'   `unconfirmed` (labels), `tau_range` (NULL or the automatic range),
 #'   `revisit` (NULL, or when the greedy order was revisited a data frame
-#'   `order`, `terms`, `chi2`, `criterion`, `kept`, one row per run) and
-#'   `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,
+#'   `order`, `terms`, `chi2`, `criterion`, `kept`, one row per run),
+#'   `alternatives` (NULL, or the effects the raw data confirm that the
+#'   final model lacks though the curve prefers it with them, by less
+#'   than `min_gain` when the steps ended: a data frame `effect`, `label`,
+#'   `params`, `gain` (the criterion's fall with it, beside the final
+#'   model), `evidence`, `chi2`; at most 3), `alternative_coefs` (their
+#'   models' coefficients; a reading one of them reads 25% or more lower
+#'   is an upper bound, higher not determined, with the reason in the
+#'   readings' `why`) and `removed`. `unexplained` is a data frame (kind, tau_from, tau_to,
 #'   strength in sigma, size = largest ADEV error inside in percent,
 #'   description) and `series` the series pass (or NULL) without its
 #'   cleaned series `x` (the result does not carry a copy of the data). The object keeps
@@ -335,6 +342,12 @@ print_refine_notes <- function(x) {
   if (nr) {
     cat(nr, " candidate(s) rejected (contradicted by the raw data or not a valid ",
         "instance); see $refine$rejected.\n", sep = "")
+  }
+  al <- r$alternatives
+  if (NROW(al)) {
+    cat(sprintf(paste("Not in the model, though the raw data confirm it and the curve gains %s",
+                      "with it (min_gain %s): %s (%s); see $refine$alternatives.\n"),
+                format_num(al$gain), format_num(r$min_gain), al$effect, al$params), sep = "")
   }
   rv <- r$revisit
   if (NROW(rv)) {

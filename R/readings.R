@@ -25,10 +25,11 @@
 #' `series`: the axis' series pass (detect_series_effects()) or NULL.
 #' `unexplained`: the runs the loop left unexplained (avrefine()'s
 #' `$unexplained`, taus as the curve's) or NULL; a reading resting on one is
-#' not measured (R/verdicts.R).
+#' not measured (R/verdicts.R). `alternatives`: near_alternatives() of the
+#' fit, or NULL (mark_model_choice()).
 #' @noRd
 channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL,
-                             series = NULL, unexplained = NULL) {
+                             series = NULL, unexplained = NULL, alternatives = NULL) {
   tau <- curve$tau
   adev <- curve$adev
   ok <- is.finite(adev) & adev > 0
@@ -46,8 +47,9 @@ channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL,
   })
   out <- do.call(rbind, rows)
   rownames(out) <- NULL
-  mark_series_bias(reading_verdicts(out, curve, lay, ok, rel, unexplained),
-                   series)
+  out <- mark_series_bias(reading_verdicts(out, curve, lay, ok, rel, unexplained),
+                          series)
+  mark_model_choice(out, alternatives, curve, ok, rel, tau_min, sensor)
 }
 
 # The readings of a dead axis: one row per reading, no value, `reason` as

@@ -65,6 +65,14 @@ screen_trial <- function(st, tr, nl_now) {
     # raw-data values that do not pay alone may pay beside a family form
     # the raw data refused alone (family_pairs())
     if (length(pin)) st$unpaid <- add_refused(st$unpaid, tr)
+    # one the curve prefers by less than min_gain may be an alternative
+    # description of the final model (stage_alternatives())
+    if (!set_line && is.finite(c1) && c1 < c0) {
+      lab <- new_label(cur$terms, tr$effect)
+      st$short_trials[[length(st$short_trials) + 1L]] <- list(
+        trial = tr, gain = c0 - c1,
+        par = instance_params(stats::coef(new), new$layout, lab))
+    }
     return(list(st = st, cand = NULL))
   }
   lab <- new_label(cur$terms, tr$effect)

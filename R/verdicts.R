@@ -322,6 +322,70 @@ mark_series_bias <- function(rd, pass) {
   rd
 }
 
+# Alternative descriptions of the record (avrefine()'s $refine$alternatives: an
+# effect the raw data confirm that the final model lacks because the curve
+# gains less than min_gain with it) and the readings: one that the
+# alternative's model reads `bias_bound` or more lower no longer measures
+# the sensor but bounds it from above (its term took what the left-out
+# effect describes); one it reads that much higher is not determined.
+# `alternatives`: near_alternatives(); the other arguments as
+# channel_readings() makes them.
+mark_model_choice <- function(rd, alternatives, curve, ok, rel, tau_min, sensor) {
+  if (!length(alternatives)) return(rd)
+  entries <- entries_with("reading")
+  for (a in alternatives) {
+    lay <- check_coef(a$coef)
+    alt <- vapply(entries, function(e) {
+      reading_row(e, lay, a$coef, NULL, curve, ok, rel, tau_min, sensor)$value
+    }, 0)
+    what <- effect_entry(split_term(a$effect)$kind)$title
+    for (i in seq_len(nrow(rd))) {
+      v <- rd$value[i]
+      w <- alt[i]
+      if (!rd$verdict[i] %in% c("measured", "lower_bound") || !is.finite(v) ||
+          !is.finite(w) || v <= 0) next
+      change <- w / v - 1
+      if (abs(change) < bias_bound) next
+      gained <- if (a$gain < a$min_gain) {
+        sprintf("the curve gains only %s with it, under min_gain %s", format_num(a$gain),
+                format_num(a$min_gain))
+      } else {
+        sprintf("the steps ended below min_gain %s, though the final model gains %s with it",
+                format_num(a$min_gain), format_num(a$gain))
+      }
+      note <- sprintf(paste("a %s (%s) that the raw data confirm (%s) is not in the model:",
+                            "%s; with it %s reads %s (%+.0f%%)"),
+                      what, a$params, a$evidence, gained, rd$term[i], format_num(w),
+                      100 * change)
+      down <- change < 0 && rd$verdict[i] == "measured"
+      rd$why[i] <- if (down) paste0(note, ": ", rd$term[i], " is at most this")
+        else if (nzchar(rd$why[i])) paste0(rd$why[i], "; ", note) else note
+      rd$verdict[i] <- if (down) "upper_bound" else "not_determined"
+    }
+  }
+  rd$is_bound <- rd$verdict %in% c("upper_bound", "lower_bound")
+  rd
+}
+
+# The alternatives of a refined fit (its $refine$alternatives) for
+# mark_model_choice(), their amplitudes scaled by `k` as the readings'
+# coefficients are; NULL when there are none.
+near_alternatives <- function(fit, k = 1) {
+  r <- if (is.null(fit)) NULL else fit$refine
+  nr <- r$alternatives
+  cf <- r$alternative_coefs
+  if (!NROW(nr) || length(cf) != nrow(nr)) return(NULL)
+  lapply(seq_len(nrow(nr)), function(i) {
+    co <- cf[[i]]
+    if (k != 1) {
+      lay <- check_coef(co)
+      co <- co * ifelse(lay$role[match(names(co), lay$name)] == "amp", k, 1)
+    }
+    list(coef = co, effect = nr$effect[i], params = nr$params[i], gain = nr$gain[i],
+         evidence = nr$evidence[i], min_gain = r$min_gain)
+  })
+}
+
 # One line for a file's comment or a summary: the verdict and what marks it.
 verdict_note <- function(verdict, why = "", biased_by = "", bias_change = NA_real_) {
   out <- toupper(verdict_label(verdict))
