@@ -55,7 +55,7 @@ fit_analysis <- function(fit, unit = NULL, name = NULL) {
   label <- name %||% (fit$channel %||% (fit$input$channel %||% "fit"))
   readings <- channel_readings(curve, coef, sensor, se = se, fitted = fitted,
                                series = fit$series, unexplained = fit$unexplained,
-                               alternatives = near_alternatives(fit, k))
+                               alternatives = model_alternatives(fit, k))
   ch <- list(channel = label, sensor = sensor, unit = unit %||% "u",
              freq = fit$freq, n = fit$n, curve = curve, fit = fit,
              fit_error = NULL, fit_condition = NULL, coef = coef,

@@ -334,7 +334,7 @@ analyze_channel <- function(job, opts) {
                                fitted = if (!is.null(fit)) fit$data,
                                series = if (!is.null(fit$series)) fit$series else series,
                                unexplained = fit$unexplained,
-                               alternatives = near_alternatives(fit))
+                               alternatives = model_alternatives(fit))
   res <- list(channel = job$channel, sensor = job$sensor, unit = job$unit,
               freq = job$freq, n = length(job$x), curve = curve, fit = fit,
               fit_error = failure$message, fit_condition = failure$condition,

@@ -25,7 +25,7 @@
 #' `series`: the axis' series pass (detect_series_effects()) or NULL.
 #' `unexplained`: the runs the loop left unexplained (avrefine()'s
 #' `$unexplained`, taus as the curve's) or NULL; a reading resting on one is
-#' not measured (R/verdicts.R). `alternatives`: near_alternatives() of the
+#' not measured (R/verdicts.R). `alternatives`: model_alternatives() of the
 #' fit, or NULL (mark_model_choice()).
 #' @noRd
 channel_readings <- function(curve, coef, sensor, se = NULL, fitted = NULL,

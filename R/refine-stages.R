@@ -644,9 +644,10 @@ leave_model <- function(st, w, dead, step, reason, note) {
 # K half. Those trials of the screening that ended the steps are refitted
 # beside the final model from their values (the best `alternatives_max`
 # by that gain); one the curve still prefers, a valid instance the raw
-# data confirm, is an alternative description of the record. Listed in $refine$alternatives with its
-# model's coefficients ($refine$alternative_coefs), whose readings mark the final
-# model's (mark_model_choice()); the model is unchanged.
+# data confirm, is an alternative description of the record. Listed in
+# $refine$alternatives with its model's coefficients
+# ($refine$alternative_coefs), whose readings mark the final model's
+# (mark_model_choice()); the model is unchanged.
 alternatives_max <- 3L
 stage_alternatives <- function(st) {
   recs <- st$short_trials

@@ -42,7 +42,7 @@ new_refine_state <- function(fit, args, settings) {
     seeds = list(),            # pinned value sets a revisit takes first (stage_revisit())
     until = NULL,              # a revisit stops on reaching these terms (sorted)
     revisit = NULL,            # what the revisit compared, or NULL
-    short_trials = list(),      # the last screening's trials that gained less than min_gain
+    short_trials = list(),     # the last screening's trials that gained under min_gain
     alternatives = NULL,       # stage_alternatives()'s alternatives to the final model, or NULL
     remaining = NULL,          # signatures left when the loop stopped
     unexplained = NULL,

@@ -328,7 +328,7 @@ mark_series_bias <- function(rd, pass) {
 # alternative's model reads `bias_bound` or more lower no longer measures
 # the sensor but bounds it from above (its term took what the left-out
 # effect describes); one it reads that much higher is not determined.
-# `alternatives`: near_alternatives(); the other arguments as
+# `alternatives`: model_alternatives(); the other arguments as
 # channel_readings() makes them.
 mark_model_choice <- function(rd, alternatives, curve, ok, rel, tau_min, sensor) {
   if (!length(alternatives)) return(rd)
@@ -370,7 +370,7 @@ mark_model_choice <- function(rd, alternatives, curve, ok, rel, tau_min, sensor)
 # The alternatives of a refined fit (its $refine$alternatives) for
 # mark_model_choice(), their amplitudes scaled by `k` as the readings'
 # coefficients are; NULL when there are none.
-near_alternatives <- function(fit, k = 1) {
+model_alternatives <- function(fit, k = 1) {
   r <- if (is.null(fit)) NULL else fit$refine
   nr <- r$alternatives
   cf <- r$alternative_coefs
