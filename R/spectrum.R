@@ -294,7 +294,8 @@ visible_band <- function(tau_min, tau_max, freq = NULL) {
 # resolution (`tol` bins of it), or NA: the nearest, or with `pick =
 # "strongest"` the one standing highest above its background.
 match_line <- function(f0, lines, tol = 1, pick = c("nearest", "strongest")) {
-  pick <- match.arg(pick)
+  # (match.arg() cost more than the rest: the callers name a choice)
+  if (!(identical(pick, "strongest") || identical(pick, "nearest"))) pick <- match.arg(pick)
   if (!nrow(lines) || !is.finite(f0)) return(NA_integer_)
   res <- attr(lines, "resolution")
   if (is.null(res)) res <- 0
