@@ -61,6 +61,18 @@ detrend_linear <- function(x) detrend_line(as.double(x))
 # in which the ACF of the block means is kept by block size m, so that the
 # checks of many candidate Tc that share m read the series once.
 acf_exponential <- function(x, freq, tc, cache = NULL) {
+  # the loop judges the same Tc again (a candidate screened, refitted,
+  # judged at the next step): the whole result kept by its arguments
+  if (is.null(cache)) return(acf_exponential_now(x, freq, tc, NULL))
+  key <- paste0("acf_exponential:", sprintf("%a", freq), ":", sprintf("%a", tc))
+  hit <- cache[[key]]
+  if (is.null(hit)) {
+    hit <- acf_exponential_now(x, freq, tc, cache)
+    cache[[key]] <- hit
+  }
+  hit
+}
+acf_exponential_now <- function(x, freq, tc, cache) {
   m <- max(1L, floor(tc * freq / 8))
   key <- paste0("acf_exponential.", m)
   hit <- if (!is.null(cache)) cache[[key]]

@@ -10,7 +10,10 @@
 # Split "kind:variant" -> list(kind, variant ("" for none)).
 split_term <- function(terms) {
   kind <- sub(":.*$", "", terms)
-  variant <- ifelse(grepl(":", terms, fixed = TRUE), sub("^[^:]*:", "", terms), "")
+  has <- grepl(":", terms, fixed = TRUE)
+  # (no variant anywhere, the common case: what ifelse() gives, without it)
+  variant <- if (length(has) && !any(has)) rep("", length(has)) else
+    ifelse(has, sub("^[^:]*:", "", terms), "")
   list(kind = kind, variant = variant)
 }
 
@@ -59,6 +62,23 @@ check_terms_now <- function(terms, arg) {
 
 # Labels of the term instances: c("N", "gm", "gm") -> c("N", "gm1", "gm2").
 term_labels <- function(terms) {
+  # the loop asks for the labels of the same few sets hundreds of times:
+  # kept with the layouts (a pure function of the terms and the catalogue)
+  key <- if (is.character(terms) && length(terms) && !anyNA(terms) &&
+             is.null(attributes(terms)))
+    paste0("\003", paste(terms, collapse = "\r"))
+  if (!is.null(key)) {
+    hit <- .catalogue$layouts[[key]]
+    if (!is.null(hit)) return(hit)
+  }
+  out <- term_labels_now(terms)
+  if (!is.null(key)) {
+    if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
+    assign(key, out, envir = .catalogue$layouts)
+  }
+  out
+}
+term_labels_now <- function(terms) {
   terms <- check_terms(terms)
   sp <- split_term(terms)
   lab <- sp$kind

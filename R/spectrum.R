@@ -294,7 +294,8 @@ visible_band <- function(tau_min, tau_max, freq = NULL) {
 # resolution (`tol` bins of it), or NA: the nearest, or with `pick =
 # "strongest"` the one standing highest above its background.
 match_line <- function(f0, lines, tol = 1, pick = c("nearest", "strongest")) {
-  pick <- match.arg(pick)
+  # (match.arg() cost more than the rest: the callers name a choice)
+  if (!(identical(pick, "strongest") || identical(pick, "nearest"))) pick <- match.arg(pick)
   if (!nrow(lines) || !is.finite(f0)) return(NA_integer_)
   res <- attr(lines, "resolution")
   if (is.null(res)) res <- 0
@@ -433,7 +434,6 @@ fit_lines <- function(x, freq, f0, done = NULL) {
                      amp = numeric())
   if (!length(f0)) return(fits)
   n <- length(x)
-  xc <- x - mean(x)
   # least-squares amplitudes on sin and cos at f from their sums, the
   # fitted power sum(fitted^2) being b'X'y; the sums near a line from its
   # block moments (C++, src/lines.cpp: one pass over the record per line,
@@ -446,10 +446,17 @@ fit_lines <- function(x, freq, f0, done = NULL) {
   }
   bin <- freq / n
   rows <- vector("list", length(f0))
-  for (k in seq_len(NROW(done))) {
-    rows[[k]] <- done[k, , drop = FALSE]
-    xc <- line_subtract(xc, done$f[k], freq, done$s[k], done$c[k])
+  for (k in seq_len(NROW(done))) rows[[k]] <- done[k, , drop = FALSE]
+  # (the lines done taken out again, or found taken out: line_chain())
+  same <- NULL
+  if (NROW(done)) {
+    ch <- line_chain(x, freq, done, x - mean(x))
+    xc <- ch$xc
+    same <- ch$same
+  } else {
+    xc <- x - mean(x)
   }
+  taken <- NROW(done)
   for (k in seq_along(f0)[seq_along(f0) > NROW(done)]) {
     f <- f0[k]
     mom <- line_moments(xc, f, freq, 2 * bin)
@@ -460,11 +467,61 @@ fit_lines <- function(x, freq, f0, done = NULL) {
     rows[[k]] <- data.frame(f0 = f, f = o$minimum, s = b[1L], c = b[2L],
                             amp = sqrt(sum(b^2)))
     # the next line is fitted with this one out
-    if (k < length(f0)) xc <- line_subtract(xc, o$minimum, freq, b[1L], b[2L])
+    if (k < length(f0)) {
+      xc <- line_subtract(xc, o$minimum, freq, b[1L], b[2L])
+      taken <- k
+    }
   }
   out <- do.call(rbind, rows)
   rownames(out) <- NULL
+  if (taken > NROW(done)) {
+    line_chain_keep(x, freq, out[seq_len(taken), , drop = FALSE], xc, same)
+  }
   out
+}
+
+# x - mean(x) less the sinusoids (f, s, c) of the rows of `fits`, one by
+# one in their order (line_subtract()), as fit_lines() and
+# subtract_line_fits() take them out. The last such chain made on a record
+# is kept (record_store): the loop's diagnostics take out the lines the
+# series pass fitted on the same record, and a chain that begins with the
+# kept one goes on from it (the same operations, so the same values).
+# `xc`: x - mean(x), as the caller made it (not evaluated when the kept
+# chain is used). Returns list(xc, same): `same`, whether the kept chain
+# is of this record (for line_chain_keep()).
+line_chain <- function(x, freq, fits, xc) {
+  hit <- record_store[["chain"]]
+  # (one comparison of the record per call: identical() reads 1e6 values
+  # one by one unless they are the same object)
+  same <- !is.null(hit) && identical(hit$key, list(x, freq))
+  k0 <- 0L
+  if (same) {
+    j <- length(hit$fits$f)
+    if (j <= nrow(fits) && identical(hit$fits$f, fits$f[seq_len(j)]) &&
+        identical(hit$fits$s, fits$s[seq_len(j)]) &&
+        identical(hit$fits$c, fits$c[seq_len(j)])) {
+      xc <- hit$xc
+      k0 <- j
+    }
+  }
+  for (k in seq_len(nrow(fits))[seq_len(nrow(fits)) > k0]) {
+    xc <- line_subtract(xc, fits$f[k], freq, fits$s[k], fits$c[k])
+  }
+  if (nrow(fits) > k0) line_chain_keep(x, freq, fits, xc, same)
+  list(xc = xc, same = same)
+}
+
+# Keep the chain `fits` -> `xc` of record x; `same`: whether the kept one
+# is of this record (NULL: not known). A shorter chain on the same record
+# (a subset of its lines) does not replace a longer one.
+line_chain_keep <- function(x, freq, fits, xc, same = NULL) {
+  hit <- record_store[["chain"]]
+  if (is.null(same)) same <- !is.null(hit) && identical(hit$key, list(x, freq))
+  if (same && length(hit$fits$f) > nrow(fits)) return(invisible(NULL))
+  record_store[["chain"]] <- list(key = list(x, freq),
+                                  fits = list(f = fits$f, s = fits$s, c = fits$c),
+                                  xc = xc)
+  invisible(NULL)
 }
 
 # A line is sharp (one frequency over the whole record) when its
@@ -496,11 +553,9 @@ without_sharp_lines <- function(x, freq) {
 # `x` less the sinusoids of record_line_fits() (its mean kept).
 subtract_line_fits <- function(x, freq, fits) {
   if (!nrow(fits)) return(x)
-  xc <- x - mean(x)
-  # xc - s sin(2 pi f t) - c cos(2 pi f t), t = (0..n-1) / freq (C++)
-  for (k in seq_len(nrow(fits))) {
-    xc <- line_subtract(xc, fits$f[k], freq, fits$s[k], fits$c[k])
-  }
+  # xc - s sin(2 pi f t) - c cos(2 pi f t), t = (0..n-1) / freq (C++),
+  # line by line (line_chain())
+  xc <- line_chain(x, freq, fits, x - mean(x))$xc
   as.numeric(xc) + mean(x)
 }
 

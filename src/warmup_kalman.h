@@ -8,6 +8,7 @@
 #include <Rcpp.h>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 // Gains K (m x nb, column j at K + j m) and innovation sds sF (nb) from
@@ -98,11 +99,25 @@ inline double warmup_filter(const double* Y, R_xlen_t nb, R_xlen_t nc, double h,
   }
   for (R_xlen_t c = 0; c < m; ++c)
     for (R_xlen_t i = 0; i < m; ++i) PP[i + c * m] = phi[i] * phi[c];
-  std::vector<double> K(m * nb), sF(nb);
+  // The gains and sds are written whole by every call: buffers kept
+  // between calls (the optimiser's hundreds of evaluations spent a tenth
+  // of the filter allocating and zeroing them).
+  static thread_local std::vector<double> K, sF;
+  if (K.size() < static_cast<size_t>(m * nb)) K.resize(m * nb);
+  if (sF.size() < static_cast<size_t>(nb)) sF.resize(nb);
   warmup_gains_core(P0.data(), PP.data(), Q.data(), phi.data(), h, m, nb, K.data(), sF.data());
   warmup_whiten_core(Y, nb, nc, K.data(), sF.data(), phi.data(), m, E);
+  // sF holds one value from the steady state on: its log taken once per
+  // value (the same double added in the same order)
   long double ld = 0;
-  for (R_xlen_t j = 1; j < nb; ++j) ld += std::log(sF[j]);
+  double last = std::numeric_limits<double>::quiet_NaN(), lg = 0;
+  for (R_xlen_t j = 1; j < nb; ++j) {
+    if (!(sF[j] == last)) {
+      last = sF[j];
+      lg = std::log(last);
+    }
+    ld += lg;
+  }
   return static_cast<double>(ld);
 }
 

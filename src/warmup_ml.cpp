@@ -27,7 +27,9 @@ Rcpp::List warmup_gls_ll(const Rcpp::NumericMatrix& Y, double q,
   }
   const R_xlen_t n = nb - 1;
   int k = static_cast<int>(nc - 1);
-  std::vector<double> E(n * nc);
+  // (written whole by the filter: a buffer kept between calls)
+  static thread_local std::vector<double> E;
+  if (E.size() < static_cast<size_t>(n * nc)) E.resize(n * nc);
   const double logdet = warmup_filter(Y.begin(), nb, nc, 1.0, q, phis.begin(), s.begin(),
                                       phis.size(), E.data());
   std::vector<double> e(E.begin(), E.begin() + n);
@@ -35,7 +37,7 @@ Rcpp::List warmup_gls_ll(const Rcpp::NumericMatrix& Y, double q,
   if (k > 0) {
     int ni = static_cast<int>(n), rank = 0, ny = 1, info = 0;
     double tol = 1e-7;
-    std::vector<double> X(E.begin() + n, E.end()), qraux(k), work(2 * k);
+    std::vector<double> X(E.begin() + n, E.begin() + n * nc), qraux(k), work(2 * k);
     std::vector<int> pivot(k);
     for (int j = 0; j < k; ++j) pivot[j] = j + 1;
     F77_CALL(dqrdc2)(X.data(), &ni, &ni, &k, &tol, &rank, qraux.data(), pivot.data(),

@@ -572,3 +572,62 @@ test_that("the warm-up likelihood kernel is R's whitening, qr() and sums to the 
     }
   }
 })
+
+test_that("the warm-up's Kalman filter is the R loop it replaced, to the bit", {
+  # src/warmup_kalman.h as R: gains to the steady state, then each column
+  # whitened; the log-determinant sum(log(sF[-1]))
+  by_r <- function(Y, h, q, phis, s) {
+    nb <- nrow(Y)
+    m <- length(phis) + 1L
+    phi <- c(1, phis)
+    Q <- c(q, s * (1 - phis^2))
+    P <- diag(c(1e6 * (h + sum(s) + q * nb), s), m)
+    PP <- outer(phi, phi)
+    K <- matrix(0, m, nb)
+    sF <- numeric(nb)
+    for (j in seq_len(nb)) {
+      Pz <- rowSums(P)
+      F <- sum(Pz) + h
+      K[, j] <- phi * Pz / F
+      sF[j] <- sqrt(F)
+      if (j > 2L && abs(sF[j] / sF[j - 1L] - 1) < 1e-12 &&
+          max(abs(K[, j] - K[, j - 1L])) < 1e-12 * max(abs(K[, j]))) {
+        if (j < nb) {
+          K[, (j + 1L):nb] <- K[, j]
+          sF[(j + 1L):nb] <- sF[j]
+        }
+        break
+      }
+      P <- PP * (P - outer(Pz, Pz) / F)
+      diag(P) <- diag(P) + Q
+    }
+    E <- matrix(0, nb - 1L, ncol(Y))
+    for (cl in seq_len(ncol(Y))) {
+      a <- numeric(m)
+      for (j in seq_len(nb)) {
+        st <- 0
+        for (l in seq_len(m)) st <- st + a[l] * 1
+        v <- Y[j, cl] - st
+        if (j > 1L) E[j - 1L, cl] <- v / sF[j]
+        a <- phi * a + (0 + v * K[, j])
+      }
+    }
+    attr(E, "logdet") <- sum(log(sF[-1L]))
+    E
+  }
+  set.seed(41)
+  # long records reach the steady state (one sd over most rows); a short
+  # one after a long one reuses the kernel's larger buffers
+  for (nb in c(40L, 1500L, 25L, 700L)) {
+    phis <- exp(-1 / 4^(0:floor(log(nb / 4, 4))))
+    t <- seq_len(nb)
+    Y <- cbind(cumsum(rnorm(nb)) * 0.05 + rnorm(nb), exp(-t / 30))
+    for (k in 1:3) {
+      th <- runif(length(phis) + 1L, -12, 3)
+      h <- exp(runif(1, -1, 1))
+      a <- by_r(Y, h, exp(th[1L]), phis, exp(th[-1L]))
+      b <- warmup_whiten_cpp(Y, h, exp(th[1L]), phis, exp(th[-1L]))
+      expect_identical(b, a)
+    }
+  }
+})
