@@ -67,15 +67,18 @@ term_labels <- function(terms) {
   key <- if (is.character(terms) && length(terms) && !anyNA(terms) &&
              is.null(attributes(terms)))
     paste0("\003", paste(terms, collapse = "\r"))
-  if (!is.null(key)) {
-    hit <- .catalogue$layouts[[key]]
-    if (!is.null(hit)) return(hit)
-  }
-  out <- term_labels_now(terms)
-  if (!is.null(key)) {
-    if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
-    assign(key, out, envir = .catalogue$layouts)
-  }
+  catalogue_memo(key, function() term_labels_now(terms))
+}
+
+# `make()`'s value kept under `key` in the catalogue's store (emptied by
+# register_effect() and unregister_effect()); NULL `key`: not kept.
+catalogue_memo <- function(key, make) {
+  if (is.null(key)) return(make())
+  hit <- .catalogue$layouts[[key]]
+  if (!is.null(hit)) return(hit)
+  out <- make()
+  if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
+  assign(key, out, envir = .catalogue$layouts)
   out
 }
 term_labels_now <- function(terms) {
@@ -118,16 +121,7 @@ coef_layout <- function(terms) {
   # each set of terms is built once per catalogue (register_effect() and
   # unregister_effect() empty the store)
   key <- if (is.character(terms) && !anyNA(terms)) paste(terms, collapse = "\r")
-  if (!is.null(key)) {
-    hit <- .catalogue$layouts[[key]]
-    if (!is.null(hit)) return(hit)
-  }
-  lay <- build_coef_layout(terms)
-  if (!is.null(key)) {
-    if (is.null(.catalogue$layouts)) .catalogue$layouts <- new.env(parent = emptyenv())
-    assign(key, lay, envir = .catalogue$layouts)
-  }
-  lay
+  catalogue_memo(key, function() build_coef_layout(terms))
 }
 
 build_coef_layout <- function(terms) {
