@@ -60,19 +60,24 @@ detrend_linear <- function(x) detrend_line(as.double(x))
 # `cache`: NULL or an environment (avrefine()'s, one per call and series)
 # in which the ACF of the block means is kept by block size m, so that the
 # checks of many candidate Tc that share m read the series once.
-acf_exponential <- function(x, freq, tc, cache = NULL) {
+# `beside`: time constants (s) of other exponentials read with it, their
+# amplitudes free (a model's other GMs: beside a faster one the block means'
+# ACF falls steeply over the first lags, and one exponential alone reads
+# between the two).
+acf_exponential <- function(x, freq, tc, cache = NULL, beside = numeric()) {
   # the loop judges the same Tc again (a candidate screened, refitted,
   # judged at the next step): the whole result kept by its arguments
-  if (is.null(cache)) return(acf_exponential_now(x, freq, tc, NULL))
-  key <- paste0("acf_exponential:", sprintf("%a", freq), ":", sprintf("%a", tc))
+  if (is.null(cache)) return(acf_exponential_now(x, freq, tc, NULL, beside))
+  key <- paste0("acf_exponential:", sprintf("%a", freq), ":", sprintf("%a", tc),
+                paste0(":", sprintf("%a", beside), collapse = ""))
   hit <- cache[[key]]
   if (is.null(hit)) {
-    hit <- acf_exponential_now(x, freq, tc, cache)
+    hit <- acf_exponential_now(x, freq, tc, cache, beside)
     cache[[key]] <- hit
   }
   hit
 }
-acf_exponential_now <- function(x, freq, tc, cache) {
+acf_exponential_now <- function(x, freq, tc, cache, beside = numeric()) {
   m <- max(1L, floor(tc * freq / 8))
   key <- paste0("acf_exponential.", m)
   hit <- if (!is.null(cache)) cache[[key]]
@@ -97,13 +102,15 @@ acf_exponential_now <- function(x, freq, tc, cache) {
   # profiled on a grid within a factor 5 of the hint; a minimum on the
   # grid's edge means Tc is not identified.
   grid <- tc * 10^seq(-0.7, 0.7, by = 0.02)
+  # the other exponentials, beside the line
+  rest <- cbind(vapply(beside, function(b) exp(-lag * m / (freq * b)), numeric(max_lag)), 1, lag)
   # (.lm.fit(): lm.fit()'s QR and residuals without its bookkeeping)
   rss <- vapply(grid, function(g) {
-    X <- cbind(exp(-lag * m / (freq * g)), 1, lag)
+    X <- cbind(exp(-lag * m / (freq * g)), rest)
     sum(stats::.lm.fit(X, r)$residuals^2)
   }, 0)
   k <- which.min(rss)
-  X <- cbind(exp(-lag * m / (freq * grid[k])), 1, lag)
+  X <- cbind(exp(-lag * m / (freq * grid[k])), rest)
   a <- unname(stats::lm.fit(X, r)$coefficients[1L])
   est <- if (k > 1L && k < length(grid) && is.finite(a) && a > 0) grid[k] else NA_real_
   rss_line <- sum(stats::lm.fit(X[, -1L, drop = FALSE], r)$residuals^2)

@@ -119,6 +119,39 @@ evidence_gm <- function(par, raw, x, freq) {
   }
 }
 
+# The ACF check read again beside the model's other GMs (their Tc held,
+# amplitudes free): a GM of 40 s beside one of 3 s read 16 s alone, between
+# the two, and was left undecided. Only a reading the other GMs leave
+# undecided or contradicted can become support; one that reads it no better
+# stays as it was.
+evidence_gm_beside <- function(ev, fit, label, raw, freq) {
+  if (isTRUE(ev$support)) return(ev)
+  lay <- fit$layout
+  cf <- stats::coef(fit)
+  others <- lay$name[lay$kind == "gm" & lay$param == "tc" & lay$label != label]
+  par <- instance_params(cf, lay, label)
+  tc <- par[["tc"]]
+  x <- diag_series(raw)
+  if (!length(others) || is.null(x) || !is.finite(tc) || tc * freq < 4 ||
+      tc * freq * 40 / 8 > length(x)) {
+    return(ev)
+  }
+  beside <- unname(cf[others])
+  # the others that fall within the ACF's lags (longer ones are the line's)
+  m <- max(1L, floor(tc * freq / 8))
+  beside <- beside[is.finite(beside) & beside < 48 * m / freq]
+  if (!length(beside)) return(ev)
+  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw), beside = beside)
+  if (!(is.finite(a$tc) && a$z > 5 && isTRUE(a$shape >= 0.5) &&
+        a$tc > tc / 2 && a$tc < tc * 2)) {
+    return(ev)
+  }
+  list(text = sprintf("exponential ACF of %s-sample means beside the other GMs' Tc %s s: Tc = %s s (z = %.1f); alone, %s",
+                      a$m, paste(format_num(beside), collapse = ", "), format_num(a$tc), a$z,
+                      ev$text),
+       support = TRUE)
+}
+
 effect_gauss_markov <- function() {
   new_effect(
     name = "gm", title = "first-order Gauss-Markov process",
@@ -172,6 +205,7 @@ effect_gauss_markov <- function() {
            score = if (ctx$kind == "bump") 2 else 1)
     },
     evidence = evidence_gm,
+    model_evidence = evidence_gm_beside,
     # Correlated over fewer than 2 samples, an AR(1) is the sensor's own
     # averaging (the filter term), not a slow process.
     admissible = function(par, tau, freq) {

@@ -790,12 +790,23 @@ screen_trials <- function(st) {
   st$short_trials <- list()
   nl_now <- stats::coef(cur)[cur$layout$role == "nonlinear"]
   nl_now <- nl_now[!names(nl_now) %in% names(st$settings$fixed)]
-  holds <- if (length(nl_now) && nrow(st$sig)) list(nl_now, numeric(0))
-    else if (length(nl_now)) list(nl_now) else list(numeric(0))
+  holds <- if (length(nl_now)) list(nl_now, numeric(0)) else list(numeric(0))
   trials <- st$trials
+  # Without a residual signature the free pass screens only a further
+  # instance of a repeatable entry the model holds and that the curve
+  # alone places (the raw data propose none: their values are never
+  # pinned). Beside the first held at its one-term compromise, a second
+  # GM of another time constant does not pay, and the terms the first
+  # shares the curve with (B, K) leave no signature to trace it by.
+  again <- vapply(trials$effect, function(k) {
+    e <- effect_entry(split_term(k)$kind)
+    isTRUE(e$repeatable) && is.null(e$propose) && e$name %in% split_term(cur$terms)$kind
+  }, NA)
   for (h in holds) {
     st$hold <- h
+    free_only_again <- !length(h) && length(nl_now) && !nrow(st$sig)
     for (tier in list(which(trials$traced), which(!trials$traced))) {
+      if (free_only_again) tier <- tier[again[tier]]
       for (i in tier) {
         r <- screen_trial(st, trials[i, ], nl_now)
         st <- r$st

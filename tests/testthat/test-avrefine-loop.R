@@ -329,3 +329,42 @@ test_that("an instance the final model does without leaves it; one the raw data 
   expect_identical(vapply(out_r$steps, function(s) s$label, ""), c("left:gm1", "gm1"))
   expect_equal(coef(out_r$current)[["gm1.tc"]], 5, tolerance = 0.25)
 })
+
+test_that("a GM's ACF check is read beside the model's other GMs: a faster one no longer hides it", {
+  freq <- 10
+  n <- 2e5
+  # a 3 s GM strong enough that the block means' ACF alone reads far short
+  # of the slow GM's Tc (or contradicts it)
+  set.seed(4)
+  x <- gen_white(n, freq, 0.003 / sqrt(freq)) + gen_gm(n, freq, 0.006, 3) +
+    gen_gm(n, freq, 0.0027, 40)
+  fit <- avfit(allan(x, freq), terms = c("N", "gm", "gm"), start = c(gm1.tc = 3, gm2.tc = 40))
+  tc <- unname(coef(fit)[c("gm1.tc", "gm2.tc")])
+  expect_equal(tc, c(3, 40), tolerance = 0.25)
+  raw <- refine_diagnostics(x, freq)
+  par <- as.list(instance_params(coef(fit), fit$layout, "gm2"))
+  alone <- raw_evidence("gm", par, raw, diag_series(raw), freq)
+  expect_false(isTRUE(alone$support))
+  beside <- raw_evidence("gm", par, raw, diag_series(raw), freq, fit, "gm2")
+  expect_true(beside$support)
+  expect_match(beside$text, "beside the other GMs' Tc 3.0")
+  # the ACF read beside reads the slow one's Tc, within a factor 2
+  read <- as.numeric(sub(".*: Tc = ([0-9.]+) s.*", "\\1", beside$text))
+  expect_gt(read, tc[2] / 2)
+  expect_lt(read, tc[2] * 2)
+
+  # a slow GM the series does not hold (a walk there instead) is not
+  # confirmed beside the fast one
+  set.seed(4)
+  y <- gen_white(n, freq, 0.003 / sqrt(freq)) + gen_gm(n, freq, 0.006, 3) + gen_rrw(n, freq, 2e-4)
+  fy <- avfit(allan(y, freq), terms = c("N", "K", "gm", "gm"), start = c(gm1.tc = 3),
+              fixed = c(gm2.tc = 40))
+  raw_y <- refine_diagnostics(y, freq)
+  py <- as.list(instance_params(coef(fy), fy$layout, "gm2"))
+  expect_false(raw_evidence("gm", py, raw_y, diag_series(raw_y), freq, fy, "gm2")$support)
+  # with no other GM in the model the check is the one of the GM alone
+  f1 <- avfit(allan(x, freq), terms = c("N", "gm"), start = c(gm1.tc = 40), fixed = c(gm1.tc = 40))
+  p1 <- as.list(instance_params(coef(f1), f1$layout, "gm1"))
+  expect_identical(raw_evidence("gm", p1, raw, diag_series(raw), freq, f1, "gm1"),
+                   raw_evidence("gm", p1, raw, diag_series(raw), freq))
+})
