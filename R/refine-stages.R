@@ -770,8 +770,8 @@ step_reform <- function(st) {
 # screening finds nothing, the candidates are tried once more with all
 # nonlinear parameters free (slower, but catches effects that only pay
 # once the others may move). Traced candidates first; the others only when
-# none of those pays. (Without any residual signature, only the screening
-# pass is run.)
+# none of those pays. (Without any residual signature, the free pass
+# screens only a further instance of an entry the model holds: below.)
 step_screen <- function(st) {
   st <- screen_trials(st)
   # a revisit's seeds that do not pay leave the step to every trial
