@@ -43,7 +43,9 @@
 #' The rules of acceptance:
 #' * Candidates are compared by the criterion, not gated by a residual
 #'   threshold: with no residual signature left, every candidate is still
-#'   tried (screening pass only).
+#'   tried (the screening pass; everything free only for a further
+#'   Gauss-Markov process beside one the model holds, whose one-term
+#'   compromise held would keep a second from paying).
 #' * An effect the raw data contradict is never accepted, nor an instance
 #'   the catalogue declares not valid on this curve (a Gauss-Markov process
 #'   with \eqn{T_c} below 2 samples is the sensor's filter; a sinusoid outside
