@@ -91,7 +91,7 @@ evidence_gm <- function(par, raw, x, freq) {
     }
     return(list(text = text, support = ok))
   }
-  if (!is.finite(tc) || tc * freq * 40 / 8 > length(x)) {
+  if (!gm_acf_checkable(tc, freq, length(x))) {
     return(list(text = "record too short for an ACF check", support = NA))
   }
   # avrefine()'s per-call store (NULL elsewhere)
@@ -133,7 +133,7 @@ evidence_gm_beside <- function(ev, fit, label, raw, freq) {
   tc <- par[["tc"]]
   x <- diag_series(raw)
   if (!length(others) || is.null(x) || !is.finite(tc) || tc * freq < 4 ||
-      tc * freq * 40 / 8 > length(x)) {
+      !gm_acf_checkable(tc, freq, length(x))) {
     return(ev)
   }
   beside <- unname(cf[others])
@@ -146,11 +146,15 @@ evidence_gm_beside <- function(ev, fit, label, raw, freq) {
         a$tc > tc / 2 && a$tc < tc * 2)) {
     return(ev)
   }
-  list(text = sprintf("exponential ACF of %s-sample means beside the other GMs' Tc %s s: Tc = %s s (z = %.1f); alone, %s",
+  list(text = sprintf(paste("exponential ACF of %s-sample means beside the other GMs' Tc %s s:",
+                            "Tc = %s s (z = %.1f); alone, %s"),
                       a$m, paste(format_num(beside), collapse = ", "), format_num(a$tc), a$z,
                       ev$text),
        support = TRUE)
 }
+
+# Enough block means (40 of Tc / 8 samples each) for the ACF check.
+gm_acf_checkable <- function(tc, freq, n) is.finite(tc) && tc * freq * 40 / 8 <= n
 
 effect_gauss_markov <- function() {
   new_effect(
