@@ -77,8 +77,12 @@ acf_exponential <- function(x, freq, tc, cache = NULL, beside = numeric()) {
   }
   hit
 }
+# The block size (samples) the ACF of a GM of `tc` is read at, and the
+# most lags read: the exponential spans a few lags of 8 blocks per Tc.
+acf_block_size <- function(tc, freq) max(1L, floor(tc * freq / 8))
+acf_max_lag <- 48L
 acf_exponential_now <- function(x, freq, tc, cache, beside = numeric()) {
-  m <- max(1L, floor(tc * freq / 8))
+  m <- acf_block_size(tc, freq)
   key <- paste0("acf_exponential.", m)
   hit <- if (!is.null(cache)) cache[[key]]
   if (is.null(hit)) {
@@ -87,7 +91,7 @@ acf_exponential_now <- function(x, freq, tc, cache, beside = numeric()) {
     r <- NULL
     if (nb >= 40L) {
       b <- detrend_linear(b)
-      r <- acf_lags(b, min(nb - 2L, 48L))[-1L]
+      r <- acf_lags(b, min(nb - 2L, acf_max_lag))[-1L]
     }
     hit <- list(nb = nb, r = r)
     if (!is.null(cache)) cache[[key]] <- hit

@@ -138,8 +138,7 @@ evidence_gm_beside <- function(ev, fit, label, raw, freq) {
   }
   beside <- unname(cf[others])
   # the others that fall within the ACF's lags (longer ones are the line's)
-  m <- max(1L, floor(tc * freq / 8))
-  beside <- beside[is.finite(beside) & beside < 48 * m / freq]
+  beside <- beside[is.finite(beside) & beside < acf_max_lag * acf_block_size(tc, freq) / freq]
   if (!length(beside)) return(ev)
   a <- acf_exponential(x, freq, tc, cache = diag_cache(raw), beside = beside)
   if (!(is.finite(a$tc) && a$z > 5 && isTRUE(a$shape >= 0.5) &&

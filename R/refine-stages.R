@@ -798,15 +798,17 @@ screen_trials <- function(st) {
   # pinned). Beside the first held at its one-term compromise, a second
   # GM of another time constant does not pay, and the terms the first
   # shares the curve with (B, K) leave no signature to trace it by.
-  again <- vapply(trials$effect, function(k) {
-    e <- effect_entry(split_term(k)$kind)
-    isTRUE(e$repeatable) && is.null(e$propose) && e$name %in% split_term(cur$terms)$kind
-  }, NA)
+  only_again <- length(nl_now) && !nrow(st$sig)
+  if (only_again) {
+    again <- vapply(trials$effect, function(k) {
+      e <- effect_entry(split_term(k)$kind)
+      isTRUE(e$repeatable) && is.null(e$propose) && e$name %in% split_term(cur$terms)$kind
+    }, NA)
+  }
   for (h in holds) {
     st$hold <- h
-    free_only_again <- !length(h) && length(nl_now) && !nrow(st$sig)
     for (tier in list(which(trials$traced), which(!trials$traced))) {
-      if (free_only_again) tier <- tier[again[tier]]
+      if (only_again && !length(h)) tier <- tier[again[tier]]
       for (i in tier) {
         r <- screen_trial(st, trials[i, ], nl_now)
         st <- r$st

@@ -87,7 +87,7 @@ plot_periodogram <- function(psd, mark = numeric(), band = NULL, unit = "u",
 # ACF of block means of a raw axis beside the exponential a process with
 # correlation time `tc` gives (exp(-lag m / (freq tc))).
 plot_block_acf <- function(x, freq, tc, main = "ACF of block means") {
-  m <- max(1L, floor(tc * freq / 8))
+  m <- acf_block_size(tc, freq)
   b <- block_means(x, m)
   if (length(b) < 40L) {
     graphics::plot.new()
@@ -95,7 +95,7 @@ plot_block_acf <- function(x, freq, tc, main = "ACF of block means") {
     graphics::text(0.5, 0.5, "too few blocks for an ACF")
     return(invisible())
   }
-  r <- acf_lags(detrend_linear(b), min(length(b) - 2L, 48L))[-1L]
+  r <- acf_lags(detrend_linear(b), min(length(b) - 2L, acf_max_lag))[-1L]
   lag <- seq_along(r) * m / freq
   graphics::plot(lag, r, type = "h", lwd = 2, col = "grey35",
                  ylim = range(c(r, 0, 1)), xlab = "lag [s]", ylab = "ACF",

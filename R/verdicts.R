@@ -339,6 +339,13 @@ mark_model_choice <- function(rd, alternatives, curve, ok, rel, tau_min, sensor)
       reading_row(e, lay, a$coef, NULL, curve, ok, rel, tau_min, sensor)$value
     }, 0)
     what <- effect_entry(split_term(a$effect)$kind)$title
+    gained <- if (a$gain < a$min_gain) {
+      sprintf("the curve gains only %s with it, under min_gain %s", format_num(a$gain),
+              format_num(a$min_gain))
+    } else {
+      sprintf("the steps ended below min_gain %s, though the final model gains %s with it",
+              format_num(a$min_gain), format_num(a$gain))
+    }
     for (i in seq_len(nrow(rd))) {
       v <- rd$value[i]
       w <- alt[i]
@@ -346,13 +353,6 @@ mark_model_choice <- function(rd, alternatives, curve, ok, rel, tau_min, sensor)
           !is.finite(w) || v <= 0) next
       change <- w / v - 1
       if (abs(change) < bias_bound) next
-      gained <- if (a$gain < a$min_gain) {
-        sprintf("the curve gains only %s with it, under min_gain %s", format_num(a$gain),
-                format_num(a$min_gain))
-      } else {
-        sprintf("the steps ended below min_gain %s, though the final model gains %s with it",
-                format_num(a$min_gain), format_num(a$gain))
-      }
       note <- sprintf(paste("a %s (%s) that the raw data confirm (%s) is not in the model:",
                             "%s; with it %s reads %s (%+.0f%%)"),
                       what, a$params, a$evidence, gained, rd$term[i], format_num(w),
