@@ -2,7 +2,8 @@
 # squared amplitudes come from a non-negative Gauss-Newton solve (C++,
 # src/avfit.cpp); the nonlinear parameters (catalogue `nl_range`) are
 # profiled on log grids, refined by one-dimensional optimisation and, with
-# several, jointly by Nelder-Mead. Every knob is in avfit_control().
+# several, jointly by Levenberg-Marquardt (R/fit-polish.R; Nelder-Mead
+# where it does not converge). Every knob is in avfit_control().
 
 #' Settings of the noise-model search
 #'
@@ -38,7 +39,7 @@
 #'   when refining.
 #' @param tol Tolerance of the one-dimensional refinement (log units).
 #' @param maxit Maximum Nelder-Mead iterations.
-#' @param reltol Relative convergence tolerance of Nelder-Mead.
+#' @param reltol Relative convergence tolerance of the joint refinement.
 #' @param cycles Passes over the nonlinear parameters.
 #' @param max_orders Greedy entry orders tried.
 #' @param inner_maxit Maximum Gauss-Newton steps of the amplitude solve.
@@ -60,6 +61,10 @@
 #'   reading's verdict checks the final model against the curve over the
 #'   taus it rests on (see [analyze_imu()]), and [avrefine()] names what
 #'   stays unexplained. [avrefine()] judges its candidates without it.
+#' @param polish The joint refinement of several nonlinear parameters:
+#'   `"lm"` (default; Levenberg-Marquardt, Nelder-Mead only where it does
+#'   not converge) or `"nelder-mead"`.
+#' @param polish_maxit Maximum Levenberg-Marquardt steps.
 #' @return An object of class `"avfit_control"`: a list of the settings.
 #' @seealso [avfit()]
 #' @export
@@ -73,7 +78,8 @@ avfit_control <- function(grid_smooth = 40L, grid_oscillatory = 120L,
                           grid_start = 13L, start_span = 4, local_span = 1.5,
                           tol = 1e-7, maxit = 400L, reltol = 1e-10,
                           cycles = 2L, max_orders = 6L, inner_maxit = 100L,
-                          inner_tol = 1e-12, edf_passes = 2L, model_error = FALSE) {
+                          inner_tol = 1e-12, edf_passes = 2L, model_error = FALSE,
+                          polish = "lm", polish_maxit = 50L) {
   out <- list(
     grid_smooth = check_number(grid_smooth, "grid_smooth", 3, 1e5, integer = TRUE),
     grid_oscillatory = check_number(grid_oscillatory, "grid_oscillatory", 3, 1e5,
@@ -89,7 +95,9 @@ avfit_control <- function(grid_smooth = 40L, grid_oscillatory = 120L,
     inner_maxit = check_number(inner_maxit, "inner_maxit", 1, 1e7, integer = TRUE),
     inner_tol = check_number(inner_tol, "inner_tol", 0, 1, open = TRUE),
     edf_passes = check_number(edf_passes, "edf_passes", 1, 10, integer = TRUE),
-    model_error = check_flag(model_error, "model_error"))
+    model_error = check_flag(model_error, "model_error"),
+    polish = check_choice(polish, c("lm", "nelder-mead"), "polish"),
+    polish_maxit = check_number(polish_maxit, "polish_maxit", 1, 1e5, integer = TRUE))
   structure(out, class = "avfit_control")
 }
 
@@ -350,31 +358,45 @@ fit_search <- function(pr, start, prev, control) {
       }
       nm <- NULL
       if (length(nlrows) > 1L) {
+        v0 <- obj(lognl)
+        count <- 0L
+        nm_count <- 0L
+        conv <- 1L
+        if (control$polish == "lm") {
+          pol <- polish_lm(pr, lognl, lb, ub, control)
+          evals <<- evals + pol$evals
+          count <- pol$evals
+          if (pol$value <= v0) {
+            lognl <- pol$lognl
+            v0 <- pol$value
+          }
+          if (pol$converged) conv <- 0L
+        }
         # Nelder-Mead restarted from its own result (a fresh simplex) until
         # it stops on its tolerance or a restart no longer improves: a
         # simplex that collapsed along a curved valley otherwise spends
         # maxit crawling. A restart that gains less than reltol (relative)
         # means the search sits at the optimum.
-        v0 <- obj(lognl)
-        count <- 0L
-        conv <- 1L
-        for (restart in seq_len(4L)) {
-          o <- stats::optim(lognl, obj, method = "Nelder-Mead",
-                            control = list(reltol = control$reltol,
-                                           maxit = control$maxit))
-          count <- count + o$counts[["function"]]
-          gain <- v0 - o$value
-          if (o$value <= v0) lognl <- o$par
-          # (a restart too short to move the simplex proves nothing)
-          if (o$convergence == 0L ||
-              (restart > 1L && o$counts[["function"]] >= 20L * length(lognl) &&
-               gain <= control$reltol * (abs(v0) + control$reltol))) {
-            conv <- 0L
-            break
+        if (conv != 0L) {
+          for (restart in seq_len(4L)) {
+            o <- stats::optim(lognl, obj, method = "Nelder-Mead",
+                              control = list(reltol = control$reltol,
+                                             maxit = control$maxit))
+            count <- count + o$counts[["function"]]
+            nm_count <- nm_count + o$counts[["function"]]
+            gain <- v0 - o$value
+            if (o$value <= v0) lognl <- o$par
+            # (a restart too short to move the simplex proves nothing)
+            if (o$convergence == 0L ||
+                (restart > 1L && o$counts[["function"]] >= 20L * length(lognl) &&
+                 gain <= control$reltol * (abs(v0) + control$reltol))) {
+              conv <- 0L
+              break
+            }
+            v0 <- min(v0, o$value)
           }
-          v0 <- min(v0, o$value)
         }
-        nm <- list(convergence = conv, count = count)
+        nm <- list(convergence = conv, count = count, nm_count = nm_count)
       }
       list(lognl = lognl, value = obj(lognl), nm = nm)
     }
@@ -409,7 +431,7 @@ fit_search <- function(pr, start, prev, control) {
 }
 
 # What the search says about its own convergence: the final amplitude solve
-# and, with several nonlinear parameters, Nelder-Mead.
+# and, with several nonlinear parameters, the joint refinement.
 search_convergence <- function(sol, nm, evals, control) {
   msg <- character()
   if (!isTRUE(sol$converged)) {
@@ -419,8 +441,11 @@ search_convergence <- function(sol, nm, evals, control) {
   }
   if (!is.null(nm) && nm$convergence != 0L) {
     msg <- c(msg, sprintf(
-      "Nelder-Mead stopped after %d evaluations (maxit = %d) before converging",
-      nm$count, control$maxit))
+      "%sNelder-Mead stopped after %d evaluations (maxit = %d) before converging",
+      if (control$polish == "lm") sprintf(
+        "Levenberg-Marquardt did not converge in %d steps (polish_maxit) and ",
+        control$polish_maxit) else "",
+      nm$nm_count, control$maxit))
   }
   list(converged = !length(msg),
        iterations = if (is.null(nm)) as.integer(sol$iterations) else as.integer(nm$count),
