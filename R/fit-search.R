@@ -21,10 +21,17 @@
 #' `nl_bounds`: what the curve and the record can see, e.g. a filter
 #' between the sampling interval and the longest tau, a frequency below
 #' Nyquist); a start value outside them starts at the nearest bound. Terms
-#' enter greedily; with several nonlinear parameters, `cycles` passes refine
-#' each within a factor `local_span` of its value, and Nelder-Mead
-#' ([stats::optim()], `maxit` iterations, relative tolerance `reltol`)
-#' refines them jointly. The greedy order matters, so up to `max_orders`
+#' enter greedily (the first of `cycles` passes); with several nonlinear
+#' parameters, each further pass refines each within a factor `local_span`
+#' of its value, and a joint refinement follows (`polish`):
+#' Levenberg-Marquardt on the profiled problem (at most `polish_maxit`
+#' steps, each one amplitude solve and one finite difference of the basis
+#' per parameter; it stops when a step gains less than `reltol` relatively
+#' or none lowers the objective), then, only if it did not stop so,
+#' Nelder-Mead ([stats::optim()], `maxit` iterations, relative tolerance
+#' `reltol`) from where it left off. `polish = "nelder-mead"` (with
+#' `cycles = 2`, the search before this version) skips the first. The
+#' greedy order matters, so up to `max_orders`
 #' orders (rotations and their reverses) are tried. For each set of
 #' nonlinear values the squared amplitudes are found by at most
 #' `inner_maxit` Gauss-Newton steps, stopping when the objective falls by
@@ -40,7 +47,8 @@
 #' @param tol Tolerance of the one-dimensional refinement (log units).
 #' @param maxit Maximum Nelder-Mead iterations.
 #' @param reltol Relative convergence tolerance of the joint refinement.
-#' @param cycles Passes over the nonlinear parameters.
+#' @param cycles Passes over the nonlinear parameters (the first enters
+#'   them greedily).
 #' @param max_orders Greedy entry orders tried.
 #' @param inner_maxit Maximum Gauss-Newton steps of the amplitude solve.
 #' @param inner_tol Relative tolerance of the amplitude solve.
@@ -77,7 +85,7 @@
 avfit_control <- function(grid_smooth = 40L, grid_oscillatory = 120L,
                           grid_start = 13L, start_span = 4, local_span = 1.5,
                           tol = 1e-7, maxit = 400L, reltol = 1e-10,
-                          cycles = 2L, max_orders = 6L, inner_maxit = 100L,
+                          cycles = 1L, max_orders = 6L, inner_maxit = 100L,
                           inner_tol = 1e-12, edf_passes = 2L, model_error = FALSE,
                           polish = "lm", polish_maxit = 50L) {
   out <- list(
@@ -123,6 +131,11 @@ check_control <- function(control) {
   if (!inherits(control, "avfit_control")) {
     abort("`control` must be avfit_control() or a list of its arguments, not ",
           describe_type(control), ".", class = "argument")
+  }
+  # a fit saved by an earlier version lacks the knobs added since: their
+  # defaults
+  if (!all(names(formals(avfit_control)) %in% names(control))) {
+    control <- do.call(avfit_control, unclass(control))
   }
   control
 }

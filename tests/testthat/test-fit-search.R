@@ -19,6 +19,14 @@ test_that("avfit_control() holds every knob, with the documented defaults", {
                n = nn, freq = f, bias_correct = FALSE,
                control = list(grid_smooth = 20))
   expect_identical(fit$control$grid_smooth, 20L)
+  # a control saved by an earlier version (without the knobs added since)
+  # takes their defaults
+  old <- structure(unclass(avfit_control())[c("grid_smooth", "maxit", "reltol", "cycles")],
+                   class = "avfit_control")
+  fit_old <- avfit(exact(c(N = 0.01, gm1.sigma = 0.01, gm1.tc = 3)), c("N", "gm"),
+                   n = nn, freq = f, bias_correct = FALSE, control = old)
+  expect_identical(fit_old$control$polish, "lm")
+  expect_identical(fit_old$control$grid_start, 13L)
   expect_equal(unname(coef(fit)["gm1.tc"]), 3, tolerance = 1e-4)
   expect_snapshot(error = TRUE, {
     avfit_control(grid_smooth = 2)
@@ -104,7 +112,7 @@ test_that("Levenberg-Marquardt reaches Nelder-Mead's optimum with a fraction of 
     tab <- exact(cs$coef)
     lm <- avfit(tab, cs$terms, n = nn, freq = f, bias_correct = FALSE)
     nm <- avfit(tab, cs$terms, n = nn, freq = f, bias_correct = FALSE,
-                control = avfit_control(polish = "nelder-mead"))
+                control = avfit_control(polish = "nelder-mead", cycles = 2))
     expect_true(lm$convergence$converged)
     expect_lte(lm$objective, nm$objective + 1e-8)
     # (the labels may come in another order)
@@ -122,7 +130,7 @@ test_that("Levenberg-Marquardt reaches Nelder-Mead's optimum with a fraction of 
   av <- allan(x, f)
   lm <- avfit(av, c("N", "resonance"), start = c(resonance1.fr = 1.2))
   nm <- avfit(av, c("N", "resonance"), start = c(resonance1.fr = 1.2),
-              control = avfit_control(polish = "nelder-mead"))
+              control = avfit_control(polish = "nelder-mead", cycles = 2))
   expect_true(lm$convergence$converged)
   expect_lte(lm$objective, nm$objective + 1e-6)
   expect_equal(coef(lm)[["resonance1.fr"]], coef(nm)[["resonance1.fr"]], tolerance = 1e-3)
