@@ -44,7 +44,8 @@
 #' problem (C++); the nonlinear parameters are profiled on a log grid
 #' (`tc` over \eqn{[\tau_{min}/4, 4\tau_{max}]}, `f0` from
 #' \eqn{0.2/\tau_{max}} to the Nyquist frequency), refined by
-#' one-dimensional optimisation and, with several, jointly by Nelder-Mead.
+#' one-dimensional optimisation and, with several, jointly by
+#' Levenberg-Marquardt (see [avfit_control()]).
 #'
 #' @section EDF:
 #' When the input has no `edf` column it is computed from `n`, the cluster
@@ -128,7 +129,7 @@
 #'   `edf_source`, `steps` (zero-row data frame with the columns of
 #'   [avrefine()]'s steps),
 #'   `input` (the full curve before `tau_range`, an [as_av_curve()] object),
-#'   `convergence` (list `converged`, `iterations` (Nelder-Mead evaluations
+#'   `convergence` (list `converged`, `iterations` (the joint refinement's evaluations
 #'   with several nonlinear parameters, else Gauss-Newton steps of the last
 #'   amplitude solve), `evaluations` (objective evaluations of the search)
 #'   and `message`), `control` and `call`.

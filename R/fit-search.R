@@ -273,11 +273,12 @@ fit_search <- function(pr, start, prev, control) {
   evals <- 0L
   # Every nonlinear parameter stays within its entry's hard bounds (what
   # the curve and the record can see): outside them the objective is
-  # infinite, so neither a start, a grid nor Nelder-Mead can leave them.
+  # infinite, so neither a start, a grid nor Nelder-Mead can leave them
+  # (polish_lm() clamps its steps to them).
   lb <- ub <- numeric(length(nlrows))
   # The grids' columns go to the call's store (the same candidate's grid
-  # comes back at the next step); the values optimize() and Nelder-Mead
-  # visit are met by no other search, so they are not stored.
+  # comes back at the next step); the values optimize() and the joint
+  # refinement visit are met by no other search, so they are not stored.
   store <- NULL
   obj <- function(lognl, off = NULL) {
     if (any(lognl < lb | lognl > ub)) return(Inf)
