@@ -40,8 +40,8 @@ polish_lm <- function(pr, lognl, lb, ub, control) {
     values[nl_names] <- v
     m <- model_av_at(pr, values, s$c)
     if (!all(m$av > 0)) return(NULL)
-    free <- which(!pr$amp$fixed)
-    on <- free[s$c[pr$amp$name[free]] > 0]
+    free_amp <- which(!pr$amp$fixed)
+    on <- free_amp[s$c[pr$amp$name[free_amp]] > 0]
     list(S = s$objective, c = s$c, values = values, lav = log(m$av),
          r = drop(wmul(pr$W, pr$y - log(m$av))),
          Jc = if (length(on)) wmul(pr$W, m$B[, pr$amp$col[on], drop = FALSE] / m$av))
@@ -65,13 +65,13 @@ polish_lm <- function(pr, lognl, lb, ub, control) {
     dA <- pmax(diag(A), 1e-12 * max(diag(A), .Machine$double.xmin))
     moved <- FALSE
     repeat {
-      free <- !((lognl >= ub & g < 0) | (lognl <= lb & g > 0))
-      if (!any(free) || lambda > 1e12) break
-      Mf <- (A + lambda * diag(dA, K))[free, free, drop = FALSE]
-      df <- tryCatch(-solve(Mf, g[free]), error = function(e) NULL)
+      movable <- !((lognl >= ub & g < 0) | (lognl <= lb & g > 0))
+      if (!any(movable) || lambda > 1e12) break
+      Mf <- (A + lambda * diag(dA, K))[movable, movable, drop = FALSE]
+      df <- tryCatch(-solve(Mf, g[movable]), error = function(e) NULL)
       if (!is.null(df) && all(is.finite(df))) {
         new <- lognl
-        new[free] <- pmin(pmax(lognl[free] + df, lb[free]), ub[free])
+        new[movable] <- pmin(pmax(lognl[movable] + df, lb[movable]), ub[movable])
         nw <- if (any(new != lognl)) at(new)
         if (!is.null(nw) && nw$S < cur$S) {
           gain <- cur$S - nw$S
