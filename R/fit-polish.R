@@ -11,8 +11,7 @@
 model_av_at <- function(pr, values, c) {
   Bm <- solve_basis(pr, values, NULL)
   amp <- pr$amp
-  av <- pr$zero
-  for (i in amp$fixed_idx) av <- av + amp$value[i]^2 * Bm[, amp$col[i]]
+  av <- fixed_av(pr, Bm)
   free <- which(!amp$fixed)
   if (length(free)) av <- av + drop(Bm[, amp$col[free], drop = FALSE] %*% c[amp$name[free]])
   list(av = av, B = Bm)

@@ -209,6 +209,15 @@ solve_basis <- function(pr, values, store = pr$store) {
   Bm
 }
 
+# The Allan variance of the fixed amplitudes' terms in basis `Bm`: a
+# solve's offset.
+fixed_av <- function(pr, Bm) {
+  amp <- pr$amp
+  av <- pr$zero
+  for (i in amp$fixed_idx) av <- av + amp$value[i]^2 * Bm[, amp$col[i]]
+  av
+}
+
 # Solve for the squared amplitudes at nonlinear values `nlv` (named by
 # coefficient). `off`: instance labels left out (amplitude 0) for this
 # solve. Returns c (named by free amplitude coefficient), objective,
@@ -232,8 +241,7 @@ solve_amps <- function(pr, nlv, control, off = NULL, layout = TRUE, store = pr$s
     if (is.null(off)) assign("\001free", fs, envir = pr$memo)
   }
   free <- fs$free
-  offset <- pr$zero
-  for (i in amp$fixed_idx) offset <- offset + amp$value[i]^2 * Bm[, amp$col[i]]
+  offset <- fixed_av(pr, Bm)
   cc <- amp$cc0
   lay <- NULL
   if (layout) {
