@@ -151,18 +151,18 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
       }
       ch <- channels
     }
+    rec_jobs <- lapply(ch, function(chn) list(
+      record = i, name = r$name, channel = chn, sensor = r$sensors[[chn]],
+      unit = r$si_units[[chn]], x = r$data[, chn], freq = r$freq))
     # Every axis dead: nothing to analyse. One dead axis among live ones is
     # reported by analyze_channel() and the others are analysed.
-    dead <- ch[vapply(ch, function(c) isTRUE(all(r$data[, c] == r$data[1L, c])), NA)]
-    if (length(dead) && length(dead) == length(ch)) {
+    # (max == min: one pass over the column, nothing allocated)
+    dead <- vapply(rec_jobs, function(j) isTRUE(max(j$x) == min(j$x)), NA)
+    if (length(dead) && all(dead)) {
       abort("`x`: every channel of ", r$name, " is constant (dead or ",
             "saturated axes); there is no noise to analyse.", class = "argument")
     }
-    for (chn in ch) {
-      jobs[[length(jobs) + 1L]] <- list(
-        record = i, name = r$name, channel = chn, sensor = r$sensors[[chn]],
-        unit = r$si_units[[chn]], x = r$data[, chn], freq = r$freq)
-    }
+    jobs <- c(jobs, rec_jobs)
   }
   n_jobs <- length(jobs)
   for (k in seq_along(jobs)) jobs[[k]]$label <- sprintf("[%d/%d] %s: %s", k,
@@ -190,25 +190,15 @@ analyze_imu <- function(x, taus = "octave", type = "overlapping",
     # Two levels of threads would oversubscribe the cores: the workers
     # run their kernels on one thread each.
     opts$threads <- 1L
-    old_plan <- if (future::supportsMulticore()) {
-      future::plan(future::multicore, workers = w)
-    } else {
-      future::plan(future::multisession, workers = w)
-    }
-    on.exit(future::plan(old_plan), add = TRUE)
+    restore_plan <- axis_plan(w)
+    on.exit(restore_plan(), add = TRUE)
   }
   run <- function() {
     p <- progressr::progressor(steps = n_jobs)
-    # an axis's error comes back as a value, so that every axis's future
-    # is collected (none cancelled half-way, no worker left behind) before
-    # the first error is signalled again, as it was raised
-    future.apply::future_lapply(jobs, function(job, opts) {
-      res <- tryCatch(analyze_channel(job, opts),
-                      error = function(e) structure(list(condition = e),
-                                                    class = "axis_failure"))
-      p(job$label)
-      res
-    }, opts = opts, future.seed = TRUE, future.scheduling = Inf)
+    # run_axis() lives in the namespace: a closure made here would carry
+    # this frame (every axis's data) to each worker that is not a fork
+    future.apply::future_lapply(jobs, run_axis, opts = opts, p = p,
+                                future.seed = TRUE, future.scheduling = Inf)
   }
   results <- if (bar) {
     progressr::with_progress(run(), handlers = progress_handlers())
@@ -275,6 +265,43 @@ axis_workers <- function(workers, n_jobs, n) {
     return(1L)
   }
   as.integer(max(1L, min(allanvar_threads(), n_jobs, future::availableCores())))
+}
+
+# Sets the plan for `w` axis workers and returns the function that puts
+# the caller's plan back. Where the platform can fork, the workers are a
+# fork cluster started once: future's multicore forks a fresh process per
+# axis, and each fresh fork pays again for copying the parent's memory
+# pages as R's collector and allocator first write them (on a 6-axis
+# ADIS16405 record, about 1.5 s of CPU per axis: the two workers were no
+# faster than one process). Elsewhere (or if the local sockets cannot be
+# opened), multicore or multisession.
+axis_plan <- function(w) {
+  cl <- if (future::supportsMulticore()) {
+    tryCatch(parallel::makeForkCluster(w), error = function(e) NULL)
+  }
+  old <- if (!is.null(cl)) {
+    future::plan(future::cluster, workers = cl)
+  } else if (future::supportsMulticore()) {
+    future::plan(future::multicore, workers = w)
+  } else {
+    future::plan(future::multisession, workers = w)
+  }
+  function() {
+    future::plan(old)
+    if (!is.null(cl)) parallel::stopCluster(cl)
+  }
+}
+
+# One axis on a future worker, with its progress step. An axis's error
+# comes back as a value, so that every axis's future is collected (none
+# cancelled half-way, no worker left behind) before the first error is
+# signalled again, as it was raised.
+run_axis <- function(job, opts, p) {
+  res <- tryCatch(analyze_channel(job, opts),
+                  error = function(e) structure(list(condition = e),
+                                                class = "axis_failure"))
+  p(job$label)
+  res
 }
 
 # The work for one axis; runs on a future worker, so it only uses its

@@ -698,6 +698,7 @@ record_segment <- function(x, segment = "longest") {
     abort("`segment` must be \"longest\", \"each\" or a segment number in 1..",
           nrow(seg), ".")
   }
+  if (seg$start[i] == 1L && seg$end[i] == nrow(x$data)) return(x$data)
   x$data[seg$start[i]:seg$end[i], , drop = FALSE]
 }
 

@@ -6,8 +6,9 @@
 #   the first fit as analyze_imu() makes them, then the loop timed alone:
 #   avrefine(fit, data = x, series = <the series pass>) (CPU and elapsed);
 # - per unit: analyze_imu() of the 6-axis record with its defaults (elapsed
-#   and CPU, the forked workers' included), again with workers = 1
-#   (elapsed), the reading (readRDS + imu_record()) timed apart.
+#   and CPU, the forked workers' included once they are reaped), again
+#   with workers = 1 (elapsed), the reading (readRDS + imu_record()) timed
+#   apart.
 # Builds alternate unit by unit so that the machine's load moves them
 # alike. Prints a per-axis table and the summary; CPU is the figure to
 # compare (elapsed follows the shared machine's load); the machine's own
@@ -34,6 +35,11 @@ if (length(args) >= 2L && args[1L] == "--worker") {
   t0 <- proc.time()
   a <- suppressWarnings(suppressMessages(analyze_imu(rec, progress = FALSE)))
   t_an <- proc.time() - t0
+  # the workers' CPU counts once they are reaped, shortly after the call
+  # returns (a fork cluster's workers exit after stopCluster()): CPU is
+  # read after a pause, elapsed at once
+  Sys.sleep(1)
+  cpu_an <- cpu(proc.time() - t0)
   t_seq <- if ("workers" %in% names(formals(analyze_imu))) {
     t0 <- proc.time()
     a1 <- suppressWarnings(suppressMessages(analyze_imu(rec, progress = FALSE, workers = 1)))
@@ -56,7 +62,7 @@ if (length(args) >= 2L && args[1L] == "--worker") {
   saveRDS(list(axes = do.call(rbind, rows),
                unit = data.frame(unit = unit, read_elapsed = t_read[["elapsed"]],
                                  analyze_elapsed = t_an[["elapsed"]],
-                                 analyze_cpu = cpu(t_an),
+                                 analyze_cpu = cpu_an,
                                  sequential_elapsed = t_seq[["elapsed"]])), out)
   quit(save = "no")
 }

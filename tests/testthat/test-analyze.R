@@ -48,6 +48,13 @@ test_that("forked workers give the run one after another; `workers` is checked",
   # the caller's plan is back, and the caller's thread option untouched
   expect_true(inherits(future::plan(), "sequential"))
   expect_identical(getOption("allanvar.threads"), threads)
+  # the workers are one fork cluster started once (multicore would fork a
+  # fresh process per axis), and the caller's plan comes back after it
+  restore <- axis_plan(2L)
+  expect_s3_class(future::plan(), "cluster")
+  expect_identical(future::nbrOfWorkers(), 2L)
+  restore()
+  expect_true(inherits(future::plan(), "sequential"))
   # by default: forks only under the sequential plan, for a large record
   expect_identical(axis_workers(NULL, 6L, 6e6),
                    min(allanvar_threads(), as.integer(future::availableCores())))
