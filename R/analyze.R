@@ -16,9 +16,10 @@
 #' how they are run. They run on whatever [future::plan()] is set
 #' (`multisession`, a cluster, ...). Under the sequential plan (future's
 #' default) a record large enough to pay for it (at least 2 axes and
-#' 200,000 samples in all) runs its axes in `workers` forked processes
-#' (future's `multicore`, where the platform can fork: not on Windows, not
-#' in RStudio), each kernel then on one thread.
+#' 200,000 samples in all) runs its axes in `workers` forked processes,
+#' started once for the call (a fork cluster, where the platform can fork:
+#' not on Windows, not in RStudio; elsewhere background R sessions), each
+#' kernel then on one thread.
 #'
 #' Readings (typed columns `source`, `is_bound`, `folded`; the `method`
 #' column says the same in words): N is

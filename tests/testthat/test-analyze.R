@@ -140,16 +140,20 @@ test_that("analyze_imu reports one progressr step per axis, also from future wor
                   freq = 100)
   old_opt <- options(progressr.enable = TRUE)   # progressr is off when not interactive
   on.exit(options(old_opt), add = TRUE)
-  got <- function() {
+  got <- function(...) {
     steps <- character()
     withCallingHandlers(
       progressr::with_progress(
-        suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE)),
+        suppressWarnings(analyze_imu(r, refine = FALSE, progress = FALSE, ...)),
         handlers = progressr::handler_void()),
       progression = function(p) if (identical(p$type, "update")) steps <<- c(steps, p$message))
     steps
   }
   expect_setequal(got(), c("[1/2] in memory: gyro_x", "[2/2] in memory: accel_x"))
+  if (future::supportsMulticore()) {
+    # from the fork cluster's workers
+    expect_setequal(got(workers = 2), c("[1/2] in memory: gyro_x", "[2/2] in memory: accel_x"))
+  }
   skip_if_not_installed("future")
   skip_if_not(installed_allanvar(), "workers need the installed package")
   skip_on_cran()
