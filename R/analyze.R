@@ -281,7 +281,9 @@ axis_plan <- function(w) {
     tryCatch(parallel::makeForkCluster(w), error = function(e) NULL)
   }
   old <- if (!is.null(cl)) {
-    future::plan(future::cluster, workers = cl)
+    # (no trial future at set-up: 0.3-0.4 s a call; the axes' futures
+    # meet any fault of the workers themselves)
+    future::plan(future::cluster, workers = cl, .init = FALSE)
   } else if (future::supportsMulticore()) {
     future::plan(future::multicore, workers = w)
   } else {
