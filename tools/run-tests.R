@@ -1,5 +1,10 @@
 # Runs tests/testthat against the installed package and ends with the plain
 # closing line "N passed, N failed, N skipped"; exits 1 on any failure.
+# Tests start R processes through callr (processx) and fork workers
+# (parallel). processx's SIGCHLD handler replaces parallel's unless told to
+# call it: the forked workers then go unreaped, and R waited 10 s at exit
+# and said "unable to terminate some child processes".
+Sys.setenv(PROCESSX_NOTIFY_OLD_SIGCHLD = "true")
 suppressPackageStartupMessages({
   library(testthat)
   library(allanvar)
