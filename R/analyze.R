@@ -19,7 +19,11 @@
 #' 200,000 samples in all) runs its axes in `workers` forked processes,
 #' started once for the call (a fork cluster, where the platform can fork:
 #' not on Windows, not in RStudio; elsewhere background R sessions), each
-#' kernel then on one thread.
+#' kernel then on one thread. In a session that also starts processes
+#' through 'processx' (as 'callr' does), set the environment variable
+#' `PROCESSX_NOTIFY_OLD_SIGCHLD=true` before it loads: otherwise its signal
+#' handler keeps the finished workers of any fork (this call's, or
+#' [parallel::mclapply()]'s) from being reaped, and R waits 10 s at exit.
 #'
 #' Readings (typed columns `source`, `is_bound`, `folded`; the `method`
 #' column says the same in words): N is
