@@ -22,7 +22,7 @@
 #' kernel then on one thread. In a session that also starts processes
 #' through 'processx' (as 'callr' does), set the environment variable
 #' `PROCESSX_NOTIFY_OLD_SIGCHLD=true` before it loads: otherwise its signal
-#' handler keeps the finished workers of any fork (this call's, or
+#' handler can keep the finished workers of a fork (this call's, or
 #' [parallel::mclapply()]'s) from being reaped, and R waits 10 s at exit.
 #'
 #' Readings (typed columns `source`, `is_bound`, `folded`; the `method`
