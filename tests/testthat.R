@@ -1,5 +1,5 @@
-# processx (callr) calls parallel's SIGCHLD handler too, so the forked
-# workers of analyze_imu() are reaped (tools/run-tests.R says why)
+# processx (the callr tests) otherwise replaces parallel's SIGCHLD handler:
+# analyze_imu()'s forked workers then go unreaped and R waits 10 s at exit
 Sys.setenv(PROCESSX_NOTIFY_OLD_SIGCHLD = "true")
 library(testthat)
 library(allanvar)
