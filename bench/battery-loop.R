@@ -20,7 +20,7 @@
 # before any run on them, once the sets before were in use ("d" also has
 # simulated axes that carry a sensor's own filter, line and resonance);
 # set "h" draws every class afresh from one seed (an out-of-sample check),
-# set "i" from another.
+# set "i" from another, sets "k" and "l" from two more.
 #
 # The recordings stay in the shared data directory (never shipped).
 suppressPackageStartupMessages(library(allanvar))
@@ -591,9 +591,10 @@ if (identical(set, "g")) {
 # sensor with a two-pole low-pass, a band and a line of its own, and on
 # two effects per measured axis. An out-of-sample check of what sets a-g
 # were fixed against. Set "i" draws the same classes from another seed
-# (session 33, written before any run on it).
-if (set %in% c("h", "i")) {
-  set.seed(c(h = 4300, i = 4500)[[set]])
+# (session 33, written before any run on it); sets "k" and "l" from two
+# more (session 40, likewise).
+if (set %in% c("h", "i", "k", "l")) {
+  set.seed(c(h = 4300, i = 4500, k = 5100, l = 5500)[[set]])
   lu <- function(lo, hi) round(exp(runif(1, log(lo), log(hi))), 1)
   ru <- function(lo, hi, d = 2) round(runif(1, lo, hi), d)
   h_white <- ru(0.005, 0.02, 4)
@@ -907,7 +908,7 @@ for (nm in grep(only, names(cases), value = TRUE)) {
   # (BATTERY_SEED_OFFSET=k shifts every case's seed: the same cases on
   # other noise, to see whether a change generalises)
   set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500, f = 3700, g = 3900, h = 4100,
-             i = 4700, j = 4900)[[set]] +
+             i = 4700, j = 4900, k = 5300, l = 5700)[[set]] +
              match(nm, names(cases)) + as.integer(Sys.getenv("BATTERY_SEED_OFFSET", "0")))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
