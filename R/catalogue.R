@@ -84,6 +84,11 @@
 #                 and `fit` does not hold yet (a square wave's sharp
 #                 harmonics), or NULL: a family's form is chosen on the
 #                 curve without it during the steps
+#   known_acov(raw, fit, h, tau0)  the same instances' autocovariance at
+#                 lags `h` (samples), or NULL: the short-lag shape checks
+#                 compare the raw series with the model and them (a line
+#                 near Nyquist not yet in the model swings the raw
+#                 autocovariance at every lag)
 #   replaces    kinds this entry takes the place of when the loop adds it
 #                 (the filter replaces N: its DC level is the white level)
 #   replaces_instance  NULL (every instance of those kinds goes), or
@@ -205,7 +210,8 @@ new_effect <- function(name, title, params, component = "av",
                        replaces_instance = NULL, admissible = NULL, proposed_only = FALSE,
                        statespace = NULL, diagnose = NULL, family = NULL,
                        exact_edf = NULL, noise_lookalike = FALSE,
-                       detect_again = FALSE, known_av = NULL, model_evidence = NULL) {
+                       detect_again = FALSE, known_av = NULL, known_acov = NULL,
+                       model_evidence = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -221,7 +227,7 @@ new_effect <- function(name, title, params, component = "av",
        proposed_only = proposed_only, statespace = statespace,
        diagnose = diagnose, family = family, exact_edf = exact_edf,
        noise_lookalike = noise_lookalike, detect_again = detect_again,
-       known_av = known_av, model_evidence = model_evidence)
+       known_av = known_av, known_acov = known_acov, model_evidence = model_evidence)
 }
 
 validate_effect <- function(e) {

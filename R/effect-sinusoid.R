@@ -90,22 +90,35 @@ hold_sinusoid <- function(par, raw) {
                       format_num(m$line$amp), format_num(m$amp)))
 }
 
-# The AV of the sharp lines (one frequency over the whole record: the
-# periodogram measures f0 and the record's least-squares sinusoid its
-# amplitude) that `fit` holds no sinusoid at (within 1% of f0), at `tau`;
-# NULL when there are none.
-known_av_sinusoid <- function(raw, fit, tau, tau0) {
+# The sharp lines (one frequency over the whole record: the periodogram
+# measures f0 and the record's least-squares sinusoid its amplitude) that
+# `fit` holds no sinusoid at (within 1% of f0); NULL when there are none.
+known_lines <- function(raw, fit) {
   lines <- diag_part(raw, "lines")
   if (is.null(lines) || !nrow(lines) || is.null(lines$record_amp)) return(NULL)
   lines <- lines[is_sharp(lines$record_amp, lines$amp), , drop = FALSE]
   lay <- fit$layout
   held <- stats::coef(fit)[lay$name[lay$kind == "sinusoid" & lay$param == "f0"]]
   lines <- lines[!vapply(lines$f0, function(f) any(abs(held / f - 1) < 0.01), NA), , drop = FALSE]
-  if (!nrow(lines)) return(NULL)
+  if (nrow(lines)) lines else NULL
+}
+
+# Their AV at `tau` and their autocovariance at lags `h` (samples).
+known_av_sinusoid <- function(raw, fit, tau, tau0) {
+  lines <- known_lines(raw, fit)
+  if (is.null(lines)) return(NULL)
   basis <- effect_entry("sinusoid")$basis
   rowSums(vapply(seq_len(nrow(lines)), function(j) {
     lines$record_amp[j]^2 * basis(tau, tau0, list(f0 = lines$f0[j]))
   }, numeric(length(tau))))
+}
+known_acov_sinusoid <- function(raw, fit, h, tau0) {
+  lines <- known_lines(raw, fit)
+  if (is.null(lines)) return(NULL)
+  acf <- effect_entry("sinusoid")$acf
+  rowSums(vapply(seq_len(nrow(lines)), function(j) {
+    lines$record_amp[j]^2 * acf(h, tau0, list(f0 = lines$f0[j]))
+  }, numeric(length(h))))
 }
 
 effect_sinusoid <- function() {
@@ -211,6 +224,7 @@ effect_sinusoid <- function() {
     evidence = evidence_sinusoid,
     raw_hold = hold_sinusoid,
     known_av = known_av_sinusoid,
+    known_acov = known_acov_sinusoid,
     # The periodogram's lines, less the bins of the broad bands (a
     # resonance's bins are not sinusoids); the checks of the other effects
     # see the series with them taken out (a line disturbs the ACF that

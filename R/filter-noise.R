@@ -564,7 +564,9 @@ filter_shape_support <- function(ev, spec, N, fit, raw, freq) {
   st <- diag_acov_steps(raw)
   if (is.null(st)) return(ev)
   tau0 <- 1 / freq
-  md <- -diff(model_acov(fit$layout, stats::coef(fit), 1:4, tau0))[2:3]
+  # the model's steps and those of the sharp lines it does not hold yet
+  md <- -diff(model_acov(fit$layout, stats::coef(fit), 1:4, tau0) +
+                unheld_acov(raw, fit, 1:4, tau0))[2:3]
   own <- -diff(N^2 * filter_acf(spec, tau0, 1:4))[2:3]
   d <- st$d[2:3]
   z <- (d - md) / st$se[2:3]

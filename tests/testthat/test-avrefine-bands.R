@@ -418,3 +418,32 @@ test_that("a band added to a measured accelerometer: the pair of bands enters be
   expect_true(any(abs(fr / 28.2 - 1) < 0.05))
   expect_lt(r1$chi2, 4)
 })
+
+test_that("a line near Nyquist added to a two-pole sensor with a resonance: N within 5% of the run without it", {
+  # white noise through y = w + 0.5 y[-1] - 0.15 y[-2], a 9.8 Hz resonance
+  # (own AR(2), tc 0.4 s), a 0.52 Hz line and a random walk, then a 44.16
+  # Hz line at 0.7 x the white sd. The line, not yet in the model at step
+  # 1, let a measured band take the resonance's place and a moving average
+  # the filter's; the raw short-lag autocovariance steps were off at
+  # chi-square 139 and N read 7.1% high (main 9148074; 4 of 4 seeds above
+  # 5%). The resonance is described again where those steps say so.
+  skip_on_cran()
+  set.seed(1)
+  freq <- 100
+  n <- 5e5
+  s <- 0.0131
+  w <- as.numeric(stats::filter(stats::rnorm(n + 100, sd = s), c(0.5, -0.15),
+                                method = "recursive"))[-(1:100)]
+  b <- w + 0.8 * s * ar2_unit(n, 9.8, 0.4, freq) +
+    0.9 * s * sin(2 * pi * 0.52 * seq_len(n) / freq + stats::runif(1, 0, 2 * pi)) +
+    cumsum(stats::rnorm(n, sd = 6e-5 / sqrt(freq)))
+  x <- b + 0.7 * s * sin(2 * pi * 44.16 * seq_len(n) / freq + stats::runif(1, 0, 2 * pi))
+  nf <- function(r) unname(coef(r)[grepl("^filter[^.]*\\.Nf$", names(coef(r)))])
+  r0 <- loop_raw(b, freq)
+  r1 <- loop_raw(x, freq)
+  expect_equal(nf(r1), nf(r0), tolerance = 0.05)
+  f0 <- coef(r1)[grepl("^sinusoid[0-9]*\\.f0$", names(coef(r1)))]
+  expect_true(any(abs(f0 / 44.16 - 1) < 0.01))
+  expect_true("resonance" %in% r1$terms)
+  expect_lt(r1$chi2, 2)
+})

@@ -77,6 +77,39 @@ test_that("quantization's lag-1 evidence is read without the periodogram's lines
                                       allanvar:::diag_series(dg), freq)$support)
 })
 
+test_that("the raw short-lag autocovariance is compared with the model and the sharp lines it lacks", {
+  # own generator: white noise through a two-tap filter (weights 1, 0.25)
+  # and a 46.8 Hz line of the white sd. A model of the filtered noise alone
+  # (a moving average of the same lag-1 excess) lacks the line; its
+  # autocovariance steps at lags 1-3, with the line's A^2/2 cos(2 pi f k /
+  # freq) added, are the raw series' to within a few se; without it they
+  # are off by the line's swing.
+  set.seed(2714)
+  freq <- 100
+  n <- 4e5
+  e <- rnorm(n + 1L)
+  x <- e[-1L] + 0.25 * e[-(n + 1L)] + sin(2 * pi * 46.8 * seq_len(n) / freq + 0.4)
+  dg <- allanvar:::refine_diagnostics(x, freq)
+  # the filtered noise as a moving average over L samples (lag-1
+  # autocorrelation 1 - 1/L = 0.25 / 1.0625) at its white level 1.25 /
+  # sqrt(freq); a free K keeps the fit's shape
+  L <- 1 / (1 - 0.25 / 1.0625)
+  fit <- avfit(allan(x, freq), terms = c("filter", "K"), start = c(K = 1e-9),
+               fixed = c(filter.Nf = 1.25 / sqrt(freq), filter.L = L))
+  k <- allanvar:::unheld_acov(dg, fit, 1:4, 1 / freq)
+  expect_equal(k, cos(2 * pi * 46.8 * (1:4) / freq) / 2, tolerance = 0.02)
+  raw <- allanvar:::diag_acov_steps(dg)
+  md <- allanvar:::model_acov(fit$layout, coef(fit), 1:4, 1 / freq)
+  z_with <- (raw$d + diff(md + k)) / raw$se
+  z_without <- (raw$d + diff(md)) / raw$se
+  expect_lt(max(abs(z_with)), 4)
+  expect_gt(min(abs(z_without)), 50)
+  # a model that holds the line: nothing is added
+  g <- avfit(allan(x, freq), terms = c("filter", "sinusoid"), start = c(sinusoid1.amp = 1),
+             fixed = c(filter.Nf = 1.25 / sqrt(freq), filter.L = L, sinusoid1.f0 = 46.8))
+  expect_identical(allanvar:::unheld_acov(dg, g, 1:4, 1 / freq), numeric(4))
+})
+
 test_that("a line at 46.8 Hz on a measured accelerometer: no quantization term beside it", {
   # unit 2 accel_y carries the sensor's filter (positive short-lag ACF); a
   # 46.8 Hz line of the white sd made its raw lag-1 ACF negative, and a Q
