@@ -103,22 +103,22 @@ known_lines <- function(raw, fit) {
   if (nrow(lines)) lines else NULL
 }
 
-# Their AV at `tau` and their autocovariance at lags `h` (samples).
-known_av_sinusoid <- function(raw, fit, tau, tau0) {
+# Their AV at `tau` and their autocovariance at lags `h` (samples): the
+# sum over those lines of record_amp^2 times the entry's `basis` or `acf`.
+known_lines_sum <- function(raw, fit, len, per_unit) {
   lines <- known_lines(raw, fit)
   if (is.null(lines)) return(NULL)
-  basis <- effect_entry("sinusoid")$basis
-  rowSums(vapply(seq_len(nrow(lines)), function(j) {
-    lines$record_amp[j]^2 * basis(tau, tau0, list(f0 = lines$f0[j]))
-  }, numeric(length(tau))))
+  rowSums(matrix(vapply(seq_len(nrow(lines)), function(j) {
+    lines$record_amp[j]^2 * per_unit(list(f0 = lines$f0[j]))
+  }, numeric(len)), nrow = len))
+}
+known_av_sinusoid <- function(raw, fit, tau, tau0) {
+  known_lines_sum(raw, fit, length(tau),
+                  function(nl) effect_entry("sinusoid")$basis(tau, tau0, nl))
 }
 known_acov_sinusoid <- function(raw, fit, h, tau0) {
-  lines <- known_lines(raw, fit)
-  if (is.null(lines)) return(NULL)
-  acf <- effect_entry("sinusoid")$acf
-  rowSums(vapply(seq_len(nrow(lines)), function(j) {
-    lines$record_amp[j]^2 * acf(h, tau0, list(f0 = lines$f0[j]))
-  }, numeric(length(h))))
+  known_lines_sum(raw, fit, length(h),
+                  function(nl) effect_entry("sinusoid")$acf(h, tau0, nl))
 }
 
 effect_sinusoid <- function() {
