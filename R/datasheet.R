@@ -4,9 +4,11 @@
 #' random walk), bias instability B with the tau where the Allan deviation
 #' is minimal (the flat region where B is read), rate random walk K, each in
 #' SI and in datasheet units, how each was obtained, and the effects the
-#' closed-loop refinement ([avrefine()]) added to the model. Axes are never
-#' averaged unless `average = TRUE`, which appends a row with the arithmetic
-#' mean of the axes.
+#' closed-loop refinement ([avrefine()]) added to the model (with a note for
+#' each added term whose fitted values the record does not determine, e.g.
+#' a Gauss-Markov Tc whose 95% interval is wider than a factor 2 either
+#' way). Axes are never averaged unless `average = TRUE`, which appends a
+#' row with the arithmetic mean of the axes.
 #'
 #' Units (see [av_units()]): gyroscope N in rad/s/sqrt(Hz) and deg/sqrt(h),
 #' B in rad/s and deg/h, K in rad/s^2/sqrt(Hz) and deg/h/sqrt(h);
@@ -86,6 +88,18 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
   for (ch in x$channels) {
     rd <- ch$readings
     eff <- if (is.null(ch$dead)) added_effects(ch$fit) else "none"
+    # an added term whose fitted values the record does not determine says
+    # so beside its values (a Gauss-Markov Tc of 84 s, 95% interval 31-230 s)
+    if (is.null(ch$dead)) {
+      tv <- own_term_verdicts(ch$fit, ch$coef, rd, free_only = TRUE)
+      nd <- tv[vapply(tv, function(v) !identical(v$verdict, "measured"), NA)]
+      if (length(nd)) {
+        note <- paste(sprintf("%s %s: %s", names(nd),
+                              verdict_label(vapply(nd, `[[`, "", "verdict")),
+                              vapply(nd, `[[`, "", "why")), collapse = "; ")
+        eff <- if (identical(eff, "none")) note else paste0(eff, "; ", note)
+      }
+    }
     for (j in seq_len(nrow(rd))) {
       r <- rd[j, ]
       si <- r$unit

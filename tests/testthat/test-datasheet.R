@@ -183,3 +183,28 @@ test_that("write_datasheet() quotes names copied from the user and writes whole 
   expect_error(write_datasheet(a, file.path(d, "no", "x.csv")),
                class = "allanvar_error_output_path")
 })
+
+test_that("an added term the record does not determine says so in the datasheet's effects", {
+  # own generator: white noise and a Gauss-Markov process of tc 60 s, in a
+  # 600 s record (about 10 time constants: its tc's 95% interval spans more
+  # than a factor 2 either way) and in a 6000 s one with tc 6 s (it does not)
+  gm_series <- function(n, tc, seed) {
+    set.seed(seed)
+    phi <- exp(-1 / (100 * tc))
+    rnorm(n, sd = 0.01) +
+      as.numeric(stats::filter(rnorm(n, sd = 0.01 * sqrt(1 - phi^2)), phi, method = "recursive"))
+  }
+  effects_of <- function(x) {
+    f <- avfit(allan(x, 100), terms = c("N", "gm"))
+    ci <- confint(f)["gm1.tc", ]
+    list(text = unique(datasheet(allanvar:::fit_analysis(f, unit = "rad/s"))$long$effects),
+         ratio = max(coef(f)[["gm1.tc"]] / ci[[1]], ci[[2]] / coef(f)[["gm1.tc"]]), ci = ci)
+  }
+  short <- effects_of(gm_series(6e4, 60, 5))
+  expect_gt(short$ratio, 2)
+  expect_match(short$text, "^gm1 not determined: tc's 95% interval ")
+  expect_match(short$text, format_num(short$ci[[2]], 3), fixed = TRUE)
+  long <- effects_of(gm_series(6e5, 6, 5))
+  expect_lt(long$ratio, 2)
+  expect_identical(long$text, "none")
+})
