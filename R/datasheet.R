@@ -91,8 +91,7 @@ datasheet.imu_analysis <- function(x, average = FALSE, ...) {
     # an added term whose fitted values the record does not determine says
     # so beside its values (a Gauss-Markov Tc of 84 s, 95% interval 31-230 s)
     if (is.null(ch$dead)) {
-      tv <- own_term_verdicts(ch$fit, ch$coef, rd, free_only = TRUE)
-      nd <- tv[vapply(tv, function(v) !identical(v$verdict, "measured"), NA)]
+      nd <- undetermined_own_terms(ch, rd)
       if (length(nd)) {
         note <- paste(sprintf("%s %s: %s", names(nd),
                               verdict_label(vapply(nd, `[[`, "", "verdict")),

@@ -165,15 +165,11 @@ channel_guidance <- function(ch) {
   msg <- c(msg, sprintf("%s = %.3g %s is %s: %s.", judged$term, judged$value,
                         judged$unit, verdict_phrase(judged$verdict), judged$why))
   # Every fitted term that is no reading, by the rule of kalman_params()'
-  # verdicts (its values within a factor 2 at 95%) over the values the fit
-  # estimated: a value held at the raw data's reading is no want of record.
-  tv <- own_term_verdicts(ch$fit, ch$coef, rd, free_only = TRUE)
-  for (l in names(tv)) {
-    if (tv[[l]]$verdict != "measured") {
-      msg <- c(msg, sprintf("term %s is %s from this record: %s.", l,
-                            verdict_phrase(tv[[l]]$verdict), tv[[l]]$why))
-    }
-  }
+  # verdicts (its values within a factor 2 at 95%)
+  nd <- undetermined_own_terms(ch, rd)
+  msg <- c(msg, sprintf("term %s is %s from this record: %s.", names(nd),
+                        verdict_phrase(vapply(nd, `[[`, "", "verdict")),
+                        vapply(nd, `[[`, "", "why")))
   msg <- c(msg, series_guidance(if (!is.null(ch$series)) ch$series else ch$fit$series,
                                 hours))
   if (!is.null(ch$fit_error)) {

@@ -463,3 +463,12 @@ own_term_verdicts <- function(fit, coef, rd, free_only = FALSE) {
   names(out) <- shown[own]
   out[!vapply(out, is.null, NA)]
 }
+
+# Those of axis `ch` whose estimated values the record does not determine
+# (own_term_verdicts() over the values the fit estimated: a value held at
+# the raw data's reading is no want of record); the guidance and the
+# datasheet say so.
+undetermined_own_terms <- function(ch, rd) {
+  tv <- own_term_verdicts(ch$fit, ch$coef, rd, free_only = TRUE)
+  tv[vapply(tv, function(v) v$verdict != "measured", NA)]
+}

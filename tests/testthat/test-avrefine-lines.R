@@ -52,6 +52,14 @@ test_that("a line at 49.3 Hz (100 Hz sampling, amplitude the white sd) is named;
   expect_lt(r$chi2, 2)
 })
 
+# Own generator: unit white noise through a two-tap filter (weights 1,
+# 0.25: lag-1 ACF +0.235) and a 46.8 Hz line of amplitude 1 (the white
+# sd), n samples at `freq`.
+two_tap_with_line <- function(n, freq) {
+  e <- rnorm(n + 1L)
+  e[-1L] + 0.25 * e[-(n + 1L)] + sin(2 * pi * 46.8 * seq_len(n) / freq + 0.4)
+}
+
 test_that("quantization's lag-1 evidence is read without the periodogram's lines", {
   # own generator: white noise through a two-tap filter (lag-1 ACF +0.235)
   # and a 46.8 Hz line of the white sd: the raw lag-1 ACF is -0.17, the
@@ -59,8 +67,7 @@ test_that("quantization's lag-1 evidence is read without the periodogram's lines
   set.seed(2713)
   freq <- 100
   n <- 2e5
-  e <- rnorm(n + 1L)
-  x <- e[-1L] + 0.25 * e[-(n + 1L)] + sin(2 * pi * 46.8 * seq_len(n) / freq + 0.4)
+  x <- two_tap_with_line(n, freq)
   d <- avdiagnose(x, freq)
   expect_lt(d$acf1, -0.1)
   q <- allanvar:::quantization_lag1(x, freq, d$lines)
@@ -87,8 +94,7 @@ test_that("the raw short-lag autocovariance is compared with the model and the s
   set.seed(2714)
   freq <- 100
   n <- 4e5
-  e <- rnorm(n + 1L)
-  x <- e[-1L] + 0.25 * e[-(n + 1L)] + sin(2 * pi * 46.8 * seq_len(n) / freq + 0.4)
+  x <- two_tap_with_line(n, freq)
   dg <- allanvar:::refine_diagnostics(x, freq)
   # the filtered noise as a moving average over L samples (lag-1
   # autocorrelation 1 - 1/L = 0.25 / 1.0625) at its white level 1.25 /
