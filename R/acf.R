@@ -63,16 +63,22 @@ detrend_linear <- function(x) detrend_line(as.double(x))
 # `beside`: time constants (s) of other exponentials read with it, their
 # amplitudes free (a model's other GMs: beside a faster one the block means'
 # ACF falls steeply over the first lags, and one exponential alone reads
-# between the two).
-acf_exponential <- function(x, freq, tc, cache = NULL, beside = numeric()) {
+# between the two). `lines`: the series' periodogram lines (list(f0, amp)),
+# read with it as cosines of free amplitude (a line the record's
+# sinusoid does not take out whole, its frequency wandering, swings the
+# block means' ACF: an accelerometer's 0.56 Hz line left a 6 s GM's
+# exponential 16% of the ACF's shape).
+acf_exponential <- function(x, freq, tc, cache = NULL, beside = numeric(),
+                            lines = list(f0 = numeric(), amp = numeric())) {
   # the loop judges the same Tc again (a candidate screened, refitted,
   # judged at the next step): the whole result kept by its arguments
-  if (is.null(cache)) return(acf_exponential_now(x, freq, tc, NULL, beside))
+  if (is.null(cache)) return(acf_exponential_now(x, freq, tc, NULL, beside, lines))
   key <- paste0("acf_exponential:", sprintf("%a", freq), ":", sprintf("%a", tc),
-                paste0(":", sprintf("%a", beside), collapse = ""))
+                paste0(":", sprintf("%a", beside), collapse = ""),
+                paste0("~", sprintf("%a", c(lines$f0, lines$amp)), collapse = ""))
   hit <- cache[[key]]
   if (is.null(hit)) {
-    hit <- acf_exponential_now(x, freq, tc, cache, beside)
+    hit <- acf_exponential_now(x, freq, tc, cache, beside, lines)
     cache[[key]] <- hit
   }
   hit
@@ -81,7 +87,8 @@ acf_exponential <- function(x, freq, tc, cache = NULL, beside = numeric()) {
 # most lags read: the exponential spans a few lags of 8 blocks per Tc.
 acf_block_size <- function(tc, freq) max(1L, floor(tc * freq / 8))
 acf_max_lag <- 48L
-acf_exponential_now <- function(x, freq, tc, cache, beside = numeric()) {
+acf_exponential_now <- function(x, freq, tc, cache, beside = numeric(),
+                                lines = list(f0 = numeric(), amp = numeric())) {
   m <- acf_block_size(tc, freq)
   key <- paste0("acf_exponential.", m)
   hit <- if (!is.null(cache)) cache[[key]]
@@ -89,11 +96,13 @@ acf_exponential_now <- function(x, freq, tc, cache, beside = numeric()) {
     b <- block_means(x, m)
     nb <- length(b)
     r <- NULL
+    v <- NA_real_
     if (nb >= 40L) {
       b <- detrend_linear(b)
       r <- acf_lags(b, min(nb - 2L, acf_max_lag))[-1L]
+      v <- mean(b^2)
     }
-    hit <- list(nb = nb, r = r)
+    hit <- list(nb = nb, r = r, v = v)
     if (!is.null(cache)) cache[[key]] <- hit
   }
   nb <- hit$nb
@@ -106,8 +115,9 @@ acf_exponential_now <- function(x, freq, tc, cache, beside = numeric()) {
   # profiled on a grid within a factor 5 of the hint; a minimum on the
   # grid's edge means Tc is not identified.
   grid <- tc * 10^seq(-0.7, 0.7, by = 0.02)
-  # the other exponentials, beside the line
-  rest <- cbind(vapply(beside, function(b) exp(-lag * m / (freq * b)), numeric(max_lag)), 1, lag)
+  # the other exponentials and the lines, beside the line
+  rest <- cbind(vapply(beside, function(b) exp(-lag * m / (freq * b)), numeric(max_lag)),
+                acf_line_cosines(lines, m, freq, lag, hit$v, nb), 1, lag)
   # (.lm.fit(): lm.fit()'s QR and residuals without its bookkeeping)
   rss <- vapply(grid, function(g) {
     X <- cbind(exp(-lag * m / (freq * g)), rest)
@@ -120,4 +130,28 @@ acf_exponential_now <- function(x, freq, tc, cache, beside = numeric()) {
   rss_line <- sum(stats::lm.fit(X[, -1L, drop = FALSE], r)$residuals^2)
   shape <- if (rss_line > 0) 1 - rss[k] / rss_line else NA_real_
   list(tc = est, r1 = r[1L], amp = a, z = a * sqrt(nb), m = m, shape = shape)
+}
+
+# The cosines the lines `lines` (list(f0, amp): frequencies in Hz, rate
+# amplitudes) add to the ACF of means of blocks of m samples at lags `lag`,
+# one column each, for the lines whose swing there is above the ACF's
+# noise: amp^2 / 2 through the block mean's gain, over the block means'
+# variance `v`, at least 2 / sqrt(nb) (at 30 s blocks a 0.56 Hz line is
+# averaged away). A line whose alias in the block means completes less
+# than a quarter period over the lags is left out too: the straight line
+# takes that shape. (A sawtooth's 0.27 Hz fundamental over lags of 1.4 s,
+# left out, read as an exponential of 0.43 s.)
+acf_line_cosines <- function(lines, m, freq, lag, v, nb) {
+  f0 <- lines$f0
+  amp <- lines$amp
+  dt <- m / freq
+  gain <- abs(sin(pi * f0 * dt) / (m * sin(pi * f0 / freq)))
+  swing <- (amp * gain)^2 / 2 / v
+  alias <- abs(f0 - round(f0 * dt) / dt)
+  keep <- is.finite(f0) & f0 > 0 & f0 < freq / 2 & is.finite(swing) &
+    swing > 2 / sqrt(nb) & alias * max(lag) * dt >= 0.25
+  # (the strongest first: a few lags per column stay free)
+  f0 <- utils::head(f0[keep][order(-swing[keep])], floor(length(lag) / 4))
+  matrix(vapply(f0, function(f) cos(2 * pi * f * dt * lag), numeric(length(lag))),
+         nrow = length(lag))
 }

@@ -125,6 +125,14 @@
 #                 list(shape, coef, phi) of its structure function, shape one
 #                 of "linear" (coef * l), "cubic" (-coef (l^3 - l) / 6),
 #                 "step" (2 coef for l > 0), "ar1" (coef = sigma^2, phi)
+#   apart(par, others)  NULL, or for a repeatable entry TRUE when the
+#                 instance `par` (its values) describes a process other than
+#                 the model's instances of the entry (`others`: a list of
+#                 their values) that the curve sees too weakly to size it
+#                 against them: its raw-data confirmation then counts as
+#                 min_gain, as a harmonic set's line's does (a GM an order
+#                 slower than the model's, which had taken a compromise
+#                 between the two on the curve)
 #   noise_lookalike  TRUE for a "series" kind that a stationary noise
 #                 term's own excursions can produce (a Gauss-Markov
 #                 term's slow swings are transients to the series pass): a
@@ -211,7 +219,7 @@ new_effect <- function(name, title, params, component = "av",
                        statespace = NULL, diagnose = NULL, family = NULL,
                        exact_edf = NULL, noise_lookalike = FALSE,
                        detect_again = FALSE, known_av = NULL, known_acov = NULL,
-                       model_evidence = NULL) {
+                       model_evidence = NULL, apart = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -227,7 +235,8 @@ new_effect <- function(name, title, params, component = "av",
        proposed_only = proposed_only, statespace = statespace,
        diagnose = diagnose, family = family, exact_edf = exact_edf,
        noise_lookalike = noise_lookalike, detect_again = detect_again,
-       known_av = known_av, known_acov = known_acov, model_evidence = model_evidence)
+       known_av = known_av, known_acov = known_acov, model_evidence = model_evidence,
+       apart = apart)
 }
 
 validate_effect <- function(e) {
@@ -264,7 +273,7 @@ validate_effect <- function(e) {
               "raw_hold",
               "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible",
-              "statespace", "exact_edf")) {
+              "statespace", "exact_edf", "apart")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
   if (!is.null(e$variants) && !is.function(e$variants)) {

@@ -95,7 +95,7 @@ evidence_gm <- function(par, raw, x, freq) {
     return(list(text = "record too short for an ACF check", support = NA))
   }
   # avrefine()'s per-call store (NULL elsewhere)
-  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw))
+  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw), lines = raw_lines_of(raw))
   # an exponential that explains less than half of the ACF's variation
   # about a line is not the ACF's shape (an oscillating residue)
   if (is.finite(a$tc) && a$z > 5 && isTRUE(a$shape >= 0.5)) {
@@ -140,7 +140,8 @@ evidence_gm_beside <- function(ev, fit, label, raw, freq) {
   # the others that fall within the ACF's lags (longer ones are the line's)
   beside <- beside[is.finite(beside) & beside < acf_max_lag * acf_block_size(tc, freq) / freq]
   if (!length(beside)) return(ev)
-  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw), beside = beside)
+  a <- acf_exponential(x, freq, tc, cache = diag_cache(raw), beside = beside,
+                       lines = raw_lines_of(raw))
   if (!(is.finite(a$tc) && a$z > 5 && isTRUE(a$shape >= 0.5) &&
         a$tc > tc / 2 && a$tc < tc * 2)) {
     return(ev)
@@ -150,6 +151,14 @@ evidence_gm_beside <- function(ev, fit, label, raw, freq) {
                       a$m, paste(format_num(beside), collapse = ", "), format_num(a$tc), a$z,
                       ev$text),
        support = TRUE)
+}
+
+# The raw series' periodogram lines, list(f0, amp) (the ACF check reads
+# them beside the exponential).
+raw_lines_of <- function(raw) {
+  lines <- diag_part(raw, "lines")
+  if (is.null(lines) || !nrow(lines)) return(list(f0 = numeric(), amp = numeric()))
+  list(f0 = lines$f0, amp = lines$amp)
 }
 
 # Enough block means (40 of Tc / 8 samples each) for the ACF check.
@@ -209,6 +218,16 @@ effect_gauss_markov <- function() {
     },
     evidence = evidence_gm,
     model_evidence = evidence_gm_beside,
+    # A GM an order slower than the model's is another process. (The
+    # curve sees a slow one at its few long-tau points of small EDF, where
+    # the block means' ACF reads it over many lags; a faster one the curve
+    # measures well needs no such credit: beside an added 8 s GM, one of
+    # 2.4 s that gained under min_gain split it into 2.4 and 24.5 s.)
+    apart = function(par, others) {
+      tc <- par[["tc"]]
+      o <- vapply(others, function(v) v[["tc"]] %||% NA_real_, 0)
+      is.finite(tc) && length(o) && all(is.finite(o)) && all(tc >= 10 * o)
+    },
     # Correlated over fewer than 2 samples, an AR(1) is the sensor's own
     # averaging (the filter term), not a slow process.
     admissible = function(par, tau, freq) {

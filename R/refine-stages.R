@@ -458,7 +458,7 @@ stage_reconsider <- function(st) {
       if (is.null(w$fit)) next
       holds <- all(broken_without(st, w) %in% broken)
       gain <- refine_crit(st, w$fit) - c_cur
-      if (holds && gain < st$args$min_gain) {
+      if (holds && gain < instance_need(st, cur, l)) {
         if (is.null(best) || gain < best$gain) best <- list(w = w, label = l, gain = gain)
         next
       }

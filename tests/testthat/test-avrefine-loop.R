@@ -77,6 +77,39 @@ test_that("one GM over two processes an order apart is split in two in one step 
   expect_match(ref$steps$evidence[2], "split from gm1")
 })
 
+test_that("a GM an order slower than the model's, confirmed by the block means, enters and stays below min_gain", {
+  # A fast GM of 3 s and a slow one of 60 s. Beside the first, the curve
+  # gains little from the second (a few long-tau points of small EDF), and
+  # without it the first takes a compromise between the two; the block
+  # means' ACF reads the slow one over many lags. (Measured on these five
+  # seeds: two GMs in 3 before the rule, 4 with it.)
+  freq <- 10
+  n <- 2e5
+  realised_tc <- function(g) -1 / (freq * log(sum(g[-1] * g[-n]) / sum(g[-n]^2)))
+  two <- 0L
+  for (seed in 1:5) {
+    set.seed(seed)
+    g1 <- gen_gm(n, freq, 0.004, 3)
+    g2 <- gen_gm(n, freq, 0.002, 60)
+    x <- gen_white(n, freq, 0.005) + g1 + g2
+    fit <- avfit(allan(x, freq), terms = c("N", "B", "K"))
+    ref <- suppressMessages(avrefine(fit, data = x))
+    cf <- coef(ref)
+    tc <- sort(unname(cf[grepl("^gm[0-9]+\\.tc$", names(cf))]))
+    expect_false(any(ref$steps$confirmed %in% FALSE))
+    if (length(tc) == 2L) {
+      two <- two + 1L
+      expect_equal(tc, c(realised_tc(g1), realised_tc(g2)), tolerance = 0.3)
+    }
+  }
+  expect_gte(two, 4L)
+  # the rule's reach: an order slower only; a faster one the curve sizes well
+  apart <- effect_entry("gm")$apart
+  expect_true(apart(list(tc = 60), list(list(tc = 3))))
+  expect_false(apart(list(tc = 20), list(list(tc = 3))))
+  expect_false(apart(list(tc = 2.4), list(list(tc = 24.5))))
+})
+
 test_that("a GM beside a sinusoid: both found and both confirmed by the raw data", {
   set.seed(303)
   freq <- 100

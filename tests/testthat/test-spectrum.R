@@ -144,6 +144,44 @@ test_that("removing the lines lets the Gauss-Markov ACF check work beside a sinu
   expect_true(is.na(match_line(0.2, spectral_lines(y, freq))))
 })
 
+test_that("the Gauss-Markov ACF check reads a wandering line beside the exponential", {
+  # a line whose frequency wanders slowly (0.56 Hz +- 0.002 Hz, correlated
+  # over 1000 s): coherent over the ACF's lags, not over the record, so the
+  # record's sinusoid leaves most of it in the series
+  freq <- 100
+  n <- 1e6
+  for (seed in c(3, 4)) {
+    set.seed(seed)
+    phi <- exp(-1 / (freq * 6))
+    gm <- as.numeric(stats::filter(rnorm(n, sd = 4e-4 * sqrt(1 - phi^2)), phi,
+                                   method = "recursive"))
+    pf <- exp(-1 / (freq * 1000))
+    df <- as.numeric(stats::filter(rnorm(n, sd = 0.002 * sqrt(1 - pf^2)), pf,
+                                   method = "recursive"))
+    x <- rnorm(n, sd = 3.6e-3) + gm + 6e-4 * sin(2 * pi * cumsum(0.56 + df) / freq)
+    realised <- -1 / (freq * log(sum(gm[-1] * gm[-n]) / sum(gm[-n]^2)))
+    l <- spectral_lines(x, freq)
+    expect_false(is.na(match_line(0.56, l)))
+    y <- remove_lines(x, freq, l$f0[l$kind == "line"])
+    # the line's remainder swings the block means' ACF: the exponential
+    # alone explains little of its shape (the check refuses it) ...
+    expect_lt(acf_exponential(y, freq, 6)$shape, 0.5)
+    # ... and read beside the lines' cosines it is the GM's
+    a <- acf_exponential(y, freq, 6, lines = l)
+    expect_gt(a$shape, 0.5)
+    expect_gt(a$z, 5)
+    expect_equal(a$tc, realised, tolerance = 0.25)
+  }
+  # a line whose alias completes less than a quarter period over the lags is
+  # left to the exponential and the straight line, and one the block means
+  # average away is left out
+  two <- list(f0 = c(0.001, 0.56), amp = c(1, 1))
+  expect_identical(ncol(acf_line_cosines(two, 75L, 100, 1:48, 1, 1e4)), 1L)
+  expect_identical(ncol(acf_line_cosines(list(f0 = 0.56, amp = 1), 3000L, 100, 1:48, 1, 1e4)), 0L)
+  expect_identical(ncol(acf_line_cosines(list(f0 = numeric(), amp = numeric()),
+                                         75L, 100, 1:48, 1, 1e4)), 0L)
+})
+
 test_that("line_sums_near() (block moments) equals the sums of sin and cos near f0", {
   set.seed(14)
   freq <- 100
