@@ -321,11 +321,6 @@ split_trial <- function(st, tr, tm, jd, lab, settings, pin, c1) {
   list(st = out$st, fit = f, crit = crit, jd = j1)
 }
 
-# An instance that is not a valid instance of its effect on this curve (a
-# sub-sample GM, a sinusoid the curve cannot see) is never accepted, however
-# well it bends the curve; nor one the raw data contradict, nor one whose
-# refit moves an effect accepted earlier to values the raw data contradict.
-# Returns list(par, why (NULL when it holds), ev, moved).
 # TRUE when the instance `label` of `f` is, by its entry's `apart`, another
 # process than each of the model's other instances of its entry, and the
 # raw data confirm it there (support, not undecided).
@@ -360,6 +355,11 @@ instance_need <- function(st, f, label) {
   st$args$min_gain
 }
 
+# An instance that is not a valid instance of its effect on this curve (a
+# sub-sample GM, a sinusoid the curve cannot see) is never accepted, however
+# well it bends the curve; nor one the raw data contradict, nor one whose
+# refit moves an effect accepted earlier to values the raw data contradict.
+# Returns list(par, why (NULL when it holds), ev, moved).
 judge_instance <- function(st, f, effect, label, tau) {
   freq <- st$args$freq
   par <- instance_params(stats::coef(f), f$layout, label)
