@@ -347,9 +347,8 @@ apart_confirmed <- function(st, f, label) {
 instance_need <- function(st, f, label) {
   if (length(label) != 1L) return(st$args$min_gain)
   lay <- f$layout
-  kind <- lay$kind[lay$label == label][1L]
-  same <- unique(lay$label[lay$kind == kind])
-  for (l in c(label, setdiff(same, label))) {
+  same <- unique(lay$label[lay$kind == lay$kind[match(label, lay$label)]])
+  for (l in same) {
     if (apart_confirmed(st, f, l)) return(0)
   }
   st$args$min_gain
