@@ -238,9 +238,16 @@ effect_band <- function() {
     peak_tau = function(par) 0.371 * 2 / (par[["f_lo"]] + par[["f_hi"]]),
     # each band of the raw periodogram's own spectrum, read once per call
     diagnose = list(
-      part = "band_spectra", reads = "raw", needs = "bands",
+      part = "band_spectra", reads = "raw", needs = c("bands", "lines"),
       make = function(x, freq, dg) {
         bands <- diag_part(dg, "bands")
+        # a line the record's resolution shows on top of a band is a
+        # sinusoid, not the band's: measured without it (an 8.97 Hz line
+        # added beside an accelerometer's 9.8 Hz resonance moved the
+        # measured band's centre to 9.39 Hz and its power up 23%, and the
+        # band took the line's place in the model)
+        xb <- without_lines_on_bands(x, freq, bands, diag_part(dg, "lines"))
+        welch <- if (identical(xb, x)) raw_welch(dg) else centred_welch
         Filter(Negate(is.null), lapply(seq_len(nrow(bands)), function(j) {
           # a run with two peaks is two resonances (the resonance entry
           # proposes both, each measured), not one measured band: measured
@@ -248,7 +255,7 @@ effect_band <- function() {
           # + an 8.1 Hz band beside its 9.86 Hz resonance: a first-order
           # low-pass in place of its moving average, N +9%)
           if (isTRUE(!is.na(bands$pair_fr1[j]))) return(NULL)
-          measure_band(x, freq, bands[j, ], welch = raw_welch(dg), others = bands[-j, ])
+          measure_band(xb, freq, bands[j, ], welch = welch, others = bands[-j, ])
         }))
       }),
     describe = function(values) {

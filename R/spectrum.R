@@ -378,6 +378,34 @@ lines_outside_bands <- function(lines, bands) {
   out
 }
 
+# The broad bands of find_bands(), read again without the lines the
+# record's resolution shows on top of them (its attribute "lines", kept):
+# such a line is a sinusoid, and read as part of the band it widened it
+# (an 8.97 Hz line beside an accelerometer's 9.8 Hz resonance: FWHM 0.9
+# -> 2.2 Hz, centre 9.69 Hz), so that a resonance or band fitted to it
+# took the line's place in the model.
+bands_without_lines <- function(x, freq, welch = centred_welch) {
+  b <- find_bands(x, freq, welch = welch)
+  on <- attr(b, "lines") %||% numeric()
+  if (!length(on)) return(b)
+  out <- find_bands(remove_lines(x, freq, on), freq)
+  attr(out, "lines") <- sort(unique(c(on, attr(out, "lines"))))
+  out
+}
+
+# The series without the lines of `lines` (the lines part: those
+# lines_outside_bands() kept) that sit where a band of `bands` is measured
+# (measure_band(): the band and its background either side, its width or
+# 4 Welch bins of `seg` samples), each its least-squares sinusoid over the
+# record. `x` itself when there are none.
+without_lines_on_bands <- function(x, freq, bands, lines, seg = 512L) {
+  if (!NROW(bands) || !NROW(lines)) return(x)
+  wd <- pmax(bands$f_to - bands$f_from, 4 * freq / seg)
+  on <- vapply(lines$f0, function(f) any(f >= bands$f_from - wd & f <= bands$f_to + wd), NA)
+  if (!any(on)) return(x)
+  remove_lines(x, freq, lines$f0[on])
+}
+
 # The series with the given lines taken out: for each line, the least
 # squares sinusoid near its frequency (amplitude, phase and frequency fitted
 # over the whole record; the frequency refined within +-2 Fourier bins of
