@@ -275,7 +275,9 @@ effect_resonance <- function() {
     # the broad bands of the raw periodogram; the checks of the other
     # effects see them brought down to their background
     diagnose = list(part = "bands", reads = "raw",
-                    make = function(x, freq, dg) bands_without_lines(x, freq, raw_welch(dg)),
+                    make = function(x, freq, dg) {
+                      bands_without_lines(x, freq, diag_value(dg, "lines"), raw_welch(dg))
+                    },
                     clean = function(x, freq, bands) remove_bands(x, freq, bands)),
     describe = function(values) {
       sprintf("resonance (%s Hz)", paste(signif(values$fr, 3), collapse = ", "))

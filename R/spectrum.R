@@ -378,32 +378,44 @@ lines_outside_bands <- function(lines, bands) {
   out
 }
 
-# The broad bands of find_bands(), read again without the lines the
-# record's resolution shows on top of them (its attribute "lines", kept):
-# such a line is a sinusoid, and read as part of the band it widened it
-# (an 8.97 Hz line beside an accelerometer's 9.8 Hz resonance: FWHM 0.9
-# -> 2.2 Hz, centre 9.69 Hz), so that a resonance or band fitted to it
-# took the line's place in the model.
-bands_without_lines <- function(x, freq, welch = centred_welch) {
+# The broad bands of find_bands(), read again without the lines that sit
+# where a band is read (band_reach_lines(): on it, at the record's
+# resolution, or in its background): such a line is a sinusoid, and read
+# as part of the band, or of its background, it moved the band's fit (an
+# 8.97 Hz line on the flank of an accelerometer's 9.8 Hz resonance: FWHM
+# 0.9 -> 2.2 Hz, centre 9.69 Hz), so that a resonance or band fitted to it
+# took the line's place in the model. `lines`: the raw series' lines
+# (avdiagnose()'s); the attribute "lines" (lines on a band) is kept.
+bands_without_lines <- function(x, freq, lines, welch = centred_welch) {
   b <- find_bands(x, freq, welch = welch)
   on <- attr(b, "lines") %||% numeric()
-  if (!length(on)) return(b)
-  out <- find_bands(remove_lines(x, freq, on), freq)
-  attr(out, "lines") <- sort(unique(c(on, attr(out, "lines"))))
+  near <- if (NROW(lines)) band_reach_lines(b, lines_outside_bands(lines, b), freq) else numeric()
+  # a line on a band that the raw lines do not list, by find_bands()' own reading
+  res <- attr(lines, "resolution") %||% 0
+  near <- c(near, on[!vapply(on, function(f) any(abs(near - f) <= 1.5 * res), NA)])
+  if (!length(near)) return(b)
+  out <- find_bands(remove_lines(x, freq, near), freq)
+  attr(out, "lines") <- sort(unique(c(attr(b, "lines"), attr(out, "lines"))))
   out
 }
 
-# The series without the lines of `lines` (the lines part: those
-# lines_outside_bands() kept) that sit where a band of `bands` is measured
-# (measure_band(): the band and its background either side, its width or
-# 4 Welch bins of `seg` samples), each its least-squares sinusoid over the
-# record. `x` itself when there are none.
-without_lines_on_bands <- function(x, freq, bands, lines, seg = 512L) {
-  if (!NROW(bands) || !NROW(lines)) return(x)
+# The frequencies of `lines` (rows with f0; those lines_outside_bands()
+# keeps) that sit where a band of `bands` is measured (measure_band(): the
+# band and its background either side, its width or 4 Welch bins of `seg`
+# samples).
+band_reach_lines <- function(bands, lines, freq, seg = 512L) {
+  if (!NROW(bands) || !NROW(lines)) return(numeric())
   wd <- pmax(bands$f_to - bands$f_from, 4 * freq / seg)
   on <- vapply(lines$f0, function(f) any(f >= bands$f_from - wd & f <= bands$f_to + wd), NA)
-  if (!any(on)) return(x)
-  remove_lines(x, freq, lines$f0[on])
+  lines$f0[on]
+}
+
+# The series without the lines of `lines` (the lines part) where a band of
+# `bands` is measured (band_reach_lines()), each its least-squares sinusoid
+# over the record; `x` itself when there are none.
+without_lines_on_bands <- function(x, freq, bands, lines) {
+  near <- band_reach_lines(bands, lines, freq)
+  if (!length(near)) x else remove_lines(x, freq, near)
 }
 
 # The series with the given lines taken out: for each line, the least
