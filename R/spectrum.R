@@ -385,7 +385,8 @@ lines_outside_bands <- function(lines, bands) {
 # 8.97 Hz line on the flank of an accelerometer's 9.8 Hz resonance: FWHM
 # 0.9 -> 2.2 Hz, centre 9.69 Hz), so that a resonance or band fitted to it
 # took the line's place in the model. `lines`: the raw series' lines
-# (avdiagnose()'s); the attribute "lines" (lines on a band) is kept.
+# (avdiagnose()'s); the lines taken out are in attribute "lines" (lines on
+# a band, which lines_outside_bands() keeps).
 bands_without_lines <- function(x, freq, lines, welch = centred_welch) {
   b <- find_bands(x, freq, welch = welch)
   on <- attr(b, "lines") %||% numeric()
@@ -395,7 +396,8 @@ bands_without_lines <- function(x, freq, lines, welch = centred_welch) {
   near <- c(near, on[!vapply(on, function(f) any(abs(near - f) <= 1.5 * res), NA)])
   if (!length(near)) return(b)
   out <- find_bands(remove_lines(x, freq, near), freq)
-  attr(out, "lines") <- sort(unique(c(attr(b, "lines"), attr(out, "lines"))))
+  # (a band read without a line can grow over it: the line stays a line)
+  attr(out, "lines") <- sort(unique(c(near, attr(out, "lines"))))
   out
 }
 
