@@ -133,8 +133,10 @@ resonance_raw_support <- function(sigma, fr, tc, bands) {
                  format(signif(m$band$f_center, 4)), format(signif(m$band$width, 2)),
                  100 * m$band$share, pr, m$wr)
   # a resonance is a band, not a tone: its width matches the band's
-  # within a factor 3
-  list(text = txt, support = m$near && pr > 1 / 2 && pr < 2 && m$wr > 1 / 3 && m$wr < 3)
+  # within a factor 3; and at most twice as wide, where the raw data show
+  # no band (a resonance beside a square wave's harmonics on its flanks,
+  # 2.9 x the band's width, took their power and kept them out)
+  list(text = txt, support = m$near && pr > 1 / 2 && pr < 2 && m$wr > 1 / 2 && m$wr < 3)
 }
 
 # The band of find_bands() nearest a resonance at fr (a band's own fit and,
