@@ -186,6 +186,14 @@ test_that("the raw data support a resonance where a band is, and contradict one 
     expect_false(ev$support)
     expect_match(ev$text, sprintf("power %.2g x", 1 / k), fixed = TRUE)
   }
+  # the width: up to 3 x narrower (the curve hardly tells a band from a
+  # tone), but at most 2 x wider than the band, whose flanks the raw data
+  # do not show
+  w <- b$width[1]
+  for (k in c(0.4, 1.6)) {
+    expect_true(resonance_raw_support(sqrt(p), 20, 1 / (pi * w * k), b)$support)
+  }
+  expect_false(resonance_raw_support(sqrt(p), 20, 1 / (pi * w * 2.5), b)$support)
 })
 
 test_that("find_bands invents no band on smooth spectra (own generators, 10 seeds each)", {
