@@ -241,11 +241,10 @@ effect_band <- function() {
       part = "band_spectra", reads = "raw", needs = c("bands", "lines"),
       make = function(x, freq, dg) {
         bands <- diag_part(dg, "bands")
-        # a line the record's resolution shows on top of a band is a
-        # sinusoid, not the band's: measured without it (an 8.97 Hz line
-        # added beside an accelerometer's 9.8 Hz resonance moved the
-        # measured band's centre to 9.39 Hz and its power up 23%, and the
-        # band took the line's place in the model)
+        # a line on a band or in its background is a sinusoid, not the
+        # band's: measured without it (an 8.97 Hz line added on an
+        # accelerometer's band moved its measured centre from 10.09 to
+        # 9.39 Hz, and the band took the line's place in the model)
         xb <- without_lines_on_bands(x, freq, bands, diag_part(dg, "lines"))
         welch <- if (identical(xb, x)) raw_welch(dg) else centred_welch
         Filter(Negate(is.null), lapply(seq_len(nrow(bands)), function(j) {
