@@ -87,7 +87,7 @@ sim_band <- function(n, tau0, scale, f_lo, f_hi, s) {
 measure_band <- function(x, freq, b, seg = 512L, knots = band_knots,
                          welch = centred_welch, others = NULL) {
   w <- welch(x, freq, seg)
-  wd <- max(b$f_to - b$f_from, 4 * w$df)
+  wd <- band_reach(b, w$df)
   fl <- (w$f > b$f_from - wd & w$f < b$f_from & w$f > 0) |
     (w$f > b$f_to & w$f < min(b$f_to + wd, 0.49 * freq))
   # the other bands found are not background (a band beside it would lift

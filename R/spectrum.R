@@ -401,13 +401,17 @@ bands_without_lines <- function(x, freq, lines, welch = centred_welch) {
   out
 }
 
+# How far either side of each band of `bands` measure_band() reads its
+# background: the band's width, at least 4 Welch bins of width `df`.
+band_reach <- function(bands, df) pmax(bands$f_to - bands$f_from, 4 * df)
+
 # The frequencies of `lines` (rows with f0; those lines_outside_bands()
 # keeps) that sit where a band of `bands` is measured (measure_band(): the
-# band and its background either side, its width or 4 Welch bins of `seg`
-# samples).
+# band and its background either side, band_reach() at Welch segments of
+# `seg` samples).
 band_reach_lines <- function(bands, lines, freq, seg = 512L) {
   if (!NROW(bands) || !NROW(lines)) return(numeric())
-  wd <- pmax(bands$f_to - bands$f_from, 4 * freq / seg)
+  wd <- band_reach(bands, freq / seg)
   on <- vapply(lines$f0, function(f) any(f >= bands$f_from - wd & f <= bands$f_to + wd), NA)
   lines$f0[on]
 }
