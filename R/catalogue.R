@@ -84,6 +84,15 @@
 #                 and `fit` does not hold yet (a square wave's sharp
 #                 harmonics), or NULL: a family's form is chosen on the
 #                 curve without it during the steps
+#   unheld(raw, fit)  NULL, or the same instances as a list of list(values
+#                 (every parameter, named), at (where they sit, Hz)), the
+#                 strongest first: stage_absorbed() adds those that sit in
+#                 the reach of an instance that `absorbs` them
+#   absorbs(par, raw)  NULL, or for an instance whose shape on the curve
+#                 can take the power of an unheld one in its reach (a
+#                 band, a line on it): list(lo, hi (Hz), start (named
+#                 nonlinear values the raw data read for it, without what
+#                 it took), what (a few words))
 #   known_acov(raw, fit, h, tau0)  the same instances' autocovariance at
 #                 lags `h` (samples), or NULL: the short-lag shape checks
 #                 compare the raw series with the model and them (a line
@@ -219,7 +228,8 @@ new_effect <- function(name, title, params, component = "av",
                        statespace = NULL, diagnose = NULL, family = NULL,
                        exact_edf = NULL, noise_lookalike = FALSE,
                        detect_again = FALSE, known_av = NULL, known_acov = NULL,
-                       model_evidence = NULL, apart = NULL) {
+                       model_evidence = NULL, apart = NULL, unheld = NULL,
+                       absorbs = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -236,7 +246,7 @@ new_effect <- function(name, title, params, component = "av",
        diagnose = diagnose, family = family, exact_edf = exact_edf,
        noise_lookalike = noise_lookalike, detect_again = detect_again,
        known_av = known_av, known_acov = known_acov, model_evidence = model_evidence,
-       apart = apart)
+       apart = apart, unheld = unheld, absorbs = absorbs)
 }
 
 validate_effect <- function(e) {
@@ -273,7 +283,7 @@ validate_effect <- function(e) {
               "raw_hold",
               "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible",
-              "statespace", "exact_edf", "apart")) {
+              "statespace", "exact_edf", "apart", "unheld", "absorbs")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
   if (!is.null(e$variants) && !is.function(e$variants)) {

@@ -235,6 +235,15 @@ effect_band <- function() {
            note = sprintf("amp held at the measured band's power (the curve asked for %.3f x it)",
                           par[["amp"]]^2))
     },
+    # its measured spectrum, read without the lines in its reach, is
+    # pinned; its scale can still take such a line's power on the curve
+    absorbs = function(par, raw) {
+      res <- attr(diag_part(raw, "bands"), "resolution") %||% 0
+      wd <- max(par[["f_hi"]] - par[["f_lo"]], 4 * res)
+      list(lo = par[["f_lo"]] - wd, hi = par[["f_hi"]] + wd, start = numeric(0),
+           what = sprintf("the measured band at %s-%s Hz", format_num(par[["f_lo"]], 4),
+                          format_num(par[["f_hi"]], 4)))
+    },
     peak_tau = function(par) 0.371 * 2 / (par[["f_lo"]] + par[["f_hi"]]),
     # each band of the raw periodogram's own spectrum, read once per call
     diagnose = list(

@@ -271,6 +271,7 @@ effect_resonance <- function() {
       out
     },
     raw_hold = hold_resonance,
+    absorbs = resonance_absorbs,
     peak_tau = function(par) 0.371 / par[["fr"]],
     # the broad bands of the raw periodogram; the checks of the other
     # effects see them brought down to their background

@@ -103,6 +103,18 @@ known_lines <- function(raw, fit) {
   if (nrow(lines)) lines else NULL
 }
 
+# The same lines as instances to add at the raw data's values (the
+# catalogue's `unheld`), the strongest (by the line's peak over its
+# background) first.
+unheld_lines <- function(raw, fit) {
+  lines <- known_lines(raw, fit)
+  if (is.null(lines)) return(NULL)
+  lines <- lines[order(-lines$ratio), , drop = FALSE]
+  lapply(seq_len(nrow(lines)), function(j) {
+    list(values = c(amp = lines$record_amp[j], f0 = lines$f0[j]), at = lines$f0[j])
+  })
+}
+
 # Their AV at `tau` and their autocovariance at lags `h` (samples): the
 # sum over those lines of record_amp^2 times the entry's `basis` or `acf`.
 known_lines_sum <- function(raw, fit, len, per_unit) {
@@ -225,6 +237,7 @@ effect_sinusoid <- function() {
     raw_hold = hold_sinusoid,
     known_av = known_av_sinusoid,
     known_acov = known_acov_sinusoid,
+    unheld = unheld_lines,
     # The periodogram's lines, less the bins of the broad bands (a
     # resonance's bins are not sinusoids); the checks of the other effects
     # see the series with them taken out (a line disturbs the ACF that

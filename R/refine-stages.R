@@ -13,6 +13,7 @@ refine_stages <- function() {
        trim = stage_trim,            # leave out a short end nothing describes
        release = stage_release,      # values the last screening held, freed
        hold = stage_hold,            # instances the curve sizes off the raw data's
+       absorbed = stage_absorbed,    # lines a band took on the curve, at the raw data's values
        prune = stage_prune,          # instances the final model holds at 0 leave
        reconsider = stage_reconsider, # instances the final model does without leave
        alternatives = stage_alternatives, # confirmed effects left out below min_gain

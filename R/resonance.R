@@ -181,3 +181,26 @@ hold_resonance <- function(par, raw) {
                       format_num(m$band$f_center, 4), format_num(m$band$tc),
                       format_num(par[["tc"]])))
 }
+
+# Where a resonance's shape can take a line's power (the catalogue's
+# `absorbs`): the band of find_bands() it stands on (read without the
+# lines there) and that band's background either side (band_reach(), at
+# least 4 bins). Fitted while such a line was not yet in the model, the
+# resonance moved towards it and took its power (an AR(2) at 9.8 Hz with a
+# line at 8.97 Hz: 9.65 Hz, tc 0.48 s against the band's 9.80 Hz, 0.38
+# s), and the line screened beside it held there gained nothing. Its
+# start: the band's own centre and width.
+resonance_absorbs <- function(par, raw) {
+  bands <- diag_part(raw, "bands")
+  if (!NROW(bands)) return(NULL)
+  m <- resonance_band_match(par[["fr"]], par[["tc"]], bands)
+  if (is.null(m) || !m$near) return(NULL)
+  b <- m$band
+  res <- attr(bands, "resolution") %||% 0
+  # (one of a run's two resonances has its own centre and width only)
+  lo <- if (is.null(b$f_from)) b$f_center - b$width / 2 else b$f_from
+  hi <- if (is.null(b$f_to)) b$f_center + b$width / 2 else b$f_to
+  wd <- max(hi - lo, 4 * res)
+  list(lo = lo - wd, hi = hi + wd, start = c(fr = b$f_center, tc = b$tc),
+       what = sprintf("the resonance at %s Hz", format_num(b$f_center, 4)))
+}
