@@ -193,7 +193,10 @@ locate_signature <- function(sig, fit, label) {
   tchar <- if (!is.null(e$peak_tau)) e$peak_tau(par)
     else if (all(is.na(share))) NA_real_ else tau[which.max(share)]
   big <- which(share > 0.25)
-  range <- if (length(big)) range(tau[big]) else range(tau)
+  # (a term that never carries a quarter of the model, a weak line beside
+  # a band, is placed where its share is largest)
+  top <- if (all(is.na(share))) NA_integer_ else which.max(share)
+  range <- if (length(big)) range(tau[big]) else if (!is.na(top)) tau[c(top, top)] else range(tau)
   s <- sig[sig$kind != "slope" & sig$kind != "oscillation", , drop = FALSE]
   if (is.finite(tchar) && nrow(s)) {
     dist <- ifelse(tchar < s$tau_from, log(s$tau_from / tchar),
@@ -205,9 +208,14 @@ locate_signature <- function(sig, fit, label) {
                   text = s$description[j]))
     }
   }
-  list(tau_from = range[1L], tau_to = range[2L],
-       text = sprintf("no residual signature near tau = %s s (the term carries >25%% of the model AV over tau %s-%s s)",
-                      format_num(tchar), format_num(range[1L]), format_num(range[2L])))
+  text <- if (length(big) || is.na(top)) {
+    sprintf("no residual signature near tau = %s s (the term carries >25%% of the model AV over tau %s-%s s)",
+            format_num(tchar), format_num(range[1L]), format_num(range[2L]))
+  } else {
+    sprintf("no residual signature near tau = %s s (the term carries at most %.0f%% of the model AV, at tau = %s s)",
+            format_num(tchar), 100 * share[top], format_num(tau[top]))
+  }
+  list(tau_from = range[1L], tau_to = range[2L], text = text)
 }
 
 # Largest share of the model AV carried by one term instance over the taus.

@@ -776,6 +776,10 @@ test_that("a line on a resonance's flank is named, and the resonance stays where
   expect_equal(nrow(s), 1L)
   expect_match(s$evidence, "in the reach of the resonance at 9[.][78]")
   expect_true(s$confirmed)
+  # it carries at most a seventh of the model AV at any tau: placed where
+  # its share is largest, not said to carry a quarter over the whole curve
+  expect_match(s$evidence, "carries at most 1[0-9]% of the model AV, at tau = 0.04 s")
+  expect_equal(s$tau_from, s$tau_to)
   # nothing else: the run without the line has the resonance alone
   expect_setequal(rx$terms, c(rb$terms, "sinusoid"))
 })
