@@ -79,7 +79,7 @@ take_absorbed <- function(st, cand) {
   for (start in unique(list(moved, nl))) {
     args <- refit_args(cur, c(tm), settings, start = start)
     if (!is.null(st$tau_range)) args$tau_range <- c(st$tau_range[1L], Inf)
-    r <- state_refit(st, args, "refit with a line a band took", cand$effect, step)
+    r <- state_refit(st, args, "refit with an instance another took on the curve", cand$effect, step)
     st <- r$st
     if (!is.null(r$fit) && is.finite(refine_crit(st, r$fit)) &&
         (is.null(best) || refine_crit(st, r$fit) < refine_crit(st, best))) {
