@@ -239,7 +239,7 @@ effect_band <- function() {
     # pinned; its scale can still take such a line's power on the curve
     absorbs = function(par, raw) {
       res <- attr(diag_part(raw, "bands"), "resolution") %||% 0
-      wd <- max(par[["f_hi"]] - par[["f_lo"]], 4 * res)
+      wd <- band_reach(list(f_from = par[["f_lo"]], f_to = par[["f_hi"]]), res)
       list(lo = par[["f_lo"]] - wd, hi = par[["f_hi"]] + wd, start = numeric(0),
            what = sprintf("the measured band at %s-%s Hz", format_num(par[["f_lo"]], 4),
                           format_num(par[["f_hi"]], 4)))

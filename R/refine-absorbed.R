@@ -74,26 +74,27 @@ take_absorbed <- function(st, cand) {
   nl <- stats::coef(cur)[cur$layout$role == "nonlinear"]
   nl <- nl[!names(nl) %in% names(settings$fixed)]
   moved <- nl
-  moved[intersect(names(cand$start), names(moved))] <- cand$start[intersect(names(cand$start), names(moved))]
+  again <- intersect(names(cand$start), names(moved))
+  moved[again] <- cand$start[again]
   best <- NULL
+  c1 <- Inf
   for (start in unique(list(moved, nl))) {
     args <- refit_args(cur, c(tm), settings, start = start)
     if (!is.null(st$tau_range)) args$tau_range <- c(st$tau_range[1L], Inf)
     r <- state_refit(st, args, "refit with an instance another took on the curve", cand$effect, step)
     st <- r$st
-    if (!is.null(r$fit) && is.finite(refine_crit(st, r$fit)) &&
-        (is.null(best) || refine_crit(st, r$fit) < refine_crit(st, best))) {
+    c_r <- if (is.null(r$fit)) Inf else refine_crit(st, r$fit)
+    if (is.finite(c_r) && c_r < c1) {
       best <- r$fit
+      c1 <- c_r
     }
   }
   if (is.null(best)) return(st)
   c0 <- refine_crit(st, cur)
-  c1 <- refine_crit(st, best)
   par <- instance_params(stats::coef(best), best$layout, lab)
   ev <- raw_evidence(cand$effect, as.list(par), st$raw, diag_series(st$raw),
                      st$args$freq, best, lab)
-  if (c1 > c0 + st$args$min_gain || !isTRUE(ev$support) ||
-      !all(earlier_broken(st, best) %in% earlier_broken(st, cur))) {
+  if (!isTRUE(ev$support) || !taken_at_raw_values(st, best, cur)) {
     st$rejected <- add_rejected(st$rejected, step, cand$effect, par, sprintf(
       "in the reach of %s: held at the raw data's values it %s",
       cand$what,

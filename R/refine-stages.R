@@ -353,14 +353,20 @@ stage_hold <- function(st) {
     f <- r$fit
     if (is.null(f)) return(st)
   }
-  if (!length(notes) || refine_crit(st, f) > refine_crit(st, cur) + st$args$min_gain ||
-      !all(earlier_broken(st, f) %in% earlier_broken(st, cur))) {
-    return(st)
-  }
+  if (!length(notes) || !taken_at_raw_values(st, f, cur)) return(st)
   st <- note_at_end(st, notes)
   st$settings <- settings
   st$current <- f
   st
+}
+
+# A refit `f` of the model `cur` with values held at the raw data's
+# (measured, not charged) is taken when its criterion rises less than
+# `min_gain` and it leaves no effect contradicted by the raw data that
+# `cur` did not (stage_hold(), stage_absorbed()).
+taken_at_raw_values <- function(st, f, cur) {
+  refine_crit(st, f) <= refine_crit(st, cur) + st$args$min_gain &&
+    all(earlier_broken(st, f) %in% earlier_broken(st, cur))
 }
 
 # Each step whose label `notes` names gets that note at the end of its

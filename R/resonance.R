@@ -200,7 +200,7 @@ resonance_absorbs <- function(par, raw) {
   # (one of a run's two resonances has its own centre and width only)
   lo <- if (is.null(b$f_from)) b$f_center - b$width / 2 else b$f_from
   hi <- if (is.null(b$f_to)) b$f_center + b$width / 2 else b$f_to
-  wd <- max(hi - lo, 4 * res)
+  wd <- band_reach(list(f_from = lo, f_to = hi), res)
   list(lo = lo - wd, hi = hi + wd, start = c(fr = b$f_center, tc = b$tc),
        what = sprintf("the resonance at %s Hz", format_num(b$f_center, 4)))
 }
