@@ -656,10 +656,14 @@ record_taper <- function(n) {
 # (the background PSD, a function of f) outside the lines' lobes is
 # significant (5 sd of a sum of bins whose taper correlates them over its
 # 2-bin noise bandwidth) and at least a tenth of the lines' excess (else it
-# is the lines' own shoulder or an error of the background). Returns
-# list(lines = frequencies, line_power, band = logical, band_power,
-# rest_ratio = the excess outside the lines' lobes over the background there).
-record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
+# may be the lines' own shoulder or an error of the background), or, when
+# `far` (Hz) is given, significant by itself beyond `far` of every line,
+# where no line's shoulder reaches (a measured accelerometer's band, 9% of
+# a strong line's power 0.7 Hz beside it, stood 11-18 sd out there and was
+# lost). Returns list(lines = frequencies, line_power, band = logical,
+# band_power, rest_ratio = the excess outside the lines' lobes over the
+# background there).
+record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3, far = NULL) {
   nb <- length(rp$psd)
   i_lo <- max(2L, floor(f_lo / rp$df) + 1L)
   i_hi <- min(nb - 1L, ceiling(f_hi / rp$df) + 1L)
@@ -696,8 +700,11 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3) {
   if (!length(lines)) return(none)
   e_rest <- sum(p[rest] - b[rest])
   sd_rest <- sqrt(2 * sum(b[rest]^2))
+  significant <- function(k) length(k) > 0L && sum(p[k] - b[k]) > 5 * sqrt(2 * sum(b[k]^2))
+  beyond <- if (is.null(far)) integer()
+    else rest[vapply(rp$f[ext[rest]], function(f) all(abs(f - lines) > far), NA)]
   band <- length(rest) > 0L && e_rest > 5 * sd_rest &&
-    e_rest * rp$df > 0.1 * sum(lpow)
+    (e_rest * rp$df > 0.1 * sum(lpow) || significant(beyond))
   list(lines = lines, line_power = lpow, band = band,
        band_power = max(e_rest, 0) * rp$df,
        rest_ratio = if (length(rest)) e_rest / sum(b[rest]) else NA_real_)
@@ -808,7 +815,7 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     on <- numeric()
     for (k in seq_along(r2$from)) {
       sh <- record_peak_shape(rp, w$f[r2$from[k]] - w$df, w$f[r2$to[k]] + w$df,
-                              bgf, alpha)
+                              bgf, alpha, far = w$df)
       if (sh$band && length(sh$lines)) {
         sh$band <- line_free_run(x, freq, seg, sh$lines, r2$from[k]:r2$to[k], bg,
                                  stands_out, min_bins)
