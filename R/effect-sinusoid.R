@@ -204,6 +204,13 @@ effect_sinusoid <- function() {
                              diag_value(raw, "freq"))
       sharp <- if (is.null(lines$record_amp)) logical(nrow(lines))
         else is_sharp(lines$record_amp, lines$amp)
+      # a sharp line where a band is read (its band or that band's
+      # background) enters at its measured amplitude: sized free on the
+      # curve it took 10-15% more and, with it, the band's power (a line
+      # 0.6 Hz beside a measured accelerometer's 9.9 Hz band: the band was
+      # lost); the record's least-squares sinusoid measures it
+      on_band <- sharp & lines$f0 %in% band_reach_lines(diag_part(raw, "bands"), lines,
+                                                        diag_value(raw, "freq"))
       for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
         if (!lines$visible[j]) next
@@ -226,7 +233,8 @@ effect_sinusoid <- function() {
           # there cannot take the power of the set's lines not yet in the
           # model (a square wave's 9th and 11th harmonics, free, took 2.8
           # x their lines, and the axis's resonance beside them was lost)
-          pin = if (any(stronger) && sharp[j]) list(f0 = f0, amp = lines$amp[j])
+          pin = if (on_band[j]) list(f0 = f0, amp = lines$record_amp[j])
+            else if (any(stronger) && sharp[j]) list(f0 = f0, amp = lines$amp[j])
             else list(f0 = f0),
           note = sprintf("proposed by a periodogram line at %s Hz%s",
                          format_num(f0, 4), src))
