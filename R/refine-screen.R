@@ -99,13 +99,13 @@ screen_trial <- function(st, tr, nl_now) {
     !is.null(f) && is.finite(crit(f)) && crit(f) < c0 - min_gain && f$chi2 < 0.9 * cur$chi2
   }
   freed <- FALSE
-  if (!set_line && max_share(new, lab) < 0.02) {
+  if (!set_line && max_share(new, lab, settings$fixed) < 0.02) {
     if (!length(hold_now)) return(list(st = st, cand = NULL))
     r <- refit_from(st, cur, new, settings, pin, "free refit of a screen that explains little",
                     tr$effect)
     st <- r$st
     free <- r$fit
-    if (!free_pays(free) || max_share(free, lab) < 0.02) return(list(st = st, cand = NULL))
+    if (!free_pays(free) || max_share(free, lab, settings$fixed) < 0.02) return(list(st = st, cand = NULL))
     new <- free
     c1 <- crit(free)
     freed <- TRUE
@@ -146,7 +146,7 @@ screen_trial <- function(st, tr, nl_now) {
                       "refit at the raw data's shape", tr$effect)
       st <- r$st
       g <- r$fit
-      if (free_pays(g) && max_share(g, lab) >= 0.02) {
+      if (free_pays(g) && max_share(g, lab, settings$fixed) >= 0.02) {
         jg <- judge_instance(st, g, tr$effect, lab, tau)
         if (is.null(jg$why)) {
           new <- g
@@ -185,7 +185,7 @@ screen_trial <- function(st, tr, nl_now) {
       held <- r$fit
       c_held <- if (is.null(held)) Inf else refine_crit_held(st, held, length(keep))
       if (is.finite(c_held) && c_held < c0 - min_gain &&
-          held$chi2 < 0.9 * cur$chi2 && max_share(held, lab) >= 0.02) {
+          held$chi2 < 0.9 * cur$chi2 && max_share(held, lab, settings$fixed) >= 0.02) {
         jh <- judge_instance(st, held, tr$effect, lab, tau)
         if (is.null(jh$why)) {
           new <- held
@@ -232,7 +232,7 @@ screen_trial <- function(st, tr, nl_now) {
     rel <- refit_with(cur, c(tm), tr$effect, tr$pin[[1L]], settings, local = TRUE)
     st$failures <- record_conditions(st$failures, rel$conditions, st$step, tr$effect)
     f <- rel$fit
-    if (!is.null(f) && is.finite(crit(f)) && crit(f) < c1 && max_share(f, lab) >= 0.02) {
+    if (!is.null(f) && is.finite(crit(f)) && crit(f) < c1 && max_share(f, lab, settings$fixed) >= 0.02) {
       jr <- judge_instance(st, f, tr$effect, lab, tau)
       if (is.null(jr$why)) {
         new <- f
@@ -312,7 +312,7 @@ split_trial <- function(st, tr, tm, jd, lab, settings, pin, c1) {
   j1 <- judge_instance(out$st, f, tr$effect, lab, tau)
   j2 <- judge_instance(out$st, f, tr$effect, lab2, tau)
   if (!is.null(j1$why) || !is.null(j2$why) || !isTRUE(j1$ev$support) ||
-      !isTRUE(j2$ev$support) || min(max_share(f, lab), max_share(f, lab2)) < 0.02) {
+      !isTRUE(j2$ev$support) || min(max_share(f, lab, settings$fixed), max_share(f, lab2, settings$fixed)) < 0.02) {
     return(out)
   }
   j1$ev$text <- sprintf("%s; split in two, %s with %s (%s): %s", j1$ev$text, lab, lab2,
@@ -573,7 +573,7 @@ rechoose_descriptions <- function(st) {
         st <- r$st
         f <- r$fit
         if (is.null(f) || !is.finite(refine_crit(st, f)) ||
-            f$chi2 >= cur$chi2 || max_share(f, lab) < 0.02) next
+            f$chi2 >= cur$chi2 || max_share(f, lab, settings$fixed) < 0.02) next
         c_f <- refine_crit(st, f)
         pays <- c_f < min(c0, best$crit %||% Inf) - st$args$min_gain
         # one the curve cannot tell from the model: the raw short-lag
@@ -773,7 +773,7 @@ raw_pairs <- function(st) {
       if (!pays && is.null(fm)) break
       if (!pays) next
       if (c1 >= (st$best$crit %||% Inf) ||
-          min(max_share(f, lab1), max_share(f, lab2)) < 0.02) next
+          min(max_share(f, lab1, st$settings$fixed), max_share(f, lab2, st$settings$fixed)) < 0.02) next
       j1 <- judge_instance(st, f, t1$effect, lab1, tau)
       if (!is.null(j1$why) || !isTRUE(j1$ev$support)) next
       j2 <- judge_instance(st, f, t2$effect, lab2, tau)
@@ -873,7 +873,7 @@ family_pairs <- function(st) {
         if (is.null(f)) next
         c1 <- refine_crit(st, f)
         if (!is.finite(c1) || c1 >= c0 - min_gain || f$chi2 >= 0.9 * cur$chi2 ||
-            c1 >= (st$best$crit %||% Inf) || max_share(f, lab) < 0.02) next
+            c1 >= (st$best$crit %||% Inf) || max_share(f, lab, settings$fixed) < 0.02) next
         jd <- judge_instance(st, f, tr$effect, lab, tau)
         if (!is.null(jd$why) || !isTRUE(jd$ev$support)) next
         fj <- judge_form(st, f, v, vlab)
