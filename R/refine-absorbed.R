@@ -28,6 +28,22 @@ stage_absorbed <- function(st, max_absorbed = 4L) {
   st
 }
 
+# Every candidate of stage_absorbed() on the current model, strongest
+# first (at most `max_absorbed`): the seeds a revisit takes first
+# (stage_revisit()).
+absorbed_seeds <- function(st, max_absorbed = 4L) {
+  out <- list()
+  if (is.null(st$raw)) return(out)
+  tried <- numeric()
+  for (round in seq_len(max_absorbed)) {
+    cand <- absorbed_candidate(st, st$current, tried)
+    if (is.null(cand)) break
+    tried <- c(tried, cand$at)
+    out[[length(out) + 1L]] <- cand
+  }
+  out
+}
+
 # The strongest unheld instance (the catalogue's `unheld`) inside the
 # reach of an instance of `fit` that `absorbs` it, not at a place in
 # `tried`: list(effect, values, at, label (the absorbing instance), start
