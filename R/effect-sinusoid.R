@@ -204,13 +204,12 @@ effect_sinusoid <- function() {
                              diag_value(raw, "freq"))
       sharp <- if (is.null(lines$record_amp)) logical(nrow(lines))
         else is_sharp(lines$record_amp, lines$amp)
-      # a sharp line where a band is read (its band or that band's
-      # background) enters at its measured amplitude: sized free on the
-      # curve it took 10-15% more and, with it, the band's power (a line
-      # 0.6 Hz beside a measured accelerometer's 9.9 Hz band: the band was
-      # lost); the record's least-squares sinusoid measures it
-      on_band <- sharp & lines$f0 %in% band_reach_lines(diag_part(raw, "bands"), lines,
-                                                        diag_value(raw, "freq"))
+      # a sharp line where a band's shape has power enters at its measured
+      # amplitude: sized free on the curve it took 10-15% more and, with
+      # it, the band's power (a line 0.6 Hz beside a measured
+      # accelerometer's 9.9 Hz band: the band was lost); the record's
+      # least-squares sinusoid measures it
+      on_band <- sharp & lines$f0 %in% lines_by_band_shape(diag_part(raw, "bands"), lines)
       for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
         if (!lines$visible[j]) next

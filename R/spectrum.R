@@ -416,6 +416,18 @@ band_reach_lines <- function(bands, lines, freq, seg = 512L) {
   lines$f0[on]
 }
 
+# The frequencies of `lines` on a band of `bands` or within its width
+# (FWHM) of it, where the band's shape has power the curve can trade for
+# a line's (not its whole background reach: a line 5 Hz below a broad
+# band's run is apart from it).
+lines_by_band_shape <- function(bands, lines) {
+  if (!NROW(bands) || !NROW(lines)) return(numeric())
+  on <- vapply(lines$f0, function(f) {
+    any(f >= bands$f_from - bands$width & f <= bands$f_to + bands$width)
+  }, NA)
+  lines$f0[on]
+}
+
 # The series without the lines of `lines` (the lines part) where a band of
 # `bands` is measured (band_reach_lines()), each its least-squares sinusoid
 # over the record; `x` itself when there are none.
