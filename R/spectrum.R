@@ -416,15 +416,16 @@ band_reach_lines <- function(bands, lines, freq, seg = 512L) {
   lines$f0[on]
 }
 
-# The frequencies of `lines` on a band of `bands` or within its width
-# (FWHM) of it, where the band's shape has power the curve can trade for
-# a line's (not its whole background reach: a line 5 Hz below a broad
-# band's run is apart from it).
+# The frequencies of `lines` on a band of `bands` or within twice its
+# width (FWHM; at least 4 bins of the bands' resolution) of its run, where
+# the band's shape still has a tenth of its peak power or more and the
+# curve can trade it for a line's (a line 1 Hz, 1.5 FWHM, from a measured
+# accelerometer's 9.84 Hz resonance took its power). Not a broad band's
+# whole background reach: a line 5 Hz below such a run is apart from it.
 lines_by_band_shape <- function(bands, lines) {
   if (!NROW(bands) || !NROW(lines)) return(numeric())
-  on <- vapply(lines$f0, function(f) {
-    any(f >= bands$f_from - bands$width & f <= bands$f_to + bands$width)
-  }, NA)
+  wd <- pmax(2 * bands$width, 4 * (attr(bands, "resolution") %||% 0))
+  on <- vapply(lines$f0, function(f) any(f >= bands$f_from - wd & f <= bands$f_to + wd), NA)
   lines$f0[on]
 }
 
