@@ -1,13 +1,14 @@
 # A line added beside a measured accelerometer's own ~10 Hz band (the
 # ADIS16405 records of ../shared/data, never shipped): on each of the 9
 # accelerometer axes a line 5-15% below or above 9.9 Hz at 0.3-0.6 x the
-# axis's white sd (seed 4301). Each case runs the loop as analyze_imu()
+# axis's white sd (seed 4301 unless given). Each case runs the loop as analyze_imu()
 # does per axis, with and without the line, and prints: the line named
 # (within 3%), N against the run without it, the band or resonance centres
-# of both runs, and their terms.
-#   R_LIBS=/tmp/lib Rscript bench/line-beside-axis-band.R [data dir]
+# of both runs, and their terms. Another seed draws other lines.
+#   R_LIBS=/tmp/lib Rscript bench/line-beside-axis-band.R [data dir] [seed]
 args <- commandArgs(TRUE)
 dir <- if (length(args)) args[1] else "../shared/data"
+seed <- if (length(args) > 1L) as.integer(args[2]) else 4301L
 suppressMessages(library(allanvar))
 options(allanvar.threads = 1L)
 run <- function(x, freq) {
@@ -17,7 +18,7 @@ run <- function(x, freq) {
        f0 = cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))],
        band = cf[grepl("resonance[0-9]\\.fr$|band[0-9]\\.f_c$", names(cf))])
 }
-set.seed(4301)
+set.seed(seed)
 k <- 0; named <- 0; nok <- 0; same_band <- 0
 for (u in 1:3) for (ax in c("accel_x", "accel_y", "accel_z")) {
   m <- readRDS(file.path(dir, sprintf("adis16405_unit%d.rds", u)))
