@@ -17,15 +17,7 @@
 # stage_hold() charges none), the raw data still confirm it and every
 # earlier effect keeps its raw-data support. At most `max_absorbed`.
 stage_absorbed <- function(st, max_absorbed = 4L) {
-  if (is.null(st$raw)) return(st)
-  tried <- numeric()
-  for (round in seq_len(max_absorbed)) {
-    cand <- absorbed_candidate(st, st$current, tried)
-    if (is.null(cand)) break
-    tried <- c(tried, cand$at)
-    st <- take_absorbed(st, cand)
-  }
-  st
+  each_absorbed(st, take_absorbed, max_absorbed)
 }
 
 # Every candidate of stage_absorbed() on the current model, strongest
@@ -33,15 +25,25 @@ stage_absorbed <- function(st, max_absorbed = 4L) {
 # (stage_revisit()).
 absorbed_seeds <- function(st, max_absorbed = 4L) {
   out <- list()
-  if (is.null(st$raw)) return(out)
+  each_absorbed(st, function(s, cand) {
+    out[[length(out) + 1L]] <<- cand
+    s
+  }, max_absorbed)
+  out
+}
+
+# `take(st, cand)` for each absorbed_candidate() in turn (on the model as
+# `take` leaves it), each place once; the state `take` returns last.
+each_absorbed <- function(st, take, max_absorbed) {
+  if (is.null(st$raw)) return(st)
   tried <- numeric()
   for (round in seq_len(max_absorbed)) {
     cand <- absorbed_candidate(st, st$current, tried)
     if (is.null(cand)) break
     tried <- c(tried, cand$at)
-    out[[length(out) + 1L]] <- cand
+    st <- take(st, cand)
   }
-  out
+  st
 }
 
 # The strongest unheld instance (the catalogue's `unheld`) inside the

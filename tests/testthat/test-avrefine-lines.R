@@ -809,6 +809,20 @@ test_that("a strong line beside a weak band enters at its measured amplitude, an
   expect_equal(n_reading(rx), n_reading(rb), tolerance = 0.01)
 })
 
+# a line of `amp` x the white sd at f0 Hz added to a measured axis beside
+# its own band: the line named, the terms those of the run without it and
+# the line, the band where it was and N within 1%; the run with the line
+line_beside_axis_band <- function(unit, axis, amp, f0, phase) {
+  ax <- measured_axis(unit, axis)
+  r0 <- loop(ax$b, ax$freq)
+  r <- loop(with_wave(ax, amp, f0, phase), ax$freq)
+  expect_lte(min(abs(fitted_f0(r) / f0 - 1)), 0.01)
+  expect_setequal(r$terms, c(r0$terms, "sinusoid"))
+  expect_equal(unname(band_centre(r)), unname(band_centre(r0)), tolerance = 0.01)
+  expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.01)
+  invisible(r)
+}
+
 test_that("a line beside a measured accelerometer's weak resonance: the resonance stays beside the line held at its amplitude", {
   # unit 3 accel_z carries a 9.84 Hz resonance of 1% of its variance; a
   # 9.13 Hz line of 0.42 x the white sd is added. With the line pinned at
@@ -817,13 +831,7 @@ test_that("a line beside a measured accelerometer's weak resonance: the resonanc
   # the denominator) and was dropped as a refit artefact (on main 6bd0c80)
   skip_if_no_shared()
   skip_on_cran()
-  ax <- measured_axis(3, "accel_z")
-  r0 <- loop(ax$b, ax$freq)
-  r <- loop(with_wave(ax, 0.42, 9.13, 6.12), ax$freq)
-  expect_lte(min(abs(fitted_f0(r) / 9.13 - 1)), 0.01)
-  expect_setequal(r$terms, c(r0$terms, "sinusoid"))
-  expect_equal(unname(band_centre(r)), unname(band_centre(r0)), tolerance = 0.01)
-  expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.01)
+  line_beside_axis_band(3, "accel_z", 0.42, 9.13, 6.12)
 })
 
 test_that("a line a measured accelerometer's resonance took at step 2 is taken first on a revisit", {
@@ -834,13 +842,7 @@ test_that("a line a measured accelerometer's resonance took at step 2 is taken f
   # N +5% (on main 9b7b4be). The revisit takes the line first.
   skip_if_no_shared()
   skip_on_cran()
-  ax <- measured_axis(1, "accel_y")
-  r0 <- loop(ax$b, ax$freq)
-  r <- loop(with_wave(ax, 0.32, 8.46, 3.72), ax$freq)
-  expect_lte(min(abs(fitted_f0(r) / 8.46 - 1)), 0.01)
-  expect_setequal(r$terms, c(r0$terms, "sinusoid"))
-  expect_equal(unname(band_centre(r)), unname(band_centre(r0)), tolerance = 0.01)
-  expect_lte(abs(n_reading(r) / n_reading(r0) - 1), 0.01)
+  r <- line_beside_axis_band(1, "accel_y", 0.32, 8.46, 3.72)
   expect_true(isTRUE(r$refine$revisit$kept[2L]))
   expect_match(r$steps$evidence[1L], "taken first on a revisit")
   expect_lt(r$chi2 / r$df.residual, 4)
