@@ -24,12 +24,12 @@ stage_absorbed <- function(st, max_absorbed = 4L) {
 # first (at most `max_absorbed`): the seeds a revisit takes first
 # (stage_revisit()).
 absorbed_seeds <- function(st, max_absorbed = 4L) {
-  out <- list()
-  each_absorbed(st, function(s, cand) {
-    out[[length(out) + 1L]] <<- cand
+  st$seen <- list()                # (on this copy of the state only)
+  st <- each_absorbed(st, function(s, cand) {
+    s$seen[[length(s$seen) + 1L]] <- cand
     s
   }, max_absorbed)
-  out
+  st$seen
 }
 
 # `take(st, cand)` for each absorbed_candidate() in turn (on the model as
