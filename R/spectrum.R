@@ -712,12 +712,10 @@ record_peak_shape <- function(rp, f_lo, f_hi, bg, alpha = 1e-3, far = NULL) {
   rest <- reg[!masked[reg]]
   if (!length(lines)) return(none)
   e_rest <- sum(p[rest] - b[rest])
-  sd_rest <- sqrt(2 * sum(b[rest]^2))
   significant <- function(k) length(k) > 0L && sum(p[k] - b[k]) > 5 * sqrt(2 * sum(b[k]^2))
   beyond <- if (is.null(far)) integer()
-    else rest[vapply(rp$f[ext[rest]], function(f) all(abs(f - lines) > far), NA)]
-  band <- length(rest) > 0L && e_rest > 5 * sd_rest &&
-    (e_rest * rp$df > 0.1 * sum(lpow) || significant(beyond))
+    else rest[rowSums(abs(outer(rp$f[ext[rest]], lines, "-")) <= far) == 0]
+  band <- significant(rest) && (e_rest * rp$df > 0.1 * sum(lpow) || significant(beyond))
   list(lines = lines, line_power = lpow, band = band,
        band_power = max(e_rest, 0) * rp$df,
        rest_ratio = if (length(rest)) e_rest / sum(b[rest]) else NA_real_)
