@@ -209,7 +209,7 @@ effect_sinusoid <- function() {
       # it, the band's power (a line 0.6 Hz beside a measured
       # accelerometer's 9.9 Hz band: the band was lost); the record's
       # least-squares sinusoid measures it
-      on_band <- sharp & lines$f0 %in% lines_by_band_shape(diag_part(raw, "bands"), lines)
+      on_band <- sharp & by_band_shape(diag_part(raw, "bands"), lines$f0)
       for (j in seq_len(nrow(lines))) {
         f0 <- lines$f0[j]
         if (!lines$visible[j]) next

@@ -405,28 +405,30 @@ bands_without_lines <- function(x, freq, lines, welch = centred_welch) {
 # background: the band's width, at least 4 Welch bins of width `df`.
 band_reach <- function(bands, df) pmax(bands$f_to - bands$f_from, 4 * df)
 
+# Which of the frequencies `f` lie on a band's run of `bands` or within
+# `wd` (per band) either side of it.
+near_band_runs <- function(bands, f, wd) {
+  vapply(f, function(x) any(x >= bands$f_from - wd & x <= bands$f_to + wd), NA)
+}
+
 # The frequencies of `lines` (rows with f0; those lines_outside_bands()
 # keeps) that sit where a band of `bands` is measured (measure_band(): the
 # band and its background either side, band_reach() at Welch segments of
 # `seg` samples).
 band_reach_lines <- function(bands, lines, freq, seg = 512L) {
   if (!NROW(bands) || !NROW(lines)) return(numeric())
-  wd <- band_reach(bands, freq / seg)
-  on <- vapply(lines$f0, function(f) any(f >= bands$f_from - wd & f <= bands$f_to + wd), NA)
-  lines$f0[on]
+  lines$f0[near_band_runs(bands, lines$f0, band_reach(bands, freq / seg))]
 }
 
-# The frequencies of `lines` on a band of `bands` or within twice its
+# Which of the frequencies `f` lie on a band of `bands` or within twice its
 # width (FWHM; at least 4 bins of the bands' resolution) of its run, where
 # the band's shape still has a tenth of its peak power or more and the
 # curve can trade it for a line's (a line 1 Hz, 1.5 FWHM, from a measured
 # accelerometer's 9.84 Hz resonance took its power). Not a broad band's
 # whole background reach: a line 5 Hz below such a run is apart from it.
-lines_by_band_shape <- function(bands, lines) {
-  if (!NROW(bands) || !NROW(lines)) return(numeric())
-  wd <- pmax(2 * bands$width, 4 * (attr(bands, "resolution") %||% 0))
-  on <- vapply(lines$f0, function(f) any(f >= bands$f_from - wd & f <= bands$f_to + wd), NA)
-  lines$f0[on]
+by_band_shape <- function(bands, f) {
+  if (!NROW(bands)) return(logical(length(f)))
+  near_band_runs(bands, f, pmax(2 * bands$width, 4 * (attr(bands, "resolution") %||% 0)))
 }
 
 # The series without the lines of `lines` (the lines part) where a band of
