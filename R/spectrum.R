@@ -993,7 +993,10 @@ find_bands <- function(x, freq, seg = 512L, min_bins = 3L, alpha = 1e-3,
     for (k in which(skirt)) {
       nb_lo <- k > 1L && r2$from[k] - r2$to[k - 1L] <= 2L
       nb_hi <- k < length(fits) && r2$from[k + 1L] - r2$to[k] <= 2L
-      if (!nb_lo && !nb_hi) {
+      # a piece stronger than each neighbour it borders is no skirt of theirs
+      # (a 9.9 Hz band cut from a stretch of background 8% high at 7.6 Hz)
+      nbr <- c(if (nb_lo) k - 1L, if (nb_hi) k + 1L)
+      if (!length(nbr) || fits[[k]]$sigma > max(vapply(fits[nbr], `[[`, 0, "sigma"))) {
         skirt[k] <- FALSE
         next
       }
