@@ -20,7 +20,8 @@
 # before any run on them, once the sets before were in use ("d" also has
 # simulated axes that carry a sensor's own filter, line and resonance);
 # set "h" draws every class afresh from one seed (an out-of-sample check),
-# set "i" from another, sets "k" and "l" from two more.
+# set "i" from another, sets "k" and "l" from two more, set "m" from a
+# fifth (session 45).
 #
 # The recordings stay in the shared data directory (never shipped).
 suppressPackageStartupMessages(library(allanvar))
@@ -120,6 +121,17 @@ extra_kinds <- function(r, base, expect, harmonics_of = NULL) {
   }
   if (length(out)) paste(out, collapse = "+") else ""
 }
+# A control's effects beyond N, B, K and the kinds its generator put in by
+# design (a simulated sensor's filter, band and line), each counted.
+control_extra <- function(r, design = NULL) {
+  k <- kinds_all(r)
+  k <- k[!k %in% c("N", "B", "K")]
+  for (d in design) {
+    i <- match(d, k)
+    if (!is.na(i)) k <- k[-i]
+  }
+  paste(k, collapse = "+")
+}
 # the run without the effect's effects that the run with it lost (an added
 # effect must not replace or displace what the axis already has)
 lost_kinds <- function(r, base) extra_kinds(base, r, character())
@@ -127,8 +139,11 @@ contradicted <- function(r) sum(r$steps$confirmed %in% FALSE)
 
 # ---- cases --------------------------------------------------------------------
 # Each case: a function(seed) returning list(x, base, expect = list(kind,
-# value) pairs); base NULL for a control (the run is compared with nothing).
+# value) pairs); base NULL for a control (the run is compared with nothing;
+# `design`: the kinds a simulated sensor carries by design, which its
+# control may name: its filter, band and line).
 n_sim <- 5e5
+sensor_design <- c("filter", "band", "sinusoid")
 sim_base <- function(n = n_sim) g_white(n, 0.01) + g_rw(n, 1e-4)
 cases <- list(
   "sim: line 49.3 Hz at 100 Hz, amp = white sd" = function() {
@@ -397,7 +412,7 @@ if (identical(set, "d")) {
     "sim sensor: band 4 Hz" = function() {
       b <- sensor_base(); list(x = b + g_band(n_sim, 0.006, 4, 0.3), base = b, expect = list(list("band", 4)))
     },
-    "control: sim sensor as it is" = function() list(x = sensor_base(), base = NULL),
+    "control: sim sensor as it is" = function() list(x = sensor_base(), base = NULL, design = sensor_design),
     "control: N + K (seed 4)" = function() list(x = sim_base(), base = NULL),
     "control: N + B + K low B" = function() list(x = sim_base() + g_flicker(n_sim, 3e-4), base = NULL)
   )
@@ -465,7 +480,7 @@ if (identical(set, "e")) {
       b <- sensor_base(); sz <- g_step_size(b)
       list(x = b + g_step(n_sim, 2800, sz), base = b, expect = list(list("steps", c(2800, sz))))
     },
-    "control: sim sensor as it is" = function() list(x = sensor_base(), base = NULL),
+    "control: sim sensor as it is" = function() list(x = sensor_base(), base = NULL, design = sensor_design),
     "control: N + K (seed 5)" = function() list(x = sim_base(), base = NULL),
     "control: N + B + K" = function() list(x = sim_base() + g_flicker(n_sim, 6e-4), base = NULL)
   )
@@ -545,7 +560,7 @@ if (identical(set, "f")) {
       b <- sensor_base(); sz <- g_step_size(b)
       list(x = b + g_step(n_sim, 1700, sz), base = b, expect = list(list("steps", c(1700, sz))))
     },
-    "control: sim lp sensor as it is" = function() list(x = sensor_base(), base = NULL),
+    "control: sim lp sensor as it is" = function() list(x = sensor_base(), base = NULL, design = sensor_design),
     "control: N + K + R (seed 6)" = function() {
       t <- seq_len(n_sim) / freq
       list(x = sim_base() + 3e-7 * t, base = NULL)
@@ -592,9 +607,9 @@ if (identical(set, "g")) {
 # two effects per measured axis. An out-of-sample check of what sets a-g
 # were fixed against. Set "i" draws the same classes from another seed
 # (session 33, written before any run on it); sets "k" and "l" from two
-# more (session 40, likewise).
-if (set %in% c("h", "i", "k", "l")) {
-  set.seed(c(h = 4300, i = 4500, k = 5100, l = 5500)[[set]])
+# more (session 40, likewise); set "m" from a fifth (session 45, likewise).
+if (set %in% c("h", "i", "k", "l", "m")) {
+  set.seed(c(h = 4300, i = 4500, k = 5100, l = 5500, m = 6100)[[set]])
   lu <- function(lo, hi) round(exp(runif(1, log(lo), log(hi))), 1)
   ru <- function(lo, hi, d = 2) round(runif(1, lo, hi), d)
   h_white <- ru(0.005, 0.02, 4)
@@ -668,7 +683,9 @@ if (set %in% c("h", "i", "k", "l")) {
   cases[[sprintf("sim sensor: warm-up tc %s s", p$wu3)]] <- function() {
     b <- sensor_base(); list(x = b + g_warmup(b, p$wu3), base = b, expect = list(list("warmup", p$wu3)))
   }
-  cases[["control: sim sensor (h) as it is"]] <- function() list(x = sensor_base(), base = NULL)
+  cases[["control: sim sensor (h) as it is"]] <- function() {
+    list(x = sensor_base(), base = NULL, design = sensor_design)
+  }
   cases[["control: N + K (h)"]] <- function() list(x = sim_base(), base = NULL)
   cases[["control: N + B + K (h)"]] <- function() {
     list(x = sim_base() + g_flicker(n_sim, 0.04 * h_white), base = NULL)
@@ -833,7 +850,7 @@ if (identical(set, "j")) {
         x <- switch(what, sensor = sensor_base(), "N + K" = sim_base(),
                     "N + B + K" = sim_base() + g_flicker(n_j, 0.04 * j_white),
                     "Q + N + K" = round(sim_base() / (2 * wsd())) * (2 * wsd()))
-        list(x = x, base = NULL)
+        list(x = x, base = NULL, design = if (what == "sensor") sensor_design)
       })
     })
   })
@@ -908,7 +925,7 @@ for (nm in grep(only, names(cases), value = TRUE)) {
   # (BATTERY_SEED_OFFSET=k shifts every case's seed: the same cases on
   # other noise, to see whether a change generalises)
   set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500, f = 3700, g = 3900, h = 4100,
-             i = 4700, j = 4900, k = 5300, l = 5700)[[set]] +
+             i = 4700, j = 4900, k = 5300, l = 5700, m = 6300)[[set]] +
              match(nm, names(cases)) + as.integer(Sys.getenv("BATTERY_SEED_OFFSET", "0")))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
@@ -916,7 +933,7 @@ for (nm in grep(only, names(cases), value = TRUE)) {
     r <- cached_run(cs$x)
     rows[[length(rows) + 1L]] <- data.frame(
       case = nm, named = NA, got = "", N_change = NA,
-      extra = paste(setdiff(kinds_all(r), c("N", "B", "K")), collapse = "+"), lost = "",
+      extra = control_extra(r, cs$design), lost = "",
       spikes = sprintf("%d", n_spikes(r)),
       contradicted = contradicted(r), chi2 = round(r$chi2, 2), seconds = round(r$seconds, 1))
   } else {
