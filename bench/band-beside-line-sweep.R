@@ -8,24 +8,13 @@
 # the line (a random walk added) and prints its terms, N against the run
 # without the line and the band's centre.
 #   R_LIBS=/tmp/lib Rscript bench/band-beside-line-sweep.R
+# (from the repository root: it sources bench/band-line-helpers.R)
 suppressMessages(library(allanvar))
 options(allanvar.threads = 1L)
 freq <- 100
 n <- 5e5
 t <- seq_len(n) / freq
-ar2_unit <- function(fr, tc, burn = 2000L) {
-  r <- exp(-1 / (freq * tc))
-  z <- as.numeric(stats::filter(rnorm(n + burn), c(2 * r * cos(2 * pi * fr / freq), -r^2),
-                                method = "recursive"))[-seq_len(burn)]
-  z / stats::sd(z)
-}
-run <- function(x) {
-  r <- suppressWarnings(suppressMessages(avrefine(avfit(allan(x, freq), terms = c("N", "B", "K")), data = x)))
-  cf <- coef(r)
-  list(terms = paste(r$terms, collapse = "+"),
-       N = unname(cf[grepl("^N$|^filter[^.]*\\.Nf$", names(cf))][1L]),
-       band = cf[grepl("^resonance[0-9]+\\.fr$|^band[0-9]+\\.f_c$", names(cf))])
-}
+source("bench/band-line-helpers.R")
 configs <- list(c(0.0012, 10.8), c(0.0016, 10.8), c(0.002, 9.0), c(0.0016, 9.1),
                 c(0.0025, 11.2), c(0.0014, 10.6))
 count <- c(alone = 0, with_another = 0, lost = 0)

@@ -7,26 +7,13 @@
 # terms, N against the run without it, the band's centre and the line's
 # fitted f0 and amplitude (true 0.005).
 #   R_LIBS=/tmp/lib Rscript bench/line-beside-sim-band.R
+# (from the repository root: it sources bench/band-line-helpers.R)
 suppressMessages(library(allanvar))
 options(allanvar.threads = 1L)
 freq <- 100
 n <- 5e5
 t <- seq_len(n) / freq
-ar2_unit <- function(fr, tc, burn = 2000L) {
-  r <- exp(-1 / (freq * tc))
-  z <- as.numeric(stats::filter(rnorm(n + burn), c(2 * r * cos(2 * pi * fr / freq), -r^2),
-                                method = "recursive"))[-seq_len(burn)]
-  z / stats::sd(z)
-}
-run <- function(x) {
-  r <- suppressWarnings(suppressMessages(avrefine(avfit(allan(x, freq), terms = c("N", "B", "K")), data = x)))
-  cf <- coef(r)
-  list(terms = paste(r$terms, collapse = "+"),
-       N = unname(cf[grepl("^N$|^filter[^.]*\\.Nf$", names(cf))][1L]),
-       f0 = cf[grepl("^sinusoid[0-9]+\\.f0$", names(cf))],
-       amp = cf[grepl("^sinusoid[0-9]+\\.amp$", names(cf))],
-       band = cf[grepl("^resonance[0-9]+\\.fr$|^band[0-9]+\\.f_c$", names(cf))])
-}
+source("bench/band-line-helpers.R")
 kept <- 0; near <- 0; nok <- 0; k <- 0
 for (seed in 1:4) for (cfg in list(c(0.003, 10.65), c(0.002, 10.7))) {
   set.seed(seed)

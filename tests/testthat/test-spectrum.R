@@ -485,19 +485,27 @@ test_that("find_bands(): a band with a line on top is measured without the line"
   expect_true(any(abs(attr(b, "lines") - 7.6) < 0.01))
 })
 
-test_that("find_bands(): a weak band beside a strong line is a band", {
-  # own generator: an MA(1) sensor filter, a weak 9.9 Hz two-pole band and
-  # a 10.8 Hz line of 0.5 x the white sd, carrying about 9 times the
-  # band's power. The excess beside the line was under a tenth of the
-  # line's, read as the line's shoulder, and the band was lost in 5 of 6
-  # seeds (on main 28eac03); away from the line it stands 10-20 sd out
-  set.seed(1)
-  freq <- 100
+# own generator: white noise (sd 0.01) through an MA(1) sensor filter
+# with a 10.8 Hz line of 0.5 x the white sd (`line`), and a 9.9 Hz
+# two-pole band of unit sd (`z`), 5e5 samples at 100 Hz
+weak_band_and_line <- function(seed) {
+  set.seed(seed)
   n <- 5e5
   w <- rnorm(n + 1L, sd = 0.01)
-  z <- ar2_unit(n, 9.9, 0.3, freq)
-  line <- w[-1L] + 0.25 * w[-(n + 1L)] + 0.005 * sin(2 * pi * 10.8 * seq_len(n) / freq + 1)
-  b <- allanvar:::find_bands(line + 0.0012 * z, freq)
+  z <- ar2_unit(n, 9.9, 0.3, 100)
+  list(line = w[-1L] + 0.25 * w[-(n + 1L)] + 0.005 * sin(2 * pi * 10.8 * seq_len(n) / 100 + 1),
+       z = z)
+}
+
+test_that("find_bands(): a weak band beside a strong line is a band", {
+  # the band at 0.12 x the white sd, the line carrying about 9 times its
+  # power. The excess beside the line was under a tenth of the line's,
+  # read as the line's shoulder, and the band was lost in 5 of 6 seeds (on
+  # main 28eac03); away from the line it stands 10-20 sd out
+  freq <- 100
+  g <- weak_band_and_line(1)
+  line <- g$line
+  b <- allanvar:::find_bands(line + 0.0012 * g$z, freq)
   expect_equal(nrow(b), 1L)
   expect_equal(b$f_center, 9.9, tolerance = 0.02)
   expect_equal(b$tc, 0.3, tolerance = 0.25)
@@ -508,19 +516,14 @@ test_that("find_bands(): a weak band beside a strong line is a band", {
 })
 
 test_that("find_bands(): a band split from a stretch of background beside it is no skirt of that stretch", {
-  # own generator: as above, with the band at 0.16 x the white sd. Seed 2
-  # leaves a stretch of background about 8% high at 7.6 Hz in the band's
-  # run; the two-resonance split cut it off, and the line's side, whose
-  # rest stood 22.5% over the background (under the skirt check's 25%),
-  # was dropped as that stretch's skirt: only a 7.58 Hz "band" was left
-  # (on main 82a0c19). The loop lost the band with it.
-  set.seed(2)
-  freq <- 100
-  n <- 5e5
-  w <- rnorm(n + 1L, sd = 0.01)
-  z <- ar2_unit(n, 9.9, 0.3, freq)
-  x <- w[-1L] + 0.25 * w[-(n + 1L)] + 0.0016 * z + 0.005 * sin(2 * pi * 10.8 * seq_len(n) / freq + 1)
-  b <- allanvar:::find_bands(x, freq)
+  # the band at 0.16 x the white sd. Seed 2 leaves a stretch of
+  # background about 8% high at 7.6 Hz in the band's run; the
+  # two-resonance split cut it off, and the line's side, whose rest stood
+  # 22.5% over the background (under the skirt check's 25%), was dropped
+  # as that stretch's skirt: only a 7.58 Hz "band" was left (on main
+  # 82a0c19). The loop lost the band with it.
+  g <- weak_band_and_line(2)
+  b <- allanvar:::find_bands(g$line + 0.0016 * g$z, 100)
   k <- which.min(abs(b$f_center - 9.9))
   expect_equal(b$f_center[k], 9.9, tolerance = 0.02)
   expect_equal(b$tc[k], 0.3, tolerance = 0.25)
