@@ -112,25 +112,23 @@ extra_kinds <- function(r, base, expect, harmonics_of = NULL) {
     expect <- c(expect[expect != "sinusoid"],
                 rep("sinusoid", sum(round(k) >= 1 & abs(k / round(k) - 1) <= 0.03)))
   }
-  ke <- table(kinds_all(r))
-  kb <- table(kinds_all(base))
+  kinds_beyond(kinds_all(r), c(kinds_all(base), expect))
+}
+# The kinds of `k` beyond those of `allowed`, each counted ("" when none).
+kinds_beyond <- function(k, allowed) {
+  ke <- table(k)
   out <- character()
-  for (k in names(ke)) {
-    allowed <- (if (k %in% names(kb)) kb[[k]] else 0) + sum(expect == k)
-    if (ke[[k]] > allowed) out <- c(out, rep(k, ke[[k]] - allowed))
+  for (x in names(ke)) {
+    n <- ke[[x]] - sum(allowed == x)
+    if (n > 0) out <- c(out, rep(x, n))
   }
-  if (length(out)) paste(out, collapse = "+") else ""
+  paste(out, collapse = "+")
 }
 # A control's effects beyond N, B, K and the kinds its generator put in by
 # design (a simulated sensor's filter, band and line), each counted.
 control_extra <- function(r, design = NULL) {
   k <- kinds_all(r)
-  k <- k[!k %in% c("N", "B", "K")]
-  for (d in design) {
-    i <- match(d, k)
-    if (!is.na(i)) k <- k[-i]
-  }
-  paste(k, collapse = "+")
+  kinds_beyond(k[!k %in% c("N", "B", "K")], design)
 }
 # the run without the effect's effects that the run with it lost (an added
 # effect must not replace or displace what the axis already has)
