@@ -9,11 +9,6 @@
 # without the line and the band's centre.
 #   R_LIBS=/tmp/lib Rscript bench/band-beside-line-sweep.R
 # (from the repository root: it sources bench/band-line-helpers.R)
-suppressMessages(library(allanvar))
-options(allanvar.threads = 1L)
-freq <- 100
-n <- 5e5
-t <- seq_len(n) / freq
 source("bench/band-line-helpers.R")
 configs <- list(c(0.0012, 10.8), c(0.0016, 10.8), c(0.002, 9.0), c(0.0016, 9.1),
                 c(0.0025, 11.2), c(0.0014, 10.6))

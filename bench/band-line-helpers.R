@@ -1,7 +1,13 @@
 # Shared by bench/line-beside-sim-band.R and bench/band-beside-line-sweep.R
-# (sourced from the repository root after `freq` and `n` are set): a
-# two-pole band of unit sd (own generator, stats::filter), and the loop's
-# run as analyze_imu() makes it, read for its terms, N, lines and band.
+# (sourced from the repository root): their record (5e5 samples at 100 Hz,
+# one thread), a two-pole band of unit sd (own generator, stats::filter),
+# and the loop's run as analyze_imu() makes it, read for its terms, N,
+# lines and band.
+suppressMessages(library(allanvar))
+options(allanvar.threads = 1L)
+freq <- 100
+n <- 5e5
+t <- seq_len(n) / freq
 ar2_unit <- function(fr, tc, burn = 2000L) {
   r <- exp(-1 / (freq * tc))
   z <- as.numeric(stats::filter(rnorm(n + burn), c(2 * r * cos(2 * pi * fr / freq), -r^2),

@@ -8,11 +8,6 @@
 # fitted f0 and amplitude (true 0.005).
 #   R_LIBS=/tmp/lib Rscript bench/line-beside-sim-band.R
 # (from the repository root: it sources bench/band-line-helpers.R)
-suppressMessages(library(allanvar))
-options(allanvar.threads = 1L)
-freq <- 100
-n <- 5e5
-t <- seq_len(n) / freq
 source("bench/band-line-helpers.R")
 kept <- 0; near <- 0; nok <- 0; k <- 0
 for (seed in 1:4) for (cfg in list(c(0.003, 10.65), c(0.002, 10.7))) {
