@@ -271,7 +271,18 @@ info_at <- function(acc, n, extend = FALSE) {
 
 info_result <- function(im, I, n) {
   dimnames(I) <- list(im$names, im$names)
-  V <- tryCatch(solve(I), error = function(e) NULL)
+  if (!all(is.finite(I))) {
+    abort("The Fisher information of this model is not finite at `freq` = ",
+          format(im$freq), " Hz and `n` = ", format(n), ": the rate or the ",
+          "record puts its terms beyond double precision.", class = "argument")
+  }
+  # inverted on the unit diagonal: parameters whose information differs by
+  # 20 orders (N and K of a 1000-sample record at 1 MHz) made solve()
+  # call the matrix singular and every bound Inf
+  d <- sqrt(diag(I))
+  V <- if (all(d > 0)) {
+    tryCatch(solve(I / outer(d, d)) / outer(d, d), error = function(e) NULL)
+  }
   rel <- if (is.null(V)) rep(Inf, length(im$names)) else sqrt(pmax(diag(V), 0))
   bound <- data.frame(parameter = im$names, value = unname(im$values),
                       se = unname(im$values * rel), rel_se = unname(rel),

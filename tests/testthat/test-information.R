@@ -133,3 +133,26 @@ test_that("bad models and arguments are refused with classed errors", {
   expect_error(av_plan(c(N = 0.01, K = 1e-3), freq = 1, target = -1),
                class = "allanvar_error_argument")
 })
+
+test_that("information that spans many orders is inverted; information beyond double precision is refused", {
+  # 1000 samples at 1 MHz: K's information is 1e-21 of N's, and solve()
+  # called the matrix singular, every bound Inf (on main 5294e57). The
+  # bounds are the 2 x 2 inverse's, written out (information of the log
+  # parameters): N's about 2%, K's finite but enormous
+  p <- c(N = 0.01, K = 1e-3)
+  b <- av_information(p, n = 1000, freq = 1e6)
+  I <- b$information
+  det <- I[1, 1] * I[2, 2] - I[1, 2]^2
+  expect_equal(b$bound$rel_se, sqrt(c(I[2, 2], I[1, 1]) / det), tolerance = 1e-9)
+  expect_lt(b$bound$rel_se[1], 0.03)
+  expect_gt(b$bound$rel_se[2], 1e6)
+  expect_true(all(is.finite(av_plan(p, freq = 1e6, target = 0.1, n = 1000)$rel_se)))
+  # at 100 Hz the bounds are those of the plain inverse
+  b100 <- av_information(p, n = 1000, freq = 100)
+  expect_equal(b100$bound$rel_se, sqrt(diag(solve(b100$information))), tolerance = 1e-9,
+               ignore_attr = TRUE)
+  expect_error(av_information(p, n = 1000, freq = 1e300), "`freq`",
+               class = "allanvar_error_argument")
+  expect_error(av_plan(p, freq = 1e-300, target = 0.1, n = 1000), "`freq`",
+               class = "allanvar_error_argument")
+})
