@@ -79,6 +79,11 @@
 #                 outlier detector, a step's first sample) or whose
 #                 shape they bend (a warm-up beside a step): it reads the
 #                 series again with the other kinds' instances removed
+#   judge(x, freq, table)  a "series" entry's judge of its instances beside
+#                 the others found (`x`: the series as the pass read it,
+#                 nothing removed; `table`: every instance found): the
+#                 rows of its own kind that stand. Where it drops any,
+#                 the detect_again kinds read the series again without them
 #   known_av(raw, fit, tau, tau0)  the AV, at `tau`, of the instances of
 #                 this entry the raw data measure exactly (every parameter)
 #                 and `fit` does not hold yet (a square wave's sharp
@@ -229,7 +234,7 @@ new_effect <- function(name, title, params, component = "av",
                        exact_edf = NULL, noise_lookalike = FALSE,
                        detect_again = FALSE, known_av = NULL, known_acov = NULL,
                        model_evidence = NULL, apart = NULL, unheld = NULL,
-                       absorbs = NULL) {
+                       absorbs = NULL, judge = NULL) {
   list(name = name, title = title, params = params, component = component,
        repeatable = repeatable, variants = variants, slope = slope,
        psd_alpha = psd_alpha, formula = formula, signature = signature,
@@ -246,7 +251,7 @@ new_effect <- function(name, title, params, component = "av",
        diagnose = diagnose, family = family, exact_edf = exact_edf,
        noise_lookalike = noise_lookalike, detect_again = detect_again,
        known_av = known_av, known_acov = known_acov, model_evidence = model_evidence,
-       apart = apart, unheld = unheld, absorbs = absorbs)
+       apart = apart, unheld = unheld, absorbs = absorbs, judge = judge)
 }
 
 validate_effect <- function(e) {
@@ -283,7 +288,7 @@ validate_effect <- function(e) {
               "raw_hold",
               "peak_tau",
               "discrete", "describe", "detect", "remove", "admissible",
-              "statespace", "exact_edf", "apart", "unheld", "absorbs")) {
+              "statespace", "exact_edf", "apart", "unheld", "absorbs", "judge")) {
     if (!fun_ok(e[[f]])) bad("`", f, "` must be a function or NULL.")
   }
   if (!is.null(e$variants) && !is.function(e$variants)) {

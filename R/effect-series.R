@@ -90,6 +90,20 @@ effect_bias_step <- function() {
       remove_steps(x, data.frame(index = row_index(par, freq, length(x)),
                                  size = par$size))
     },
+    # a step within a warm-up's reach is judged with it by the warm-up's
+    # likelihood (steps_beside_warmup_z()), at the warm-up's own level: the
+    # Allan differences read the exponential's misfit as a step
+    judge = function(x, freq, table) {
+      own <- table[table$kind == "steps", , drop = FALSE]
+      wu <- table[table$kind == "warmup", , drop = FALSE]
+      if (!nrow(own) || !nrow(wu)) return(own)
+      x <- remove_series(x, freq, table[!table$kind %in% c("steps", "warmup"), , drop = FALSE])
+      z <- steps_beside_warmup_z(x, freq, own$time, wu$tc)
+      read <- !is.na(z)
+      own$evidence[read] <- sprintf("%s; beside the warm-up, likelihood ratio z = %s",
+                                    own$evidence[read], format_num(z[read], 2))
+      own[!read | z > warmup_z_level, , drop = FALSE]
+    },
     describe = function(values) {
       sprintf("bias step%s of %s at %s s", if (nrow(values) == 1L) "" else "s",
               paste(format_num(values$size), collapse = ", "),

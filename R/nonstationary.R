@@ -499,7 +499,11 @@ steps_prefix <- function(x, lv, lo, hi) {
 #'   `tc_upper`: the 95% interval of tc, warmup_tc_interval()) of every
 #'   exponential found (none, one or two), strongest first.
 #' @noRd
-detect_warmup <- function(x, freq, z_level = 5, target_blocks = 1000L,
+# (the level at which the warm-up's likelihood names one; steps beside a
+# warm-up are judged at the same level)
+warmup_z_level <- 5
+
+detect_warmup <- function(x, freq, z_level = warmup_z_level, target_blocks = 1000L,
                           min_tc = NULL, max_iter = 4L) {
   n <- length(x)
   tau0 <- 1 / freq

@@ -143,6 +143,8 @@ series_columns <- c("kind", "index", "time", "size", "tc", "duration", "z",
 # other kind's instances out (found or not the first time: a warm-up and a
 # step at its start hide each other), and when that changed what they
 # found, the kinds after them are read again beside it (at most twice).
+# Last, the entries with a judge weigh their instances beside the rest (a
+# step beside a warm-up, by the warm-up's likelihood).
 detect_series <- function(x, freq, kinds) {
   # detectors that read the same thing of the same series compute it once
   series_pass_open()
@@ -188,6 +190,25 @@ detect_series <- function(x, freq, kinds) {
       parts[[k]] <- if (NROW(d)) d
     }
     if (!changed) break
+    parts <- pass(held)
+  }
+  # each entry's judge of its instances beside the others; where one drops
+  # any, the detect_again kinds read the series again without them
+  judged <- FALSE
+  for (k in kinds[vapply(kinds, function(k) is.function(effect_entry(k)$judge), TRUE)]) {
+    if (is.null(parts[[k]])) next
+    d <- effect_entry(k)$judge(base, freq, do.call(rbind, unname(parts)))
+    judged <- judged || NROW(d) < NROW(parts[[k]])
+    held[[k]] <- d
+    parts[[k]] <- if (NROW(d)) d
+  }
+  if (judged) {
+    for (k in again) {
+      others <- parts[names(parts) != k]
+      if (!length(others)) next
+      held[[k]] <- as_part(effect_entry(k)$detect(
+        remove_series(base, freq, do.call(rbind, unname(others))), freq), k)
+    }
     parts <- pass(held)
   }
   out <- if (length(parts)) do.call(rbind, parts) else

@@ -139,6 +139,31 @@ test_that("a warm-up and a step at its start: each read with the other out", {
   expect_gte(sum(both), 4L)
 })
 
+test_that("a sharp step inside a slow warm-up stands beside it", {
+  # own generator: white noise, a random walk, a warm-up of 50 x ADEV(tc)
+  # with tc 780 s and a step of 11 x ADEV(10 s) at 530 s. The step is
+  # judged beside the warm-up by the warm-up's likelihood, which must not
+  # take a genuine step for the exponential's misfit
+  freq <- 100
+  n <- 1e6
+  t <- (seq_len(n) - 1) / freq
+  for (seed in 611:612) {
+    set.seed(seed)
+    b <- rnorm(n, sd = 0.01) + cumsum(rnorm(n, sd = 1e-4 / sqrt(freq)))
+    a10 <- allan(b, freq, taus = I(10))$adev
+    size <- -11 * a10
+    x <- b + 50 * allan(b, freq, taus = I(780))$adev * exp(-t / 780) + size * (t >= 530)
+    tb <- detect_series_effects(x, freq)$table
+    st <- tb[tb$kind == "steps", ]
+    w <- tb[tb$kind == "warmup", ]
+    expect_equal(nrow(st), 1L)
+    expect_lt(abs(st$time - 530), 2)
+    expect_lt(abs(st$size / size - 1), 0.25)
+    expect_match(st$evidence, "beside the warm-up, likelihood ratio z = ")
+    expect_equal(nrow(w), 1L)
+  }
+})
+
 test_that("spikes: all found, none invented; removal restores the short-tau ADEV", {
   n <- 1e5
   freq <- 100
