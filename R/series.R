@@ -24,7 +24,12 @@
 #' step's first sample is an outlier of the AR model until the step is
 #' removed; a step at a warm-up's start bends the exponential), and
 #' where that changed what they found, the steps and transients are
-#' read again beside them (at most two such rounds). Thresholds are
+#' read again beside them (at most two such rounds). A step within five
+#' time constants of a warm-up is then judged beside it by the warm-up's
+#' likelihood (the block means with and without the step each fitting
+#' their noise model by maximum likelihood, the warm-up's time constant
+#' refitted) and kept when it adds z above 5, as its `evidence` says;
+#' where one is dropped the warm-up is read again. Thresholds are
 #' Bonferroni over the record and never below 5 (warm-up) or 6 (spikes,
 #' steps) standard deviations. A spike is an additive outlier of the
 #' series' own AR model (its filter, lines and colour), so that a line or a
