@@ -21,7 +21,7 @@
 # simulated axes that carry a sensor's own filter, line and resonance);
 # set "h" draws every class afresh from one seed (an out-of-sample check),
 # set "i" from another, sets "k" and "l" from two more, set "m" from a
-# fifth (session 45).
+# fifth (session 45), set "n" from a sixth (session 46).
 #
 # The recordings stay in the shared data directory (never shipped).
 suppressPackageStartupMessages(library(allanvar))
@@ -605,9 +605,10 @@ if (identical(set, "g")) {
 # two effects per measured axis. An out-of-sample check of what sets a-g
 # were fixed against. Set "i" draws the same classes from another seed
 # (session 33, written before any run on it); sets "k" and "l" from two
-# more (session 40, likewise); set "m" from a fifth (session 45, likewise).
-if (set %in% c("h", "i", "k", "l", "m")) {
-  set.seed(c(h = 4300, i = 4500, k = 5100, l = 5500, m = 6100)[[set]])
+# more (session 40, likewise); set "m" from a fifth (session 45, likewise),
+# set "n" from a sixth (session 46, likewise).
+if (set %in% c("h", "i", "k", "l", "m", "n")) {
+  set.seed(c(h = 4300, i = 4500, k = 5100, l = 5500, m = 6100, n = 6500)[[set]])
   lu <- function(lo, hi) round(exp(runif(1, log(lo), log(hi))), 1)
   ru <- function(lo, hi, d = 2) round(runif(1, lo, hi), d)
   h_white <- ru(0.005, 0.02, 4)
@@ -923,7 +924,7 @@ for (nm in grep(only, names(cases), value = TRUE)) {
   # (BATTERY_SEED_OFFSET=k shifts every case's seed: the same cases on
   # other noise, to see whether a change generalises)
   set.seed(c(a = 2700, b = 2900, c = 3100, d = 3300, e = 3500, f = 3700, g = 3900, h = 4100,
-             i = 4700, j = 4900, k = 5300, l = 5700, m = 6300)[[set]] +
+             i = 4700, j = 4900, k = 5300, l = 5700, m = 6300, n = 6700)[[set]] +
              match(nm, names(cases)) + as.integer(Sys.getenv("BATTERY_SEED_OFFSET", "0")))
   cs <- cases[[nm]]()
   if (is.null(cs)) next
