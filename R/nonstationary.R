@@ -23,6 +23,16 @@ block_avg <- function(x, b) {
   .colMeans(if (nb * b == length(x)) x else x[seq_len(nb * b)], b, nb)
 }
 
+# Exact block means (nb blocks of b samples, tau0 apart) of exp(-t / tc),
+# t from the first sample: a function of tc.
+block_expo <- function(nb, b, tau0) {
+  dt <- b * tau0
+  function(tc) {
+    exp(-(seq_len(nb) - 1) * dt / tc) * (1 - exp(-tau0 * b / tc)) /
+      (b * (1 - exp(-tau0 / tc)))
+  }
+}
+
 # Allan differences of y at window w (blocks) for every split point i
 # (mean of y[i+1..i+w] minus mean of y[i-w+1..i]), i = w..length(y)-w.
 # (`cs`: c(0, cumsum(y)), when the caller has it for several w)
@@ -464,6 +474,10 @@ steps_prefix <- function(x, lv, lo, hi) {
   shifted_prefix(x, lv$at, lv$level, lo, hi)
 }
 
+# The level at which the warm-up's likelihood names one; steps beside a
+# warm-up are judged at the same level.
+warmup_z_level <- 5
+
 #' Exponential warm-up (internal)
 #'
 #' A warm-up is a decaying offset at the start, y = c + A exp(-t / T). It
@@ -499,10 +513,6 @@ steps_prefix <- function(x, lv, lo, hi) {
 #'   `tc_upper`: the 95% interval of tc, warmup_tc_interval()) of every
 #'   exponential found (none, one or two), strongest first.
 #' @noRd
-# (the level at which the warm-up's likelihood names one; steps beside a
-# warm-up are judged at the same level)
-warmup_z_level <- 5
-
 detect_warmup <- function(x, freq, z_level = warmup_z_level, target_blocks = 1000L,
                           min_tc = NULL, max_iter = 4L) {
   n <- length(x)
@@ -525,11 +535,7 @@ detect_warmup <- function(x, freq, z_level = warmup_z_level, target_blocks = 100
   # a constant series has no warm-up (and no noise to judge one by)
   if (max_tc <= min_tc || nb < 64L || max(x) == min(x)) return(none)
   grid <- exp(seq(log(min_tc), log(max_tc), by = 0.07))
-  # exact block means of exp(-t / T), t from the first sample
-  expo <- function(tc) {
-    exp(-(seq_len(nb) - 1) * dt / tc) * (1 - exp(-tau0 * b / tc)) /
-      (b * (1 - exp(-tau0 / tc)))
-  }
+  expo <- block_expo(nb, b, tau0)
   X <- vapply(grid, expo, numeric(nb))
   fixed <- NULL                      # regressors already found
   found <- data.frame(amplitude = numeric(), tc = numeric(), z = numeric())

@@ -177,18 +177,26 @@ detect_series <- function(x, freq, kinds) {
     }
     parts
   }
+  # every other kind's instances in `parts`, one table (NULL: none)
+  others_of <- function(parts, k) {
+    o <- parts[names(parts) != k]
+    if (length(o)) do.call(rbind, unname(o))
+  }
+  # kind k read on the series with `others` taken out
+  detect_beside <- function(k, others) {
+    as_part(effect_entry(k)$detect(remove_series(base, freq, others), freq), k)
+  }
   parts <- pass(list())
   held <- list()
   read_beside <- list()          # what each kind was last read beside
   for (round in 1:2) {
     changed <- FALSE
     for (k in again) {
-      others <- parts[names(parts) != k]
-      if (!length(others)) next
-      others <- do.call(rbind, unname(others))
+      others <- others_of(parts, k)
+      if (is.null(others)) next
       if (identical(others, read_beside[[k]])) next
       read_beside[[k]] <- others
-      d <- as_part(effect_entry(k)$detect(remove_series(base, freq, others), freq), k)
+      d <- detect_beside(k, others)
       before <- parts[[k]]
       if (NROW(d) || NROW(before)) changed <- changed || !identical(d, before)
       held[[k]] <- d
@@ -209,10 +217,8 @@ detect_series <- function(x, freq, kinds) {
   }
   if (judged) {
     for (k in again) {
-      others <- parts[names(parts) != k]
-      if (!length(others)) next
-      held[[k]] <- as_part(effect_entry(k)$detect(
-        remove_series(base, freq, do.call(rbind, unname(others))), freq), k)
+      others <- others_of(parts, k)
+      if (!is.null(others)) held[[k]] <- detect_beside(k, others)
     }
     parts <- pass(held)
   }

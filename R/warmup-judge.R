@@ -147,9 +147,7 @@ steps_lr_z <- function(x, freq, times, tcs, near, target_blocks) {
   t_start <- (seq_len(nb) - 1) * dt
   # a step's share of each block (the block holding its edge in part)
   S <- vapply(times, function(t0) pmin(1, pmax(0, (t_start + dt - t0) / dt)), numeric(nb))
-  expo <- function(tc) {
-    exp(-t_start / tc) * (1 - exp(-tau0 * b / tc)) / (b * (1 - exp(-tau0 / tc)))
-  }
+  expo <- block_expo(nb, b, tau0)
   slow <- which.max(tcs)
   E_rest <- vapply(tcs[-slow], expo, numeric(nb))
   # each fit starts from the last fit's noise model (neighbouring time

@@ -18,6 +18,12 @@ new_steps <- function(t1, t0) {
   s0 <- t0$time[t0$kind == "steps"]
   sum(vapply(s1, function(s) !any(abs(s0 - s) <= 2), NA))
 }
+# the warm-ups a table names, and whether one is within 25% of tc
+warmup_read <- function(t1, tc) {
+  w <- t1[t1$kind == "warmup", ]
+  list(warmup_tc = if (nrow(w)) paste(signif(w$tc, 3), collapse = ",") else "-",
+       tc_ok = nrow(w) >= 1L && any(abs(w$tc / tc - 1) <= 0.25))
+}
 rows <- list()
 set.seed(seed)
 for (u in 1:3) {
@@ -30,11 +36,8 @@ for (u in 1:3) {
     t0 <- proc.time()[["elapsed"]]
     t1 <- tab(b + a * exp(-t / tc))
     sec <- proc.time()[["elapsed"]] - t0
-    w <- t1[t1$kind == "warmup", ]
     rows[[length(rows) + 1L]] <- data.frame(
-      case = sprintf("unit %d %s + warm-up %s s", u, ax, tc),
-      warmup_tc = if (nrow(w)) paste(signif(w$tc, 3), collapse = ",") else "-",
-      tc_ok = nrow(w) >= 1L && any(abs(w$tc / tc - 1) <= 0.25),
+      case = sprintf("unit %d %s + warm-up %s s", u, ax, tc), warmup_read(t1, tc),
       new_steps = new_steps(t1, tab(b)), step_ok = NA, seconds = round(sec, 1))
   }
 }
@@ -50,12 +53,9 @@ for (k in 1:12) {
   t0 <- proc.time()[["elapsed"]]
   t1 <- tab(x)
   sec <- proc.time()[["elapsed"]] - t0
-  w <- t1[t1$kind == "warmup", ]
   st <- t1[t1$kind == "steps", ]
   rows[[length(rows) + 1L]] <- data.frame(
-    case = sprintf("sim: warm-up %s s, step at %s s", tc, ts),
-    warmup_tc = if (nrow(w)) paste(signif(w$tc, 3), collapse = ",") else "-",
-    tc_ok = nrow(w) >= 1L && any(abs(w$tc / tc - 1) <= 0.25),
+    case = sprintf("sim: warm-up %s s, step at %s s", tc, ts), warmup_read(t1, tc),
     new_steps = sum(abs(st$time - ts) > 2),
     step_ok = any(abs(st$time - ts) <= 2 & abs(st$size / sz - 1) <= 0.25),
     seconds = round(sec, 1))
